@@ -10,12 +10,11 @@ from __future__ import annotations
 from .errors import SceneError
 
 
-def plate_mesh(length_m: float, thickness_m: float, width_m: float, mesh_size_m: float,
-               curve_order: int = 2):
+def plate_mesh(length_m: float, thickness_m: float, width_m: float, mesh_size_m: float):
     """Return an ``ngsolve.Mesh`` of the plate with end faces named ``end_a`` and ``end_b``.
 
-    All sizes in metres; ``mesh_size_m`` is netgen's ``maxh``. ``curve_order`` is the
-    geometric order (straight-sided plates need none, kept for curved links).
+    All sizes in metres; ``mesh_size_m`` is netgen's ``maxh``. The faces are flat, so
+    the mesh needs no curving even for second-order elements.
     """
     for name, value in (("length_m", length_m), ("thickness_m", thickness_m),
                         ("width_m", width_m), ("mesh_size_m", mesh_size_m)):
@@ -29,5 +28,4 @@ def plate_mesh(length_m: float, thickness_m: float, width_m: float, mesh_size_m:
     box.faces.Min(X).name = "end_a"
     box.faces.Max(X).name = "end_b"
     mesh = ngs.Mesh(OCCGeometry(box).GenerateMesh(maxh=mesh_size_m))
-    del curve_order  # a box has flat faces: no curving needed
     return mesh
