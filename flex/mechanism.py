@@ -1,0 +1,231 @@
+"""Slider-crank assembly in Exudyn: a ready multibody system from a scene.
+
+Sketch (mechanism plane x-y; rotation axes along z)::
+
+                 B (revolute, crank-coupler)
+                / \\
+     crank L1  /   \\  coupler L2 (rigid body or FFRF flexible plate)
+              /     \\
+    frame == A       C (x,y pinned: non-redundant loop) -- slider ==[spring]== frame
+    (revolute)         prismatic joint along x, slide line y = offset
+
+All three links are 3D bodies moving in the x-y plane (nodes with Tait-Bryan rotation
+coordinates, so the z-rotation coordinate is the planar angle). A planar loop of 3D joints
+is redundant, so joint C constrains only x and y (17 constraints on 18 coordinates: one
+degree of freedom, as Gruebler's count in the thesis, Eq. 1). The same builder makes the
+rigid model and the flexible one: only the coupler body changes (``coupler.model``).
+
+Drives: ``spring`` -- a linear spring (and optional damper) on the slider's x coordinate,
+compressed by ``spring_preload_m`` at t = 0 and attached throughout, released from rest;
+``constant_speed`` -- a velocity-level constraint on the crank angle.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .kinematics import slider_crank
+from .scene import Scene, plate_mass_properties
+
+os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
+
+
+@dataclass
+class InitialConfiguration:
+    """Assembled configuration at t = 0 (metres, radians, per second)."""
+
+    crank_angle_rad: float
+    coupler_angle_rad: float
+    joint_B_m: np.ndarray
+    joint_C_m: np.ndarray
+    crank_speed_rad_per_s: float
+    coupler_speed_rad_per_s: float
+    joint_B_velocity_m_per_s: np.ndarray
+    joint_C_velocity_m_per_s: np.ndarray
+
+
+def initial_configuration(scene: Scene) -> InitialConfiguration:
+    """Positions and consistent velocities of the joints at t = 0 (closed form)."""
+    l1, l2 = scene["crank"]["length_m"], scene["coupler"]["length_m"]
+    offset_m = scene["slider"]["offset_m"]
+    theta = np.radians(scene["crank"]["initial_angle_deg"])
+    drive = scene["drive"]
+    omega = drive["crank_speed_rad_per_s"] if drive["kind"] == "constant_speed" else 0.0
+    state = slider_crank(l1, l2, theta, omega, 0.0, offset_m)
+    joint_b = np.array([l1 * np.cos(theta), l1 * np.sin(theta), 0.0])
+    joint_c = np.array([float(state.slider_position_m), offset_m, 0.0])
+    vel_b = omega * l1 * np.array([-np.sin(theta), np.cos(theta), 0.0])
+    vel_c = np.array([float(state.slider_velocity_m_per_s), 0.0, 0.0])
+    return InitialConfiguration(float(theta), float(state.coupler_angle_rad), joint_b, joint_c,
+                                float(omega), float(state.coupler_angular_velocity_rad_per_s),
+                                vel_b, vel_c)
+
+
+@dataclass
+class Mechanism:
+    """A built, assembled Exudyn system and the handles the solver reads.
+
+    ``sensors`` maps a name to ``(sensor index, columns)``: the columns of the stored sensor
+    data (after the time column) that hold the quantity. ``joint_frames`` tells how each
+    joint's local force output maps to global axes.
+    """
+
+    system_container: Any
+    mbs: Any
+    scene: Scene
+    initial: InitialConfiguration
+    sensors: dict[str, int] = field(default_factory=dict)
+    joint_frames: dict[str, str | None] = field(default_factory=dict)
+    constraint_points: list[tuple[str, str]] = field(default_factory=list)
+    rigid_bodies: dict[str, tuple[float, np.ndarray]] = field(default_factory=dict)
+    coupler: dict[str, Any] = field(default_factory=dict)
+
+
+def _rotation_z(angle_rad: float) -> np.ndarray:
+    c, s = np.cos(angle_rad), np.sin(angle_rad)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
+    """Build and assemble the slider-crank of ``scene`` in a new Exudyn system.
+
+    ``reduction`` is the Craig-Bampton reduction (:func:`flex.reduction.build_reduction`)
+    for an ``ffrf`` coupler; ``None`` for a rigid coupler. Returns a :class:`Mechanism`.
+    """
+    import exudyn as exu
+    import exudyn.itemInterface as eii
+    from exudyn.utilities import RigidBodyInertia
+
+    init = initial_configuration(scene)
+    system_container = exu.SystemContainer()
+    mbs = system_container.AddSystem()
+    mech = Mechanism(system_container, mbs, scene, init)
+    ground = mbs.CreateGround()
+    out = exu.OutputVariableType
+
+    def rigid_body(name: str, mass_kg: float, inertia_kgm2: float, position, angle_rad: float,
+                   velocity, angular_velocity_rad_per_s: float) -> dict:
+        # out-of-plane inertias do not enter planar motion; any positive, physically
+        # admissible values will do, so take the in-plane one
+        inertia = RigidBodyInertia(mass=mass_kg, inertiaTensor=np.eye(3) * inertia_kgm2)
+        body = mbs.CreateRigidBody(
+            name=name, inertia=inertia, referencePosition=list(position),
+            referenceRotationMatrix=_rotation_z(angle_rad), initialVelocity=list(velocity),
+            initialAngularVelocity=[0.0, 0.0, angular_velocity_rad_per_s],
+            nodeType=exu.NodeType.RotationRxyz, returnDict=True)
+        mech.rigid_bodies[name] = (mass_kg, np.eye(3) * inertia_kgm2)
+        return body
+
+    crank = scene["crank"]
+    crank_body = rigid_body("crank", crank["mass_kg"], crank["inertia_kgm2"], init.joint_B_m / 2,
+                            init.crank_angle_rad, init.joint_B_velocity_m_per_s / 2,
+                            init.crank_speed_rad_per_s)
+    slider = scene["slider"]
+    slider_body = rigid_body("slider", slider["mass_kg"], slider["inertia_kgm2"], init.joint_C_m,
+                             0.0, init.joint_C_velocity_m_per_s, 0.0)
+
+    def body_marker(body: dict, global_point) -> int:
+        node = mbs.GetNode(body["nodeNumber"])
+        reference = np.asarray(node["referenceCoordinates"][:3])
+        rotation = _rotation_z(node["referenceCoordinates"][5])
+        local = rotation.T @ (np.asarray(global_point) - reference)
+        return mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=body["bodyNumber"],
+                                                 localPosition=list(local)))
+
+    ground_a = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground, localPosition=[0, 0, 0]))
+    ground_c = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground,
+                                                 localPosition=list(init.joint_C_m)))
+    crank_a = body_marker(crank_body, [0.0, 0.0, 0.0])
+    crank_b = body_marker(crank_body, init.joint_B_m)
+    slider_c = body_marker(slider_body, init.joint_C_m)
+
+    if scene["coupler"]["model"] == "ffrf":
+        from .reduction import add_ffrf_coupler
+
+        coupler = add_ffrf_coupler(mbs, reduction, list(init.joint_B_m),
+                                   init.coupler_angle_rad,
+                                   damping_ratio=scene["coupler"]["damping_ratio"])
+        coupler_b, coupler_c = coupler["marker_B"], coupler["marker_C"]
+        mech.coupler = coupler
+    else:
+        mass_kg, inertia_kgm2 = plate_mass_properties(scene)
+        coupler_body = rigid_body(
+            "coupler", mass_kg, inertia_kgm2, (init.joint_B_m + init.joint_C_m) / 2,
+            init.coupler_angle_rad,
+            (init.joint_B_velocity_m_per_s + init.joint_C_velocity_m_per_s) / 2,
+            init.coupler_speed_rad_per_s)
+        coupler_b = body_marker(coupler_body, init.joint_B_m)
+        coupler_c = body_marker(coupler_body, init.joint_C_m)
+        mech.coupler = {"body": coupler_body["bodyNumber"], "node": coupler_body["nodeNumber"]}
+
+    crank_ref = _rotation_z(init.crank_angle_rad)
+    coupler_ref = _rotation_z(init.coupler_angle_rad)
+    # joint frames coincide with the global axes at t = 0; force outputs are in the frame of
+    # marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where it can
+    joint_a = mbs.AddObject(eii.ObjectJointRevoluteZ(markerNumbers=[ground_a, crank_a],
+                                                     rotationMarker1=crank_ref.T))
+    joint_b = mbs.AddObject(eii.ObjectJointRevoluteZ(markerNumbers=[crank_b, coupler_b],
+                                                     rotationMarker0=crank_ref.T,
+                                                     rotationMarker1=coupler_ref.T))
+    joint_c = mbs.AddObject(eii.ObjectJointSpherical(markerNumbers=[slider_c, coupler_c],
+                                                     constrainedAxes=[1, 1, 0]))
+    joint_p = mbs.AddObject(eii.ObjectJointPrismaticX(markerNumbers=[ground_c, slider_c]))
+    mech.joint_frames = {"A": None, "B": "crank", "C": None, "P": None}
+
+    drive = scene["drive"]
+    ground_node = mbs.AddNode(eii.NodePointGround())
+    ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node,
+                                                               coordinate=0))
+    if drive["kind"] == "spring":
+        slider_x = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=slider_body["nodeNumber"],
+                                                          coordinate=0))
+        # slider coordinate = displacement from t = 0; spring force k (q + preload) pushes -x
+        mbs.AddObject(eii.ObjectConnectorCoordinateSpringDamper(
+            markerNumbers=[ground_coordinate, slider_x],
+            stiffness=drive["spring_stiffness_N_per_m"],
+            damping=drive["spring_damping_Ns_per_m"], offset=-drive["spring_preload_m"]))
+    else:
+        crank_rotation = mbs.AddMarker(eii.MarkerNodeCoordinate(
+            nodeNumber=crank_body["nodeNumber"], coordinate=5))
+        # velocity-level constraint: no Python callback per step, crank speed held exactly
+        mbs.AddObject(eii.ObjectConnectorCoordinate(
+            markerNumbers=[ground_coordinate, crank_rotation], velocityLevel=True,
+            offset=drive["crank_speed_rad_per_s"]))
+
+    def add(name: str, sensor) -> None:
+        mech.sensors[name] = mbs.AddSensor(sensor)
+
+    for name, body in (("crank", crank_body), ("slider", slider_body)):
+        node = body["nodeNumber"]
+        for output in ("Position", "Velocity", "Acceleration", "Rotation", "AngularVelocity",
+                       "AngularAcceleration"):
+            add(f"{name}.{output}", eii.SensorNode(nodeNumber=node, storeInternal=True,
+                                                   outputVariableType=getattr(out, output)))
+    if scene["coupler"]["model"] == "rigid":
+        for output in ("Position", "Velocity", "Acceleration", "Rotation", "AngularVelocity"):
+            add(f"coupler.{output}", eii.SensorNode(nodeNumber=mech.coupler["node"],
+                                                    storeInternal=True,
+                                                    outputVariableType=getattr(out, output)))
+    for name, joint in (("A", joint_a), ("B", joint_b), ("C", joint_c), ("P", joint_p)):
+        # the spherical joint reports its force in global axes ("Force"), the others in
+        # the frame of marker 0 ("ForceLocal")
+        output = out.Force if name == "C" else out.ForceLocal
+        add(f"joint_{name}.Force",
+            eii.SensorObject(objectNumber=joint, storeInternal=True, outputVariableType=output))
+    for name, marker in (("ground_A", ground_a), ("crank_A", crank_a), ("crank_B", crank_b),
+                         ("coupler_B", coupler_b), ("coupler_C", coupler_c),
+                         ("slider_C", slider_c)):
+        add(f"marker_{name}.Position",
+            eii.SensorMarker(markerNumber=marker, storeInternal=True,
+                             outputVariableType=out.Position))
+    mech.constraint_points = [("ground_A", "crank_A"), ("crank_B", "coupler_B"),
+                              ("coupler_C", "slider_C")]
+    if scene["coupler"]["model"] == "ffrf":
+        for key, sensor in coupler.get("sensors", {}).items():
+            add(f"coupler.{key}", sensor)
+    mbs.Assemble()
+    return mech

@@ -1,0 +1,228 @@
+"""Time integration of a built mechanism and collection of its outputs.
+
+:func:`simulate` is the one entry point the studies use. Contract:
+
+- input: a validated scene (and, for an FFRF coupler, its reduction);
+- output: a :class:`~flex.results.CaseResult` whose datasets are the quantities of the
+  result layout (``time``, ``crank/...``, ``slider/...``, ``joints/<A|B|C>/...``,
+  ``constraint_norm``, ``energy/...`` for rigid couplers, ``coupler/...``), each with units;
+- status: ``ok``; a diverging run (solver failure, NaN, exploding constraint norm) raises
+  :class:`~flex.errors.SimulationError` naming the step and time, and
+  :func:`simulate_case` turns that into a ``failed`` case instead of data;
+- counters: steps, Newton iterations, Jacobian updates, wall time [s].
+
+The integrator is Exudyn's implicit generalized-alpha (index 3) with fixed step.
+"""
+
+from __future__ import annotations
+
+import io
+import time
+from contextlib import redirect_stdout
+from typing import Any
+
+import numpy as np
+
+from .errors import FlexError, SimulationError
+from .mechanism import Mechanism, _rotation_z, build_mechanism
+from .results import CaseResult, Dataset
+from .scene import Scene, to_toml
+
+# a constraint norm above this is a failed assembly, not a tolerance question
+CONSTRAINT_NORM_LIMIT_M = 1e-4
+
+
+def solver_settings(scene: Scene) -> dict[str, Any]:
+    """The integrator settings used for ``scene`` (stored in every result file)."""
+    sim = scene["simulation"]
+    return {
+        "integrator": "generalized-alpha (Exudyn, index 3)",
+        "step_s": sim["step_s"],
+        "end_time_s": sim["end_time_s"],
+        "steps": int(round(sim["end_time_s"] / sim["step_s"])),
+        "output_step_s": sim["output_step_s"],
+        "spectral_radius": sim["spectral_radius"],
+        "newton_relative_tolerance": 1e-10,
+        "newton_absolute_tolerance": 1e-12,
+        "modified_newton": False,
+    }
+
+
+def _exudyn_settings(settings: dict[str, Any]):
+    import exudyn as exu
+
+    s = exu.SimulationSettings()
+    ti = s.timeIntegration
+    ti.numberOfSteps = settings["steps"]
+    ti.endTime = settings["steps"] * settings["step_s"]
+    ti.generalizedAlpha.spectralRadius = settings["spectral_radius"]
+    ti.newton.relativeTolerance = settings["newton_relative_tolerance"]
+    ti.newton.absoluteTolerance = settings["newton_absolute_tolerance"]
+    ti.newton.useModifiedNewton = settings["modified_newton"]
+    ti.verboseMode = 0
+    s.solution.file.write = False
+    s.solution.sensors.writePeriod = settings["output_step_s"]
+    s.solution.sensors.writeHeader = False
+    s.show.computationTime = False
+    s.show.statistics = False
+    return s
+
+
+def run(mech: Mechanism) -> dict[str, Any]:
+    """Integrate ``mech`` in place; return counters. Raises SimulationError on failure."""
+    import exudyn as exu
+
+    settings = solver_settings(mech.scene)
+    solver = exu.MainSolverImplicitSecondOrder()
+    captured = io.StringIO()
+    start = time.perf_counter()
+    try:
+        with redirect_stdout(captured):
+            ok = solver.SolveSystem(mech.mbs, _exudyn_settings(settings))
+    except Exception as exc:  # Exudyn raises RuntimeError/ValueError on Newton failure
+        ok = False
+        captured.write(str(exc))
+    wall = time.perf_counter() - start
+    if not ok:
+        step, now = solver.it.currentStepIndex, solver.it.currentTime
+        detail = " ".join(captured.getvalue().split())[-300:]
+        raise SimulationError(f"solver diverged at step {step} (t = {now:.6g} s, step "
+                              f"{settings['step_s']:g} s): {detail or 'Newton failed'}; try a "
+                              f"smaller simulation.step_s")
+    return {"steps": int(solver.it.currentStepIndex), "newton_iterations":
+            int(solver.it.newtonStepsCount), "jacobian_updates": int(solver.it.newtonJacobiCount),
+            "wall_time_s": wall}
+
+
+def _sensor(mech: Mechanism, name: str) -> np.ndarray:
+    return np.asarray(mech.mbs.GetSensorStoredData(mech.sensors[name]))
+
+
+def collect(mech: Mechanism) -> dict[str, Dataset]:
+    """Datasets of the result layout from the stored sensor data of a solved mechanism."""
+    scene, init = mech.scene, mech.initial
+    rotation = _sensor(mech, "crank.Rotation")
+    time_s = rotation[:, 0]
+    crank_angle = rotation[:, 3]
+    out: dict[str, Dataset] = {"time": Dataset(time_s, "s", "simulation time")}
+    out["crank/angle"] = Dataset(crank_angle, "rad", "crank angle from the slide line (+x)")
+    out["crank/angular_velocity"] = Dataset(_sensor(mech, "crank.AngularVelocity")[:, 3],
+                                            "rad/s", "crank angular velocity")
+    out["crank/angular_acceleration"] = Dataset(
+        _sensor(mech, "crank.AngularAcceleration")[:, 3], "rad/s^2", "crank angular acceleration")
+    out["crank/midpoint_position"] = Dataset(_sensor(mech, "crank.Position")[:, 1:3], "m",
+                                             "crank midpoint (centre of mass) x, y")
+    out["slider/position"] = Dataset(_sensor(mech, "slider.Position")[:, 1], "m",
+                                     "slider x (joint C) along the slide line")
+    out["slider/velocity"] = Dataset(_sensor(mech, "slider.Velocity")[:, 1], "m/s",
+                                     "slider velocity along the slide line")
+    out["slider/acceleration"] = Dataset(_sensor(mech, "slider.Acceleration")[:, 1], "m/s^2",
+                                         "slider acceleration along the slide line")
+    out["slider/displacement"] = Dataset(init.joint_C_m[0] - out["slider/position"].data, "m",
+                                         "slider travel toward the crank pivot since t = 0")
+
+    # joint forces: frame of marker 0 -> global axes; Exudyn reports the force acting on
+    # body 0, so the force on body 1 is its negative (checked against the reference DAE)
+    def force(joint: str, frame_angle: np.ndarray | None) -> np.ndarray:
+        local = -_sensor(mech, f"joint_{joint}.Force")[:, 1:3]
+        if frame_angle is None:
+            return local
+        c, s = np.cos(frame_angle), np.sin(frame_angle)
+        return np.column_stack([c * local[:, 0] - s * local[:, 1],
+                                s * local[:, 0] + c * local[:, 1]])
+
+    on_crank_a = force("A", None)
+    on_coupler_b = force("B", crank_angle - init.crank_angle_rad)
+    on_coupler_c = force("C", None)
+    on_slider_p = force("P", None)
+    out["joints/A/force_on_crank"] = Dataset(on_crank_a, "N", "frame on crank at A, x y")
+    out["joints/A/force_modulus"] = Dataset(np.hypot(*on_crank_a.T), "N", "|force| at A")
+    out["joints/B/force_on_crank"] = Dataset(-on_coupler_b, "N", "coupler on crank at B, x y")
+    out["joints/B/force_on_coupler"] = Dataset(on_coupler_b, "N", "crank on coupler at B, x y")
+    out["joints/B/force_modulus"] = Dataset(np.hypot(*on_coupler_b.T), "N", "|force| at B")
+    out["joints/C/force_on_coupler"] = Dataset(on_coupler_c, "N", "slider on coupler at C, x y")
+    out["joints/C/force_on_slider"] = Dataset(-on_coupler_c, "N", "coupler on slider at C, x y")
+    out["joints/C/force_modulus"] = Dataset(np.hypot(*on_coupler_c.T), "N", "|force| at C")
+    out["joints/P/force_on_slider"] = Dataset(on_slider_p, "N",
+                                              "frame on slider, prismatic joint, x y")
+
+    residual_sq = np.zeros_like(time_s)
+    for first, second in mech.constraint_points:
+        gap = (_sensor(mech, f"marker_{first}.Position")[:, 1:3]
+               - _sensor(mech, f"marker_{second}.Position")[:, 1:3])
+        residual_sq += np.sum(gap**2, axis=1)
+    slider_y = _sensor(mech, "slider.Position")[:, 2] - scene["slider"]["offset_m"]
+    residual_sq += slider_y**2 + _sensor(mech, "slider.Rotation")[:, 3] ** 2
+    out["constraint_norm"] = Dataset(np.sqrt(residual_sq), "m",
+                                     "norm of the position constraint equations (A, B, C, "
+                                     "slide line; slider angle in rad)")
+
+    if scene["coupler"]["model"] == "rigid":
+        kinetic = np.zeros_like(time_s)
+        for name, (mass_kg, inertia) in mech.rigid_bodies.items():
+            velocity = _sensor(mech, f"{name}.Velocity")[:, 1:4]
+            omega = _sensor(mech, f"{name}.AngularVelocity")[:, 1:4]
+            kinetic += 0.5 * mass_kg * np.sum(velocity**2, axis=1)
+            kinetic += 0.5 * np.einsum("ij,jk,ik->i", omega, inertia, omega)
+        out["coupler/angle"] = Dataset(_sensor(mech, "coupler.Rotation")[:, 3], "rad",
+                                       "coupler angle from +x (B to C)")
+        drive = scene["drive"]
+        if drive["kind"] == "spring":
+            compression = drive["spring_preload_m"] - out["slider/displacement"].data
+            potential = 0.5 * drive["spring_stiffness_N_per_m"] * compression**2
+            out["energy/kinetic"] = Dataset(kinetic, "J", "kinetic energy of all links")
+            out["energy/spring_potential"] = Dataset(potential, "J", "spring strain energy")
+            out["energy/total"] = Dataset(kinetic + potential, "J",
+                                          "kinetic + spring energy (constant if undamped)")
+        else:
+            out["energy/kinetic"] = Dataset(kinetic, "J", "kinetic energy of all links")
+    return out
+
+
+def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any]) -> None:
+    time_s = datasets["time"].data
+    for name, dataset in datasets.items():
+        data = np.asarray(dataset.data, dtype=float)
+        bad = ~np.isfinite(data.reshape(len(time_s), -1)).all(axis=1)
+        if bad.any():
+            index = int(np.argmax(bad))
+            raise SimulationError(f"solution diverged: {name} is not finite at t = "
+                                  f"{time_s[index]:.6g} s (sample {index}, step "
+                                  f"{settings['step_s']:g} s)")
+    norm = datasets["constraint_norm"].data
+    if np.max(norm) > CONSTRAINT_NORM_LIMIT_M:
+        index = int(np.argmax(norm > CONSTRAINT_NORM_LIMIT_M))
+        raise SimulationError(f"solution diverged: constraint norm {norm[index]:.3g} m exceeds "
+                              f"{CONSTRAINT_NORM_LIMIT_M:g} m at t = {time_s[index]:.6g} s")
+
+
+def simulate(scene: Scene, name: str = "case", reduction: Any = None) -> CaseResult:
+    """Build, integrate and collect one case; raises on divergence (see module doc)."""
+    if scene["coupler"]["model"] == "ffrf" and reduction is None:
+        from .reduction import reduction_for_scene
+
+        reduction = reduction_for_scene(scene)
+    mech = build_mechanism(scene, reduction)
+    counters = run(mech)
+    datasets = collect(mech)
+    if scene["coupler"]["model"] == "ffrf":
+        from .reduction import coupler_datasets
+
+        datasets.update(coupler_datasets(mech, datasets))
+    settings = solver_settings(scene)
+    _check_finite(datasets, settings)
+    import tomli_w
+
+    return CaseResult(name, to_toml(scene), datasets, counters=counters,
+                      solver_settings_toml=tomli_w.dumps(settings))
+
+
+def simulate_case(scene: Scene, name: str = "case", reduction: Any = None) -> CaseResult:
+    """Like :func:`simulate`, but a failure becomes a ``failed`` case with its message."""
+    try:
+        return simulate(scene, name, reduction)
+    except FlexError as exc:
+        return CaseResult(name, to_toml(scene), status="failed", message=str(exc))
+
+
+__all__ = ["simulate", "simulate_case", "solver_settings", "run", "collect", "_rotation_z"]
