@@ -1,0 +1,134 @@
+"""Running a study: its cases, its summary, its file and its figures.
+
+A study is a module in ``studies/`` that declares what it runs and what it stores::
+
+    NAME = "kinematics"
+    DESCRIPTION = "one line"
+    OVERRIDES = ["drive.kind=\"constant_speed\"", ...]   # applied to the base scene
+    def cases(scene) -> dict[str, Scene]                   # the scenes it simulates
+    def summarize(scene, results) -> Summary               # tables, report text
+    def figures(results, summary, folder) -> list[Path]    # PNGs (optional)
+
+Optionally ``def simulate_cases(scenes, progress) -> dict[str, CaseResult]`` replaces the
+default one-case-at-a-time simulation (the flexible study shares reductions that way).
+:func:`execute` runs a study and returns its :class:`StudyOutput`; :func:`run_study` also
+writes ``results/<study>.h5`` (atomically) and the figures.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import ModuleType
+
+from .errors import FlexError, SceneError
+from .results import CaseResult, Dataset, write_results
+from .scene import Scene, load_scene, to_toml
+from .solver import simulate_case
+
+STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring")
+RESULTS_DIR = Path("results")
+
+
+@dataclass
+class Summary:
+    """Study-level outputs: datasets stored under ``/summary`` and the printed report."""
+
+    datasets: dict[str, Dataset] = field(default_factory=dict)
+    report: str = ""
+
+
+@dataclass
+class StudyOutput:
+    """Everything a study run produced (before or after it was written)."""
+
+    name: str
+    scene: Scene
+    results: dict[str, CaseResult]
+    summary: Summary
+    wall_time_s: float
+    path: Path | None = None
+    figures: list[Path] = field(default_factory=list)
+
+
+def load_study(name: str) -> ModuleType:
+    """Import ``studies.<name>``; unknown names get a message listing the studies."""
+    if name not in STUDIES:
+        raise FlexError(f"unknown study '{name}'; accepted: {', '.join(STUDIES)}")
+    try:
+        return importlib.import_module(f"studies.{name}")
+    except ModuleNotFoundError as exc:
+        if exc.name == f"studies.{name}":
+            raise FlexError(f"study '{name}' is not available in this installation") from None
+        raise
+
+
+def study_scene(module: ModuleType, source: str | Path | None = None,
+                overrides: list[str] | None = None) -> Scene:
+    """The study's resolved base scene: bundled or user scene, the study's own overrides,
+    then the user's ``--set`` overrides (which win)."""
+    return load_scene(source, list(getattr(module, "OVERRIDES", [])) + list(overrides or []))
+
+
+def progress_printer(stream=None) -> Callable[[str, int, int], None]:
+    """A progress callback printing ``[done/total] case`` lines (to stderr by default)."""
+    stream = stream or sys.stderr
+
+    def report(case: str, done: int, total: int) -> None:
+        print(f"  [{done}/{total}] {case}", file=stream, flush=True)
+
+    return report
+
+
+def execute(module: ModuleType, scene: Scene,
+            progress: Callable[[str, int, int], None] | None = None) -> StudyOutput:
+    """Run every case of a study and summarize; nothing is written."""
+    start = time.perf_counter()
+    scenes = module.cases(scene)
+    if hasattr(module, "simulate_cases"):
+        results = module.simulate_cases(scenes, progress)
+    else:
+        results = {}
+        for index, (name, case_scene) in enumerate(scenes.items()):
+            if progress:
+                progress(name, index, len(scenes))
+            results[name] = simulate_case(case_scene, name)
+        if progress:
+            progress("done", len(scenes), len(scenes))
+    summary = module.summarize(scene, results)
+    return StudyOutput(module.NAME, scene, results, summary, time.perf_counter() - start)
+
+
+def run_study(name: str, source: str | Path | None = None, overrides: list[str] | None = None,
+              out: str | Path | None = None, figures: bool = True, quiet: bool = False
+              ) -> StudyOutput:
+    """Run study ``name``, write its HDF5 file (default ``results/<name>.h5``) and figures
+    (``results/figures/<name>-*.png``), print its report, and return the output."""
+    module = load_study(name)
+    scene = study_scene(module, source, overrides)
+    path = Path(out) if out else RESULTS_DIR / f"{name}.h5"
+    if path.suffix not in (".h5", ".hdf5"):
+        raise SceneError(f"--out '{path}': result files end in .h5 or .hdf5")
+    output = execute(module, scene, None if quiet else progress_printer())
+    failed = [case for case in output.results.values() if case.status != "ok"]
+    output.path = write_results(path, name, list(output.results.values()), to_toml(scene),
+                                output.summary.datasets,
+                                {"wall_time_s": output.wall_time_s,
+                                 "failed_cases": len(failed)})
+    if figures and hasattr(module, "figures") and len(failed) < len(output.results):
+        folder = path.parent / "figures"
+        folder.mkdir(parents=True, exist_ok=True)
+        output.figures = module.figures(output.results, output.summary, folder)
+    if not quiet:
+        print(output.summary.report)
+        for case in failed:
+            print(f"FAILED case {case.name}: {case.message}")
+        print(f"wrote {output.path} ({len(output.results)} cases, {len(failed)} failed, "
+              f"{output.wall_time_s:.1f} s)")
+        for figure in output.figures:
+            print(f"wrote {figure}")
+    return output
