@@ -146,11 +146,13 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
     if scene["coupler"]["model"] == "ffrf":
         from .reduction import add_ffrf_coupler
 
-        coupler = add_ffrf_coupler(mbs, reduction, list(init.joint_B_m),
-                                   init.coupler_angle_rad,
-                                   damping_ratio=scene["coupler"]["damping_ratio"])
+        coupler = add_ffrf_coupler(
+            mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
+            damping_ratio=scene["coupler"]["damping_ratio"],
+            initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+            initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
         coupler_b, coupler_c = coupler["marker_B"], coupler["marker_C"]
-        mech.coupler = coupler
+        mech.coupler = dict(coupler, reduction=reduction)
     else:
         mass_kg, inertia_kgm2 = plate_mass_properties(scene)
         coupler_body = rigid_body(
@@ -206,6 +208,7 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
             add(f"{name}.{output}", eii.SensorNode(nodeNumber=node, storeInternal=True,
                                                    outputVariableType=getattr(out, output)))
     if scene["coupler"]["model"] == "rigid":
+        # the centre of mass is the coupler's midpoint
         for output in ("Position", "Velocity", "Acceleration", "Rotation", "AngularVelocity"):
             add(f"coupler.{output}", eii.SensorNode(nodeNumber=mech.coupler["node"],
                                                     storeInternal=True,
@@ -225,7 +228,12 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
     mech.constraint_points = [("ground_A", "crank_A"), ("crank_B", "coupler_B"),
                               ("coupler_C", "slider_C")]
     if scene["coupler"]["model"] == "ffrf":
-        for key, sensor in coupler.get("sensors", {}).items():
-            add(f"coupler.{key}", sensor)
+        for output in ("Position", "Velocity"):
+            add(f"marker_coupler_mid.{output}",
+                eii.SensorMarker(markerNumber=coupler["marker_mid"], storeInternal=True,
+                                 outputVariableType=getattr(out, output)))
+        add("coupler.modal_coordinates",
+            eii.SensorNode(nodeNumber=coupler["node_modal"], storeInternal=True,
+                           outputVariableType=out.Coordinates))
     mbs.Assemble()
     return mech

@@ -177,8 +177,9 @@ def solve_reference(scene: Scene, time_s: np.ndarray | None = None, rtol: float 
     dae = SliderCrankDAE(scene)
     sim = scene["simulation"]
     if time_s is None:
-        count = int(round(sim["end_time_s"] / sim["output_step_s"]))
-        time_s = np.linspace(0.0, count * sim["output_step_s"], count + 1)
+        interval = sim["output_step_s"] or sim["step_s"]
+        count = int(round(sim["end_time_s"] / interval))
+        time_s = np.linspace(0.0, count * interval, count + 1)
     start = time.perf_counter()
     sol = solve_ivp(dae.rhs, (float(time_s[0]), float(time_s[-1])),
                     np.concatenate([dae.q0, dae.q_dot0]), method=method, t_eval=time_s,

@@ -98,7 +98,8 @@ SCHEMA: dict[str, dict[str, Field]] = {
     "simulation": {
         "end_time_s": Field(doc="simulated time span", **_POS),
         "step_s": Field(doc="time step of the generalized-alpha integrator", **_POS),
-        "output_step_s": Field(doc="interval of the stored samples (>= step_s)", **_POS),
+        "output_step_s": Field(float, "interval of the stored samples (>= step_s; 0: every "
+                               "step)", minimum=0.0),
         "spectral_radius": Field(float, "generalized-alpha spectral radius at infinity",
                                  minimum=0.0, maximum=1.0),
     },
@@ -253,9 +254,9 @@ def _check_geometry(scene: Scene) -> None:
     if sim["step_s"] > sim["end_time_s"]:
         raise SceneError(f"simulation.step_s = {sim['step_s']:g} must be <= "
                          f"simulation.end_time_s = {sim['end_time_s']:g}")
-    if sim["output_step_s"] < sim["step_s"] * (1 - 1e-9):
+    if 0 < sim["output_step_s"] < sim["step_s"] * (1 - 1e-9):
         raise SceneError(f"simulation.output_step_s = {sim['output_step_s']:g} must be >= "
-                         f"simulation.step_s = {sim['step_s']:g}")
+                         f"simulation.step_s = {sim['step_s']:g} (or 0: every step)")
     steps = sim["end_time_s"] / sim["step_s"]
     if steps > 5e7:
         raise SceneError(f"simulation needs {steps:.3g} steps (end_time_s / step_s); "

@@ -17,8 +17,10 @@ The integrator is Exudyn's implicit generalized-alpha (index 3) with fixed step.
 from __future__ import annotations
 
 import io
+import os
 import time
 from contextlib import redirect_stdout
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -40,7 +42,7 @@ def solver_settings(scene: Scene) -> dict[str, Any]:
         "step_s": sim["step_s"],
         "end_time_s": sim["end_time_s"],
         "steps": int(round(sim["end_time_s"] / sim["step_s"])),
-        "output_step_s": sim["output_step_s"],
+        "output_step_s": sim["output_step_s"] or sim["step_s"],
         "spectral_radius": sim["spectral_radius"],
         "newton_relative_tolerance": 1e-10,
         "newton_absolute_tolerance": 1e-12,
@@ -157,6 +159,7 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
                                      "norm of the position constraint equations (A, B, C, "
                                      "slide line; slider angle in rad)")
 
+    out.update(_coupler_datasets(mech, time_s))
     if scene["coupler"]["model"] == "rigid":
         kinetic = np.zeros_like(time_s)
         for name, (mass_kg, inertia) in mech.rigid_bodies.items():
@@ -176,6 +179,65 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
                                           "kinetic + spring energy (constant if undamped)")
         else:
             out["energy/kinetic"] = Dataset(kinetic, "J", "kinetic energy of all links")
+    return out
+
+
+def reduction_cache_dir() -> Path:
+    """Where reductions are cached: ``$FLEX_CACHE_DIR`` or ``.cache/reductions``."""
+    return Path(os.environ.get("FLEX_CACHE_DIR", ".cache/reductions"))
+
+
+def reduction_for_scene(scene: Scene):
+    """The (cached) Craig-Bampton reduction of the scene's plate coupler."""
+    from .reduction import build_reduction
+
+    c = scene["coupler"]
+    return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
+                           c["youngs_modulus_Pa"], c["density_kg_per_m3"], c["poisson_ratio"],
+                           c["mesh_size_m"], c["modes"], reduction_cache_dir())
+
+
+def _coupler_datasets(mech: Mechanism, time_s: np.ndarray) -> dict[str, Dataset]:
+    """Coupler midpoint motion; for an FFRF coupler also its elastic response."""
+    out: dict[str, Dataset] = {}
+    if mech.scene["coupler"]["model"] == "rigid":
+        out["coupler/midpoint_position"] = Dataset(_sensor(mech, "coupler.Position")[:, 1:3],
+                                                   "m", "coupler midpoint x, y")
+        out["coupler/midpoint_acceleration"] = Dataset(
+            _sensor(mech, "coupler.Acceleration")[:, 1:3], "m/s^2",
+            "coupler midpoint acceleration x, y (thesis figs. 35-42)")
+        out["coupler/midpoint_deflection"] = Dataset(np.zeros_like(time_s), "m",
+                                                     "elastic midpoint deflection (rigid: 0)")
+        return out
+    from .reduction import bending_stress_history, midpoint_deflection
+
+    position_b = _sensor(mech, "marker_coupler_B.Position")[:, 1:4]
+    position_c = _sensor(mech, "marker_coupler_C.Position")[:, 1:4]
+    position_mid = _sensor(mech, "marker_coupler_mid.Position")[:, 1:4]
+    velocity_mid = _sensor(mech, "marker_coupler_mid.Velocity")[:, 1:3]
+    deflection = midpoint_deflection(position_b, position_c, position_mid)
+    chord = position_c - position_b
+    out["coupler/angle"] = Dataset(np.unwrap(np.arctan2(chord[:, 1], chord[:, 0])), "rad",
+                                   "angle of the chord B-C from +x")
+    out["coupler/midpoint_position"] = Dataset(position_mid[:, :2], "m",
+                                               "coupler midpoint x, y")
+    # the superelement marker reports no acceleration: differentiate its velocity (2nd order)
+    out["coupler/midpoint_acceleration"] = Dataset(
+        np.gradient(velocity_mid, time_s, axis=0), "m/s^2",
+        "coupler midpoint acceleration x, y (thesis figs. 35-42), from the marker velocity")
+    out["coupler/midpoint_deflection"] = Dataset(
+        deflection.transverse_m, "m",
+        "transverse elastic deflection of the midpoint from the chord B-C, 0 at t = 0")
+    out["coupler/chord_change"] = Dataset(deflection.chord_change_m, "m",
+                                          "change of the distance B-C (axial strain x L2)")
+    modal = _sensor(mech, "coupler.modal_coordinates")[:, 1:]
+    out["coupler/modal_coordinates"] = Dataset(modal, "1",
+                                               "elastic coordinates: 6 static + eigenmodes")
+    reduction = mech.coupler["reduction"]
+    if reduction.has_stress_modes:
+        out["coupler/peak_bending_stress"] = Dataset(
+            bending_stress_history(reduction, modal), "Pa",
+            "largest |sigma_xx| away from the end faces (bending + membrane)")
     return out
 
 
@@ -199,16 +261,10 @@ def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any]) -> Non
 def simulate(scene: Scene, name: str = "case", reduction: Any = None) -> CaseResult:
     """Build, integrate and collect one case; raises on divergence (see module doc)."""
     if scene["coupler"]["model"] == "ffrf" and reduction is None:
-        from .reduction import reduction_for_scene
-
         reduction = reduction_for_scene(scene)
     mech = build_mechanism(scene, reduction)
     counters = run(mech)
     datasets = collect(mech)
-    if scene["coupler"]["model"] == "ffrf":
-        from .reduction import coupler_datasets
-
-        datasets.update(coupler_datasets(mech, datasets))
     settings = solver_settings(scene)
     _check_finite(datasets, settings)
     import tomli_w
