@@ -1,0 +1,346 @@
+"""Tests of flex.reduction: cache, FFRF coupler against beam theory, post-processing.
+
+One coarse 3 mm plate (second-order tets, maxh 3 mm, 3.6k DOF, 6 fixed-interface modes) is
+built once per module; Euler-Bernoulli references: I = w t^3 / 12 (bending height t in plane).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+
+import h5py
+import numpy as np
+import pytest
+
+from flex.errors import SceneError
+from flex.reduction import (
+    add_ffrf_coupler,
+    bending_stress_history,
+    build_reduction,
+    midpoint_deflection,
+)
+
+# flex.reduction imports exudyn lazily, so this is in time for the first import
+os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
+
+LENGTH, THICKNESS, WIDTH = 0.08, 0.003, 0.01  # m
+E, RHO, NU = 200e9, 7850.0, 0.3
+MESH_SIZE, MODES = 0.003, 6
+INERTIA = WIDTH * THICKNESS**3 / 12  # m^4
+AREA = WIDTH * THICKNESS
+ARGS = (LENGTH, THICKNESS, WIDTH, E, RHO, NU, MESH_SIZE, MODES)
+
+# a pose that is neither axis-aligned nor at the origin, to catch frame mix-ups
+POSITION_B = np.array([0.01, 0.02, 0.0])
+ANGLE = 0.5
+ROTATION = np.array([[np.cos(ANGLE), -np.sin(ANGLE), 0.0],
+                     [np.sin(ANGLE), np.cos(ANGLE), 0.0],
+                     [0.0, 0.0, 1.0]])
+
+
+def pinned_pinned_Hz() -> float:
+    return (np.pi / LENGTH) ** 2 * np.sqrt(E * INERTIA / (RHO * AREA)) / (2 * np.pi)
+
+
+@pytest.fixture(scope="module")
+def cache_dir(tmp_path_factory):
+    return tmp_path_factory.mktemp("reduction_cache")
+
+
+@pytest.fixture(scope="module")
+def reduction(cache_dir):
+    return build_reduction(*ARGS, cache_dir=cache_dir)
+
+
+def new_system():
+    import exudyn as exu
+
+    system_container = exu.SystemContainer()
+    return system_container, system_container.AddSystem()
+
+
+def static_settings():
+    import exudyn as exu
+
+    settings = exu.SimulationSettings()
+    settings.solution.file.write = False
+    settings.staticSolver.verboseMode = 0
+    return settings
+
+
+def dynamic_settings(end_time: float, step: float):
+    import exudyn as exu
+
+    settings = exu.SimulationSettings()
+    settings.solution.file.write = False
+    settings.timeIntegration.verboseMode = 0
+    settings.timeIntegration.endTime = end_time
+    settings.timeIntegration.numberOfSteps = int(round(end_time / step))
+    settings.solution.sensors.writePeriod = step
+    return settings
+
+
+# ------------------------------------------------------------------------------------------
+# inputs
+# ------------------------------------------------------------------------------------------
+@pytest.mark.parametrize(("index", "value", "words"), [
+    (0, 0.0, "length_m"), (1, -0.001, "thickness_m"), (2, float("nan"), "width_m"),
+    (3, 0.0, "youngs_modulus_Pa"), (4, -1.0, "density_kg_per_m3"),
+    (5, 0.0, "(0, 0.5)"), (5, 0.5, "(0, 0.5)"), (6, 0.0, "mesh_size_m"),
+    (6, 0.1, "<= length_m"), (7, 0, ">= 1"), (7, 2.5, ">= 1"),
+])
+def test_bad_inputs_raise_scene_error_naming_the_range(index, value, words, tmp_path):
+    args = list(ARGS)
+    args[index] = value
+    with pytest.raises(SceneError, match=re.escape(words)):
+        build_reduction(*args, cache_dir=tmp_path)
+
+
+# ------------------------------------------------------------------------------------------
+# cache
+# ------------------------------------------------------------------------------------------
+def _assert_same_reduction(a, b, exact: bool):
+    """Loaded entries are bit-identical; a rebuild differs by threaded round-off only."""
+    same = (np.testing.assert_array_equal if exact
+            else lambda x, y: np.testing.assert_allclose(x, y, rtol=1e-7,
+                                                         atol=1e-7 * np.abs(y).max()))
+    assert a.key == b.key
+    same(a.fem.modeBasis["matrix"], b.fem.modeBasis["matrix"])
+    same(a.fem.postProcessingModes["matrix"], b.fem.postProcessingModes["matrix"])
+    for sparse_a, sparse_b in ((a.fem.massMatrix, b.fem.massMatrix),
+                               (a.fem.stiffnessMatrix, b.fem.stiffnessMatrix)):
+        difference = abs(sparse_a - sparse_b).max()
+        assert difference <= (0 if exact else 1e-7 * abs(sparse_b).max())
+    for name in ("nodes_end_a", "weights_end_a", "nodes_end_b", "weights_end_b",
+                 "nodes_mid", "weights_mid", "fixed_interface_frequencies_Hz"):
+        same(getattr(a, name), getattr(b, name))
+    same(a.pinned_pinned_frequency_Hz, b.pinned_pinned_frequency_Hz)
+
+
+def test_second_build_is_a_fast_identical_cache_hit(reduction, cache_dir):
+    assert not reduction.from_cache
+    assert reduction.cache_file.parent == cache_dir and reduction.cache_file.is_file()
+    assert not list(cache_dir.glob("*.tmp.hdf5"))  # temporary file renamed away
+    again = build_reduction(*ARGS, cache_dir=cache_dir)
+    assert again.from_cache
+    assert again.build_time_s < 1.0
+    assert again.cold_build_time_s == reduction.cold_build_time_s
+    _assert_same_reduction(reduction, again, exact=True)
+
+
+def test_key_depends_on_every_argument(reduction, tmp_path):
+    from flex.reduction import _cache_key
+
+    base = {"length_m": LENGTH, "modes": MODES}
+    assert _cache_key(base) == _cache_key(dict(base))
+    assert _cache_key(base) != _cache_key({**base, "modes": MODES + 1})
+    assert _cache_key(base) != _cache_key({**base, "length_m": LENGTH * (1 + 1e-12)})
+
+
+def _copy_entry(reduction, directory):
+    target = directory / reduction.cache_file.name
+    shutil.copyfile(reduction.cache_file, target)
+    return target
+
+
+def test_truncated_entry_is_rebuilt_and_replaced(reduction, tmp_path):
+    entry = _copy_entry(reduction, tmp_path)
+    entry.write_bytes(entry.read_bytes()[: entry.stat().st_size // 2])
+    rebuilt = build_reduction(*ARGS, cache_dir=tmp_path)
+    assert not rebuilt.from_cache
+    _assert_same_reduction(reduction, rebuilt, exact=False)
+    assert build_reduction(*ARGS, cache_dir=tmp_path).from_cache  # the entry is whole again
+
+
+def test_entry_of_another_key_is_not_trusted(reduction, tmp_path):
+    entry = _copy_entry(reduction, tmp_path)
+    with h5py.File(entry, "r+") as h5:
+        key = h5["metaData"]["flex"]["key"]
+        key[()] = "0" * 24
+    assert not build_reduction(*ARGS, cache_dir=tmp_path).from_cache
+
+
+def test_damaged_data_in_a_readable_entry_is_rebuilt(reduction, tmp_path):
+    entry = _copy_entry(reduction, tmp_path)
+    with h5py.File(entry, "r+") as h5:
+        basis = h5["modeBasis"]["matrix"]
+        basis[0, 0] = basis[0, 0] + 1.0
+    rebuilt = build_reduction(*ARGS, cache_dir=tmp_path)
+    assert not rebuilt.from_cache
+    _assert_same_reduction(reduction, rebuilt, exact=False)
+
+
+# ------------------------------------------------------------------------------------------
+# reduction against beam theory
+# ------------------------------------------------------------------------------------------
+def test_mesh_stats_node_sets_and_mass(reduction):
+    assert reduction.n_dof == 3 * reduction.n_nodes > 1000
+    assert reduction.n_modal_coordinates == 6 + MODES
+    assert len(reduction.fixed_interface_frequencies_Hz) == MODES
+    assert reduction.mass_kg == pytest.approx(RHO * LENGTH * AREA, rel=1e-9)
+    np.testing.assert_allclose(reduction.centre_end_a, [0, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(reduction.centre_end_b, [LENGTH, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(reduction.centre_mid, [LENGTH / 2, 0, 0], atol=1e-9)
+    for weights in (reduction.weights_end_a, reduction.weights_end_b, reduction.weights_mid):
+        assert weights.sum() == pytest.approx(1.0) and np.all(weights > 0)
+
+
+def test_frequencies_match_euler_bernoulli(reduction):
+    # L/t = 27: shear and rotary inertia < 0.5 %; the coarse mesh is stiff by ~1 %
+    assert reduction.pinned_pinned_frequency_Hz == pytest.approx(pinned_pinned_Hz(), rel=0.02)
+    clamped_clamped = 4.730**2 / np.pi**2 * pinned_pinned_Hz()
+    assert reduction.fixed_interface_frequencies_Hz[0] == pytest.approx(clamped_clamped,
+                                                                       rel=0.03)
+
+
+def test_cantilever_tip_load_deflection_and_stress(reduction):
+    import exudyn as exu
+    import exudyn.itemInterface as eii
+
+    _, mbs = new_system()
+    coupler = add_ffrf_coupler(mbs, reduction, POSITION_B, ANGLE)
+    np.testing.assert_allclose(coupler["position_C"], POSITION_B + ROTATION @ [LENGTH, 0, 0],
+                               atol=1e-15)
+    ground = mbs.AddObject(eii.ObjectGround())
+    clamp = mbs.AddMarker(eii.MarkerBodyRigid(
+        bodyNumber=ground, localHT=exu.HT(rotation=ROTATION, translation=list(POSITION_B))))
+    mbs.AddObject(eii.GenericJoint(markerNumbers=[clamp, coupler["marker_B"]],
+                                   constrainedAxes=[1] * 6))
+    force = 1.0  # N, along the body's +y
+    mbs.AddLoad(eii.LoadForceVector(markerNumber=coupler["marker_C"],
+                                    loadVector=list(ROTATION @ [0, force, 0])))
+    mbs.Assemble()
+    mbs.SolveStatic(static_settings())
+
+    tip = mbs.GetMarkerOutput(coupler["marker_C"], exu.OutputVariableType.Position)
+    tip_local = ROTATION.T @ (tip - coupler["position_C"])
+    # the 3D clamp (rigid face) restrains Poisson contraction: ~1 % stiffer than the beam
+    assert tip_local[1] == pytest.approx(force * LENGTH**3 / (3 * E * INERTIA), rel=0.03)
+
+    modal = mbs.GetNodeOutput(coupler["node_modal"], exu.OutputVariableType.Coordinates)
+    mid_stress = bending_stress_history(reduction, modal, (0.495 * LENGTH, 0.505 * LENGTH))
+    # sigma = M c / I at x = 0.495 L (the window's largest moment)
+    expected = force * 0.505 * LENGTH * (THICKNESS / 2) / INERTIA
+    assert mid_stress.shape == (1,)
+    assert mid_stress[0] == pytest.approx(expected, rel=0.03)
+
+
+def _pinned_pinned_step_response(reduction, damping_ratio: float):
+    """Pinned at B (revolute about z), C held in x and y, unit step force at the midpoint."""
+    import exudyn as exu
+    import exudyn.itemInterface as eii
+
+    _, mbs = new_system()
+    coupler = add_ffrf_coupler(mbs, reduction, POSITION_B, ANGLE, damping_ratio=damping_ratio)
+    ground = mbs.AddObject(eii.ObjectGround())
+    mbs.CreateRevoluteJoint(itemNumbers=[ground, coupler["marker_B"]], position=[],
+                            axis=[0, 0, 1])
+    mbs.CreateSphericalJoint(itemNumbers=[ground, coupler["marker_C"]], position=[],
+                             constrainedAxes=[1, 1, 0])
+    mbs.AddLoad(eii.LoadForceVector(markerNumber=coupler["marker_mid"],
+                                    loadVector=list(ROTATION @ [0, 1.0, 0])))
+    sensors = {name: mbs.AddSensor(eii.SensorMarker(
+        markerNumber=coupler[name], outputVariableType=exu.OutputVariableType.Position,
+        storeInternal=True)) for name in ("marker_B", "marker_C", "marker_mid")}
+    mbs.Assemble()
+    mbs.SolveDynamic(dynamic_settings(end_time=4e-3, step=1e-5))
+    tracks = {name: mbs.GetSensorStoredData(sensor) for name, sensor in sensors.items()}
+    time = tracks["marker_B"][:, 0]
+    deflection = midpoint_deflection(*(tracks[name][:, 1:4]
+                                       for name in ("marker_B", "marker_C", "marker_mid")))
+    return time, deflection, coupler
+
+
+def test_step_load_at_midpoint_oscillates_at_the_pinned_pinned_frequency(reduction):
+    time, deflection, _ = _pinned_pinned_step_response(reduction, damping_ratio=0.0)
+    static = LENGTH**3 / (48 * E * INERTIA)  # m per N
+    transverse = deflection.transverse_m
+    # undamped step response of the first mode: 0 .. 2 x static
+    assert transverse.max() == pytest.approx(2 * static, rel=0.03)
+    assert np.abs(deflection.chord_change_m).max() < 1e-3 * static
+    oscillation = transverse - 0.5 * (transverse.max() + transverse.min())
+    upward = time[1:][(oscillation[:-1] < 0) & (oscillation[1:] >= 0)]
+    assert len(upward) >= 3
+    assert 1 / np.diff(upward).mean() == pytest.approx(pinned_pinned_Hz(), rel=0.02)
+
+
+def test_damping_ratio_sets_the_first_overshoot(reduction):
+    zeta = 0.05
+    _, deflection, coupler = _pinned_pinned_step_response(reduction, damping_ratio=zeta)
+    assert coupler["stiffness_proportional_damping_s"] == pytest.approx(
+        2 * zeta / (2 * np.pi * reduction.pinned_pinned_frequency_Hz))
+    static = LENGTH**3 / (48 * E * INERTIA)
+    overshoot_sdof = 1 + np.exp(-zeta * np.pi / np.sqrt(1 - zeta**2))
+    assert deflection.transverse_m.max() / static == pytest.approx(overshoot_sdof, rel=0.02)
+
+
+def test_initial_angular_velocity_turns_the_frame(reduction):
+    import exudyn as exu
+    import exudyn.itemInterface as eii
+
+    omega = 20.0  # rad/s about z, the coupler swinging about its pin at B
+    _, mbs = new_system()
+    coupler = add_ffrf_coupler(mbs, reduction, POSITION_B, ANGLE,
+                               initial_angular_velocity_rad_per_s=omega)
+    ground = mbs.AddObject(eii.ObjectGround())
+    mbs.CreateRevoluteJoint(itemNumbers=[ground, coupler["marker_B"]], position=[],
+                            axis=[0, 0, 1])
+    mbs.Assemble()
+    end_time = 0.01
+    mbs.SolveDynamic(dynamic_settings(end_time=end_time, step=1e-4))
+    tip = mbs.GetMarkerOutput(coupler["marker_C"], exu.OutputVariableType.Position)
+    chord = tip - POSITION_B
+    assert np.arctan2(chord[1], chord[0]) == pytest.approx(ANGLE + omega * end_time, abs=1e-5)
+
+
+# ------------------------------------------------------------------------------------------
+# pure post-processing
+# ------------------------------------------------------------------------------------------
+def _rigid_pose(angle, shift, points_local):
+    c, s = np.cos(angle), np.sin(angle)
+    rotation = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    return points_local @ rotation.T + shift
+
+
+def test_rigidly_moving_straight_link_has_no_deflection():
+    angles = np.linspace(0.0, 2.5, 7)
+    shifts = np.column_stack([np.linspace(0, 0.1, 7), np.linspace(0, -0.05, 7), np.zeros(7)])
+    local = np.array([[0.0, 0.0, 0.0], [0.08, 0.0, 0.0], [0.04, 0.0, 0.0]])
+    poses = np.array([_rigid_pose(a, s, local) for a, s in zip(angles, shifts, strict=True)])
+    result = midpoint_deflection(poses[:, 0], poses[:, 1], poses[:, 2])
+    np.testing.assert_allclose(result.transverse_m, 0.0, atol=1e-15)
+    np.testing.assert_allclose(result.chord_change_m, 0.0, atol=1e-15)
+
+
+def test_bow_of_known_sagitta_and_stretch():
+    # circular bow through B and C, bulging to the chord's left (+n); radius R, chord 2a
+    radius, half_chord = 0.5, 0.04
+    sagitta = radius - np.sqrt(radius**2 - half_chord**2)
+    stretch = 1e-5
+    straight = np.array([[0.0, 0.0, 0.0], [0.08, 0.0, 0.0], [0.04, 0.0, 0.0]])
+    bowed = np.array([[0.0, 0.0, 0.0], [0.08 + stretch, 0.0, 0.0],
+                      [0.04 + stretch / 2, sagitta, 0.0]])
+    turned = _rigid_pose(2.0, np.array([0.3, -0.2, 0.0]), bowed)  # same bow, other pose
+    poses = np.array([straight, bowed, turned])
+    result = midpoint_deflection(poses[:, 0], poses[:, 1], poses[:, 2])
+    np.testing.assert_allclose(result.transverse_m, [0.0, sagitta, sagitta], rtol=1e-12)
+    np.testing.assert_allclose(result.chord_change_m, [0.0, stretch, stretch], rtol=1e-9)
+    # the mirror bow is negative
+    mirrored = poses * np.array([1.0, -1.0, 1.0])
+    flipped = midpoint_deflection(mirrored[:, 0], mirrored[:, 1], mirrored[:, 2])
+    assert flipped.transverse_m[1] == pytest.approx(-sagitta)
+
+
+def test_midpoint_deflection_rejects_bad_shapes():
+    with pytest.raises(ValueError, match=r"\(n, 3\)"):
+        midpoint_deflection(np.zeros((4, 2)), np.zeros((4, 2)), np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="shapes differ"):
+        midpoint_deflection(np.zeros((4, 3)), np.ones((3, 3)), np.zeros((4, 3)))
+
+
+def test_bending_stress_history_checks_columns(reduction):
+    with pytest.raises(ValueError, match="columns"):
+        bending_stress_history(reduction, np.zeros((3, reduction.n_modal_coordinates + 1)))
+    assert np.all(bending_stress_history(reduction, np.zeros((3, 12))) == 0.0)
