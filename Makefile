@@ -7,7 +7,7 @@ export EXUDYN_NO_USER_SETTINGS := 1
 export MPLBACKEND := Agg
 RUN := $(PY) -m flex run
 
-STUDIES := kinematics dynamics
+STUDIES := kinematics dynamics flexible
 
 .PHONY: all test test-slow lint setup clean $(STUDIES)
 
@@ -21,7 +21,7 @@ $(STAMP): pyproject.toml
 
 setup: $(STAMP)
 
-kinematics dynamics: $(STAMP)
+$(STUDIES): $(STAMP)
 	$(RUN) $@
 
 test: $(STAMP)
