@@ -119,7 +119,8 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
                                 output.summary.datasets,
                                 {"wall_time_s": output.wall_time_s,
                                  "failed_cases": len(failed)})
-    if figures and hasattr(module, "figures") and len(failed) < len(output.results):
+    if figures and hasattr(module, "figures") and (not output.results
+                                                    or len(failed) < len(output.results)):
         folder = path.parent / "figures"
         folder.mkdir(parents=True, exist_ok=True)
         output.figures = module.figures(output.results, output.summary, folder)

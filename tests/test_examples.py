@@ -37,3 +37,10 @@ def test_simulate_runs_the_given_scene():
     angle = output.results["case"].datasets["crank/angle"].data
     assert angle[0] == pytest.approx(0.872664626, abs=1e-9)
     assert re.search(r"crank angle 0\.8727", output.summary.report)
+
+
+def test_spring_fe_agrees_with_wahl():
+    _, output = run("spring")
+    ratio = output.summary.datasets["fe/over_wahl"].data
+    assert ratio == pytest.approx(1.0, abs=0.02)  # Wahl's curved-beam correction
+    assert output.summary.datasets["design/rate"].data == pytest.approx(1500.0, rel=1e-9)
