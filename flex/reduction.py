@@ -24,6 +24,7 @@ import contextlib
 import hashlib
 import json
 import math
+import numbers
 import os
 import tempfile
 import time
@@ -45,7 +46,7 @@ END_B = "end_b"  #: mesh boundary name of the joint-C face (x = length)
 MID = "mid"  #: node-set name of the mid-length cross-section
 
 _MESH_ORDER = 2  # linear tets lock in bending (notes: first frequency 69-90 % too high)
-_RIGID_FRAME_COORDINATES = 6  # end_b static modes: 3 translations + 3 rotations
+_STATIC_MODES = 6  # of end_b: 3 translations + 3 rotations of the rigid face
 
 
 # ------------------------------------------------------------------------------------------
@@ -80,7 +81,7 @@ class Reduction:
     centre_mid: np.ndarray  #: [m], (length/2, 0, 0) unless the mesh forbade it (see _mid_set)
     fixed_interface_frequencies_Hz: np.ndarray  #: both end faces clamped
     pinned_pinned_frequency_Hz: float  #: first in-plane bending mode, ends pinned about z
-    mass_kg: float
+    mass_kg: float  #: [kg]
     n_nodes: int
     n_elements: int  #: second-order tetrahedra
     n_dof: int  #: 3 * n_nodes, unreduced
@@ -94,7 +95,7 @@ class Reduction:
     @property
     def n_modal_coordinates(self) -> int:
         """Number of elastic coordinates of the reduced body: 6 static + ``modes``."""
-        return _RIGID_FRAME_COORDINATES + self.modes
+        return _STATIC_MODES + self.modes
 
     @property
     def has_stress_modes(self) -> bool:
@@ -124,11 +125,15 @@ class MidpointDeflection(NamedTuple):
 # ------------------------------------------------------------------------------------------
 # input checks
 # ------------------------------------------------------------------------------------------
+def _is_number(value: Any) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
 def _check_inputs(sizes: dict[str, float], poisson_ratio: float, modes: int) -> None:
     for name, value in sizes.items():
-        if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+        if not (_is_number(value) and math.isfinite(value) and value > 0):
             raise SceneError(f"reduction {name} = {value!r}: must be a finite number > 0")
-    if not (isinstance(poisson_ratio, int | float) and 0.0 < poisson_ratio < 0.5):
+    if not (_is_number(poisson_ratio) and 0.0 < poisson_ratio < 0.5):
         raise SceneError(
             f"reduction poisson_ratio = {poisson_ratio!r}: must lie in the open range (0, 0.5)")
     if isinstance(modes, bool) or not isinstance(modes, int | np.integer) or modes < 1:
@@ -143,10 +148,10 @@ def _check_inputs(sizes: dict[str, float], poisson_ratio: float, modes: int) -> 
 # cache
 # ------------------------------------------------------------------------------------------
 def _engine_versions() -> dict[str, str]:
-    import exudyn
-    import ngsolve
+    # installed distribution versions: no need to import ngsolve (0.5 s) for a cache hit
+    from importlib.metadata import version
 
-    return {"exudyn": str(exudyn.__version__), "ngsolve": str(ngsolve.__version__)}
+    return {"exudyn": version("exudyn"), "ngsolve": version("ngsolve")}
 
 
 def _cache_key(parameters: dict[str, Any]) -> str:
@@ -329,7 +334,7 @@ def _fix_eigenmode_signs(basis: np.ndarray) -> None:
     one key could give modal coordinates of opposite sign; this makes them comparable. The
     first entry within 1e-6 of the largest is used, so round-off cannot change the pick.
     """
-    for column in range(_RIGID_FRAME_COORDINATES, basis.shape[1]):
+    for column in range(_STATIC_MODES, basis.shape[1]):
         magnitude = np.abs(basis[:, column])
         pick = int(np.argmax(magnitude >= (1 - 1e-6) * magnitude.max()))
         if basis[pick, column] < 0:
@@ -517,9 +522,9 @@ def add_ffrf_coupler(mbs, reduction: Reduction, position_B: Sequence[float], ang
     for label, value in (("angle_rad", angle_rad),
                          ("initial_angular_velocity_rad_per_s",
                           initial_angular_velocity_rad_per_s)):
-        if not (isinstance(value, int | float) and math.isfinite(value)):
+        if not (_is_number(value) and math.isfinite(value)):
             raise SceneError(f"{label} = {value!r}: must be a finite number")
-    if not (isinstance(damping_ratio, int | float) and 0.0 <= damping_ratio < 1.0):
+    if not (_is_number(damping_ratio) and 0.0 <= damping_ratio < 1.0):
         raise SceneError(f"damping_ratio = {damping_ratio!r}: must lie in [0, 1)")
     beta = 0.0
     if damping_ratio > 0:

@@ -344,3 +344,17 @@ def test_bending_stress_history_checks_columns(reduction):
     with pytest.raises(ValueError, match="columns"):
         bending_stress_history(reduction, np.zeros((3, reduction.n_modal_coordinates + 1)))
     assert np.all(bending_stress_history(reduction, np.zeros((3, 12))) == 0.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("thickness", "mesh_size", "low", "high"), [
+    (0.001, 0.002, 0.999, 1.003), (0.003, 0.003, 0.995, 1.002),
+    (0.005, 0.005, 0.990, 1.000), (0.010, 0.005, 0.970, 0.985),  # t = 10: shear, -2.4 %
+])
+def test_thesis_plates_pinned_pinned_frequency(thickness, mesh_size, low, high, tmp_path):
+    """The four Table 5 plates at the recommended mesh sizes against Euler-Bernoulli."""
+    reduction = build_reduction(LENGTH, thickness, WIDTH, E, RHO, NU, mesh_size, MODES,
+                                cache_dir=tmp_path)
+    inertia, area = WIDTH * thickness**3 / 12, WIDTH * thickness
+    euler_bernoulli = (np.pi / LENGTH) ** 2 * np.sqrt(E * inertia / (RHO * area)) / (2 * np.pi)
+    assert low < reduction.pinned_pinned_frequency_Hz / euler_bernoulli < high
