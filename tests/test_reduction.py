@@ -6,7 +6,6 @@ built once per module; Euler-Bernoulli references: I = w t^3 / 12 (bending heigh
 
 from __future__ import annotations
 
-import os
 import re
 import shutil
 
@@ -21,9 +20,6 @@ from flex.reduction import (
     build_reduction,
     midpoint_deflection,
 )
-
-# flex.reduction imports exudyn lazily, so this is in time for the first import
-os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
 
 LENGTH, THICKNESS, WIDTH = 0.08, 0.003, 0.01  # m
 E, RHO, NU = 200e9, 7850.0, 0.3
