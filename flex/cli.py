@@ -1,4 +1,4 @@
-"""Command line: ``python -m flex run|scene|studies ...``.
+"""Command line: ``python -m flex run|scene|inspect|plot|compare ...``.
 
 Every user error (bad scene key, impossible geometry, diverged run, bad result file) is
 printed as one line ``flex: error: ...`` and exits with status 2; no traceback.
@@ -33,12 +33,111 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--quiet", action="store_true", help="print nothing on success")
     scene = commands.add_parser("scene", help="print the fully resolved scene as TOML")
     scene_options(scene)
+    _result_tools(commands)
     return parser
+
+
+PATH_HELP = ("path inside the file: cases/<case>/crank/angle, <case>/crank/angle, or "
+             "crank/angle when the file has one case; a group means every dataset below "
+             "it; * and ? are wildcards; a [i] suffix picks one column")
+
+
+def _result_tools(commands) -> None:
+    """The ``inspect``, ``plot`` and ``compare`` subcommands (reading result files)."""
+    from .compare import DEFAULT_ATOL, DEFAULT_RTOL, INTERPOLATIONS
+
+    inspect = commands.add_parser(
+        "inspect", help="list a result file: cases, datasets, units, provenance, scene",
+        description="List the cases and datasets of a result file (shape, units, "
+                    "description), its provenance and its resolved scene.")
+    inspect.add_argument("file", metavar="FILE.h5")
+    inspect.add_argument("path", nargs="?", metavar="PATH", help=PATH_HELP)
+    inspect.add_argument("--json", action="store_true", help="print JSON (for scripts)")
+
+    plot = commands.add_parser(
+        "plot", help="plot stored curves against time (or against each other)",
+        description="Plot curves of a result file against time, with units on the axes; "
+                    "--vs overlays the same paths from another file (another run or a "
+                    "reference curve file).")
+    plot.add_argument("file", metavar="FILE.h5")
+    plot.add_argument("paths", nargs="+", metavar="PATH", help=PATH_HELP)
+    plot.add_argument("--vs", action="append", default=[], metavar="OTHER.h5",
+                      help="overlay the same paths from this file (repeatable)")
+    plot.add_argument("--x", dest="x_spec", metavar="PATH",
+                      help="plot against this dataset of the same case instead of time")
+    plot.add_argument("--out", metavar="FIG.png",
+                      help="figure file, .png/.pdf/.svg (default: figures/ beside FILE)")
+    plot.add_argument("--title", help="figure title (default: the file names)")
+
+    compare = commands.add_parser(
+        "compare", help="compare curves of two result files on a common time base",
+        description="Compare curves of A (under test) with B (reference) after "
+                    "interpolating onto a common time base (the overlap of both time "
+                    "ranges, on the finer grid). A curve (each column of a two-column "
+                    "curve) passes when max|a - b| <= atol + rtol * max|b|. Exit status: 0 "
+                    "all within tolerance, 1 some not, 2 a bad file or a PATH missing from "
+                    "either file. Without PATH every curve of the cases both files have "
+                    "is compared (/summary only when named; wall-clock timings never).")
+    compare.add_argument("file_a", metavar="A.h5")
+    compare.add_argument("file_b", metavar="B.h5")
+    compare.add_argument("paths", nargs="*", metavar="PATH", help=PATH_HELP)
+    compare.add_argument("--rtol", type=float, default=DEFAULT_RTOL,
+                         help=f"relative tolerance, times max|b| (default {DEFAULT_RTOL:g})")
+    compare.add_argument("--atol", type=float, default=DEFAULT_ATOL,
+                         help=f"absolute tolerance in the curve's units (default "
+                              f"{DEFAULT_ATOL:g})")
+    compare.add_argument("--interp", choices=INTERPOLATIONS, default="cubic",
+                         help="interpolation onto the common time base (default cubic)")
+    compare.add_argument("--limit", type=int, default=20, metavar="N",
+                         help="show the N largest deviations (failures always; 0: all)")
+    compare.add_argument("--json", action="store_true", help="print JSON (for scripts)")
+
+
+def _result_tool(args: argparse.Namespace) -> int:
+    """Run ``inspect``, ``plot`` or ``compare``; returns the exit status."""
+    import json
+
+    if args.command == "inspect":
+        from .inspect import describe, format_description
+
+        info = describe(args.file, args.path)
+        _print(json.dumps(info, indent=2) if args.json else format_description(info))
+        return 0
+    if args.command == "plot":
+        from .plotcurves import plot_curves
+
+        figure = plot_curves(args.file, args.paths, args.vs, args.x_spec, args.out,
+                             args.title)
+        _print(f"wrote {figure}")
+        return 0
+    from .compare import compare_files
+
+    report = compare_files(args.file_a, args.file_b, args.paths, args.rtol, args.atol,
+                           args.interp)
+    _print(json.dumps(report.as_dict(), indent=2) if args.json
+           else report.format(args.limit))
+    return 0 if report.passed else 1
+
+
+def _print(text: str) -> None:
+    """Print to stdout; a closed pipe (``| head``) ends quietly."""
+    import os
+
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
 
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the process exit status."""
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # PATHs after options (compare A B --rtol 1e-6 PATH): argparse leaves them over
+        if args.command in ("plot", "compare") and not any(e.startswith("-") for e in extra):
+            args.paths += extra
+        else:
+            parser.error(f"unrecognized arguments: {' '.join(extra)}")
     try:
         if args.command == "run":
             from .study import run_study
@@ -53,6 +152,8 @@ def main(argv: list[str] | None = None) -> int:
             print(to_toml(study_scene(load_study(args.study), args.scene, args.overrides)),
                   end="")
             return 0
+        if args.command in ("inspect", "plot", "compare"):
+            return _result_tool(args)
     except FlexError as exc:
         print(f"flex: error: {exc}", file=sys.stderr)
         return 2

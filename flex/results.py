@@ -20,12 +20,14 @@ reader sees the previous complete file or the new complete file, never a partial
 from __future__ import annotations
 
 import datetime as _dt
+import glob
 import os
 import platform
+import re
+import secrets
 import shlex
 import subprocess
 import sys
-import tempfile
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -98,21 +100,91 @@ def provenance() -> dict[str, str]:
     }
 
 
+PART_SUFFIX = ".part"
+_PART_TAIL = re.compile(r"^(\d+)\.[^.]+\.part$")  # <pid>.<random hex>.part
+
+
+def _part_prefix(path: Path) -> str:
+    return f".{path.name}."
+
+
+def _process_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale_parts(path: str | Path) -> list[Path]:
+    """Delete temporary files ``.<name>.<pid>.*.part`` beside ``path`` left by dead writers.
+
+    A writer killed with SIGKILL (or by a power cut) cannot remove its temporary file; the
+    next write of the same path removes it. Parts whose writer process is still alive (a
+    concurrent run) are kept. Returns the removed paths.
+    """
+    path = Path(path)
+    removed = []
+    prefix = _part_prefix(path)
+    try:
+        candidates = list(path.parent.glob(f"{glob.escape(prefix)}*{PART_SUFFIX}"))
+    except OSError:
+        return removed
+    for part in candidates:
+        match = _PART_TAIL.match(part.name[len(prefix):])
+        if not match or int(match[1]) == os.getpid() or _process_alive(int(match[1])):
+            continue
+        try:
+            part.unlink()
+            removed.append(part)
+        except OSError:
+            pass
+    return removed
+
+
 @contextmanager
 def atomic_path(path: str | Path):
-    """Yield a temporary path beside ``path``; rename it to ``path`` only on success."""
+    """Yield a temporary path beside ``path``; rename it to ``path`` only on success.
+
+    The temporary file is ``.<name>.<pid>.<random>.part`` in the same folder, created with
+    the usual permissions (0666 minus the umask). On any exception (including
+    ``KeyboardInterrupt``) it is deleted and ``path`` is untouched; on success it is flushed
+    to disk and renamed over ``path`` in one atomic step, so readers and concurrent writers
+    see a complete old or a complete new file (the last writer to finish wins). Parts left
+    by killed writers are removed here (:func:`remove_stale_parts`).
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    handle, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(handle)
+    remove_stale_parts(path)
+    # named before it exists, so an interrupt at any point after creation still removes it
+    tmp = path.parent / f"{_part_prefix(path)}{os.getpid()}.{secrets.token_hex(8)}{PART_SUFFIX}"
     try:
-        yield Path(tmp)
+        os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        yield tmp
         with open(tmp, "rb+") as stream:
             os.fsync(stream.fileno())
         os.replace(tmp, path)
+        _fsync_folder(path.parent)
     finally:
-        if os.path.exists(tmp):
+        try:
             os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+
+
+def _fsync_folder(folder: Path) -> None:
+    try:
+        handle = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(handle)
+    except OSError:
+        pass
+    finally:
+        os.close(handle)
 
 
 def _write_dataset(group, path: str, dataset: Dataset) -> None:
@@ -137,13 +209,50 @@ def write_results(path: str | Path, study: str, cases: list[CaseResult],
                   attrs: dict[str, Any] | None = None) -> Path:
     """Write a whole result file atomically and return its path.
 
-    ``summary`` datasets go under ``/summary``; ``attrs`` are extra root attributes.
+    ``summary`` datasets go under ``/summary``; ``attrs`` are extra root attributes. An
+    operating-system failure while writing (full disk, no permission) raises
+    :class:`ResultFileError` naming the file; the previous file is then unchanged.
     """
+    path = Path(path)
+    try:
+        _write_file(path, study, cases, scene_toml, summary, attrs)
+    except (OSError, RuntimeError) as exc:  # full disk, no permission: the old file stays
+        cause = _os_error_in(exc)
+        if cause is None:
+            raise
+        raise ResultFileError(f"cannot write result file '{path}': {_os_reason(cause)}; "
+                              f"the previous file (if any) is unchanged") from None
+    return path
+
+
+def _os_error_in(exc: BaseException) -> OSError | None:
+    """The ``OSError`` behind ``exc`` (h5py reports a failed write again as a RuntimeError
+    when it closes the file), or ``None``."""
+    seen = 0
+    current: BaseException | None = exc
+    while current is not None and seen < 10:
+        if isinstance(current, OSError):
+            return current
+        current = current.__context__
+        seen += 1
+    return None
+
+
+def _os_reason(exc: OSError) -> str:
+    """A one-line reason: ``No space left on device`` rather than HDF5's multi-line text."""
+    if exc.errno:
+        return os.strerror(exc.errno)
+    return " ".join(str(exc).split())[:200]
+
+
+def _write_file(path: Path, study: str, cases: list[CaseResult], scene_toml: str,
+                summary: dict[str, Dataset] | None, attrs: dict[str, Any] | None) -> None:
     import h5py
 
-    path = Path(path)
+    # The file is built in memory and written with one plain write: a full disk then fails
+    # in Python with a clean OSError (HDF5 itself can crash when its own write fails).
     with atomic_path(path) as tmp:
-        with h5py.File(tmp, "w") as h5:
+        with h5py.File(tmp.name, "w", driver="core", backing_store=False) as h5:
             for key, value in provenance().items():
                 h5.attrs[key] = value
             h5.attrs["study"] = study
@@ -157,7 +266,10 @@ def write_results(path: str | Path, study: str, cases: list[CaseResult],
                 summary_group = h5.create_group("summary")
                 for name, dataset in summary.items():
                     _write_dataset(summary_group, name, dataset)
-    return path
+            h5.flush()
+            image = h5.id.get_file_image()
+        with open(tmp, "wb") as stream:
+            stream.write(image)
 
 
 def write_case(parent, case: CaseResult) -> None:
@@ -208,7 +320,7 @@ def open_results(path: str | Path):
 
 def read_case(path: str | Path, case: str) -> dict[str, np.ndarray]:
     """All datasets of one case as ``{relative path: array}`` (for tests and scripts)."""
-    with open_results(path) as h5:
+    with reading(path) as h5:
         if f"cases/{case}" not in h5:
             raise ResultFileError(f"result file '{path}' has no case '{case}' (cases: "
                                   f"{', '.join(h5['cases'])})")
@@ -216,3 +328,175 @@ def read_case(path: str | Path, case: str) -> dict[str, np.ndarray]:
         h5[f"cases/{case}"].visititems(
             lambda name, obj: out.__setitem__(name, obj[()]) if hasattr(obj, "shape") else None)
         return out
+
+
+class ResultPathError(ResultFileError):
+    """A path asked for (``cases/<case>/crank/angle``, a case, a group) is not in the file."""
+
+
+@contextmanager
+def reading(path: str | Path):
+    """Open a result file like :func:`open_results` and close it after the block.
+
+    Low-level read errors inside the block (a damaged file whose header opened but whose
+    data cannot be read) become one :class:`ResultFileError` naming the file.
+    """
+    h5 = open_results(path)
+    try:
+        yield h5
+    except (OSError, RuntimeError) as exc:
+        raise ResultFileError(f"result file '{path}' is damaged: cannot read its data "
+                              f"({exc})") from None
+    finally:
+        h5.close()
+
+
+def list_datasets(group) -> list[str]:
+    """Paths of every dataset below ``group`` (an open h5py file or group), relative to it,
+    in the file's order."""
+    names: list[str] = []
+    group.visititems(lambda name, obj: names.append(name) if hasattr(obj, "shape") else None)
+    return names
+
+
+def case_names(h5) -> list[str]:
+    """Names of the cases of an open result file (``/cases/<case>``), in the file's order."""
+    cases = h5.get("cases")
+    return list(cases) if cases is not None and hasattr(cases, "keys") else []
+
+
+def split_case_path(path: str) -> tuple[str | None, str]:
+    """``"cases/a/crank/angle"`` -> ``("a", "crank/angle")``; other paths -> ``(None, path)``."""
+    parts = path.strip("/").split("/", 2)
+    if len(parts) == 3 and parts[0] == "cases":
+        return parts[1], parts[2]
+    return None, path.strip("/")
+
+
+_COLUMN = re.compile(r"^(.*)\[(\d+)\]$")
+
+
+def parse_spec(spec: str) -> tuple[str, int | None]:
+    """``"crank/midpoint_position[1]"`` -> ``("crank/midpoint_position", 1)``."""
+    match = _COLUMN.match(spec.strip())
+    if match:
+        return match[1].strip("/"), int(match[2])
+    return spec.strip().strip("/"), None
+
+
+def select_datasets(h5, spec: str, label: str | Path = "") -> list[str]:
+    """Full paths of the datasets that ``spec`` names in the open result file ``h5``.
+
+    ``spec`` (without a ``[column]`` suffix, see :func:`parse_spec`) is tried as written,
+    then under ``cases/``, then, when the file has exactly one case, under that case; so
+    ``cases/preload_22mm/crank/angle``, ``preload_22mm/crank/angle`` and (one case)
+    ``crank/angle`` name the same dataset. A group stands for every dataset below it;
+    ``*`` and ``?`` are wildcards (``*/crank/angle``: that curve of every case). Raises
+    :class:`ResultPathError` naming the file and suggesting close paths when nothing matches.
+    """
+    import fnmatch
+
+    spec = spec.strip().strip("/")
+    cases = case_names(h5)
+    candidates = [spec, f"cases/{spec}"] if spec else [""]
+    if len(cases) == 1 and spec:
+        candidates.append(f"cases/{cases[0]}/{spec}")
+    everything = list_datasets(h5)
+    for candidate in candidates:
+        if any(char in candidate for char in "*?"):
+            matches = [name for name in everything if fnmatch.fnmatchcase(name, candidate)]
+            if matches:
+                return matches
+            continue
+        if candidate == "":
+            return everything
+        if candidate in h5:
+            obj = h5[candidate]
+            if hasattr(obj, "shape"):
+                return [candidate]
+            below = [f"{candidate}/{name}" for name in list_datasets(obj)]
+            if below:
+                return below
+    import difflib
+
+    close = difflib.get_close_matches(spec, everything, n=3, cutoff=0.5)
+    close += [name for name in everything if name.endswith("/" + spec)][:3]
+    hint = f"; did you mean {', '.join(dict.fromkeys(close))}?" if close else ""
+    where = f"cases: {', '.join(cases)}" if cases else "no cases"
+    raise ResultPathError(f"result file '{label or h5.filename}' has no dataset or group "
+                          f"'{spec}' ({where}){hint}")
+
+
+def to_xarray(path: str | Path, case: str | None = None):
+    """One case of a result file as an ``xarray.Dataset`` with a ``time`` coordinate [s].
+
+    Variables are named by their path inside the case (``ds["crank/angle"]``); each carries
+    ``units``, ``description`` and ``long_name`` attributes (so ``ds["crank/angle"].plot()``
+    labels its axes). Curves have dimension ``time``; two-column curves (x, y) add a
+    dimension ``xy`` with coordinates ``["x", "y"]``; other arrays get their own dimensions
+    ``<name>_dim<i>``. ``ds.attrs`` hold the case's attributes and the file's provenance
+    (prefixed ``file_``). ``case`` may be omitted when the file has one case. The data are
+    read into memory; the file is closed on return. Needs ``xarray`` (``pip install
+    xarray``).
+    """
+    try:
+        import xarray as xr
+    except ImportError:
+        raise ResultFileError("to_xarray needs xarray: pip install xarray") from None
+    with reading(path) as h5:
+        cases = case_names(h5)
+        if case is None:
+            if len(cases) != 1:
+                raise ResultPathError(f"result file '{path}' has {len(cases)} cases "
+                                      f"({', '.join(cases)}); name one")
+            case = cases[0]
+        if case not in cases:
+            raise ResultPathError(f"result file '{path}' has no case '{case}' (cases: "
+                                  f"{', '.join(cases)})")
+        group = h5[f"cases/{case}"]
+        time_s = group["time"][()] if "time" in group else None
+        coords: dict[str, Any] = {}
+        if time_s is not None:
+            coords["time"] = ("time", time_s, _attrs_of(group["time"]))
+        variables = {}
+        for name in list_datasets(group):
+            if name == "time":
+                continue
+            data = group[name][()]
+            attrs = _attrs_of(group[name])
+            if isinstance(data, bytes):
+                data = data.decode()
+            elif data.dtype == object:
+                data = data.astype(str)
+            shape = np.shape(data)
+            if time_s is not None and shape[:1] == time_s.shape and len(shape) <= 2:
+                dims = ("time",) if len(shape) == 1 else ("time", "xy" if shape[1] == 2
+                                                           else f"{name}_dim1")
+                if len(shape) == 2 and shape[1] == 2:
+                    coords["xy"] = ("xy", ["x", "y"])
+            else:
+                dims = tuple(f"{name}_dim{i}" for i in range(len(shape)))
+            variables[name] = (dims, data, attrs)
+        attrs = {key: attribute_value(value) for key, value in group.attrs.items()}
+        attrs.update({f"file_{key}": attribute_value(value) for key, value in h5.attrs.items()})
+        attrs["case"] = case
+        attrs["file"] = str(path)
+        return xr.Dataset(variables, coords=coords, attrs=attrs)
+
+
+def _attrs_of(dataset) -> dict[str, str]:
+    units = attribute_value(dataset.attrs.get("units", ""))
+    description = attribute_value(dataset.attrs.get("description", ""))
+    return {"units": units, "description": description, "long_name": description or ""}
+
+
+def attribute_value(value: Any) -> Any:
+    """An HDF5 attribute (or small dataset) value as plain Python: str, int, float, bool,
+    or a list of them (bytes decoded as UTF-8)."""
+    if isinstance(value, bytes):
+        return value.decode("utf-8", "replace")
+    if isinstance(value, np.ndarray):
+        return [attribute_value(item) for item in value.tolist()]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value

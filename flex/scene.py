@@ -154,11 +154,14 @@ def _read_toml(path: Path, label: str) -> Scene:
         parsed = tomllib.loads(data.decode("utf-8"))
     except UnicodeDecodeError:
         raise SceneError(f"scene file '{label}' is not UTF-8 text") from None
-    except tomllib.TOMLDecodeError as exc:
+    except RecursionError:
+        raise SceneError(f"scene file '{label}' is not valid TOML: nested too deeply") from None
+    except ValueError as exc:  # TOMLDecodeError, or an integer of too many digits
         raise SceneError(f"scene file '{label}' is not valid TOML: {exc}") from None
     for section, table in parsed.items():
         if not isinstance(table, dict):
-            raise SceneError(f"scene file '{label}': '{section}' must be a [section] table; "
+            raise SceneError(f"scene file '{label}': '{_name(section)}' must be a [section] "
+                             f"table; "
                              f"accepted sections: {', '.join(SCHEMA)}")
     return parsed
 
@@ -168,7 +171,7 @@ def merge(base: Scene, changes: Scene) -> Scene:
     merged = copy.deepcopy(base)
     for section, table in changes.items():
         if not isinstance(table, dict):
-            raise SceneError(f"'{section}' must be a [section] table; "
+            raise SceneError(f"'{_name(section)}' must be a [section] table; "
                              f"accepted sections: {', '.join(SCHEMA)}")
         merged.setdefault(section, {}).update(copy.deepcopy(table))
     return merged
@@ -179,7 +182,7 @@ def apply_overrides(scene: Scene, overrides: list[str]) -> Scene:
     changes: Scene = {}
     for item in overrides:
         if "=" not in item or "." not in item.split("=", 1)[0]:
-            raise SceneError(f"--set '{item}': expected section.key=value, "
+            raise SceneError(f"--set {_show(item)}: expected section.key=value, "
                              f"e.g. coupler.thickness_m=0.003")
         dotted, text = item.split("=", 1)
         section, key = (part.strip() for part in dotted.split(".", 1))
@@ -190,7 +193,7 @@ def apply_overrides(scene: Scene, overrides: list[str]) -> Scene:
 def _parse_value(text: str) -> Any:
     try:
         return tomllib.loads(f"v = {text}")["v"]
-    except tomllib.TOMLDecodeError:
+    except (ValueError, RecursionError):  # not TOML (or absurdly long/deep): a bare word
         return text
 
 
@@ -203,11 +206,12 @@ def validate(scene: Scene) -> None:
     """
     for section, table in scene.items():
         if section not in SCHEMA:
-            raise SceneError(f"unknown section [{section}]; accepted sections: "
+            raise SceneError(f"unknown section [{_name(section)}]; accepted sections: "
                              f"{', '.join(SCHEMA)}")
         for key, value in table.items():
             if key not in SCHEMA[section]:
-                raise SceneError(f"unknown key {section}.{key}; accepted keys in [{section}]: "
+                raise SceneError(f"unknown key {_name(section)}.{_name(key)}; accepted keys in "
+                                 f"[{section}]: "
                                  f"{', '.join(SCHEMA[section])}")
             _check_value(f"{section}.{key}", SCHEMA[section][key], value)
     for section, fields in SCHEMA.items():
@@ -220,22 +224,44 @@ def validate(scene: Scene) -> None:
 def _check_value(name: str, field: Field, value: Any) -> None:
     if isinstance(field.kind, tuple):
         if not isinstance(value, str) or value not in field.kind:
-            raise SceneError(f"{name} = {value!r}: must be {field.accepted()}")
+            raise SceneError(f"{name} = {_show(value)}: must be {field.accepted()}")
         return
     if field.kind is bool:
         if not isinstance(value, bool):
-            raise SceneError(f"{name} = {value!r}: must be true or false")
+            raise SceneError(f"{name} = {_show(value)}: must be true or false")
         return
     is_number = isinstance(value, int | float) and not isinstance(value, bool)
     if field.kind is int and not (isinstance(value, int) and not isinstance(value, bool)):
-        raise SceneError(f"{name} = {value!r}: must be {field.accepted()}")
-    if not is_number or not math.isfinite(value):
-        raise SceneError(f"{name} = {value!r}: must be {field.accepted()}")
+        raise SceneError(f"{name} = {_show(value)}: must be {field.accepted()}")
+    if not is_number or not _finite(value):
+        raise SceneError(f"{name} = {_show(value)}: must be {field.accepted()}")
     if ((field.positive and not value > 0)
             or (field.minimum is not None and value < field.minimum)
             or (field.maximum is not None and value > field.maximum)
             or (field.below is not None and not value < field.below)):
-        raise SceneError(f"{name} = {value!r}: must be {field.accepted()}")
+        raise SceneError(f"{name} = {_show(value)}: must be {field.accepted()}")
+
+
+def _finite(value: float) -> bool:
+    try:
+        return math.isfinite(value)
+    except OverflowError:  # an integer beyond the float range
+        return False
+
+
+def _show(value: Any, limit: int = 60) -> str:
+    """``repr(value)`` shortened to one line: safe inside a one-line error message."""
+    try:
+        text = repr(value)
+    except ValueError:  # an integer beyond Python's digit limit for str()
+        text = "<an integer of thousands of digits>"
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _name(text: str, limit: int = 60) -> str:
+    """A user-written section or key name, control characters escaped, shortened."""
+    text = text if text.isprintable() else repr(text)[1:-1]
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def _check_geometry(scene: Scene) -> None:

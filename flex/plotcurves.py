@@ -1,0 +1,203 @@
+"""Plot stored curves (``python -m flex plot FILE.h5 PATH [PATH ...]``).
+
+Contract: each PATH (the forms of :func:`flex.results.select_datasets`, plus an optional
+``[column]`` suffix) is drawn against its case's ``time`` -- or, with ``x_spec``, against
+another dataset of the same case (``--x crank/angle``: speed over angle; ``--x
+crank/midpoint_position[0]`` with ``crank/midpoint_position[1]``: the trajectory). Axis
+labels carry the datasets' units; curves of a second unit go on a right-hand axis, a third
+unit is refused. Every file in ``others`` (``--vs``: another run, or a reference curve file
+such as ``tests/reference_curves/*.h5``) overlays the same PATHs, dashed, in the same colour.
+Datasets without a time axis are drawn against their index. The figure is written atomically
+(PNG, PDF or SVG by the extension) and its path returned.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import FlexError
+from .results import (
+    ResultPathError,
+    atomic_path,
+    parse_spec,
+    reading,
+    select_datasets,
+    split_case_path,
+)
+
+FORMATS = (".png", ".pdf", ".svg")
+LINESTYLES = ("-", "--", ":", "-.")
+
+
+@dataclass
+class Curve:
+    """One line of a plot: x and y values with their labels and units."""
+
+    file: str
+    label: str
+    key: str  # the same curve in every file has the same key (same colour)
+    x: np.ndarray
+    y: np.ndarray
+    x_label: str
+    x_units: str
+    y_units: str
+
+
+def load_curves(path: str | Path, specs: Sequence[str], x_spec: str | None = None
+                ) -> list[Curve]:
+    """The curves ``specs`` name in result file ``path`` (see the module contract)."""
+    curves: list[Curve] = []
+    with reading(path) as h5:
+        for spec in specs:
+            name, column = parse_spec(spec)
+            for full in select_datasets(h5, name, path):
+                case, rel = split_case_path(full)
+                if case is not None and rel == "time" and len(specs) > 1:
+                    continue
+                y, y_units, columns = _values(h5, full, column, path)
+                x, x_label, x_units = _abscissa(h5, full, case, x_spec, len(y), path)
+                for index, values in columns(y):
+                    suffix = "" if index is None else f"[{index}]"
+                    label = (f"{case}/{rel}" if case is not None else full) + suffix
+                    curves.append(Curve(str(path), label, full + suffix, x, values,
+                                        x_label, x_units, y_units))
+    return curves
+
+
+def _values(h5, full: str, column: int | None, label):
+    dataset = h5[full]
+    values = dataset[()]
+    if not isinstance(values, np.ndarray) or values.dtype.kind not in "biuf":
+        raise FlexError(f"{full} in '{label}' is text or a scalar; nothing to plot "
+                        f"(python -m flex inspect shows its value)")
+    units = str(_attr(dataset, "units"))
+    if column is not None:
+        if values.ndim != 2 or column >= values.shape[1]:
+            raise ResultPathError(f"{full}[{column}] in '{label}': no such column (shape "
+                                  f"{values.shape})")
+        values = values[:, column]
+    if values.ndim > 2:
+        raise FlexError(f"{full} in '{label}' has shape {values.shape}; plot one column "
+                        f"of a 1-D or 2-D dataset")
+
+    def columns(array: np.ndarray):
+        if array.ndim == 1:
+            return [(column, array.astype(float))]
+        return [(index, array[:, index].astype(float)) for index in range(array.shape[1])]
+
+    return values, units, columns
+
+
+def _abscissa(h5, full: str, case: str | None, x_spec: str | None, count: int, label):
+    """x values, label and units for a dataset of ``count`` rows."""
+    if x_spec:
+        name, column = parse_spec(x_spec)
+        candidates = [f"cases/{case}/{name}", name] if case else [name]
+        target = next((c for c in candidates if c in h5 and hasattr(h5[c], "shape")), None)
+        if target is None:
+            target = select_datasets(h5, name, label)[0]
+        values = h5[target][()]
+        if column is not None:
+            if np.ndim(values) != 2 or column >= np.shape(values)[1]:
+                raise ResultPathError(f"--x {x_spec}: {target} in '{label}' has no column "
+                                      f"{column} (shape {np.shape(values)})")
+            values = values[:, column]
+        if np.ndim(values) != 1 or len(values) != count:
+            raise FlexError(f"--x {x_spec}: {target} in '{label}' has shape "
+                            f"{np.shape(values)}; it must be one column of {count} values "
+                            f"like {full} (add [0] or [1] for a two-column dataset)")
+        rel = split_case_path(target)[1] + ("" if column is None else f"[{column}]")
+        return values.astype(float), rel, str(_attr(h5[target], "units"))
+    time_path = f"cases/{case}/time" if case is not None else None
+    if time_path and time_path in h5 and len(h5[time_path]) == count:
+        return h5[time_path][()].astype(float), "time", "s"
+    return np.arange(count, dtype=float), "index", ""
+
+
+def _attr(dataset, key: str) -> str:
+    value = dataset.attrs.get(key, "")
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def default_output(path: str | Path, specs: Sequence[str]) -> Path:
+    """``<folder of FILE>/figures/plot-<file stem>-<paths>.png`` (never a study's own figure)."""
+    path = Path(path)
+    slug = re.sub(r"[^A-Za-z0-9_.]+", "-", "-".join(specs)).strip("-.")[:80] or "curves"
+    return path.parent / "figures" / f"plot-{path.stem}-{slug}.png"
+
+
+def plot_curves(path: str | Path, specs: Sequence[str], others: Sequence[str | Path] = (),
+                x_spec: str | None = None, out: str | Path | None = None,
+                title: str | None = None) -> Path:
+    """Draw ``specs`` of result file ``path`` (and of each file in ``others``) and save.
+
+    Returns the figure's path (default :func:`default_output`). Raises
+    :class:`~flex.errors.FlexError` for a bad file, a missing path, mismatched x units or
+    more than two y units.
+    """
+    if not specs:
+        raise FlexError("plot needs at least one PATH, e.g. crank/angle")
+    target = Path(out) if out else default_output(path, specs)
+    if target.suffix.lower() not in FORMATS:
+        raise FlexError(f"--out '{target}': figures end in {', '.join(FORMATS)}")
+    files = [path, *others]
+    curves_by_file = [load_curves(f, specs, x_spec) for f in files]
+    curves = [c for group in curves_by_file for c in group]
+    x_units = list(dict.fromkeys((c.x_label if c.x_label in ("time", "index") else "x",
+                                  c.x_units) for c in curves))
+    if len(x_units) > 1:
+        raise FlexError("the curves have different x axes ("
+                        + ", ".join(f"{name} [{units}]" for name, units in x_units)
+                        + "); plot them separately")
+    y_units = list(dict.fromkeys(c.y_units for c in curves))
+    if len(y_units) > 2:
+        raise FlexError(f"the curves have {len(y_units)} units ({', '.join(y_units)}); "
+                        f"one plot shows at most two (left and right axis)")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, left = plt.subplots(figsize=(7.5, 4.5), layout="constrained")
+    axes = {y_units[0]: left}
+    if len(y_units) == 2:
+        axes[y_units[1]] = left.twinx()
+    keys = list(dict.fromkeys(c.key for c in curves))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    several = len(files) > 1
+    names = [Path(f).name for f in files]
+    file_labels = {str(f): (name if names.count(name) == 1 else str(f))
+                   for f, name in zip(files, names, strict=True)}
+    for file_index, group in enumerate(curves_by_file):
+        style = LINESTYLES[file_index % len(LINESTYLES)]
+        for curve in group:
+            label = f"{file_labels[curve.file]}: {curve.label}" if several else curve.label
+            colour = colours[keys.index(curve.key) % len(colours)]
+            axes[curve.y_units].plot(curve.x, curve.y, style, color=colour, label=label,
+                                     linewidth=1.4 if file_index == 0 else 1.2)
+    first = curves[0]
+    left.set_xlabel(f"{first.x_label} [{first.x_units}]" if first.x_units else first.x_label)
+    for units, ax in axes.items():
+        names = list(dict.fromkeys(c.label.split("/", 1)[-1] if "/" in c.label else c.label
+                                   for c in curves if c.y_units == units))
+        name = ", ".join(names) if len(names) <= 2 else "value"
+        ax.set_ylabel(f"{name} [{units}]" if units else name)
+    left.grid(True, alpha=0.3)
+    handles, labels = [], []
+    for ax in axes.values():
+        h, lab = ax.get_legend_handles_labels()
+        handles += h
+        labels += lab
+    if len(labels) > 1:
+        left.legend(handles, labels, fontsize="small")
+    left.set_title(title or " vs ".join(Path(f).name for f in files))
+    target.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(target) as tmp:
+        fig.savefig(tmp, dpi=120, format=target.suffix.lower()[1:])
+    plt.close(fig)
+    return target
