@@ -7,7 +7,7 @@ export EXUDYN_NO_USER_SETTINGS := 1
 export MPLBACKEND := Agg
 RUN := $(PY) -m flex run
 
-STUDIES := kinematics dynamics flexible spring
+STUDIES := kinematics dynamics modal flexible spring
 
 .PHONY: all test test-slow lint setup clean $(STUDIES)
 

@@ -44,3 +44,10 @@ def test_spring_fe_agrees_with_wahl():
     ratio = output.summary.datasets["fe/over_wahl"].data
     assert ratio == pytest.approx(1.0, abs=0.02)  # Wahl's curved-beam correction
     assert output.summary.datasets["design/rate"].data == pytest.approx(1500.0, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_modal_table5_thinnest_plate():
+    _, output = run("modal")
+    omega = output.summary.datasets["table5/fe_omega_rad_per_s"].data[0]
+    assert omega == pytest.approx(2247.04282, rel=2e-3)  # thesis Table 5, model 0
