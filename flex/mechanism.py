@@ -90,6 +90,51 @@ def _rotation_z(angle_rad: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+#: damping of the penalty joints, as a fraction of critical for the lightest link's mass
+PENALTY_DAMPING_RATIO = 0.2
+
+
+def _add_penalty_joints(mbs: Any, stiffness_N_per_m: float, lightest_mass_kg: float,
+                        joint_markers: list[tuple[int, int]], nodes: list[int]) -> list[int]:
+    """Joints A, B, C and the slide line as stiff springs, for Exudyn's explicit solvers.
+
+    ``joint_markers``: (marker 0, marker 1) of A, B, C and of the slide line (ground, slider);
+    ``nodes``: the rigid-body nodes (Tait-Bryan, coordinates x y z rx ry rz) of crank,
+    coupler and slider. A, B, C become ``CartesianSpringDamper``s of stiffness
+    ``stiffness_N_per_m`` in x and y, the slide line one in y only, damped with
+    :data:`PENALTY_DAMPING_RATIO` of critical for ``lightest_mass_kg`` (undamped, the
+    joint forces ring at the penalty frequency about their true values: measured +-20 N on
+    ~25 N at 1e8 N/m; damped, 1e-2 N, with the same crank angle). The out-of-plane
+    coordinates (z, rx, ry of every body) and the slider's angle are held by
+    ``CoordinateConstraint``s to ground, which the explicit solvers eliminate
+    (``timeIntegration.explicit.eliminateConstraints``). The joints then open by about
+    force / stiffness: the crank-angle error falls as 1 / stiffness, while the explicit
+    stability limit of the step falls as 1 / sqrt(stiffness). Returns the four connector
+    indices (their ``Force`` output is in global axes, acting on marker 0's body).
+    """
+    import exudyn.itemInterface as eii
+
+    ground_node = mbs.AddNode(eii.NodePointGround())
+    ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node,
+                                                               coordinate=0))
+    held = {node: [2, 3, 4] for node in nodes}
+    held[nodes[-1]].append(5)  # the slider does not turn
+    for node, coordinates in held.items():
+        for coordinate in coordinates:
+            marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=node,
+                                                            coordinate=coordinate))
+            mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate,
+                                                                       marker]))
+    k = stiffness_N_per_m
+    d = 2.0 * PENALTY_DAMPING_RATIO * np.sqrt(k * lightest_mass_kg)
+    springs = []
+    for index, markers in enumerate(joint_markers):
+        axes = np.array([1.0, 1.0, 0.0] if index < 3 else [0.0, 1.0, 0.0])
+        springs.append(mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
+            markerNumbers=list(markers), stiffness=list(k * axes), damping=list(d * axes))))
+    return springs
+
+
 def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
     """Build and assemble the slider-crank of ``scene`` in a new Exudyn system.
 
@@ -166,17 +211,28 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
 
     crank_ref = _rotation_z(init.crank_angle_rad)
     coupler_ref = _rotation_z(init.coupler_angle_rad)
-    # joint frames coincide with the global axes at t = 0; force outputs are in the frame of
-    # marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where it can
-    joint_a = mbs.AddObject(eii.ObjectJointRevoluteZ(markerNumbers=[ground_a, crank_a],
-                                                     rotationMarker1=crank_ref.T))
-    joint_b = mbs.AddObject(eii.ObjectJointRevoluteZ(markerNumbers=[crank_b, coupler_b],
-                                                     rotationMarker0=crank_ref.T,
-                                                     rotationMarker1=coupler_ref.T))
-    joint_c = mbs.AddObject(eii.ObjectJointSpherical(markerNumbers=[slider_c, coupler_c],
-                                                     constrainedAxes=[1, 1, 0]))
-    joint_p = mbs.AddObject(eii.ObjectJointPrismaticX(markerNumbers=[ground_c, slider_c]))
-    mech.joint_frames = {"A": None, "B": "crank", "C": None, "P": None}
+    penalty = scene["simulation"]["integrator"] == "explicit_penalty"
+    if penalty:  # explicit solvers take no joint constraints (validate: rigid coupler only)
+        joint_a, joint_b, joint_c, joint_p = _add_penalty_joints(
+            mbs, scene["simulation"]["penalty_stiffness_N_per_m"],
+            min(crank["mass_kg"], slider["mass_kg"], plate_mass_properties(scene)[0]),
+            [(ground_a, crank_a), (crank_b, coupler_b), (slider_c, coupler_c),
+             (ground_c, slider_c)],
+            [crank_body["nodeNumber"], mech.coupler["node"], slider_body["nodeNumber"]])
+        mech.joint_frames = {"A": None, "B": None, "C": None, "P": None}
+    else:
+        # joint frames coincide with the global axes at t = 0; force outputs are in the frame
+        # of marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where
+        # it can
+        joint_a = mbs.AddObject(eii.ObjectJointRevoluteZ(markerNumbers=[ground_a, crank_a],
+                                                         rotationMarker1=crank_ref.T))
+        joint_b = mbs.AddObject(eii.ObjectJointRevoluteZ(markerNumbers=[crank_b, coupler_b],
+                                                         rotationMarker0=crank_ref.T,
+                                                         rotationMarker1=coupler_ref.T))
+        joint_c = mbs.AddObject(eii.ObjectJointSpherical(markerNumbers=[slider_c, coupler_c],
+                                                         constrainedAxes=[1, 1, 0]))
+        joint_p = mbs.AddObject(eii.ObjectJointPrismaticX(markerNumbers=[ground_c, slider_c]))
+        mech.joint_frames = {"A": None, "B": "crank", "C": None, "P": None}
 
     drive = scene["drive"]
     ground_node = mbs.AddNode(eii.NodePointGround())
@@ -216,7 +272,7 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
     for name, joint in (("A", joint_a), ("B", joint_b), ("C", joint_c), ("P", joint_p)):
         # the spherical joint reports its force in global axes ("Force"), the others in
         # the frame of marker 0 ("ForceLocal")
-        output = out.Force if name == "C" else out.ForceLocal
+        output = out.Force if name == "C" or penalty else out.ForceLocal
         add(f"joint_{name}.Force",
             eii.SensorObject(objectNumber=joint, storeInternal=True, outputVariableType=output))
     for name, marker in (("ground_A", ground_a), ("crank_A", crank_a), ("crank_B", crank_b),

@@ -97,11 +97,28 @@ SCHEMA: dict[str, dict[str, Field]] = {
     },
     "simulation": {
         "end_time_s": Field(doc="simulated time span", **_POS),
-        "step_s": Field(doc="time step of the generalized-alpha integrator", **_POS),
+        "step_s": Field(doc="fixed time step of the integrator", **_POS),
         "output_step_s": Field(float, "interval of the stored samples (>= step_s; 0: every "
                                "step)", minimum=0.0),
         "spectral_radius": Field(float, "generalized-alpha spectral radius at infinity",
                                  minimum=0.0, maximum=1.0),
+        "integrator": Field(("generalized_alpha", "explicit_penalty"),
+                            "implicit generalized-alpha with exact joints, or an explicit "
+                            "Runge-Kutta method with penalty joints (rigid coupler, spring drive)"),
+        "formulation": Field(("index3", "index2"),
+                             "generalized_alpha: position-level constraints (index 3), or "
+                             "velocity-level constraints (index 2, Newmark with the same "
+                             "spectral_radius)"),
+        "newton": Field(("full", "modified"),
+                        "Newton iteration: Jacobian every iteration, or reused while it converges"),
+        "newton_relative_tolerance": Field(float, "Newton residual reduction per step "
+                                           "(absolute tolerance: 1e-2 of it)", positive=True,
+                                           maximum=1e-3),
+        "explicit_method": Field(("RK44", "RK67", "ExplicitMidpoint"),
+                                 "explicit_penalty: fixed-step Runge-Kutta method (Exudyn's "
+                                 "DOPRI5 needs its own step control and is not offered)"),
+        "penalty_stiffness_N_per_m": Field(doc="explicit_penalty: stiffness of the joint springs "
+                                           "at A, B, C and across the slide line", **_POS),
     },
 }
 
@@ -294,6 +311,12 @@ def _check_geometry(scene: Scene) -> None:
     if coupler["geometry"] == "plate" and coupler["thickness_m"] >= coupler_m:
         raise SceneError(f"coupler.thickness_m = {coupler['thickness_m']:g} must be smaller "
                          f"than coupler.length_m = {coupler_m:g}")
+    if sim["integrator"] == "explicit_penalty" and (coupler["model"] != "rigid"
+                                                    or scene["drive"]["kind"] != "spring"):
+        raise SceneError('simulation.integrator = "explicit_penalty" needs coupler.model = '
+                         '"rigid" and drive.kind = "spring" (Exudyn\'s explicit solvers take no '
+                         "algebraic constraints: the flexible bodies' Euler-parameter frames and "
+                         'the crank-speed constraint have them); accepted: "generalized_alpha"')
 
 
 def to_toml(scene: Scene) -> str:

@@ -37,17 +37,43 @@ CONSTRAINT_NORM_LIMIT_M = 1e-4
 def solver_settings(scene: Scene) -> dict[str, Any]:
     """The integrator settings used for ``scene`` (stored in every result file)."""
     sim = scene["simulation"]
-    return {
+    settings = {
         "integrator": "generalized-alpha (Exudyn, index 3)",
         "step_s": sim["step_s"],
         "end_time_s": sim["end_time_s"],
         "steps": int(round(sim["end_time_s"] / sim["step_s"])),
         "output_step_s": sim["output_step_s"] or sim["step_s"],
         "spectral_radius": sim["spectral_radius"],
-        "newton_relative_tolerance": 1e-10,
-        "newton_absolute_tolerance": 1e-12,
-        "modified_newton": False,
+        "newton_relative_tolerance": sim["newton_relative_tolerance"],
+        "newton_absolute_tolerance": 1e-2 * sim["newton_relative_tolerance"],
+        "modified_newton": sim["newton"] == "modified",
+        "adaptive_step": False,  # fixed step: a Newton failure is a divergence, not a retry
     }
+    settings.update(_integrator_settings(sim))
+    return settings
+
+
+def _integrator_settings(sim: dict[str, Any]) -> dict[str, Any]:
+    """Settings of the ``[simulation]`` integrator knobs (``integrator``, ``formulation``).
+
+    ``index2`` is Exudyn's Newmark integrator with velocity-level constraints (Exudyn allows
+    index 2 only with Newmark); its numerical damping follows ``spectral_radius`` rho:
+    gamma = 1/2 + a, beta = (1 + a)^2 / 4 with a = (1 - rho) / (1 + rho), which has the same
+    spectral radius at infinity (rho = 1: trapezoidal rule; rho < 1 is first-order accurate).
+    """
+    if sim["integrator"] == "explicit_penalty":
+        return {"integrator": f"explicit {sim['explicit_method']} (Exudyn), penalty joints",
+                "explicit_method": sim["explicit_method"],
+                "penalty_stiffness_N_per_m": sim["penalty_stiffness_N_per_m"]}
+    if sim["formulation"] == "index2":
+        damping = (1 - sim["spectral_radius"]) / (1 + sim["spectral_radius"])
+        return {"integrator": "Newmark (Exudyn, index 2)", "newmark_gamma": 0.5 + damping,
+                "newmark_beta": (1 + damping) ** 2 / 4}
+    return {}
+
+
+def _is_explicit(settings: dict[str, Any]) -> bool:
+    return "explicit_method" in settings
 
 
 def _exudyn_settings(settings: dict[str, Any]):
@@ -57,7 +83,17 @@ def _exudyn_settings(settings: dict[str, Any]):
     ti = s.timeIntegration
     ti.numberOfSteps = settings["steps"]
     ti.endTime = settings["steps"] * settings["step_s"]
+    ti.adaptiveStep = settings["adaptive_step"]
+    ti.automaticStepSize = False
     ti.generalizedAlpha.spectralRadius = settings["spectral_radius"]
+    if "newmark_beta" in settings:
+        ti.generalizedAlpha.useNewmark = True
+        ti.generalizedAlpha.useIndex2Constraints = True
+        ti.generalizedAlpha.newmarkBeta = settings["newmark_beta"]
+        ti.generalizedAlpha.newmarkGamma = settings["newmark_gamma"]
+    if _is_explicit(settings):
+        ti.solverType = getattr(exu.DynamicSolverType, settings["explicit_method"])
+        ti.explicit.eliminateConstraints = True  # the planar-motion coordinate constraints
     ti.newton.relativeTolerance = settings["newton_relative_tolerance"]
     ti.newton.absoluteTolerance = settings["newton_absolute_tolerance"]
     ti.newton.useModifiedNewton = settings["modified_newton"]
@@ -75,7 +111,8 @@ def run(mech: Mechanism) -> dict[str, Any]:
     import exudyn as exu
 
     settings = solver_settings(mech.scene)
-    solver = exu.MainSolverImplicitSecondOrder()
+    solver = (exu.MainSolverExplicit() if _is_explicit(settings)
+              else exu.MainSolverImplicitSecondOrder())
     captured = io.StringIO()
     start = time.perf_counter()
     try:
@@ -87,9 +124,10 @@ def run(mech: Mechanism) -> dict[str, Any]:
     wall = time.perf_counter() - start
     if not ok:
         step, now = solver.it.currentStepIndex, solver.it.currentTime
+        failure = "explicit solver failed" if _is_explicit(settings) else "Newton failed"
         detail = " ".join(captured.getvalue().split())[-300:]
         raise SimulationError(f"solver diverged at step {step} (t = {now:.6g} s, step "
-                              f"{settings['step_s']:g} s): {detail or 'Newton failed'}; try a "
+                              f"{settings['step_s']:g} s): {detail or failure}; try a "
                               f"smaller simulation.step_s")
     return {"steps": int(solver.it.currentStepIndex), "newton_iterations":
             int(solver.it.newtonStepsCount), "jacobian_updates": int(solver.it.newtonJacobiCount),
@@ -106,6 +144,10 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
     rotation = _sensor(mech, "crank.Rotation")
     time_s = rotation[:, 0]
     crank_angle = rotation[:, 3]
+    # the node's angle starts in (-pi, pi] (it comes from a rotation matrix): put the series on
+    # the branch of the scene's initial angle (181 deg stays 181 deg, not -179 deg)
+    crank_angle = crank_angle + 2 * np.pi * np.round((init.crank_angle_rad - crank_angle[0])
+                                                     / (2 * np.pi))
     out: dict[str, Dataset] = {"time": Dataset(time_s, "s", "simulation time")}
     out["crank/angle"] = Dataset(crank_angle, "rad", "crank angle from the slide line (+x)")
     out["crank/angular_velocity"] = Dataset(_sensor(mech, "crank.AngularVelocity")[:, 3],
@@ -134,7 +176,8 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
                                 s * local[:, 0] + c * local[:, 1]])
 
     on_crank_a = force("A", None)
-    on_coupler_b = force("B", crank_angle - init.crank_angle_rad)
+    on_coupler_b = force("B", crank_angle - init.crank_angle_rad
+                         if mech.joint_frames.get("B") == "crank" else None)
     on_coupler_c = force("C", None)
     on_slider_p = force("P", None)
     out["joints/A/force_on_crank"] = Dataset(on_crank_a, "N", "frame on crank at A, x y")
@@ -242,20 +285,50 @@ def _coupler_datasets(mech: Mechanism, time_s: np.ndarray) -> dict[str, Dataset]
 
 
 def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any]) -> None:
-    time_s = datasets["time"].data
+    """Raise :class:`SimulationError` at the earliest sample where the solution diverged.
+
+    Diverged: any dataset not finite (NaN, inf), or the constraint norm above
+    :data:`CONSTRAINT_NORM_LIMIT_M` (an exploding or torn-apart assembly). The message names
+    the integration step (time / step_s), the time [s] and what went wrong.
+    """
+    time_s = np.asarray(datasets["time"].data, dtype=float)
+    problems: list[tuple[int, str]] = []
     for name, dataset in datasets.items():
         data = np.asarray(dataset.data, dtype=float)
         bad = ~np.isfinite(data.reshape(len(time_s), -1)).all(axis=1)
         if bad.any():
-            index = int(np.argmax(bad))
-            raise SimulationError(f"solution diverged: {name} is not finite at t = "
-                                  f"{time_s[index]:.6g} s (sample {index}, step "
-                                  f"{settings['step_s']:g} s)")
-    norm = datasets["constraint_norm"].data
-    if np.max(norm) > CONSTRAINT_NORM_LIMIT_M:
-        index = int(np.argmax(norm > CONSTRAINT_NORM_LIMIT_M))
-        raise SimulationError(f"solution diverged: constraint norm {norm[index]:.3g} m exceeds "
-                              f"{CONSTRAINT_NORM_LIMIT_M:g} m at t = {time_s[index]:.6g} s")
+            problems.append((int(np.argmax(bad)), f"{name} is not finite"))
+    norm = np.asarray(datasets["constraint_norm"].data, dtype=float)
+    above = norm > CONSTRAINT_NORM_LIMIT_M
+    if above.any():
+        index = int(np.argmax(above))
+        problems.append((index, f"constraint norm {norm[index]:.3g} m exceeds "
+                                f"{CONSTRAINT_NORM_LIMIT_M:g} m"))
+    if not problems:
+        return
+    index, what = min(problems, key=lambda problem: problem[0])
+    now = time_s[index] if np.isfinite(time_s[index]) else float("nan")
+    step = int(round(now / settings["step_s"])) if np.isfinite(now) else index
+    raise SimulationError(f"solution diverged at step {step} (t = {now:.6g} s, step "
+                          f"{settings['step_s']:g} s): {what}; try a smaller "
+                          f"simulation.step_s")
+
+
+def _resolve_auto(scene: Scene) -> tuple[Scene, list[Any]]:
+    """Resolve ``model = "auto"`` links (:func:`flex.criteria.resolve_fidelity`); print the
+    choice and its reason to stderr. Scenes without ``auto`` are returned as they are."""
+    if scene["coupler"]["model"] != "auto" and scene["crank"].get("model") != "auto":
+        return scene, []
+    import sys
+
+    from .criteria import resolve_fidelity
+
+    resolved, decisions = resolve_fidelity(scene)
+    for decision in decisions:
+        modes = f" ({decision.modes} modes)" if decision.modes else ""
+        print(f"flex: fidelity: {decision.link}.model = auto -> {decision.model}{modes}: "
+              f"{decision.reason}", file=sys.stderr)
+    return resolved, decisions
 
 
 def simulate(scene: Scene, name: str = "case", reduction: Any = None) -> CaseResult:
@@ -264,7 +337,8 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None) -> CaseRes
         reduction = reduction_for_scene(scene)
     mech = build_mechanism(scene, reduction)
     counters = run(mech)
-    datasets = collect(mech)
+    with np.errstate(all="ignore"):  # a diverged run overflows; _check_finite reports it
+        datasets = collect(mech)
     settings = solver_settings(scene)
     _check_finite(datasets, settings)
     import tomli_w

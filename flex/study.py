@@ -30,7 +30,8 @@ from .results import CaseResult, Dataset, write_results
 from .scene import Scene, load_scene, to_toml
 from .solver import simulate_case
 
-STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring")
+STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring",
+           "tradeoff", "stability", "bench")
 RESULTS_DIR = Path("results")
 
 

@@ -1,0 +1,476 @@
+"""Study ``stability``: numerical stability at the extremes, each against a converged reference.
+
+Every run is checked against a reference of the same physics and stored with its verdict
+(``within_tolerance``: largest relative error <= :data:`TOLERANCE`); a run that diverges
+(Newton failure, NaN, exploding constraint norm) is a ``failed`` case whose message names
+the step and the time, with no data. Groups:
+
+- ``thickness``: FFRF plate couplers 0.3 ... 20 mm over ~one period of their first bending
+  mode, against the same discretization at a 4x smaller step; ``nonlinear``: the same FFRF
+  runs against the fully nonlinear FE coupler on the same mesh and step (a model
+  comparison: where the linear FFRF body stops being trustworthy); ``stiff_plate``: the
+  20 mm plate over a range of steps (step-size limits);
+- ``step``: time steps 1e-3 ... 1e-7 s (rigid) and 1e-3 ... 1e-6 s (FFRF 1 mm);
+- ``spectral_radius``: 0, 0.5, 0.9, 1 (rigid and FFRF 1 mm, h = 1e-4 s);
+- ``long_horizon``: 1 s of free motion (rigid: energy drift; FFRF 1 mm: boundedness);
+- ``dead_centre``: initial crank angles at and near 0 and 180 deg with the spring drive;
+- ``stiff_drive``: spring 10x and 100x stiffer, crank speed 10x and 100x (one turn);
+- ``divergence``: settings that must diverge, to show they are caught and reported.
+
+References: rigid -- the scipy DAE (rtol 1e-12, shown converged by rtol 1e-11); FFRF --
+flex's model at a finer step (shown converged by twice that step); constant crank speed --
+the closed-form slider-crank (exact).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.errors import FlexError
+from flex.kinematics import slider_crank
+from flex.plotting import figure
+from flex.results import CaseResult, Dataset
+from flex.scene import Scene, apply_overrides, to_toml, validate
+from flex.solver import simulate_case
+from flex.study import Summary
+from flex.tradeoff import (
+    Observables,
+    ReductionPool,
+    Reference,
+    Setting,
+    converged_reference,
+)
+
+NAME = "stability"
+DESCRIPTION = "extremes: thickness, step, spectral radius, 1 s horizon, dead centres, stiff drives"
+OVERRIDES: list[str] = []
+#: verdict threshold: largest relative error (angle / swing, slider / travel, peak / peak)
+TOLERANCE = 1e-3
+PLATE = ('coupler.geometry="plate"', 'coupler.model="ffrf"')
+#: plate thickness [mm] -> mesh size [mm] (about 2 t, at least 2 mm, at most 5 mm)
+THICKNESS_MESH_MM = {0.3: 2.0, 0.5: 2.0, 1.0: 2.0, 3.0: 3.0, 10.0: 5.0, 20.0: 5.0}
+NONLINEAR_THICKNESS_MM = (0.3, 0.5, 1.0)
+NONLINEAR_STEP_S = 1e-4  # the nonlinear FE coupler costs ~1 s per step
+#: numerical settings of the fine FFRF references (modified Newton converged to 1e-10)
+FINE = ('simulation.newton="modified"', "simulation.newton_relative_tolerance=1e-10")
+
+
+@dataclass(frozen=True)
+class Extreme:
+    """One run at an extreme: scene overrides, its group, the reference it is checked
+    against (``scipy``, ``fine:<step>`` = flex at that step, ``closed_form``,
+    ``nonlinear_fe``), and ``expect = "diverges"`` for the forced divergences."""
+
+    name: str
+    group: str
+    overrides: tuple[str, ...]
+    reference: str
+    parameter: float = math.nan  # the varied value (thickness, step, rho, angle, factor)
+    expect: str = "within"
+
+
+def _plate(thickness_mm: float) -> tuple[str, ...]:
+    mesh = THICKNESS_MESH_MM[thickness_mm] * 1e-3
+    return PLATE + (f"coupler.thickness_m={thickness_mm * 1e-3!r}",
+                    f"coupler.mesh_size_m={mesh!r}")
+
+
+def _period_s(thickness_mm: float) -> float:
+    """Euler-Bernoulli pinned-pinned first bending period of the thesis plate [s]."""
+    t = thickness_mm * 1e-3
+    omega = (math.pi / 0.08) ** 2 * math.sqrt(200e9 * t**2 / 12 / 7850)
+    return 2 * math.pi / omega
+
+
+def extremes() -> list[Extreme]:
+    """Every run of the study (see the module doc)."""
+    out: list[Extreme] = []
+    for t in THICKNESS_MESH_MM:
+        horizon = max(round(1.1 * _period_s(t), 4), 0.005)
+        step = 1e-5
+        common = _plate(t) + (f"simulation.end_time_s={horizon!r}", f"simulation.step_s={step}")
+        out.append(Extreme(f"thickness_{t:g}mm", "thickness", common, f"fine:{step / 4!r}", t))
+        if t in NONLINEAR_THICKNESS_MM:
+            out.append(Extreme(f"nonlinear_{t:g}mm", "nonlinear", common, "nonlinear_fe", t))
+    for step in (1e-4, 3e-5, 1e-5, 3e-6):
+        out.append(Extreme(f"stiff_plate_20mm_h{step:g}", "stiff_plate",
+                           _plate(20.0) + ("simulation.end_time_s=0.01",
+                                           f"simulation.step_s={step!r}"), "fine:1e-06", step))
+    for step in (1e-3, 1e-4, 1e-5, 1e-6, 1e-7):
+        output = f"simulation.output_step_s={max(step, 1e-5)!r}"
+        out.append(Extreme(f"step_rigid_h{step:g}", "step",
+                           (f"simulation.step_s={step!r}", output), "scipy", step))
+    for step in (1e-3, 1e-4, 1e-5, 1e-6):
+        output = f"simulation.output_step_s={max(step, 1e-5)!r}"
+        out.append(Extreme(f"step_ffrf1mm_h{step:g}", "step",
+                           _plate(1.0) + (f"simulation.step_s={step!r}", output), "fine:2e-06",
+                           step))
+    for rho in (0.0, 0.5, 0.9, 1.0):
+        out.append(Extreme(f"rho_rigid_{rho:g}", "spectral_radius",
+                           ("simulation.step_s=1e-4", f"simulation.spectral_radius={rho!r}"),
+                           "scipy", rho))
+        out.append(Extreme(f"rho_ffrf1mm_{rho:g}", "spectral_radius",
+                           _plate(1.0) + ("simulation.step_s=1e-4",
+                                          f"simulation.spectral_radius={rho!r}"), "fine:2e-06",
+                           rho))
+    long = ("simulation.end_time_s=1.0", "simulation.output_step_s=1e-4")
+    for label, knobs in (("rho0.9", ()), ("rho1", ("simulation.spectral_radius=1.0",)),
+                         ("index2_rho1", ('simulation.formulation="index2"',
+                                          "simulation.spectral_radius=1.0")),
+                         ("explicit_k1e8", ('simulation.integrator="explicit_penalty"',))):
+        out.append(Extreme(f"long_rigid_{label}", "long_horizon",
+                           long + ("simulation.step_s=1e-5",) + knobs, "scipy", 1.0))
+    out.append(Extreme("long_ffrf1mm", "long_horizon",
+                       _plate(1.0) + long + ("simulation.step_s=1e-4",
+                                             'simulation.newton="modified"',
+                                             "simulation.newton_relative_tolerance=1e-8"),
+                       "none", 1.0))
+    for angle in (0.0, 1e-3, 0.1, 1.0, 179.0, 180.0, 181.0):
+        out.append(Extreme(f"dead_centre_{angle:g}deg", "dead_centre",
+                           (f"crank.initial_angle_deg={angle!r}",), "scipy", angle))
+    for factor in (1, 10, 100):
+        out.append(Extreme(f"spring_x{factor}", "stiff_drive",
+                           (f"drive.spring_stiffness_N_per_m={1500.0 * factor!r}",), "scipy",
+                           factor))
+        speed = 2 * math.pi * factor
+        out.append(Extreme(f"crank_speed_x{factor}", "stiff_drive",
+                           ('drive.kind="constant_speed"',
+                            f"drive.crank_speed_rad_per_s={speed!r}",
+                            f"simulation.end_time_s={1.0 / factor!r}",
+                            f"simulation.output_step_s={1e-3 / factor!r}"),
+                           "closed_form", factor))
+    out.append(Extreme("diverge_explicit_above_limit", "divergence",
+                       ('simulation.integrator="explicit_penalty"', "simulation.step_s=3e-5"),
+                       "scipy", 3e-5, expect="diverges"))
+    out.append(Extreme("diverge_thin_plate_h1e-4", "divergence",
+                       _plate(0.3) + ("simulation.end_time_s=0.01", "simulation.step_s=1e-4"),
+                       "none", 1e-4, expect="diverges"))
+    return out
+
+
+def cases(scene: Scene) -> dict[str, Scene]:
+    out = {}
+    for extreme in extremes():
+        case = apply_overrides(scene, list(extreme.overrides))
+        validate(case)
+        out[extreme.name] = case
+    return out
+
+
+# ------------------------------------------------------------------------------------------
+# references
+# ------------------------------------------------------------------------------------------
+def _scene_without(scene: Scene, keys: tuple[str, ...]) -> str:
+    """TOML of ``scene`` with the numerical knobs ``keys`` of [simulation] dropped (a cache
+    key for references of the same physics)."""
+    reduced = {section: dict(table) for section, table in scene.items()}
+    for key in keys:
+        reduced["simulation"].pop(key, None)
+    return to_toml(reduced)
+
+
+_NUMERICAL = ("step_s", "spectral_radius", "integrator", "formulation", "newton",
+              "newton_relative_tolerance", "explicit_method", "penalty_stiffness_N_per_m")
+
+
+def _fine_setting(step: float) -> Setting:
+    return Setting(f"flex h={step:g}", (("simulation.step_s", step),
+                                        ("simulation.output_step_s", 0.0),
+                                        ("simulation.spectral_radius", 0.9),
+                                        ("simulation.formulation", "index3"),
+                                        ("simulation.newton", "modified"),
+                                        ("simulation.newton_relative_tolerance", 1e-10)))
+
+
+def _nonlinear_setting(step: float) -> Setting:
+    return Setting(f"nonlinear FE h={step:g}", (("simulation.step_s", step),
+                                                 ("simulation.output_step_s", 0.0)))
+
+
+def _closed_form(scene: Scene, time_s: np.ndarray) -> Reference:
+    crank, drive = scene["crank"], scene["drive"]
+    theta0 = math.radians(crank["initial_angle_deg"])
+    omega = drive["crank_speed_rad_per_s"]
+    state = slider_crank(crank["length_m"], scene["coupler"]["length_m"],
+                         theta0 + omega * time_s, omega, 0.0, scene["slider"]["offset_m"])
+    observables = Observables(time_s, theta0 + omega * time_s,
+                              np.asarray(state.slider_position_m, dtype=float))
+    exact = {"crank_angle_rad": 0.0, "slider_position_m": 0.0, "error": 0.0}
+    return Reference("closed form", observables, Setting("closed-form slider-crank"),
+                     {"closed form (exact)": exact}, TOLERANCE, 0.0,
+                     "closed-form in-line slider-crank at constant crank speed (exact)")
+
+
+class References:
+    """References built once per physics and shared by the runs that need them."""
+
+    def __init__(self, pool: ReductionPool) -> None:
+        self.pool = pool
+        self._cache: dict[tuple[str, str], Reference] = {}
+
+    def get(self, kind: str, scene: Scene, run_time_s: np.ndarray | None = None
+            ) -> Reference | None:
+        """The reference of ``kind`` for ``scene`` (None for ``none``)."""
+        if kind == "none":
+            return None
+        if kind == "closed_form":
+            if run_time_s is None:
+                raise FlexError("the closed-form reference needs the run's sample times")
+            return _closed_form(scene, run_time_s)
+        key = (kind, _scene_without(scene, _NUMERICAL + ("output_step_s",)))
+        if key in self._cache:
+            return self._cache[key]
+        if kind == "scipy":  # sampled every 1e-5 s (1e-4 s beyond 0.1 s), cubic in between
+            interval = 1e-5 if scene["simulation"]["end_time_s"] <= 0.1 else 1e-4
+            base = apply_overrides(scene, [f"simulation.output_step_s={interval!r}",
+                                           f"simulation.step_s={interval!r}"])
+            reference = converged_reference(
+                base, "scipy", Setting("scipy DOP853 rtol=1e-12", engine="scipy", rtol=1e-12,
+                                       atol=1e-14),
+                {"rtol 1e-12 -> 1e-11": Setting("scipy rtol=1e-11", engine="scipy",
+                                                rtol=1e-11, atol=1e-13)},
+                TOLERANCE / 10, self.pool,
+                "scipy DOP853 on the 9-coordinate DAE, rtol 1e-12 (evidence: rtol 1e-11)")
+        elif kind.startswith("fine:"):
+            step = float(kind.split(":", 1)[1])
+            reference = converged_reference(
+                scene, f"flex h={step:g}", _fine_setting(step),
+                {f"step {step:g} -> {2 * step:g}": _fine_setting(2 * step)}, TOLERANCE / 10,
+                self.pool, f"flex, same discretization, h = {step:g} s, modified Newton 1e-10 "
+                           f"(evidence: h = {2 * step:g} s)")
+        elif kind == "nonlinear_fe":
+            nonlinear = apply_overrides(scene, ['coupler.model="nonlinear_fe"',
+                                                "simulation.newton_relative_tolerance=1e-8"])
+            step = NONLINEAR_STEP_S
+            reference = converged_reference(
+                nonlinear, "nonlinear FE", _nonlinear_setting(step),
+                {f"step {step:g} -> {2 * step:g}": _nonlinear_setting(2 * step)}, TOLERANCE,
+                self.pool, f"fully nonlinear FE coupler, same mesh, h = {step:g} s (evidence: "
+                           f"h = {2 * step:g} s; each step costs ~1 s)")
+        else:
+            raise FlexError(f"unknown reference kind {kind!r}")
+        self._cache[key] = reference
+        return reference
+
+
+# ------------------------------------------------------------------------------------------
+# running
+# ------------------------------------------------------------------------------------------
+KEEP = ("time", "crank/angle", "crank/angular_velocity", "slider/position", "constraint_norm",
+        "energy/total", "coupler/midpoint_deflection")
+_VERDICTS: dict[str, dict[str, Any]] = {}
+
+
+def _nonlinear_available() -> bool:
+    try:
+        from flex.nonlinear import add_nonlinear_fe_coupler  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _judge(extreme: Extreme, scene: Scene, case: CaseResult, references: References,
+           ) -> dict[str, Any]:
+    """Verdict of one run: errors against its reference, energy drift, boundedness."""
+    verdict: dict[str, Any] = {"group": extreme.group, "parameter": extreme.parameter,
+                               "expect": extreme.expect, "status": case.status,
+                               "message": case.message}
+    if case.status != "ok":
+        verdict["verdict"] = ("diverged as expected, detected" if extreme.expect == "diverges"
+                              else "diverged (detected and stored as failed)")
+        verdict["within_tolerance"] = False
+        return verdict
+    data = {key: value.data for key, value in case.datasets.items()}
+    flexible = scene["coupler"]["model"] != "rigid"
+    if "energy/total" in data:
+        energy = data["energy/total"]
+        verdict["energy_drift"] = float((energy[-1] - energy[0]) / energy[0])
+        verdict["energy_range"] = float(np.ptp(energy) / energy[0])
+    if flexible:
+        deflection = np.abs(data["coupler/midpoint_deflection"])
+        tenth = max(1, len(deflection) // 10)
+        verdict["peak_deflection_first_tenth"] = float(deflection[:tenth].max())
+        verdict["peak_deflection_last_tenth"] = float(deflection[-tenth:].max())
+    try:
+        reference = references.get(extreme.reference, scene, data["time"])
+    except FlexError as exc:
+        verdict.update(verdict=f"reference failed: {exc}", within_tolerance=False)
+        return verdict
+    if reference is None:
+        bounded = data["constraint_norm"].max() < 1e-6
+        verdict.update(verdict="ran, bounded" if bounded else "ran, constraint drift",
+                       within_tolerance=bool(bounded), reference="none")
+        if extreme.expect == "diverges":
+            verdict["verdict"] = "expected to diverge but did not"
+        return verdict
+    errors = reference.errors(Observables.of_datasets(case.datasets, reference.flexible))
+    verdict.update({f"error_{key}": value for key, value in errors.items() if key != "error"})
+    verdict["reference"] = reference.description
+    verdict["reference_accuracy"] = reference.accuracy
+    verdict["error"] = errors["error"]
+    verdict["within_tolerance"] = bool(errors["error"] <= TOLERANCE)
+    if extreme.expect == "diverges":
+        verdict["verdict"] = "expected to diverge but did not"
+    else:
+        verdict["verdict"] = ("within tolerance" if verdict["within_tolerance"]
+                              else f"outside tolerance ({errors['error']:.1e} > {TOLERANCE:g})")
+    return verdict
+
+
+def simulate_cases(scenes: dict[str, Scene],
+                   progress: Callable[[str, int, int], None] | None) -> dict[str, CaseResult]:
+    """Run every extreme, judge it against its reference; keep the main curves only."""
+    pool = ReductionPool()
+    references = References(pool)
+    by_name = {extreme.name: extreme for extreme in extremes()}
+    nonlinear = _nonlinear_available()
+    results: dict[str, CaseResult] = {}
+    _VERDICTS.clear()
+    for index, (name, scene) in enumerate(scenes.items()):
+        if progress:
+            progress(name, index, len(scenes))
+        extreme = by_name[name]
+        if extreme.reference == "nonlinear_fe" and not nonlinear:
+            results[name] = CaseResult(name, to_toml(scene), status="failed",
+                                       message="nonlinear FE coupler not available")
+            _VERDICTS[name] = {"group": extreme.group, "parameter": extreme.parameter,
+                               "status": "failed", "verdict": "pending: no nonlinear FE",
+                               "within_tolerance": False, "expect": extreme.expect}
+            continue
+        try:
+            reduction = pool.for_scene(scene)
+        except FlexError as exc:
+            reduction, failure = None, str(exc)
+        else:
+            failure = ""
+        case = (CaseResult(name, to_toml(scene), status="failed", message=failure) if failure
+                else simulate_case(scene, name, reduction))
+        verdict = _judge(extreme, scene, case, references)
+        _VERDICTS[name] = verdict
+        if case.status == "ok":
+            case.datasets = {k: v for k, v in case.datasets.items() if k in KEEP}
+        case.attrs.update({key: value for key, value in verdict.items()
+                           if isinstance(value, str | float | int | bool)
+                           and key not in ("status", "message")})
+        results[name] = case
+    if progress:
+        progress("done", len(scenes), len(scenes))
+    return results
+
+
+def _trust_boundary(verdicts: dict[str, dict[str, Any]]) -> tuple[float, str]:
+    """Thinnest plate [mm] from which linear FFRF agrees with the nonlinear FE coupler within
+    1 % in peak deflection, by log-interpolation between the measured thicknesses."""
+    rows = sorted((v["parameter"], v["error_peak_deflection_relative"])
+                  for v in verdicts.values()
+                  if v["group"] == "nonlinear" and "error_peak_deflection_relative" in v)
+    if not rows:
+        return math.nan, "no nonlinear FE comparison ran"
+    for (t0, e0), (t1, e1) in zip(rows, rows[1:], strict=False):
+        if e0 > 1e-2 >= e1:
+            fraction = math.log(e0 / 1e-2) / math.log(e0 / e1)
+            boundary = math.exp(math.log(t0) + fraction * math.log(t1 / t0))
+            return boundary, (f"linear FFRF is within 1 % of the nonlinear FE coupler from "
+                              f"t ~ {boundary:.2g} mm (measured: " + ", ".join(
+                                  f"{t:g} mm {e * 100:.2g} %" for t, e in rows) + ")")
+    if rows[0][1] <= 1e-2:
+        return rows[0][0], (f"linear FFRF within 1 % down to the thinnest plate run "
+                            f"({rows[0][0]:g} mm, {rows[0][1] * 100:.2g} %)")
+    return math.inf, ("linear FFRF differs by more than 1 % at every thickness run: "
+                      + ", ".join(f"{t:g} mm {e * 100:.2g} %" for t, e in rows))
+
+
+def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+    datasets: dict[str, Dataset] = {}
+    lines = [f"stability: every extreme against its converged reference (tolerance "
+             f"{TOLERANCE:g}, largest relative error)"]
+    names = [name for name in results if name in _VERDICTS]
+    verdicts = [_VERDICTS[name] for name in names]
+
+    def column(key: str, default: Any, units: str, text: str, dtype: Any = float) -> Dataset:
+        return Dataset(np.array([v.get(key, default) for v in verdicts], dtype=dtype), units,
+                       text)
+
+    datasets["runs/name"] = Dataset(np.array(names, dtype=object), "1", "case")
+    datasets["runs/group"] = column("group", "", "1", "extreme", object)
+    datasets["runs/parameter"] = column("parameter", np.nan, "see group",
+                                        "varied value: thickness [mm], step [s], rho, angle "
+                                        "[deg], factor, horizon [s]")
+    datasets["runs/status"] = column("status", "", "1", "ok | failed", object)
+    datasets["runs/verdict"] = column("verdict", "", "1", "what happened", object)
+    datasets["runs/within_tolerance"] = column("within_tolerance", False, "1",
+                                               f"largest relative error <= {TOLERANCE:g}", bool)
+    datasets["runs/error"] = column("error", np.nan, "1", "largest relative error")
+    datasets["runs/crank_angle_error"] = column("error_crank_angle_rad", np.nan, "rad",
+                                                "max |crank angle - reference|")
+    datasets["runs/slider_position_error"] = column("error_slider_position_m", np.nan, "m",
+                                                    "max |slider x - reference|")
+    datasets["runs/peak_deflection_error"] = column("error_peak_deflection_relative", np.nan,
+                                                    "1", "|peak - reference peak| / reference")
+    datasets["runs/energy_drift"] = column("energy_drift", np.nan, "1",
+                                           "(E_end - E_0) / E_0 (rigid, spring drive)")
+    datasets["runs/energy_range"] = column("energy_range", np.nan, "1",
+                                           "(max E - min E) / E_0 (rigid, spring drive)")
+    datasets["runs/message"] = column("message", "", "1", "failure message (step, time)",
+                                      object)
+    boundary, text = _trust_boundary(_VERDICTS)
+    datasets["nonlinear/trust_thickness"] = Dataset(boundary, "mm", text)
+    groups: dict[str, list[str]] = {}
+    for name, verdict in zip(names, verdicts, strict=True):
+        groups.setdefault(verdict["group"], []).append(name)
+    for group, members in groups.items():
+        lines.append(f"  {group}:")
+        for name in members:
+            v = _VERDICTS[name]
+            extra = ""
+            if "energy_drift" in v:
+                extra += (f", energy drift {v['energy_drift']:+.1e} "
+                          f"(range {v['energy_range']:.1e})")
+            if "peak_deflection_last_tenth" in v and v["group"] == "long_horizon":
+                first = v["peak_deflection_first_tenth"] * 1e6
+                last = v["peak_deflection_last_tenth"] * 1e6
+                extra += f", |w| peak first/last tenth {first:.1f}/{last:.1f} um"
+            error = f"error {v['error']:.1e}, " if "error" in v else ""
+            message = f": {v['message'][:150]}" if v.get("message") else ""
+            lines.append(f"    {name}: {error}{v['verdict']}{extra}{message}")
+    lines.append(f"  nonlinear: {text}")
+    return Summary(datasets, "\n".join(lines))
+
+
+def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
+    table = {key[len("runs/"):]: value.data for key, value in summary.datasets.items()
+             if key.startswith("runs/")}
+    paths = []
+    path = folder / "stability-step.png"
+    with figure(path, "Error against time step (0.03 s deployment)", "time step [s]",
+                "largest relative error [-]") as ax:
+        for prefix, label in (("step_rigid", "rigid"), ("step_ffrf1mm", "FFRF 1 mm")):
+            mask = np.array([str(n).startswith(prefix) for n in table["name"]])
+            mask &= table["status"] == "ok"
+            order = np.argsort(table["parameter"][mask])
+            ax.loglog(table["parameter"][mask][order], table["error"][mask][order], "o-",
+                      label=label)
+        ax.axhline(TOLERANCE, color="grey", ls=":", label="tolerance")
+    paths.append(path)
+    path = folder / "stability-energy.png"
+    with figure(path, "Energy over 1 s of free motion (rigid)", "time [s]",
+                "(E - E0) / E0 [-]") as ax:
+        for name, case in results.items():
+            if name.startswith("long_rigid") and case.status == "ok":
+                energy = case.datasets["energy/total"].data
+                ax.plot(case.datasets["time"].data, (energy - energy[0]) / energy[0],
+                        label=name, lw=0.8)
+    paths.append(path)
+    return paths
+
+
+if __name__ == "__main__":
+    from flex.cli import main
+
+    raise SystemExit(main(["run", NAME]))

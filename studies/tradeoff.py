@@ -1,0 +1,432 @@
+"""Study ``tradeoff``: work-precision of every knob, for the rigid and the FFRF coupler.
+
+Three scenes of the thesis deployment (22 mm preload, 0.03 s): the rigid Table 1 model
+(``rigid``) and a steel-plate FFRF coupler 1 mm and 10 mm thick (``ffrf_1mm``,
+``ffrf_10mm``). For each, a converged reference is run and shown converged (one-knob
+coarsenings of it, :func:`flex.tradeoff.converged_reference`), then the knobs are varied
+one at a time around a base setting and in combination: time step, generalized-alpha
+spectral radius, index-3 versus index-2 (Newmark) constraints, full versus modified
+Newton and its tolerance, explicit Runge-Kutta with penalty joints (rigid), number of
+modes, mesh size and element order, the fully nonlinear FE coupler instead of the FFRF
+reduction (1 mm), and the independent scipy reference DAE (rigid) at several tolerances.
+
+Stored: per run a case ``<scene>__<setting>`` (attrs: knobs, status, message, counters with
+the median wall time, errors; dataset ``wall_times``: every repeat) -- a diverged run is a
+``failed`` case with the step and time in its message and no data; per scene under
+``/summary/<scene>/``: ``runs/...`` (the table, with ``on_pareto_front``), ``reference/...``
+(what it is and its convergence evidence), ``recommended/...`` (per accuracy level 1 %,
+0.1 %, 0.01 %). Figures: work-precision diagrams (error against wall time, log-log, Pareto
+front marked), one per scene.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.plotting import figure
+from flex.results import CaseResult, Dataset
+from flex.scene import Scene, apply_overrides, to_toml, validate
+from flex.study import Summary
+from flex.tradeoff import (
+    ACCURACY_LEVELS,
+    Measurement,
+    ReductionPool,
+    Reference,
+    Setting,
+    converged_reference,
+    measure,
+    measurements_table,
+    pareto_front,
+    recommend,
+    scene_for,
+)
+
+NAME = "tradeoff"
+DESCRIPTION = "work-precision: every knob against a converged reference, rigid and FFRF 1/10 mm"
+OVERRIDES: list[str] = []
+REPEATS = 3
+
+PLATE = ['coupler.geometry="plate"', 'coupler.model="ffrf"']
+SCENES: dict[str, list[str]] = {
+    "rigid": [],
+    "ffrf_1mm": PLATE + ["coupler.thickness_m=0.001", "coupler.mesh_size_m=0.002"],
+    "ffrf_10mm": PLATE + ["coupler.thickness_m=0.01", "coupler.mesh_size_m=0.005"],
+}
+#: the default scene's tolerance, as the test suite holds it to the reference DAE (crank angle
+#: 1e-6 rad, slider 1e-7 m) on the 1e-5 s output grid of the thesis table (README)
+DEFAULT_TOLERANCE = {"crank_angle_rad": 1e-6, "slider_position_m": 1e-7, "max_step_s": 1e-5}
+
+S = Setting.of
+
+
+def _scipy(rtol: float, method: str = "DOP853", group: str = "scipy reference DAE") -> Setting:
+    return Setting(f"scipy {method} rtol={rtol:g}", engine="scipy", method=method, rtol=rtol,
+                   atol=rtol * 1e-2, group=group)
+
+
+def reference_plan(scene_name: str) -> tuple[Setting, dict[str, Setting], float, str]:
+    """Finest setting, its one-knob coarsenings, claimed tolerance and a description."""
+    if scene_name == "rigid":
+        finest = _scipy(1e-13)
+        return finest, {
+            "scipy rtol 1e-13 -> 1e-12": _scipy(1e-12),
+            "independent model: Exudyn h = 1e-6 s": S("exudyn h=1e-6", step_s=1e-6,
+                                                      newton_relative_tolerance=1e-10),
+        }, 1e-8, ("scipy DOP853 on the 9-coordinate DAE, rtol 1e-13, atol 1e-15; shown "
+                  "converged by rtol 1e-12 and by flex's Exudyn model at h = 1e-6 s")
+    if scene_name == "ffrf_1mm":
+        mesh, modes, step = 0.0015, 12, 5e-6
+    else:
+        mesh, modes, step = 0.003, 12, 2.5e-6
+
+    def ref(label: str, **knobs: Any) -> Setting:
+        values = {"step_s": step, "coupler__mesh_size_m": mesh, "coupler__modes": modes,
+                  "newton": "modified", "newton_relative_tolerance": 1e-10,
+                  "spectral_radius": 0.9}
+        values.update(knobs)
+        return S(label, **values)
+
+    finest = ref(f"reference h={step:g} mesh={mesh * 1e3:g}mm modes={modes}")
+    coarsenings = {
+        f"step_s {step:g} -> {2 * step:g}": ref("coarser step", step_s=2 * step),
+        f"modes {modes} -> 8": ref("fewer modes", coupler__modes=8),
+        f"mesh_size_m {mesh:g} -> {mesh * 4 / 3:g}": ref("coarser mesh",
+                                                         coupler__mesh_size_m=mesh * 4 / 3),
+        "newton_relative_tolerance 1e-10 -> 1e-8": ref("looser Newton",
+                                                       newton_relative_tolerance=1e-8),
+    }
+    return finest, coarsenings, 1e-3, (
+        f"flex's FFRF model, generalized-alpha index 3, h = {step:g} s, mesh {mesh * 1e3:g} "
+        f"mm quadratic tetrahedra, {modes} fixed-interface modes, Newton tolerance 1e-10; "
+        f"shown converged by coarsening each knob by one level")
+
+
+def settings(scene_name: str, nonlinear_available: bool) -> list[Setting]:
+    """The knob settings measured for one scene: one knob at a time around the base, then
+    combinations."""
+    out: list[Setting] = []
+    one = "one knob: "
+    if scene_name == "rigid":
+        base = {"step_s": 1e-5}
+        for step in (3e-3, 1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6):
+            out.append(S(f"h={step:g}", one + "step", step_s=step))
+        for rho in (0.0, 0.5, 1.0):
+            out.append(S(f"h=1e-5 rho={rho:g}", one + "spectral radius", spectral_radius=rho,
+                         **base))
+        out.append(S("h=1e-5 index2", one + "index 2", formulation="index2", **base))
+        out.append(S("h=1e-5 modified", one + "Newton", newton="modified", **base))
+        for tol in (1e-8, 1e-6):
+            out.append(S(f"h=1e-5 tol={tol:g}", one + "Newton tolerance",
+                         newton_relative_tolerance=tol, **base))
+        out.append(S("h=1e-5 explicit RK44 k=1e8", one + "explicit + penalty",
+                     integrator="explicit_penalty", **base))
+        for step in (1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6):
+            for rho in (0.5, 1.0):
+                out.append(S(f"h={step:g} rho={rho:g} tol=1e-8", "combination: step x rho",
+                             step_s=step, spectral_radius=rho, newton_relative_tolerance=1e-8))
+            out.append(S(f"h={step:g} modified tol=1e-8", "combination: step x Newton",
+                         step_s=step, newton="modified", newton_relative_tolerance=1e-8))
+            out.append(S(f"h={step:g} index2 rho=1", "combination: step x index 2",
+                         step_s=step, formulation="index2", spectral_radius=1.0))
+            out.append(S(f"h={step:g} index2 rho=0.9", "combination: step x index 2",
+                         step_s=step, formulation="index2"))
+        # explicit: the step near the RK44 stability limit of each penalty stiffness
+        for stiffness, step in ((1e6, 1e-4), (1e7, 3e-5), (1e8, 1e-5), (1e9, 3e-6),
+                                (1e10, 1e-6)):
+            out.append(S(f"explicit RK44 k={stiffness:g} h={step:g}",
+                         "combination: explicit penalty", integrator="explicit_penalty",
+                         penalty_stiffness_N_per_m=stiffness, step_s=step))
+        out.append(S("explicit RK67 k=1e8 h=1e-5", "combination: explicit penalty",
+                     integrator="explicit_penalty", explicit_method="RK67", step_s=1e-5))
+        out.append(S("explicit midpoint k=1e8 h=2e-6", "combination: explicit penalty",
+                     integrator="explicit_penalty", explicit_method="ExplicitMidpoint",
+                     step_s=2e-6))
+        for rtol in (1e-4, 1e-6, 1e-8, 1e-10):
+            out.append(_scipy(rtol))
+            out.append(_scipy(rtol, "RK45"))
+        return out
+
+    thin = scene_name == "ffrf_1mm"
+    base_step = 1e-4 if thin else 1e-5
+    base_mesh = 0.002 if thin else 0.005
+    base = {"step_s": base_step}
+    for factor in (4, 2, 1, 0.5, 0.2):
+        step = base_step * factor
+        out.append(S(f"h={step:g}", one + "step", step_s=step))
+    for rho in (0.0, 0.5, 1.0):
+        out.append(S(f"h={base_step:g} rho={rho:g}", one + "spectral radius",
+                     spectral_radius=rho, **base))
+    out.append(S(f"h={base_step:g} index2", one + "index 2", formulation="index2", **base))
+    out.append(S(f"h={base_step:g} index2 rho=1", one + "index 2", formulation="index2",
+                 spectral_radius=1.0, **base))
+    out.append(S(f"h={base_step:g} modified", one + "Newton", newton="modified", **base))
+    for tol in (1e-8, 1e-6):
+        out.append(S(f"h={base_step:g} tol={tol:g}", one + "Newton tolerance",
+                     newton_relative_tolerance=tol, **base))
+    for modes in (2, 4, 12):
+        out.append(S(f"h={base_step:g} modes={modes}", one + "modes", coupler__modes=modes,
+                     **base))
+    meshes = (0.006, 0.004, 0.003) if thin else (0.01, 0.007, 0.003)
+    for mesh in meshes:
+        out.append(S(f"h={base_step:g} mesh={mesh * 1e3:g}mm", one + "mesh size",
+                     coupler__mesh_size_m=mesh, **base))
+    linear = S(f"h={base_step:g} linear tets", one + "element order", **base)
+    out.append(Setting(linear.label, linear.overrides, group=linear.group, element_order=1))
+    if thin and nonlinear_available:
+        out.append(S("nonlinear FE h=1e-4 mesh=4mm", one + "nonlinear FE coupler",
+                     coupler__model="nonlinear_fe", coupler__mesh_size_m=0.004,
+                     newton="modified", newton_relative_tolerance=1e-8, step_s=1e-4))
+    fast = {"newton": "modified", "newton_relative_tolerance": 1e-8}
+    for factor in (4, 2, 1, 0.5):
+        step = base_step * factor
+        for mesh in (base_mesh, 2 * base_mesh):
+            for modes in (2, 6):
+                out.append(S(f"h={step:g} mesh={mesh * 1e3:g}mm modes={modes} modified tol=1e-8",
+                             "combination: step x mesh x modes (modified Newton, tol 1e-8)",
+                             step_s=step, coupler__mesh_size_m=mesh, coupler__modes=modes,
+                             **fast))
+        out.append(S(f"h={step:g} full tol=1e-8", "combination: step x Newton", step_s=step,
+                     newton_relative_tolerance=1e-8))
+    return out
+
+
+def _nonlinear_available() -> bool:
+    try:
+        from flex.nonlinear import add_nonlinear_fe_coupler  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def cases(scene: Scene) -> dict[str, Scene]:
+    """One scene per work-precision diagram (the references' scenes)."""
+    out = {}
+    for name, overrides in SCENES.items():
+        case = apply_overrides(scene, overrides)
+        validate(case)
+        out[name] = case
+    return out
+
+
+def _case_name(scene_name: str, label: str) -> str:
+    return f"{scene_name}__" + re.sub(r"[^A-Za-z0-9_=.+-]+", "_", label).strip("_")
+
+
+def _reference_case(scene_name: str, scene: Scene, reference: Reference) -> CaseResult:
+    obs = reference.observables
+    datasets = {"time": Dataset(obs.time_s, "s", "simulation time"),
+                "crank/angle": Dataset(obs.crank_angle_rad, "rad", "reference crank angle"),
+                "slider/position": Dataset(obs.slider_position_m, "m",
+                                           "reference slider position")}
+    if obs.deflection_m is not None:
+        datasets["coupler/midpoint_deflection"] = Dataset(
+            obs.deflection_m, "m", "reference elastic midpoint deflection")
+    reference_scene = scene_for(scene, reference.setting)
+    return CaseResult(f"{scene_name}__reference", to_toml(reference_scene), datasets,
+                      counters={"wall_time_s": reference.wall_time_s},
+                      attrs={"knobs": repr(reference.setting.knobs()),
+                             "description": reference.description,
+                             "converged": reference.converged,
+                             "accuracy": reference.accuracy,
+                             "tolerance": reference.tolerance})
+
+
+def _measurement_case(scene_name: str, scene: Scene, m: Measurement) -> CaseResult:
+    try:
+        scene_toml = to_toml(scene_for(scene, m.setting))
+    except Exception:  # a refused setting: store the base scene and the message
+        scene_toml = to_toml(scene)
+    if not m.ok:  # a failed case carries no data
+        return CaseResult(_case_name(scene_name, m.setting.label), scene_toml, status="failed",
+                          message=m.message, attrs={"knobs": repr(m.setting.knobs()),
+                                                    "group": m.setting.group})
+    attrs: dict[str, Any] = {"knobs": repr(m.setting.knobs()), "group": m.setting.group,
+                             "label": m.setting.label}
+    attrs.update({f"error_{key}": value for key, value in m.errors.items()})
+    return CaseResult(_case_name(scene_name, m.setting.label), scene_toml,
+                      {"wall_times": Dataset(np.array(m.wall_times_s), "s",
+                                             "integration wall time of each repeat")},
+                      counters={"wall_time_s": m.wall_time_s, "total_time_s": m.total_time_s,
+                                "steps": m.steps, "newton_iterations": m.newton_iterations,
+                                "jacobian_updates": m.jacobian_updates,
+                                "repeats": len(m.wall_times_s)},
+                      attrs=attrs)
+
+
+# the run's measurements and references, for summarize (same process, right after)
+_RUN: dict[str, tuple[Reference, list[Measurement]]] = {}
+
+
+def simulate_cases(scenes: dict[str, Scene],
+                   progress: Callable[[str, int, int], None] | None) -> dict[str, CaseResult]:
+    """References first, then every setting, per scene; returns one case per run."""
+    nonlinear = _nonlinear_available()
+    plans = {name: settings(name, nonlinear) for name in scenes}
+    total = sum(len(plan) + 1 for plan in plans.values())
+    done = 0
+    results: dict[str, CaseResult] = {}
+    _RUN.clear()
+    for scene_name, scene in scenes.items():
+        pool = ReductionPool()
+        finest, coarsenings, tolerance, description = reference_plan(scene_name)
+        if progress:
+            progress(f"{scene_name}: reference", done, total)
+        reference = converged_reference(scene, scene_name, finest, coarsenings, tolerance,
+                                        pool, description)
+        done += 1
+        results[f"{scene_name}__reference"] = _reference_case(scene_name, scene, reference)
+        measurements = []
+        for setting in plans[scene_name]:
+            if progress:
+                progress(f"{scene_name}: {setting.label}", done, total)
+            measurement = measure(scene, setting, reference, REPEATS, pool)
+            measurements.append(measurement)
+            results[_case_name(scene_name, setting.label)] = _measurement_case(
+                scene_name, scene, measurement)
+            done += 1
+        _RUN[scene_name] = (reference, measurements)
+    if progress:
+        progress("done", total, total)
+    return results
+
+
+def default_recommendation(measurements: list[Measurement]) -> Measurement | None:
+    """The fastest Exudyn setting meeting :data:`DEFAULT_TOLERANCE` (rigid scene)."""
+    limit = DEFAULT_TOLERANCE
+    within = [m for m in measurements
+              if m.ok and m.setting.engine == "exudyn"
+              and m.errors["crank_angle_rad"] <= limit["crank_angle_rad"]
+              and m.errors["slider_position_m"] <= limit["slider_position_m"]
+              and dict(m.setting.overrides).get("simulation.step_s", np.inf)
+              <= limit["max_step_s"] * (1 + 1e-9)]
+    return min(within, key=lambda m: m.wall_time_s) if within else None
+
+
+def _describe(m: Measurement | None) -> str:
+    if m is None:
+        return "-"
+    return (f"{m.setting.label} ({m.wall_time_s * 1e3:.1f} ms, error {m.error:.1e}, "
+            f"{m.steps} steps, {m.newton_iterations} Newton iterations)")
+
+
+def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+    datasets: dict[str, Dataset] = {}
+    lines = ["tradeoff: work-precision (error = largest relative error of crank angle / swing, "
+             "slider / travel, peak deflection / peak; wall = median integration time)"]
+    for scene_name, (reference, measurements) in _RUN.items():
+        group = scene_name
+        points = [(m.wall_time_s, m.error) if m.ok else (np.nan, np.nan) for m in measurements]
+        front = pareto_front(points)
+        datasets.update({f"{group}/runs/{key}": value
+                         for key, value in measurements_table(measurements, front).items()})
+        datasets[f"{group}/reference/description"] = Dataset(reference.description, "1",
+                                                              "what the reference is")
+        datasets[f"{group}/reference/knobs"] = Dataset(repr(reference.setting.knobs()), "1",
+                                                       "reference setting")
+        datasets[f"{group}/reference/wall_time"] = Dataset(reference.wall_time_s, "s",
+                                                           "reference integration time")
+        datasets[f"{group}/reference/accuracy"] = Dataset(
+            reference.accuracy, "1", "largest relative change under one-level coarsening")
+        datasets[f"{group}/reference/tolerance"] = Dataset(reference.tolerance, "1",
+                                                           "claimed relative accuracy")
+        datasets[f"{group}/reference/converged"] = Dataset(reference.converged, "1",
+                                                           "accuracy <= tolerance")
+        if reference.flexible:
+            datasets[f"{group}/reference/peak_deflection"] = Dataset(
+                reference.peak_deflection_m, "m", "reference peak |midpoint deflection|")
+        names = list(reference.evidence)
+        datasets[f"{group}/reference/evidence/coarsening"] = Dataset(
+            np.array(names, dtype=object), "1", "one-knob coarsening of the reference")
+        for key, units in (("error", "1"), ("crank_angle_rad", "rad"),
+                           ("slider_position_m", "m"), ("peak_deflection_relative", "1")):
+            datasets[f"{group}/reference/evidence/{key}"] = Dataset(
+                np.array([reference.evidence[n][key] for n in names]), units,
+                f"change of {key} between the reference and the coarsening")
+        verdict = "converged" if reference.converged else "NOT converged"
+        lines.append(f"  {scene_name}: reference {reference.description}; accuracy "
+                     f"{reference.accuracy:.1e} ({verdict} to {reference.tolerance:g}); "
+                     f"evidence: "
+                     + ", ".join(f"{n}: {reference.evidence[n]['error']:.1e}" for n in names))
+        recommendations = recommend(measurements, reference,
+                                    eligible=lambda m: m.setting.engine == "exudyn")
+        labels, walls, errors, reasons = [], [], [], []
+        for rec in recommendations:
+            m = rec.measurement
+            labels.append(m.setting.label if m else "")
+            walls.append(m.wall_time_s if m else np.nan)
+            errors.append(m.error if m else np.nan)
+            reasons.append(rec.reason or repr(m.setting.knobs()))
+            lines.append(f"    {rec.level * 100:g} %: {_describe(m) if m else rec.reason}")
+        datasets[f"{group}/recommended/level"] = Dataset(np.array(ACCURACY_LEVELS), "1",
+                                                         "relative accuracy level")
+        datasets[f"{group}/recommended/setting"] = Dataset(np.array(labels, dtype=object), "1",
+                                                           "fastest flex setting within it")
+        datasets[f"{group}/recommended/wall_time"] = Dataset(np.array(walls), "s",
+                                                             "its median wall time")
+        datasets[f"{group}/recommended/error"] = Dataset(np.array(errors), "1",
+                                                         "its relative error")
+        datasets[f"{group}/recommended/knobs"] = Dataset(np.array(reasons, dtype=object), "1",
+                                                         "its knobs, or why there is none")
+        failed = [m for m in measurements if not m.ok]
+        lines.append("    Pareto front: " + "; ".join(
+            f"{measurements[i].setting.label} ({measurements[i].wall_time_s * 1e3:.1f} ms, "
+            f"{measurements[i].error:.1e})" for i in front))
+        lines.append(f"    {len(measurements)} settings, {len(failed)} failed"
+                     + "".join(f"\n      failed {m.setting.label}: {m.message[:160]}"
+                               for m in failed))
+        if scene_name == "rigid":
+            best = default_recommendation(measurements)
+            datasets["rigid/default/setting"] = Dataset(
+                best.setting.label if best else "", "1",
+                "fastest setting within the default scene's tolerance (DEFAULT_TOLERANCE)")
+            datasets["rigid/default/knobs"] = Dataset(repr(best.setting.knobs()) if best else "",
+                                                      "1", "its knobs")
+            lines.append(f"    default scene tolerance {DEFAULT_TOLERANCE}: {_describe(best)}")
+        scipy = [m for m in measurements if m.ok and m.setting.engine == "scipy"]
+        if scipy:
+            lines.append("    scipy reference DAE: " + "; ".join(
+                f"{m.setting.label}: {m.wall_time_s * 1e3:.1f} ms, {m.error:.1e}"
+                for m in scipy))
+    return Summary(datasets, "\n".join(lines))
+
+
+def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
+    paths = []
+    for scene_name in _RUN:
+        table = {key.split("/runs/")[1]: value.data for key, value in summary.datasets.items()
+                 if key.startswith(f"{scene_name}/runs/")}
+        if not table:
+            continue
+        ok = table["status"] == "ok"
+        path = folder / f"tradeoff-{scene_name}.png"
+        with figure(path, f"Work-precision, {scene_name} (0.03 s deployment)",
+                    "wall time of the integration [s] (median)",
+                    "largest relative error [-]", size=(8.0, 5.5)) as ax:
+            groups = sorted({g for g, good in zip(table["group"], ok, strict=True) if good})
+            for group_name in groups:
+                mask = ok & (table["group"] == group_name)
+                ax.loglog(table["wall_time"][mask], table["error"][mask], "o", ms=4,
+                          label=group_name, alpha=0.75)
+            front = table["on_pareto_front"].astype(bool)
+            order = np.argsort(table["wall_time"][front])
+            ax.loglog(table["wall_time"][front][order], table["error"][front][order], "k-",
+                      lw=1.2, label="Pareto front")
+            for level in ACCURACY_LEVELS:
+                ax.axhline(level, color="grey", lw=0.6, ls=":")
+            for label, wall, error in zip(table["label"][front], table["wall_time"][front],
+                                          table["error"][front], strict=True):
+                ax.annotate(str(label), (wall, error), fontsize=6, xytext=(3, 3),
+                            textcoords="offset points")
+        paths.append(path)
+    return paths
+
+
+if __name__ == "__main__":
+    from flex.cli import main
+
+    raise SystemExit(main(["run", NAME]))

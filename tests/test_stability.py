@@ -1,0 +1,129 @@
+"""Divergence detection and dead-centre handling, against the independent reference DAE.
+
+Dead centres (crank angle 0 or 180 deg, spring drive): the spring pushes along the slide line,
+which gives no crank torque there. flex's full-coordinate model stays regular (the constraint
+Jacobian keeps full rank, smallest singular value ~0.045 at every angle; only the one-DOF
+slider-to-crank map is singular), so flex runs these starts: at the dead centre the answer is
+to stay put (0 deg: unstable equilibrium, 180 deg: stable), near it the crank creeps away
+(0 deg) or oscillates about it (180 deg). Both are checked against the reference DAE.
+"""
+
+from __future__ import annotations
+
+import math
+
+import h5py
+import numpy as np
+import pytest
+
+from flex.errors import SimulationError
+from flex.reference import SliderCrankDAE, solve_reference
+from flex.results import Dataset, write_results
+from flex.scene import load_scene
+from flex.solver import _check_finite, simulate, simulate_case
+
+SHORT = ["simulation.end_time_s=0.01"]
+
+
+def _failed_case_is_stored_without_data(case, tmp_path) -> None:
+    path = write_results(tmp_path / "diverged.h5", "test", [case])
+    with h5py.File(path) as h5:
+        group = h5[f"cases/{case.name}"]
+        assert group.attrs["status"] == "failed"
+        assert group.attrs["message"] == case.message
+        assert len(group) == 0  # no datasets: a failed case is not data
+
+
+def test_explicit_step_above_the_stability_limit_is_caught(tmp_path):
+    # RK44 with 1e8 N/m penalty joints is stable up to ~1.6e-5 s; 3e-5 s explodes
+    scene = load_scene(overrides=SHORT + ['simulation.integrator="explicit_penalty"',
+                                          "simulation.step_s=3e-5"])
+    case = simulate_case(scene, "explicit")
+    assert case.status == "failed" and not case.datasets
+    assert "diverged at step" in case.message and "t = " in case.message
+    step = int(case.message.split("diverged at step ")[1].split()[0])
+    time_s = float(case.message.split("t = ")[1].split()[0])
+    assert step == round(time_s / 3e-5) and 0 < time_s < 0.01
+    _failed_case_is_stored_without_data(case, tmp_path)
+
+
+def test_newton_failure_is_reported_with_step_and_time(tmp_path):
+    # a 100x stiffer spring with a 5 ms step: Newton does not converge in step 6
+    scene = load_scene(overrides=["drive.spring_stiffness_N_per_m=150000.0",
+                                  "simulation.step_s=5e-3"])
+    case = simulate_case(scene, "newton")
+    assert case.status == "failed" and not case.datasets
+    assert "Newton failed" in case.message
+    assert "step 6 (t = 0.025 s" in case.message
+    _failed_case_is_stored_without_data(case, tmp_path)
+
+
+def test_nan_input_is_caught_not_returned():
+    scene = load_scene(overrides=SHORT)
+    scene["drive"]["spring_preload_m"] = math.nan  # bypasses validation on purpose
+    case = simulate_case(scene, "nan")
+    assert case.status == "failed" and not case.datasets
+    assert "step" in case.message and "t = " in case.message
+
+
+def test_check_finite_reports_the_earliest_problem_with_step_and_time():
+    time_s = np.arange(11) * 2e-5
+    angle = np.zeros(11)
+    angle[7] = np.nan
+    norm = np.zeros(11)
+    norm[4:] = 1.0  # the constraint norm explodes first
+    data = {"time": Dataset(time_s, "s"), "crank/angle": Dataset(angle, "rad"),
+            "constraint_norm": Dataset(norm, "m")}
+    with pytest.raises(SimulationError) as error:
+        _check_finite(data, {"step_s": 1e-5})
+    assert "step 8 (t = 8e-05 s" in str(error.value)
+    assert "constraint norm" in str(error.value)
+
+
+def test_constraint_jacobian_keeps_full_rank_at_the_dead_centres():
+    for angle in (0.0, 180.0, 34.19):
+        dae = SliderCrankDAE(load_scene(overrides=[f"crank.initial_angle_deg={angle}"]))
+        singular_values = np.linalg.svd(dae.jacobian(dae.q0), compute_uv=False)
+        assert singular_values.min() > 0.04
+
+
+@pytest.mark.parametrize("angle_deg", [0.0, 180.0])
+def test_start_at_a_dead_centre_stays_put_as_the_reference(angle_deg):
+    scene = load_scene(overrides=["simulation.end_time_s=0.03",
+                                  f"crank.initial_angle_deg={angle_deg}"])
+    data = simulate(scene).datasets
+    angle = data["crank/angle"].data
+    reference = solve_reference(scene, data["time"].data)
+    assert np.abs(angle - math.radians(angle_deg)).max() < 1e-12
+    assert np.abs(reference.q[:, 2] - math.radians(angle_deg)).max() < 1e-12
+    assert np.abs(data["slider/velocity"].data).max() < 1e-10
+
+
+@pytest.mark.parametrize("angle_deg, bound_rad", [
+    (1e-3, 5e-9), (0.1, 1e-6), (1.0, 1e-6), (179.0, 1e-7), (181.0, 1e-7), (-1.0, 1e-6)])
+def test_start_near_a_dead_centre_matches_the_reference(angle_deg, bound_rad):
+    scene = load_scene(overrides=["simulation.end_time_s=0.03",
+                                  f"crank.initial_angle_deg={angle_deg}"])
+    data = simulate(scene).datasets
+    angle = data["crank/angle"].data
+    reference = solve_reference(scene, data["time"].data)
+    assert angle[0] == pytest.approx(math.radians(angle_deg), abs=1e-12)  # same branch
+    assert np.abs(angle - reference.q[:, 2]).max() < bound_rad
+    swing = np.ptp(reference.q[:, 2])
+    if angle_deg in (179.0, 181.0):  # stable: oscillates about 180 deg
+        assert reference.q[:, 2].min() < math.pi < reference.q[:, 2].max()
+    else:  # unstable: the crank leaves the dead centre
+        assert swing > 10 * abs(math.radians(angle_deg))
+
+
+def test_thin_ffrf_plate_with_a_large_step_fails_cleanly_and_runs_with_a_small_one():
+    # a 0.3 mm plate (first bending mode ~107 Hz, deflection ~4x its thickness) cannot take
+    # a 0.1 ms step: Newton fails in the second step; at 0.01 ms it runs
+    plate = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.thickness_m=0.0003",
+             "coupler.mesh_size_m=0.006", "simulation.end_time_s=0.001"]
+    failed = simulate_case(load_scene(overrides=plate + ["simulation.step_s=1e-4"]), "large")
+    assert failed.status == "failed" and not failed.datasets
+    assert "Newton failed" in failed.message and "step 2 (t = 0.0001 s" in failed.message
+    small = simulate_case(load_scene(overrides=plate + ["simulation.step_s=1e-5"]), "small")
+    assert small.status == "ok"
+    assert np.isfinite(small.datasets["coupler/midpoint_deflection"].data).all()

@@ -1,0 +1,163 @@
+"""Work-precision machinery (flex.tradeoff) and the [simulation] knobs it varies."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from flex.errors import SceneError
+from flex.scene import load_scene
+from flex.solver import simulate, solver_settings
+from flex.tradeoff import (
+    Measurement,
+    Observables,
+    Reference,
+    Setting,
+    converged_reference,
+    measure,
+    pareto_front,
+    peak_value,
+    recommend,
+)
+
+SHORT = ["simulation.end_time_s=0.01"]
+
+
+@pytest.fixture(scope="module")
+def rigid_reference() -> Reference:
+    scene = load_scene(overrides=SHORT)
+    return converged_reference(
+        scene, "rigid", Setting("scipy 1e-12", engine="scipy", rtol=1e-12, atol=1e-14),
+        {"rtol x10": Setting("scipy 1e-11", engine="scipy", rtol=1e-11, atol=1e-13)}, 1e-8)
+
+
+def test_pareto_front_keeps_only_unbeaten_points():
+    points = [(1.0, 1e-2), (2.0, 1e-3), (1.5, 2e-2), (3.0, 1e-3), (0.5, 1e-1),
+              (math.nan, 1e-9), (4.0, 1e-5), (2.0, 1e-3)]
+    front = pareto_front(points)
+    assert [points[i] for i in front] == [(0.5, 1e-1), (1.0, 1e-2), (2.0, 1e-3), (4.0, 1e-5)]
+    assert 2 not in front and 3 not in front  # slower and less accurate; slower, not better
+    assert 5 not in front  # no wall time: never on the front
+
+
+def _measurement(label: str, wall: float, error: float, status: str = "ok") -> Measurement:
+    return Measurement(Setting(label), status=status, wall_time_s=wall,
+                       wall_times_s=[wall], errors={"error": error})
+
+
+def test_recommend_picks_the_fastest_within_each_level(rigid_reference):
+    runs = [_measurement("coarse", 0.01, 5e-3), _measurement("medium", 0.1, 5e-4),
+            _measurement("fine", 1.0, 5e-5), _measurement("broken", 0.001, 1e-9, "failed"),
+            _measurement("slow fine", 5.0, 4e-5)]
+    picks = recommend(runs, rigid_reference)
+    assert [p.measurement.setting.label for p in picks] == ["coarse", "medium", "fine"]
+    points = [(m.wall_time_s, m.error) if m.ok else (math.nan, math.nan) for m in runs]
+    on_front = {runs[i].setting.label for i in pareto_front(points)}
+    assert {p.measurement.setting.label for p in picks} <= on_front
+    assert "slow fine" in on_front  # more accurate, so not beaten, but never the fastest
+
+
+def test_recommend_refuses_levels_the_reference_cannot_certify(rigid_reference):
+    rough = Reference("rough", rigid_reference.observables, rigid_reference.setting,
+                      {"coarser": {"error": 1e-3}}, 1e-2, 0.0)
+    picks = recommend([_measurement("fine", 1.0, 1e-6)], rough)
+    assert picks[0].measurement is not None  # 1 % >= 3 x 1e-3
+    assert picks[1].measurement is None and "cannot certify" in picks[1].reason
+    assert picks[2].measurement is None
+
+
+def test_peak_value_refines_a_coarsely_sampled_sine():
+    # 16 samples per period, the crest halfway between two of them
+    time_s = np.arange(9) / 16.0
+    signal = 2.0 * np.cos(2 * np.pi * (time_s - 3.5 / 16.0))
+    assert np.abs(signal).max() == pytest.approx(2.0 * np.cos(np.pi / 16))  # 2 % low
+    assert peak_value(time_s, signal) == pytest.approx(2.0, rel=2e-3)
+
+
+def test_reference_is_shown_converged(rigid_reference):
+    assert rigid_reference.converged
+    assert rigid_reference.accuracy < 1e-9
+    assert rigid_reference.evidence["rtol x10"]["crank_angle_rad"] < 1e-9
+
+
+def test_generalized_alpha_converges_at_second_order(rigid_reference):
+    base = load_scene(overrides=SHORT)
+    coarse = measure(base, Setting.of("h=2e-4", step_s=2e-4), rigid_reference, repeats=1)
+    fine = measure(base, Setting.of("h=1e-4", step_s=1e-4), rigid_reference, repeats=1)
+    assert coarse.ok and fine.ok
+    ratio = coarse.errors["crank_angle_rad"] / fine.errors["crank_angle_rad"]
+    assert ratio == pytest.approx(4.0, rel=0.15)
+    assert fine.steps >= 100 and fine.newton_iterations >= 100
+    assert fine.wall_time_s > 0 and len(fine.wall_times_s) == 1
+
+
+def test_a_diverged_setting_is_measured_as_failed(rigid_reference):
+    base = load_scene(overrides=SHORT)
+    setting = Setting.of("explicit above its limit", integrator="explicit_penalty",
+                         step_s=3e-5)
+    measurement = measure(base, setting, rigid_reference, repeats=3)
+    assert measurement.status == "failed"
+    assert "step" in measurement.message and "t = " in measurement.message
+    assert not measurement.errors and math.isnan(measurement.error)
+
+
+def test_scipy_reference_is_a_setting_too(rigid_reference):
+    base = load_scene(overrides=SHORT)
+    loose = measure(base, Setting("scipy 1e-6", engine="scipy", rtol=1e-6, atol=1e-8),
+                    rigid_reference, repeats=1)
+    assert loose.ok and 1e-10 < loose.errors["crank_angle_rad"] < 1e-5
+
+
+@pytest.mark.parametrize("overrides, bound_rad", [
+    (['simulation.newton="modified"'], 2e-7),
+    (['simulation.formulation="index2"', "simulation.spectral_radius=1.0"], 2e-7),
+    (["simulation.newton_relative_tolerance=1e-8"], 2e-7),
+    # penalty joints open by force / stiffness: ~1e-5 rad at 1e8 N/m (notes: 8.5e-6)
+    (['simulation.integrator="explicit_penalty"'], 3e-5),
+])
+def test_knobs_run_and_stay_close_to_the_reference(rigid_reference, overrides, bound_rad):
+    scene = load_scene(overrides=SHORT + overrides)
+    data = simulate(scene).datasets
+    run = Observables.of_datasets(data, flexible=False)
+    assert rigid_reference.errors(run)["crank_angle_rad"] < bound_rad
+    assert data["constraint_norm"].data.max() < 1e-5
+
+
+def test_index2_with_numerical_damping_is_first_order(rigid_reference):
+    # Newmark with gamma > 1/2 (spectral radius < 1) loses second order: far worse than index 3
+    base = load_scene(overrides=SHORT)
+    index2 = measure(base, Setting.of("index2", formulation="index2", step_s=1e-4),
+                     rigid_reference, repeats=1)
+    index3 = measure(base, Setting.of("index3", step_s=1e-4), rigid_reference, repeats=1)
+    assert index2.errors["crank_angle_rad"] > 10 * index3.errors["crank_angle_rad"]
+
+
+def test_solver_settings_record_the_knobs():
+    settings = solver_settings(load_scene(overrides=['simulation.formulation="index2"',
+                                                     "simulation.spectral_radius=0.5"]))
+    assert settings["integrator"].startswith("Newmark")
+    assert settings["newmark_gamma"] == pytest.approx(0.5 + 1 / 3)
+    assert settings["newmark_beta"] == pytest.approx((1 + 1 / 3) ** 2 / 4)
+    assert settings["adaptive_step"] is False
+    explicit = solver_settings(load_scene(overrides=['simulation.integrator="explicit_penalty"']))
+    assert explicit["explicit_method"] == "RK44" and "penalty" in explicit["integrator"]
+
+
+@pytest.mark.parametrize("overrides, words", [
+    (['simulation.formulation="index1"'], ['"index3"', '"index2"']),
+    (['simulation.newton="quasi"'], ['"full"', '"modified"']),
+    (['simulation.explicit_method="DOPRI5"'], ['"RK44"']),
+    (["simulation.newton_relative_tolerance=0.1"], ["<= 0.001"]),
+    (["simulation.penalty_stiffness_N_per_m=0.0"], ["> 0"]),
+    (['simulation.integrator="explicit_penalty"', 'coupler.geometry="plate"',
+      'coupler.model="ffrf"'], ['"generalized_alpha"', "rigid"]),
+    (['simulation.integrator="explicit_penalty"', 'drive.kind="constant_speed"'],
+     ['"generalized_alpha"']),
+])
+def test_knob_values_are_validated_with_the_accepted_range(overrides, words):
+    with pytest.raises(SceneError) as error:
+        load_scene(overrides=overrides)
+    for word in words:
+        assert word in str(error.value)
