@@ -83,6 +83,7 @@ class Mechanism:
     constraint_points: list[tuple[str, str]] = field(default_factory=list)
     rigid_bodies: dict[str, tuple[float, np.ndarray]] = field(default_factory=dict)
     coupler: dict[str, Any] = field(default_factory=dict)
+    wing: dict[str, Any] = field(default_factory=dict)
 
 
 def _rotation_z(angle_rad: float) -> np.ndarray:
@@ -133,6 +134,42 @@ def _add_penalty_joints(mbs: Any, stiffness_N_per_m: float, lightest_mass_kg: fl
         springs.append(mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
             markerNumbers=list(markers), stiffness=list(k * axes), damping=list(d * axes))))
     return springs
+
+
+def wing_mass_properties(scene: Scene) -> tuple[float, float, float]:
+    """Wing plate mass [kg], inertia about its centre [kg m^2] and centre distance from A [m].
+
+    The wing is a flat plate in the mechanism plane (switchblade wing): root at the crank
+    pivot A, span along the crank direction, chord across it, thickness out of plane.
+    """
+    wing = scene["wing"]
+    mass_kg = wing["density_kg_per_m3"] * wing["span_m"] * wing["chord_m"] * wing["thickness_m"]
+    inertia_kgm2 = mass_kg * (wing["span_m"] ** 2 + wing["chord_m"] ** 2) / 12.0
+    return mass_kg, inertia_kgm2, wing["span_m"] / 2.0
+
+
+def _add_wing(mech: Mechanism, rigid_body, body_marker, crank_body: dict) -> int:
+    """Add the wing as a rigid body welded to the crank at A; return the weld joint.
+
+    The weld's reaction torque is the wing root bending moment in the mechanism plane.
+    """
+    import exudyn.itemInterface as eii
+
+    init = mech.initial
+    mass_kg, inertia_kgm2, centre_m = wing_mass_properties(mech.scene)
+    direction = np.array([np.cos(init.crank_angle_rad), np.sin(init.crank_angle_rad), 0.0])
+    normal = np.array([-direction[1], direction[0], 0.0])
+    wing_body = rigid_body("wing", mass_kg, inertia_kgm2, direction * centre_m,
+                           init.crank_angle_rad,
+                           normal * centre_m * init.crank_speed_rad_per_s,
+                           init.crank_speed_rad_per_s)
+    mech.wing = {"body": wing_body["bodyNumber"], "node": wing_body["nodeNumber"]}
+    crank_root = body_marker(crank_body, [0.0, 0.0, 0.0])
+    wing_root = body_marker(wing_body, [0.0, 0.0, 0.0])
+    crank_rotation = _rotation_z(init.crank_angle_rad)
+    return mech.mbs.AddObject(eii.ObjectJointGeneric(
+        markerNumbers=[crank_root, wing_root], constrainedAxes=[1, 1, 1, 1, 1, 1],
+        rotationMarker0=crank_rotation.T, rotationMarker1=crank_rotation.T))
 
 
 def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
@@ -187,8 +224,11 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
     crank_a = body_marker(crank_body, [0.0, 0.0, 0.0])
     crank_b = body_marker(crank_body, init.joint_B_m)
     slider_c = body_marker(slider_body, init.joint_C_m)
+    wing_joint = _add_wing(mech, rigid_body, body_marker, crank_body) \
+        if scene["wing"]["enabled"] else None
 
-    if scene["coupler"]["model"] == "ffrf":
+    model = scene["coupler"]["model"]
+    if model == "ffrf":
         from .reduction import add_ffrf_coupler
 
         coupler = add_ffrf_coupler(
@@ -198,6 +238,16 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
             initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
         coupler_b, coupler_c = coupler["marker_B"], coupler["marker_C"]
         mech.coupler = dict(coupler, reduction=reduction)
+    elif model == "nonlinear_fe":
+        from .nonlinear import add_nonlinear_fe_coupler, nonlinear_plate_for_scene
+
+        plate = reduction if reduction is not None else nonlinear_plate_for_scene(scene)
+        coupler = add_nonlinear_fe_coupler(
+            mbs, plate, list(init.joint_B_m), init.coupler_angle_rad,
+            initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+            initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
+        coupler_b, coupler_c = coupler["marker_B"], coupler["marker_C"]
+        mech.coupler = dict(coupler, plate=plate)
     else:
         mass_kg, inertia_kgm2 = plate_mass_properties(scene)
         coupler_body = rigid_body(
@@ -257,13 +307,22 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
     def add(name: str, sensor) -> None:
         mech.sensors[name] = mbs.AddSensor(sensor)
 
+    if wing_joint is not None:
+        for output in ("Velocity", "Rotation", "AngularVelocity", "AngularAcceleration"):
+            add(f"wing.{output}", eii.SensorNode(nodeNumber=mech.wing["node"],
+                                                 storeInternal=True,
+                                                 outputVariableType=getattr(out, output)))
+        for output in ("ForceLocal", "TorqueLocal"):
+            add(f"joint_W.{output}", eii.SensorObject(objectNumber=wing_joint,
+                                                      storeInternal=True,
+                                                      outputVariableType=getattr(out, output)))
     for name, body in (("crank", crank_body), ("slider", slider_body)):
         node = body["nodeNumber"]
         for output in ("Position", "Velocity", "Acceleration", "Rotation", "AngularVelocity",
                        "AngularAcceleration"):
             add(f"{name}.{output}", eii.SensorNode(nodeNumber=node, storeInternal=True,
                                                    outputVariableType=getattr(out, output)))
-    if scene["coupler"]["model"] == "rigid":
+    if model == "rigid":
         # the centre of mass is the coupler's midpoint
         for output in ("Position", "Velocity", "Acceleration", "Rotation", "AngularVelocity"):
             add(f"coupler.{output}", eii.SensorNode(nodeNumber=mech.coupler["node"],
@@ -283,11 +342,12 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
                              outputVariableType=out.Position))
     mech.constraint_points = [("ground_A", "crank_A"), ("crank_B", "coupler_B"),
                               ("coupler_C", "slider_C")]
-    if scene["coupler"]["model"] == "ffrf":
+    if model in ("ffrf", "nonlinear_fe"):
         for output in ("Position", "Velocity"):
             add(f"marker_coupler_mid.{output}",
                 eii.SensorMarker(markerNumber=coupler["marker_mid"], storeInternal=True,
                                  outputVariableType=getattr(out, output)))
+    if model == "ffrf":
         add("coupler.modal_coordinates",
             eii.SensorNode(nodeNumber=coupler["node_modal"], storeInternal=True,
                            outputVariableType=out.Coordinates))

@@ -63,6 +63,29 @@ class ReferenceSolution:
         }
 
 
+def crank_mass_properties(scene: Scene) -> tuple[float, float, float]:
+    """Mass [kg], inertia about the centre of mass [kg m^2] and distance of the centre of
+    mass from A [m] of the crank, with the welded wing of ``[wing]`` if it is enabled.
+
+    The wing is a plate in the mechanism plane from A along the crank (span), so both
+    centres lie on the line A-B and the parallel-axis theorem combines them.
+    """
+    crank = scene["crank"]
+    mass_kg, inertia_kgm2 = crank["mass_kg"], crank["inertia_kgm2"]
+    centre_m = crank["length_m"] / 2
+    wing = scene.get("wing", {})
+    if not wing.get("enabled", False):
+        return mass_kg, inertia_kgm2, centre_m
+    wing_mass_kg = wing["density_kg_per_m3"] * wing["span_m"] * wing["chord_m"] \
+        * wing["thickness_m"]
+    wing_inertia_kgm2 = wing_mass_kg * (wing["span_m"] ** 2 + wing["chord_m"] ** 2) / 12
+    total_kg = mass_kg + wing_mass_kg
+    combined_m = (mass_kg * centre_m + wing_mass_kg * wing["span_m"] / 2) / total_kg
+    inertia = (inertia_kgm2 + mass_kg * (centre_m - combined_m) ** 2 + wing_inertia_kgm2
+               + wing_mass_kg * (wing["span_m"] / 2 - combined_m) ** 2)
+    return total_kg, inertia, combined_m
+
+
 class SliderCrankDAE:
     """Right-hand side of the 9-coordinate slider-crank DAE for one scene."""
 
@@ -72,7 +95,8 @@ class SliderCrankDAE:
         self.coupler_length_m = scene["coupler"]["length_m"]
         self.offset_m = slider["offset_m"]
         coupler_mass_kg, coupler_inertia_kgm2 = plate_mass_properties(scene)
-        self.mass = np.diag([crank["mass_kg"], crank["mass_kg"], crank["inertia_kgm2"],
+        crank_mass_kg, crank_inertia_kgm2, self.crank_centre_m = crank_mass_properties(scene)
+        self.mass = np.diag([crank_mass_kg, crank_mass_kg, crank_inertia_kgm2,
                              coupler_mass_kg, coupler_mass_kg, coupler_inertia_kgm2,
                              slider["mass_kg"], slider["mass_kg"], slider["inertia_kgm2"]])
         self.constant_speed = drive["kind"] == "constant_speed"
@@ -94,17 +118,19 @@ class SliderCrankDAE:
         vb = w1 * l1 * np.array([-np.sin(th1), np.cos(th1)])
         c = np.array([float(s.slider_position_m), self.offset_m])
         vc = np.array([float(s.slider_velocity_m_per_s), 0.0])
-        q = np.array([b[0] / 2, b[1] / 2, th1, *(b + c) / 2, th2, *c, 0.0])
-        q_dot = np.array([vb[0] / 2, vb[1] / 2, w1, *(vb + vc) / 2, w2, *vc, 0.0])
+        share = self.crank_centre_m / l1  # crank centre of mass on the line A-B
+        q = np.array([b[0] * share, b[1] * share, th1, *(b + c) / 2, th2, *c, 0.0])
+        q_dot = np.array([vb[0] * share, vb[1] * share, w1, *(vb + vc) / 2, w2, *vc, 0.0])
         return q, q_dot
 
     def constraints(self, t: float, q: np.ndarray) -> np.ndarray:
         """Constraint vector Psi(q, t) [m, rad]."""
-        h1, h2 = self.crank_length_m / 2, self.coupler_length_m / 2
+        a1, h2 = self.crank_centre_m, self.coupler_length_m / 2
+        b1 = self.crank_length_m - a1  # centre of mass to B
         x1, y1, th1, x2, y2, th2, x3, y3, th3 = q
-        psi = [x1 - h1 * np.cos(th1), y1 - h1 * np.sin(th1),
-               x1 + h1 * np.cos(th1) - (x2 - h2 * np.cos(th2)),
-               y1 + h1 * np.sin(th1) - (y2 - h2 * np.sin(th2)),
+        psi = [x1 - a1 * np.cos(th1), y1 - a1 * np.sin(th1),
+               x1 + b1 * np.cos(th1) - (x2 - h2 * np.cos(th2)),
+               y1 + b1 * np.sin(th1) - (y2 - h2 * np.sin(th2)),
                x2 + h2 * np.cos(th2) - x3, y2 + h2 * np.sin(th2) - y3,
                y3 - self.offset_m, th3]
         if self.constant_speed:
@@ -113,14 +139,15 @@ class SliderCrankDAE:
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """Constraint Jacobian Psi_q (m x 9)."""
-        h1, h2 = self.crank_length_m / 2, self.coupler_length_m / 2
+        a1, h2 = self.crank_centre_m, self.coupler_length_m / 2
+        b1 = self.crank_length_m - a1
         th1, th2 = q[2], q[5]
         s1, c1, s2, c2 = np.sin(th1), np.cos(th1), np.sin(th2), np.cos(th2)
         jac = np.zeros((self.n_constraints, 9))
-        jac[0, [0, 2]] = [1, h1 * s1]
-        jac[1, [1, 2]] = [1, -h1 * c1]
-        jac[2, [0, 2, 3, 5]] = [1, -h1 * s1, -1, -h2 * s2]
-        jac[3, [1, 2, 4, 5]] = [1, h1 * c1, -1, h2 * c2]
+        jac[0, [0, 2]] = [1, a1 * s1]
+        jac[1, [1, 2]] = [1, -a1 * c1]
+        jac[2, [0, 2, 3, 5]] = [1, -b1 * s1, -1, -h2 * s2]
+        jac[3, [1, 2, 4, 5]] = [1, b1 * c1, -1, h2 * c2]
         jac[4, [3, 5, 6]] = [1, -h2 * s2, -1]
         jac[5, [4, 5, 7]] = [1, h2 * c2, -1]
         jac[6, 7] = 1
@@ -131,11 +158,12 @@ class SliderCrankDAE:
 
     def gamma(self, q: np.ndarray, q_dot: np.ndarray) -> np.ndarray:
         """Right-hand side of the acceleration constraints, -(Psi_q q_dot)_q q_dot."""
-        h1, h2 = self.crank_length_m / 2, self.coupler_length_m / 2
+        a1, h2 = self.crank_centre_m, self.coupler_length_m / 2
+        b1 = self.crank_length_m - a1
         th1, th2, w1, w2 = q[2], q[5], q_dot[2], q_dot[5]
         c1, s1, c2, s2 = np.cos(th1), np.sin(th1), np.cos(th2), np.sin(th2)
-        g = [-h1 * c1 * w1**2, -h1 * s1 * w1**2,
-             h1 * c1 * w1**2 + h2 * c2 * w2**2, h1 * s1 * w1**2 + h2 * s2 * w2**2,
+        g = [-a1 * c1 * w1**2, -a1 * s1 * w1**2,
+             b1 * c1 * w1**2 + h2 * c2 * w2**2, b1 * s1 * w1**2 + h2 * s2 * w2**2,
              h2 * c2 * w2**2, h2 * s2 * w2**2, 0.0, 0.0]
         if self.constant_speed:
             g.append(0.0)

@@ -65,12 +65,18 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "inertia_kgm2": Field(doc="crank moment of inertia about its centre of mass", **_POS),
         "initial_angle_deg": Field(float, "crank angle at t = 0, from the slide line",
                                    minimum=-360.0, maximum=360.0),
+        "model": Field(("rigid", "auto"), "rigid body; auto: rigid if the fitted criterion "
+                       "allows it for fidelity.tolerance, else refused (flex has no flexible "
+                       "crank)"),
     },
     "coupler": {
         "length_m": Field(doc="coupler length L2 between joints B and C", **_POS),
         "mass_kg": Field(doc="coupler mass (geometry = lumped)", **_POS),
         "inertia_kgm2": Field(doc="coupler inertia about its centre of mass (lumped)", **_POS),
-        "model": Field(("rigid", "ffrf"), "rigid body or floating-frame flexible body"),
+        "model": Field(("rigid", "ffrf", "nonlinear_fe", "auto"),
+                       "rigid body, floating-frame flexible body, or fully nonlinear FE body "
+                       "(accuracy reference; orders of magnitude slower); auto: rigid or "
+                       "ffrf (and modes) from the fitted criterion and fidelity.tolerance"),
         "geometry": Field(("lumped", "plate"),
                           "lumped: mass_kg/inertia_kgm2; plate: steel plate of the keys below"),
         "thickness_m": Field(doc="plate thickness, in the mechanism plane", **_POS),
@@ -81,6 +87,14 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "modes": Field(int, "fixed-interface Craig-Bampton modes", minimum=1, maximum=100),
         "mesh_size_m": Field(doc="netgen maximum element size", **_POS),
         "damping_ratio": Field(float, "modal damping ratio", minimum=0.0, below=1.0),
+    },
+    "wing": {
+        "enabled": Field(bool, "weld a wing plate to the crank at A (sec. 6.4 application)"),
+        "span_m": Field(doc="wing span, from the crank pivot A along the crank", **_POS),
+        "chord_m": Field(doc="wing chord, in the mechanism plane across the span", **_POS),
+        "thickness_m": Field(doc="wing thickness, out of the mechanism plane", **_POS),
+        "density_kg_per_m3": Field(doc="wing material density", **_POS),
+        "youngs_modulus_Pa": Field(doc="wing material Young's modulus", **_POS),
     },
     "slider": {
         "mass_kg": Field(doc="slider mass", **_POS),
@@ -119,6 +133,11 @@ SCHEMA: dict[str, dict[str, Field]] = {
                                  "DOPRI5 needs its own step control and is not offered)"),
         "penalty_stiffness_N_per_m": Field(doc="explicit_penalty: stiffness of the joint springs "
                                            "at A, B, C and across the slide line", **_POS),
+    },
+    "fidelity": {
+        "tolerance": Field(float, "model = \"auto\": accepted error of the rigid model "
+                           "(dimensionless: deflection / L2, crank-angle and slider deviation "
+                           "relative to their swing)", positive=True, maximum=0.5),
     },
 }
 
@@ -305,9 +324,16 @@ def _check_geometry(scene: Scene) -> None:
         raise SceneError(f"simulation needs {steps:.3g} steps (end_time_s / step_s); "
                          f"accepted: at most 5e7")
     coupler = scene["coupler"]
-    if coupler["model"] == "ffrf" and coupler["geometry"] != "plate":
-        raise SceneError('coupler.model = "ffrf" needs coupler.geometry = "plate" '
-                         "(the flexible body is meshed from the plate's dimensions)")
+    if coupler["model"] in ("ffrf", "nonlinear_fe") and coupler["geometry"] != "plate":
+        raise SceneError(f'coupler.model = "{coupler["model"]}" needs coupler.geometry = '
+                         '"plate" (the flexible body is meshed from the plate\'s dimensions)')
+    if coupler["model"] == "auto" and coupler["geometry"] != "plate":
+        raise SceneError('coupler.model = "auto" needs coupler.geometry = "plate" (the '
+                         "criterion needs the plate's bending frequency; a lumped coupler has "
+                         'no stiffness): use coupler.model = "rigid" for a lumped coupler')
+    if coupler["model"] == "nonlinear_fe" and coupler["damping_ratio"] != 0:
+        raise SceneError(f"coupler.damping_ratio = {coupler['damping_ratio']:g}: "
+                         'coupler.model = "nonlinear_fe" has no damping model; accepted: 0')
     if coupler["geometry"] == "plate" and coupler["thickness_m"] >= coupler_m:
         raise SceneError(f"coupler.thickness_m = {coupler['thickness_m']:g} must be smaller "
                          f"than coupler.length_m = {coupler_m:g}")

@@ -11,7 +11,12 @@
   :func:`simulate_case` turns that into a ``failed`` case instead of data;
 - counters: steps, Newton iterations, Jacobian updates, wall time [s].
 
-The integrator is Exudyn's implicit generalized-alpha (index 3) with fixed step.
+The integrator follows the scene's ``[simulation]`` knobs (:func:`solver_settings`): Exudyn's
+implicit generalized-alpha (index 3; or Newmark with index-2 constraints), full or modified
+Newton, or an explicit Runge-Kutta method with penalty joints; always at a fixed step (a
+Newton failure is reported, not retried with a smaller step). Step N covers
+t = (N - 1) h ... N h: a Newton failure names the step and its start time, a non-finite or
+exploding output the step that produced it and its end time.
 """
 
 from __future__ import annotations
@@ -33,6 +38,15 @@ from .scene import Scene, to_toml
 # a constraint norm above this is a failed assembly, not a tolerance question
 CONSTRAINT_NORM_LIMIT_M = 1e-4
 
+#: nonlinear FE coupler (~10k coordinates): a sparse LU (a dense one would take seconds and
+#: ~1 GB per Newton step), reused while Newton converges -- the factorisation is ~80 % of a
+#: full Newton iteration, and Newton converges only linearly anyway (the joints' Jacobian on
+#: the FE face markers is approximate): modified Newton measured 4x faster per step
+NONLINEAR_FE_SOLVER = {"linear_solver": "EigenSparse", "modified_newton": True}
+#: the FE residual stalls at ~1e-9 relative (round-off of the Green-Lagrange forces of a body
+#: displaced by ~L2 from its mesh position): tighter Newton tolerances cannot be met
+NONLINEAR_FE_NEWTON_TOLERANCE_FLOOR = 1e-8
+
 
 def solver_settings(scene: Scene) -> dict[str, Any]:
     """The integrator settings used for ``scene`` (stored in every result file)."""
@@ -50,6 +64,11 @@ def solver_settings(scene: Scene) -> dict[str, Any]:
         "adaptive_step": False,  # fixed step: a Newton failure is a divergence, not a retry
     }
     settings.update(_integrator_settings(sim))
+    if scene["coupler"]["model"] == "nonlinear_fe":
+        settings.update(NONLINEAR_FE_SOLVER)
+        settings["newton_relative_tolerance"] = max(settings["newton_relative_tolerance"],
+                                                    NONLINEAR_FE_NEWTON_TOLERANCE_FLOOR)
+        settings["newton_absolute_tolerance"] = 1e-2 * settings["newton_relative_tolerance"]
     return settings
 
 
@@ -97,6 +116,8 @@ def _exudyn_settings(settings: dict[str, Any]):
     ti.newton.relativeTolerance = settings["newton_relative_tolerance"]
     ti.newton.absoluteTolerance = settings["newton_absolute_tolerance"]
     ti.newton.useModifiedNewton = settings["modified_newton"]
+    if "linear_solver" in settings:
+        s.linearSolver.solverType = getattr(exu.LinearSolverType, settings["linear_solver"])
     ti.verboseMode = 0
     s.solution.file.write = False
     s.solution.sensors.writePeriod = settings["output_step_s"]
@@ -203,6 +224,8 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
                                      "slide line; slider angle in rad)")
 
     out.update(_coupler_datasets(mech, time_s))
+    if mech.wing:
+        out.update(_wing_datasets(mech))
     if scene["coupler"]["model"] == "rigid":
         kinetic = np.zeros_like(time_s)
         for name, (mass_kg, inertia) in mech.rigid_bodies.items():
@@ -241,7 +264,11 @@ def reduction_for_scene(scene: Scene):
 
 
 def _coupler_datasets(mech: Mechanism, time_s: np.ndarray) -> dict[str, Dataset]:
-    """Coupler midpoint motion; for an FFRF coupler also its elastic response."""
+    """Coupler midpoint motion; for a flexible coupler also its elastic response.
+
+    FFRF and nonlinear FE couplers give the same datasets from their B, C and midpoint
+    markers; the FFRF coupler adds its modal coordinates and bending stress.
+    """
     out: dict[str, Dataset] = {}
     if mech.scene["coupler"]["model"] == "rigid":
         out["coupler/midpoint_position"] = Dataset(_sensor(mech, "coupler.Position")[:, 1:3],
@@ -254,6 +281,7 @@ def _coupler_datasets(mech: Mechanism, time_s: np.ndarray) -> dict[str, Dataset]
         return out
     from .reduction import bending_stress_history, midpoint_deflection
 
+    model = mech.scene["coupler"]["model"]
     position_b = _sensor(mech, "marker_coupler_B.Position")[:, 1:4]
     position_c = _sensor(mech, "marker_coupler_C.Position")[:, 1:4]
     position_mid = _sensor(mech, "marker_coupler_mid.Position")[:, 1:4]
@@ -273,6 +301,9 @@ def _coupler_datasets(mech: Mechanism, time_s: np.ndarray) -> dict[str, Dataset]
         "transverse elastic deflection of the midpoint from the chord B-C, 0 at t = 0")
     out["coupler/chord_change"] = Dataset(deflection.chord_change_m, "m",
                                           "change of the distance B-C (axial strain x L2)")
+    if model == "nonlinear_fe":
+        # nodal coordinates only: no modal coordinates, and no stress output yet
+        return out
     modal = _sensor(mech, "coupler.modal_coordinates")[:, 1:]
     out["coupler/modal_coordinates"] = Dataset(modal, "1",
                                                "elastic coordinates: 6 static + eigenmodes")
@@ -282,6 +313,31 @@ def _coupler_datasets(mech: Mechanism, time_s: np.ndarray) -> dict[str, Dataset]
             bending_stress_history(reduction, modal), "Pa",
             "largest |sigma_xx| away from the end faces (bending + membrane)")
     return out
+
+
+def _wing_datasets(mech: Mechanism) -> dict[str, Dataset]:
+    """Wing angle, angular velocity and the root (weld) loads, in global axes."""
+    angle = _sensor(mech, "wing.Rotation")[:, 3]
+    span_m = mech.scene["wing"]["span_m"]
+    omega = _sensor(mech, "wing.AngularVelocity")[:, 3]
+    # weld frame = crank frame at t = 0 turned with the crank; Exudyn reports the load on
+    # body 0 (the crank), so the load on the wing is its negative
+    turn = angle - mech.initial.crank_angle_rad
+    local = -_sensor(mech, "joint_W.ForceLocal")[:, 1:3]
+    c, s = np.cos(turn), np.sin(turn)
+    force = np.column_stack([c * local[:, 0] - s * local[:, 1], s * local[:, 0] + c * local[:, 1]])
+    return {
+        "wing/angle": Dataset(angle, "rad", "wing angle from +x (along the crank)"),
+        "wing/angular_velocity": Dataset(omega, "rad/s", "wing (and wing-tip) angular velocity"),
+        "wing/angular_velocity_deg": Dataset(np.degrees(omega), "deg/s",
+                                             "wing angular velocity in the thesis's unit"),
+        "wing/angular_acceleration": Dataset(_sensor(mech, "wing.AngularAcceleration")[:, 3],
+                                             "rad/s^2", "wing angular acceleration"),
+        "wing/tip_speed": Dataset(np.abs(omega) * span_m, "m/s", "speed of the wing tip"),
+        "joints/W/force_on_wing": Dataset(force, "N", "crank on wing at the root (weld), x y"),
+        "joints/W/root_moment": Dataset(-_sensor(mech, "joint_W.TorqueLocal")[:, 3], "N m",
+                                        "in-plane bending moment at the wing root (about z)"),
+    }
 
 
 def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any]) -> None:
@@ -332,7 +388,16 @@ def _resolve_auto(scene: Scene) -> tuple[Scene, list[Any]]:
 
 
 def simulate(scene: Scene, name: str = "case", reduction: Any = None) -> CaseResult:
-    """Build, integrate and collect one case; raises on divergence (see module doc)."""
+    """Build, integrate and collect one case; raises on divergence (see module doc).
+
+    ``model = "auto"`` links are first resolved to concrete models (a given ``reduction``
+    is then ignored: auto picks the modes); the choice and its reason go to stderr and into
+    the result's attributes ``fidelity_<link>_*``, and ``scene_toml`` holds the resolved
+    scene.
+    """
+    scene, fidelity = _resolve_auto(scene)
+    if fidelity:
+        reduction = None
     if scene["coupler"]["model"] == "ffrf" and reduction is None:
         reduction = reduction_for_scene(scene)
     mech = build_mechanism(scene, reduction)
@@ -343,8 +408,11 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None) -> CaseRes
     _check_finite(datasets, settings)
     import tomli_w
 
-    return CaseResult(name, to_toml(scene), datasets, counters=counters,
-                      solver_settings_toml=tomli_w.dumps(settings))
+    result = CaseResult(name, to_toml(scene), datasets, counters=counters,
+                        solver_settings_toml=tomli_w.dumps(settings))
+    for decision in fidelity:
+        result.attrs.update(decision.attrs())
+    return result
 
 
 def simulate_case(scene: Scene, name: str = "case", reduction: Any = None) -> CaseResult:

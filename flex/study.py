@@ -30,8 +30,8 @@ from .results import CaseResult, Dataset, write_results
 from .scene import Scene, load_scene, to_toml
 from .solver import simulate_case
 
-STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring",
-           "tradeoff", "stability", "bench")
+STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring", "kfit",
+           "tradeoff", "stability", "bench", "wing")
 RESULTS_DIR = Path("results")
 
 
