@@ -7,9 +7,9 @@ export EXUDYN_NO_USER_SETTINGS := 1
 export MPLBACKEND := Agg
 RUN := $(PY) -m flex run
 
-STUDIES := kinematics dynamics modal flexible spring
+STUDIES := kinematics dynamics modal flexible spring kfit
 
-.PHONY: all test test-slow lint setup clean $(STUDIES)
+.PHONY: all test test-slow lint setup clean kfit-criterion $(STUDIES)
 
 all: $(STUDIES)
 
@@ -24,6 +24,10 @@ setup: $(STAMP)
 $(STUDIES): $(STAMP)
 	$(RUN) $@
 
+# after make kfit: install its fit as the criterion that model = "auto" reads (commit it)
+kfit-criterion: results/kfit-criterion.toml
+	cp results/kfit-criterion.toml flex/criteria_fit.toml
+
 test: $(STAMP)
 	$(PY) -m pytest -q
 
@@ -34,4 +38,4 @@ lint: $(STAMP)
 	$(PY) -m ruff check flex studies tests
 
 clean:
-	rm -rf results/*.h5 results/figures .cache
+	rm -rf results/*.h5 results/figures .cache results/kfit-cases results/kfit-criterion.toml

@@ -1,0 +1,623 @@
+"""Sweeps: many independent cases through one executor seam, one result file per case.
+
+:func:`run_sweep` runs ``case_function(name, scene) -> CaseResult`` for every scene of a
+sweep and returns the results. Contract:
+
+- **one executor seam** (:func:`make_executor`): ``scheduler`` selects where cases run --
+  ``None``/``"processes"`` (default): a local ``concurrent.futures.ProcessPoolExecutor`` on
+  all cores (or ``workers``), no set-up; ``"local"``: a local Dask cluster
+  (``LocalCluster``, one single-threaded worker process per core, loopback only);
+  ``"tcp://host:8786"``: an existing Dask distributed scheduler; ``"serial"``: in this
+  process, one case after the other (debugging). The case function and its arguments
+  must be importable/picklable (a module-level function; ``flex`` installed on the workers).
+- **pure cases, own files**: each case is a function of its scene alone; its result is
+  written (by this process, atomically, :func:`flex.results.write_results`) to
+  ``<folder>/cases/<name>.h5`` as soon as it arrives, with the hash of its scene and case
+  function. A rerun **resumes**: cases whose file holds the same hash are read back, not
+  run; ``retry_failed`` reruns the recorded failures too.
+- **failures are data**: an exception in a case (a diverged run, a bug) or a dead worker
+  process (crash, out of memory) is recorded as a ``failed`` case with its message and the
+  sweep goes on. A case whose local worker dies is rerun alone in a fresh process to tell it
+  from its innocent neighbours; if it kills that one too it is recorded as failed.
+- **shared preparation**: ``prepare_key(scene)`` groups cases that need the same expensive
+  preparation (e.g. a reduction per plate geometry, cached on disk); ``prepare(scene)`` runs
+  once per group before its cases are submitted (a failed preparation fails its cases).
+- **progress**: a ``tqdm`` bar on stderr shows cases done, failed and remaining.
+
+The environment selects the executor for sweeps started by studies (``python -m flex run
+kfit``): ``FLEX_SCHEDULER`` (as ``scheduler``), ``FLEX_WORKERS``, ``FLEX_SWEEP_DIR`` and
+``FLEX_RETRY_FAILED=1``; ``python -m flex.sweep STUDY --scheduler ...`` sets them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import hashlib
+import os
+import re
+import sys
+import time
+import traceback
+from collections.abc import Callable, Hashable, Iterable, Mapping
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import FlexError
+from .results import CaseResult, Dataset, open_results, write_results
+from .scene import Scene, to_toml
+
+CaseFunction = Callable[[str, Scene], CaseResult]
+_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
+SWEEP_FORMAT = "flex-sweep-case/1"
+
+
+# ------------------------------------------------------------------------------------------
+# the default case function
+# ------------------------------------------------------------------------------------------
+def simulate_scene_case(name: str, scene: Scene) -> CaseResult:
+    """The default case: :func:`flex.solver.simulate_case` of the scene (never raises for a
+    diverged run: that is a ``failed`` case)."""
+    from .solver import simulate_case
+
+    return simulate_case(scene, name)
+
+
+def _guarded(function: Callable[..., Any], name: str, scene: Scene) -> Any:
+    """Run ``function(name, scene)``; any exception becomes a failed :class:`CaseResult`."""
+    try:
+        result = function(name, scene)
+    except BaseException as exc:  # noqa: BLE001 - a case must never stop the sweep
+        if isinstance(exc, KeyboardInterrupt | SystemExit):
+            raise
+        where = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
+        origin = f" (at {Path(where.filename).name}:{where.lineno})" if where else ""
+        return CaseResult(name, to_toml(scene), status="failed",
+                          message=f"{type(exc).__name__}: {exc}{origin}")
+    if not isinstance(result, CaseResult):
+        return CaseResult(name, to_toml(scene), status="failed",
+                          message=f"case function returned {type(result).__name__}, "
+                                  f"not CaseResult")
+    result.name = name
+    return result
+
+
+def _prepare_guarded(function: Callable[[Scene], Any], scene: Scene) -> tuple[bool, Any]:
+    try:
+        return True, function(scene)
+    except Exception as exc:  # noqa: BLE001 - recorded on the cases that needed it
+        return False, f"{type(exc).__name__}: {exc}"
+
+
+# ------------------------------------------------------------------------------------------
+# executors
+# ------------------------------------------------------------------------------------------
+class _DoneFuture:
+    """A finished future for the serial executor (``result()`` re-raises like a future)."""
+
+    def __init__(self, function: Callable[..., Any], args: tuple) -> None:
+        self._value: Any = None
+        self._error: BaseException | None = None
+        try:
+            self._value = function(*args)
+        except Exception as exc:  # noqa: BLE001 - delivered by result()
+            self._error = exc
+
+    def result(self) -> Any:
+        if self._error is not None:
+            raise self._error
+        return self._value
+
+    def running(self) -> bool:
+        return False
+
+
+class Executor:
+    """The executor seam: submit a function, wait for the first finished futures, close."""
+
+    description = "executor"
+    workers = 1
+
+    def submit(self, function: Callable[..., Any], *args: Any) -> Any:
+        raise NotImplementedError
+
+    def wait_first(self, futures: Iterable[Any], timeout: float | None = None) -> set:
+        """Futures of ``futures`` that are finished (at least one unless timed out)."""
+        raise NotImplementedError
+
+    def restart(self) -> None:
+        """Replace a broken pool (local processes only)."""
+
+    def isolated(self) -> Executor:
+        """A fresh single-worker executor for re-running a suspect case alone."""
+        return self
+
+    def close(self) -> None:
+        """Release workers (and the cluster, if this executor started one)."""
+
+
+class SerialExecutor(Executor):
+    """Runs every submission at once, in this process."""
+
+    description = "serial (in-process)"
+
+    def submit(self, function: Callable[..., Any], *args: Any) -> _DoneFuture:
+        return _DoneFuture(function, args)
+
+    def wait_first(self, futures: Iterable[Any], timeout: float | None = None) -> set:
+        return set(futures)
+
+
+class ProcessExecutor(Executor):
+    """``concurrent.futures.ProcessPoolExecutor`` with ``workers`` spawned processes."""
+
+    def __init__(self, workers: int | None = None) -> None:
+        import multiprocessing
+
+        self.workers = int(workers or os.cpu_count() or 1)
+        # spawn, not fork: Exudyn and NGsolve hold threads that a fork would copy half-way
+        self._context = multiprocessing.get_context("spawn")
+        self._pool = ProcessPoolExecutor(self.workers, mp_context=self._context)
+        self.description = f"local processes ({self.workers} workers)"
+
+    def submit(self, function: Callable[..., Any], *args: Any) -> Future:
+        return self._pool.submit(function, *args)
+
+    def wait_first(self, futures: Iterable[Any], timeout: float | None = None) -> set:
+        return wait(list(futures), timeout=timeout, return_when=FIRST_COMPLETED)[0]
+
+    def restart(self) -> None:
+        self._pool.shutdown(wait=False, cancel_futures=True)
+        self._pool = ProcessPoolExecutor(self.workers, mp_context=self._context)
+
+    def isolated(self) -> Executor:
+        return ProcessExecutor(1)
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=True, cancel_futures=True)
+
+
+class DaskExecutor(Executor):
+    """A ``dask.distributed.Client``: to ``address``, or to a new loopback ``LocalCluster``.
+
+    The local cluster has ``workers`` single-threaded worker processes (default: all cores)
+    bound to 127.0.0.1 without a dashboard; :meth:`close` stops it. A remote scheduler is
+    used as it is (its workers need ``flex`` installed and, to share reductions, a common
+    ``FLEX_CACHE_DIR``).
+    """
+
+    def __init__(self, address: str | None = None, workers: int | None = None) -> None:
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:  # pragma: no cover - a declared dependency
+            raise FlexError("scheduler: dask.distributed is not installed "
+                            "(pip install 'dask[distributed]')") from None
+        self._cluster = None
+        if address is None:
+            self.workers = int(workers or os.cpu_count() or 1)
+            self._cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
+                                         processes=True, host="127.0.0.1",
+                                         dashboard_address=None, silence_logs=40)
+            self.client = Client(self._cluster)
+            self.description = f"Dask local cluster ({self.workers} workers)"
+        else:
+            try:
+                self.client = Client(address, timeout="20s")
+            except OSError as exc:
+                raise FlexError(f"scheduler {address}: cannot connect ({exc})") from None
+            self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
+            self.description = f"Dask scheduler {address} ({self.workers} workers)"
+
+    def submit(self, function: Callable[..., Any], *args: Any) -> Any:
+        return self.client.submit(function, *args, pure=False)
+
+    def wait_first(self, futures: Iterable[Any], timeout: float | None = None) -> set:
+        from distributed import wait as dask_wait
+        from distributed.client import TimeoutError as DaskTimeout
+
+        futures = list(futures)
+        try:
+            return set(dask_wait(futures, timeout=timeout, return_when="FIRST_COMPLETED").done)
+        except (DaskTimeout, TimeoutError):
+            return {f for f in futures if f.done()}
+
+    def close(self) -> None:
+        self.client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+
+
+def make_executor(scheduler: str | None = None, workers: int | None = None) -> Executor:
+    """The executor for ``scheduler`` (see the module doc); unknown values are refused."""
+    if workers is not None and (not isinstance(workers, int) or workers < 1):
+        raise FlexError(f"workers = {workers!r}: must be an integer >= 1")
+    if scheduler in (None, "", "processes"):
+        return ProcessExecutor(workers)
+    if scheduler == "serial":
+        return SerialExecutor()
+    if scheduler == "local":
+        return DaskExecutor(None, workers)
+    if re.match(r"^(tcp|tls|inproc|ucx|ws|wss)://", scheduler):
+        return DaskExecutor(scheduler, workers)
+    raise FlexError(f"scheduler {scheduler!r}: expected processes (default), serial, local "
+                    f"(Dask on this machine) or a Dask address like tcp://host:8786")
+
+
+# ------------------------------------------------------------------------------------------
+# case files
+# ------------------------------------------------------------------------------------------
+def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
+    """Identity of a case: its resolved scene and the case function's qualified name."""
+    function, extra = case_function, ""
+    if isinstance(function, functools.partial):  # bound arguments are part of the identity
+        extra = repr((function.args, sorted(function.keywords.items())))
+        function = function.func
+    label = f"{function.__module__}.{function.__qualname__}{extra}"
+    return hashlib.sha256((label + "\n" + to_toml(scene)).encode()).hexdigest()[:24]
+
+
+def case_path(folder: str | Path, name: str) -> Path:
+    """``<folder>/cases/<name>.h5``."""
+    return Path(folder) / "cases" / f"{name}.h5"
+
+
+def write_case_file(folder: str | Path, case: CaseResult, digest: str, study: str) -> Path:
+    """Write one case to its own file, atomically (the hash goes in the root attributes)."""
+    return write_results(case_path(folder, case.name), study, [case], case.scene_toml,
+                         attrs={"sweep_case_hash": digest, "sweep_format": SWEEP_FORMAT})
+
+
+def _text(value: Any) -> Any:
+    return value.decode() if isinstance(value, bytes) else value
+
+
+def read_case_file(path: str | Path) -> tuple[CaseResult, str]:
+    """The :class:`CaseResult` stored in a case file and its case hash.
+
+    Raises :class:`flex.errors.ResultFileError` for a missing or damaged file.
+    """
+    import h5py
+
+    with open_results(path) as h5:
+        digest = str(_text(h5.attrs.get("sweep_case_hash", "")))
+        names = list(h5["cases"])
+        if len(names) != 1:
+            raise FlexError(f"case file '{path}' holds {len(names)} cases, expected 1")
+        group = h5["cases"][names[0]]
+        attrs = {k: _text(v) for k, v in group.attrs.items()}
+        datasets: dict[str, Dataset] = {}
+
+        def visit(name: str, obj: Any) -> None:
+            if isinstance(obj, h5py.Dataset):
+                value = obj[()]
+                if isinstance(value, bytes):
+                    value = value.decode()
+                datasets[name] = Dataset(value, str(_text(obj.attrs.get("units", ""))),
+                                         str(_text(obj.attrs.get("description", ""))))
+
+        group.visititems(visit)
+    counters = {k[len("counter_"):]: v for k, v in attrs.items() if k.startswith("counter_")}
+    fixed = ("status", "message", "scene_toml", "solver_settings_toml")
+    extra = {k: v for k, v in attrs.items() if k not in fixed and not k.startswith("counter_")}
+    case = CaseResult(names[0], str(attrs.get("scene_toml", "")), datasets,
+                      status=str(attrs.get("status", "failed")),
+                      message=str(attrs.get("message", "")), counters=counters,
+                      solver_settings_toml=str(attrs.get("solver_settings_toml", "")),
+                      attrs=extra)
+    return case, digest
+
+
+# ------------------------------------------------------------------------------------------
+# the sweep
+# ------------------------------------------------------------------------------------------
+@dataclass
+class SweepOutcome:
+    """What a sweep produced: every case (run now or read back) and how it went."""
+
+    results: dict[str, CaseResult]
+    folder: Path
+    executor: str
+    workers: int
+    ran: int = 0
+    resumed: int = 0
+    failed: int = 0
+    prepared: int = 0
+    wall_time_s: float = 0.0
+    case_wall_time_s: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass
+class _Job:
+    kind: str  # "prepare" or "case"
+    key: Any
+    function: Callable[..., Any]
+    args: tuple
+    affected: int = 0  # pool breaks this job was caught in
+    started: float = 0.0
+
+
+class _Progress:
+    def __init__(self, total: int, resumed: int, description: str, enabled: bool) -> None:
+        self.done = self.failed = 0
+        self.total = total
+        self.prepared = self.to_prepare = 0
+        self.bar = None
+        if enabled:
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, desc=description, unit="case", file=sys.stderr,
+                            mininterval=0.5, dynamic_ncols=True, leave=True)
+            if resumed:
+                self.bar.write(f"{description}: {resumed} cases resumed from their files, "
+                               f"{total} to run")
+        self._update()
+
+    def _update(self) -> None:
+        if self.bar is not None:
+            shared = (f" prepared={self.prepared}/{self.to_prepare}" if self.to_prepare
+                      else "")
+            self.bar.set_postfix_str(f"done={self.done} failed={self.failed} "
+                                     f"remaining={self.total - self.done - self.failed}"
+                                     + shared, refresh=False)
+
+    def case(self, ok: bool) -> None:
+        if ok:
+            self.done += 1
+        else:
+            self.failed += 1
+        if self.bar is not None:
+            self._update()
+            self.bar.update(1)
+
+    def preparation(self, done: bool = False) -> None:
+        if done:
+            self.prepared += 1
+        else:
+            self.to_prepare += 1
+        if self.bar is not None:
+            self._update()
+            self.bar.refresh()
+
+    def note(self, text: str) -> None:
+        if self.bar is not None:
+            self.bar.write(text)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+
+
+def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
+              case_function: CaseFunction = simulate_scene_case, *,
+              prepare: Callable[[Scene], Any] | None = None,
+              prepare_key: Callable[[Scene], Hashable | None] | None = None,
+              scheduler: str | None = None, workers: int | None = None,
+              executor: Executor | None = None, retry_failed: bool = False,
+              progress: bool = True, study: str = "sweep") -> SweepOutcome:
+    """Run (or resume) a sweep; return every case's result. See the module doc.
+
+    ``scenes`` maps case names (letters, digits, ``_.+-``; they become file names) to
+    validated scenes. ``executor`` (if given) is used and not closed; otherwise one is made
+    from ``scheduler``/``workers`` and closed at the end. Results come back in the order of
+    ``scenes``.
+    """
+    start = time.perf_counter()
+    folder = Path(folder)
+    for name in scenes:
+        if not _NAME.match(name):
+            raise FlexError(f"sweep case name {name!r}: use letters, digits and _ . + - only "
+                            f"(it becomes a file name)")
+    digests = {name: case_hash(scene, case_function) for name, scene in scenes.items()}
+    results: dict[str, CaseResult] = {}
+    for name in scenes:
+        path = case_path(folder, name)
+        if not path.exists():
+            continue
+        try:
+            case, digest = read_case_file(path)
+        except FlexError:
+            continue  # damaged or foreign: run again (the write replaces it atomically)
+        if digest == digests[name] and (case.status == "ok" or not retry_failed):
+            results[name] = case
+    resumed = len(results)
+    todo = [name for name in scenes if name not in results]
+    own_executor = executor is None
+    executor = executor or make_executor(scheduler, workers)
+    outcome = SweepOutcome({}, folder, executor.description, executor.workers,
+                           resumed=resumed)
+    bar = _Progress(len(todo), resumed, study, progress)
+    groups: dict[Hashable, list[str]] = {}
+    loose: list[str] = []
+    for name in todo:
+        key = prepare_key(scenes[name]) if (prepare and prepare_key) else None
+        if key is None:
+            loose.append(name)
+        else:
+            groups.setdefault(key, []).append(name)
+    pending: dict[Any, _Job] = {}
+    suspects: list[_Job] = []
+
+    def submit(job: _Job, where: Executor) -> None:
+        job.started = time.perf_counter()
+        pending[where.submit(*((_prepare_guarded, job.function) if job.kind == "prepare"
+                               else (_guarded, job.function)), *job.args)] = job
+
+    def case_job(name: str) -> _Job:
+        return _Job("case", name, case_function, (name, scenes[name]))
+
+    def record(name: str, case: CaseResult, seconds: float) -> None:
+        write_case_file(folder, case, digests[name], study)
+        results[name] = case
+        outcome.case_wall_time_s[name] = seconds
+        outcome.ran += 1
+        outcome.failed += case.status != "ok"
+        bar.case(case.status == "ok")
+
+    def finish(job: _Job, value: Any) -> None:
+        seconds = time.perf_counter() - job.started
+        if job.kind == "case":
+            record(job.key, value, seconds)
+            return
+        ok, detail = value
+        outcome.prepared += 1
+        bar.preparation(done=True)
+        for name in groups[job.key]:
+            if ok:
+                submit(case_job(name), executor)
+            else:
+                record(name, CaseResult(name, to_toml(scenes[name]), status="failed",
+                                        message=f"preparation failed: {detail}"), 0.0)
+
+    try:
+        for key, names in groups.items():
+            submit(_Job("prepare", key, prepare, (scenes[names[0]],)), executor)
+            bar.preparation()
+        for name in loose:
+            submit(case_job(name), executor)
+        while pending:
+            # who was running before this wait: if the pool breaks now, they are the suspects
+            running = {id(job) for future, job in pending.items() if _is_running(future)}
+            done = executor.wait_first(list(pending), timeout=0.5)
+            broken: list[_Job] = []
+            for future in done:
+                job = pending.pop(future)
+                try:
+                    value = future.result()
+                except BrokenProcessPool:
+                    broken.append(job)
+                    continue
+                except Exception as exc:  # noqa: BLE001 - e.g. Dask KilledWorker
+                    value = _lost(job, scenes, f"{type(exc).__name__}: {exc}")
+                finish(job, value)
+            if broken:
+                # a worker process died: every queued future of the pool failed with it
+                for future, job in list(pending.items()):
+                    broken.append(job)
+                    del pending[future]
+                executor.restart()
+                seen = [job for job in broken if id(job) in running]
+                for job in broken:
+                    job.affected += 1
+                    if id(job) in running or job.affected >= 2 or not seen:
+                        suspects.append(job)
+                    else:
+                        submit(job, executor)
+                bar.note(f"{study}: a worker process died; {len(suspects)} suspect case(s) "
+                         f"will be rerun alone")
+            if not pending and suspects:
+                _run_isolated(suspects, executor, scenes, finish)
+                suspects.clear()
+    finally:
+        bar.close()
+        if own_executor:
+            executor.close()
+    outcome.results = {name: results[name] for name in scenes if name in results}
+    outcome.wall_time_s = time.perf_counter() - start
+    return outcome
+
+
+def _is_running(future: Any) -> bool:
+    probe = getattr(future, "running", None)  # Dask futures have no running()
+    return bool(probe()) if callable(probe) else False
+
+
+def _lost(job: _Job, scenes: Mapping[str, Scene], message: str) -> Any:
+    if job.kind == "prepare":
+        return False, message
+    return CaseResult(job.key, to_toml(scenes[job.key]), status="failed", message=message)
+
+
+def _run_isolated(jobs: list[_Job], executor: Executor, scenes: Mapping[str, Scene],
+                  finish: Callable[[_Job, Any], None]) -> None:
+    """Rerun suspect jobs one at a time, each in a fresh single-worker process."""
+    for job in jobs:
+        alone = executor.isolated()
+        try:
+            job.started = time.perf_counter()
+            future = alone.submit(*((_prepare_guarded, job.function) if job.kind == "prepare"
+                                    else (_guarded, job.function)), *job.args)
+            try:
+                value = future.result()
+            except BrokenProcessPool:
+                value = _lost(job, scenes, "worker process died while running this case "
+                              "(crash: e.g. a segmentation fault or out of memory)")
+            except Exception as exc:  # noqa: BLE001
+                value = _lost(job, scenes, f"{type(exc).__name__}: {exc}")
+        finally:
+            if alone is not executor:
+                alone.close()
+        finish(job, value)
+
+
+# ------------------------------------------------------------------------------------------
+# settings from the environment, and ``python -m flex.sweep``
+# ------------------------------------------------------------------------------------------
+@dataclass
+class SweepSettings:
+    """Where and how a study's sweep runs (from the environment, see the module doc)."""
+
+    scheduler: str | None = None
+    workers: int | None = None
+    folder: Path | None = None
+    retry_failed: bool = False
+    progress: bool = True
+
+
+def settings_from_environment() -> SweepSettings:
+    """``FLEX_SCHEDULER``, ``FLEX_WORKERS``, ``FLEX_SWEEP_DIR``, ``FLEX_RETRY_FAILED``,
+    ``FLEX_PROGRESS`` (0 hides the bar)."""
+    workers = os.environ.get("FLEX_WORKERS") or None
+    try:
+        count = int(workers) if workers else None
+    except ValueError:
+        raise FlexError(f"FLEX_WORKERS = {workers!r}: must be an integer >= 1") from None
+    folder = os.environ.get("FLEX_SWEEP_DIR") or None
+    return SweepSettings(scheduler=os.environ.get("FLEX_SCHEDULER") or None, workers=count,
+                         folder=Path(folder) if folder else None,
+                         retry_failed=os.environ.get("FLEX_RETRY_FAILED", "") == "1",
+                         progress=os.environ.get("FLEX_PROGRESS", "1") != "0")
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m flex.sweep STUDY [--scheduler ADDR] [--workers N] [--folder DIR]
+    [--retry-failed] [--set K=V ...] [--out FILE.h5] [--no-figures] [--quiet]``."""
+    parser = argparse.ArgumentParser(prog="python -m flex.sweep",
+                                     description="run a sweep study on a chosen executor")
+    parser.add_argument("study", nargs="?", default="kfit")
+    parser.add_argument("--scheduler", help="processes (default), serial, local (Dask on this "
+                        "machine) or a Dask scheduler address tcp://host:8786")
+    parser.add_argument("--workers", type=int, help="worker processes (default: all cores)")
+    parser.add_argument("--folder", help="folder of the per-case files (resume point)")
+    parser.add_argument("--retry-failed", action="store_true", help="rerun failed cases")
+    parser.add_argument("--scene", metavar="FILE.toml")
+    parser.add_argument("--set", dest="overrides", action="append", default=[])
+    parser.add_argument("--out", metavar="FILE.h5")
+    parser.add_argument("--no-figures", action="store_true")
+    parser.add_argument("--quiet", action="store_true")
+    args = parser.parse_args(argv)
+    for variable, value in (("FLEX_SCHEDULER", args.scheduler),
+                            ("FLEX_WORKERS", args.workers and str(args.workers)),
+                            ("FLEX_SWEEP_DIR", args.folder),
+                            ("FLEX_RETRY_FAILED", "1" if args.retry_failed else None)):
+        if value:
+            os.environ[variable] = value
+    from .study import run_study
+
+    try:
+        output = run_study(args.study, args.scene, args.overrides, args.out,
+                           figures=not args.no_figures, quiet=args.quiet)
+    except FlexError as exc:
+        print(f"flex: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("flex: interrupted; finished cases are kept in their files (rerun to resume)",
+              file=sys.stderr)
+        return 130
+    return 1 if any(c.status != "ok" for c in output.results.values()) else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,200 @@
+"""Sweep engine: one file per case, resume, recorded failures and crashes, shared
+preparation, the local process pool and a real local Dask cluster."""
+
+import os
+import time
+
+import h5py
+import pytest
+
+from flex.errors import FlexError
+from flex.results import CaseResult, Dataset
+from flex.scene import load_scene
+from flex.sweep import (
+    SerialExecutor,
+    case_path,
+    make_executor,
+    read_case_file,
+    run_sweep,
+    simulate_scene_case,
+)
+
+
+def _rigid(angle_deg: float, *extra: str):
+    """A cheap rigid deployment: 50 steps of 1e-4 s."""
+    return load_scene(None, [f"crank.initial_angle_deg={angle_deg}", "simulation.step_s=1e-4",
+                             "simulation.end_time_s=0.005", *extra])
+
+
+def _scenes():
+    return {"a30": _rigid(30.0), "a40": _rigid(40.0), "a50": _rigid(50.0)}
+
+
+def failing_case(name: str, scene) -> CaseResult:
+    """Raises for the case named ``bad``; otherwise the default case."""
+    if name == "bad":
+        raise RuntimeError("this case is broken on purpose")
+    return simulate_scene_case(name, scene)
+
+
+def crashing_case(name: str, scene) -> CaseResult:
+    """Kills its worker process for the case named ``crash`` (as a segfault would)."""
+    if name == "crash":
+        os._exit(3)
+    return simulate_scene_case(name, scene)
+
+
+def tagged_prepare(scene) -> dict:
+    if scene["crank"]["initial_angle_deg"] > 45:
+        raise ValueError("no reduction for this geometry")
+    return {"ok": True}
+
+
+def angle_key(scene) -> str:
+    return "wide" if scene["crank"]["initial_angle_deg"] > 45 else "narrow"
+
+
+def test_serial_sweep_writes_one_file_per_case_and_records_failures(tmp_path):
+    scenes = {**_scenes(), "bad": _rigid(35.0)}
+    outcome = run_sweep(scenes, tmp_path, failing_case, scheduler="serial", progress=False)
+    assert list(outcome.results) == list(scenes)
+    assert outcome.ran == 4 and outcome.failed == 1 and outcome.resumed == 0
+    bad = outcome.results["bad"]
+    assert bad.status == "failed"
+    assert "RuntimeError: this case is broken on purpose" in bad.message
+    for name in scenes:
+        case, digest = read_case_file(case_path(tmp_path, name))
+        assert case.status == outcome.results[name].status and len(digest) == 24
+    good, _ = read_case_file(case_path(tmp_path, "a30"))
+    assert good.datasets["crank/angle"].units == "rad"
+    assert good.counters["steps"] >= 50 and good.counters["wall_time_s"] > 0
+    with h5py.File(case_path(tmp_path, "bad")) as h5:
+        assert h5["cases/bad"].attrs["status"] == "failed"
+
+
+def test_resume_runs_only_missing_changed_or_retried_cases(tmp_path):
+    scenes = {**_scenes(), "bad": _rigid(35.0)}
+    run_sweep(scenes, tmp_path, failing_case, scheduler="serial", progress=False)
+    again = run_sweep(scenes, tmp_path, failing_case, scheduler="serial", progress=False)
+    assert again.ran == 0 and again.resumed == 4
+    assert again.results["a40"].datasets["crank/angle"].data[0] == pytest.approx(
+        0.6981317, abs=1e-6)
+    case_path(tmp_path, "a40").unlink()  # an interrupted sweep: one file missing
+    scenes["a50"] = _rigid(50.0, "drive.spring_stiffness_N_per_m=1600.0")  # changed scene
+    partial = run_sweep(scenes, tmp_path, failing_case, scheduler="serial", progress=False)
+    assert partial.ran == 2 and partial.resumed == 2
+    assert partial.case_wall_time_s.keys() == {"a40", "a50"}
+    retried = run_sweep(scenes, tmp_path, failing_case, scheduler="serial", progress=False,
+                        retry_failed=True)
+    assert retried.ran == 1 and retried.failed == 1  # only the failed case ran again
+    case_path(tmp_path, "a30").write_bytes(b"truncated")  # a damaged file is rerun
+    assert run_sweep(scenes, tmp_path, failing_case, scheduler="serial",
+                     progress=False).ran == 1
+
+
+def test_preparation_runs_once_per_key_and_a_failed_one_fails_its_cases(tmp_path):
+    calls = []
+
+    def prepare(scene):
+        calls.append(angle_key(scene))
+        return tagged_prepare(scene)
+
+    scenes = {**_scenes(), "a35": _rigid(35.0), "a60": _rigid(60.0)}
+    outcome = run_sweep(scenes, tmp_path, simulate_scene_case, prepare=prepare,
+                        prepare_key=angle_key, executor=SerialExecutor(), progress=False)
+    assert sorted(calls) == ["narrow", "wide"]
+    assert outcome.prepared == 2
+    assert {n for n, c in outcome.results.items() if c.status == "failed"} == {"a50", "a60"}
+    assert "preparation failed: ValueError: no reduction" in outcome.results["a60"].message
+
+
+def test_progress_bar_shows_done_failed_remaining(tmp_path, capsys):
+    scenes = {"a30": _rigid(30.0), "bad": _rigid(35.0)}
+    run_sweep(scenes, tmp_path, failing_case, scheduler="serial", study="demo")
+    err = capsys.readouterr().err
+    assert "demo" in err and "done=1" in err and "failed=1" in err and "remaining=0" in err
+
+
+def test_bad_names_and_schedulers_are_refused(tmp_path):
+    with pytest.raises(FlexError, match="case name"):
+        run_sweep({"a/b": _rigid(30.0)}, tmp_path, scheduler="serial", progress=False)
+    with pytest.raises(FlexError, match="scheduler 'nope'"):
+        make_executor("nope")
+    with pytest.raises(FlexError, match="workers"):
+        make_executor("serial", workers=0)
+
+
+def test_local_process_pool_survives_a_crashing_worker(tmp_path):
+    scenes = {**_scenes(), "crash": _rigid(35.0)}
+    outcome = run_sweep(scenes, tmp_path, crashing_case, workers=2, progress=False)
+    assert outcome.executor == "local processes (2 workers)"
+    statuses = {name: case.status for name, case in outcome.results.items()}
+    assert statuses == {"a30": "ok", "a40": "ok", "a50": "ok", "crash": "failed"}
+    assert "worker process died" in outcome.results["crash"].message
+    assert read_case_file(case_path(tmp_path, "crash"))[0].status == "failed"
+
+
+def test_real_local_dask_cluster_runs_a_sweep(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    start = time.perf_counter()
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  host="127.0.0.1", dashboard_address=None,
+                                  silence_logs=40) as cluster:
+        address = cluster.scheduler_address
+        assert address.startswith("tcp://127.0.0.1:")
+        scenes = {**_scenes(), "bad": _rigid(35.0)}
+        outcome = run_sweep(scenes, tmp_path, failing_case, scheduler=address,
+                            progress=False)
+        assert outcome.executor == f"Dask scheduler {address} (2 workers)"
+        assert outcome.ran == 4 and outcome.failed == 1
+        assert outcome.results["a50"].status == "ok"
+        assert "broken on purpose" in outcome.results["bad"].message
+        # the same sweep again resumes entirely from the files
+        again = run_sweep(scenes, tmp_path, failing_case, scheduler=address, progress=False)
+        assert again.ran == 0 and again.resumed == 4
+    assert time.perf_counter() - start < 60
+
+
+def test_results_round_trip_keeps_units_and_attributes(tmp_path):
+    case = CaseResult("x", "[crank]\n", {"measures/e": Dataset(0.5, "1", "an error"),
+                                         "curves/t": Dataset([0.0, 1.0], "s", "time")},
+                      counters={"wall_time_s": 1.5}, attrs={"fidelity_coupler_model": "rigid"})
+    outcome = run_sweep({"x": _rigid(30.0)}, tmp_path,
+                        lambda name, scene: case, scheduler="serial", progress=False)
+    assert outcome.results["x"].status == "ok"
+    loaded, _ = read_case_file(case_path(tmp_path, "x"))
+    assert loaded.datasets["measures/e"].units == "1"
+    assert list(loaded.datasets["curves/t"].data) == [0.0, 1.0]
+    assert loaded.attrs["fidelity_coupler_model"] == "rigid"
+    assert loaded.counters["wall_time_s"] == 1.5
+
+
+@pytest.mark.slow
+def test_kfit_study_small_end_to_end(tmp_path, monkeypatch):
+    """A shrunken kfit (3 thicknesses, 1 stiffness family, 1 validation scene) through the
+    study runner and the local process pool: cases, fit, criterion file, validation."""
+    import studies.kfit as kfit
+    from flex.study import run_study
+
+    monkeypatch.setattr(kfit, "THICKNESSES_M", (1e-3, 3e-3, 10e-3))
+    monkeypatch.setattr(kfit, "STIFFNESS_THICKNESSES_M", (1e-3,))
+    monkeypatch.setattr(kfit, "STIFFNESSES_N_PER_M", (500.0, 5000.0))
+    monkeypatch.setattr(kfit, "PRELOAD_THICKNESSES_M", ())
+    monkeypatch.setattr(kfit, "DAMPING_RATIOS", (0.0,))
+    monkeypatch.setattr(kfit, "VALIDATION", {"val_t7mm_tol1pct": (
+        ["coupler.thickness_m=0.007"], 0.01)})
+    monkeypatch.setenv("FLEX_SWEEP_DIR", str(tmp_path / "cases"))
+    monkeypatch.setenv("FLEX_PROGRESS", "0")
+    output = run_study("kfit", out=tmp_path / "kfit.h5", figures=True, quiet=True)
+    assert all(c.status == "ok" for c in output.results.values())
+    law = kfit.analyse(output.results)["fits"][(0.0, "stop", "deflection")]
+    assert 1.5 < law.exponent < 3.0  # quasi-static expectation: 2
+    assert (tmp_path / "kfit-criterion.toml").exists()
+    validation = output.results["val_t7mm_tol1pct"]
+    assert validation.attrs["fidelity_coupler_model"] == "rigid"
+    assert validation.datasets["errors/governing"].data <= 0.01
+    with h5py.File(tmp_path / "kfit.h5") as h5:
+        assert "summary/k/zeta_0/stop/governing/central_thesis" in h5
+        assert h5["summary/table/measures/deflection"].attrs["units"] == "1"
+    assert {p.name for p in output.figures} == {"kfit-error-vs-n.png",
+                                                 "kfit-k-vs-tolerance.png"}
