@@ -24,6 +24,13 @@ setup: $(STAMP)
 $(STUDIES): $(STAMP)
 	$(RUN) $@
 
+# long runs, not part of `all` (README "Speed and accuracy", "Numerical stability"); each
+# writes results/<target>.h5 and figures. Measured on 2 shared cores: see the README.
+LONG := tradeoff stability bench
+.PHONY: $(LONG)
+$(LONG): $(STAMP)
+	$(RUN) $@
+
 # after make kfit: install its fit as the criterion that model = "auto" reads (commit it)
 kfit-criterion: results/kfit-criterion.toml
 	cp results/kfit-criterion.toml flex/criteria_fit.toml

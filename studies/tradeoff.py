@@ -39,6 +39,7 @@ from flex.tradeoff import (
     Reference,
     Setting,
     converged_reference,
+    fastest,
     measure,
     measurements_table,
     pareto_front,
@@ -79,10 +80,12 @@ def reference_plan(scene_name: str) -> tuple[Setting, dict[str, Setting], float,
                                                       newton_relative_tolerance=1e-10),
         }, 1e-8, ("scipy DOP853 on the 9-coordinate DAE, rtol 1e-13, atol 1e-15; shown "
                   "converged by rtol 1e-12 and by flex's Exudyn model at h = 1e-6 s")
+    # the peak deflection carries the plate's higher bending modes (3.2 and 9 kHz at 1 mm,
+    # ten times that at 10 mm): the reference step resolves them
     if scene_name == "ffrf_1mm":
-        mesh, modes, step = 0.0015, 12, 5e-6
+        mesh, modes, step = 0.0015, 12, 2.5e-6
     else:
-        mesh, modes, step = 0.003, 12, 2.5e-6
+        mesh, modes, step = 0.0025, 12, 1.25e-6
 
     def ref(label: str, **knobs: Any) -> Setting:
         values = {"step_s": step, "coupler__mesh_size_m": mesh, "coupler__modes": modes,
@@ -120,7 +123,7 @@ def settings(scene_name: str, nonlinear_available: bool) -> list[Setting]:
                          **base))
         out.append(S("h=1e-5 index2", one + "index 2", formulation="index2", **base))
         out.append(S("h=1e-5 modified", one + "Newton", newton="modified", **base))
-        for tol in (1e-8, 1e-6):
+        for tol in (1e-10, 1e-6):
             out.append(S(f"h=1e-5 tol={tol:g}", one + "Newton tolerance",
                          newton_relative_tolerance=tol, **base))
         out.append(S("h=1e-5 explicit RK44 k=1e8", one + "explicit + penalty",
@@ -165,7 +168,7 @@ def settings(scene_name: str, nonlinear_available: bool) -> list[Setting]:
     out.append(S(f"h={base_step:g} index2 rho=1", one + "index 2", formulation="index2",
                  spectral_radius=1.0, **base))
     out.append(S(f"h={base_step:g} modified", one + "Newton", newton="modified", **base))
-    for tol in (1e-8, 1e-6):
+    for tol in (1e-10, 1e-6):
         out.append(S(f"h={base_step:g} tol={tol:g}", one + "Newton tolerance",
                      newton_relative_tolerance=tol, **base))
     for modes in (2, 4, 12):
@@ -190,8 +193,6 @@ def settings(scene_name: str, nonlinear_available: bool) -> list[Setting]:
                              "combination: step x mesh x modes (modified Newton, tol 1e-8)",
                              step_s=step, coupler__mesh_size_m=mesh, coupler__modes=modes,
                              **fast))
-        out.append(S(f"h={step:g} full tol=1e-8", "combination: step x Newton", step_s=step,
-                     newton_relative_tolerance=1e-8))
     return out
 
 
@@ -304,7 +305,7 @@ def default_recommendation(measurements: list[Measurement]) -> Measurement | Non
               and m.errors["slider_position_m"] <= limit["slider_position_m"]
               and dict(m.setting.overrides).get("simulation.step_s", np.inf)
               <= limit["max_step_s"] * (1 + 1e-9)]
-    return min(within, key=lambda m: m.wall_time_s) if within else None
+    return fastest(within) if within else None
 
 
 def _describe(m: Measurement | None) -> str:

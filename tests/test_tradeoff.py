@@ -161,3 +161,27 @@ def test_knob_values_are_validated_with_the_accepted_range(overrides, words):
         load_scene(overrides=overrides)
     for word in words:
         assert word in str(error.value)
+
+
+@pytest.mark.slow
+def test_bundled_defaults_are_the_fastest_setting_within_the_default_tolerance():
+    # the tradeoff study's rule (studies/tradeoff.py: DEFAULT_TOLERANCE): crank angle 1e-6
+    # rad, slider 1e-7 m, step <= 1e-5 s (the thesis table's output grid); over the Newton
+    # knobs at the largest step allowed, the defaults must be the study's pick
+    from studies.tradeoff import DEFAULT_TOLERANCE, default_recommendation
+
+    base = load_scene()
+    reference = converged_reference(
+        base, "rigid", Setting("scipy 1e-13", engine="scipy", rtol=1e-13, atol=1e-15),
+        {"rtol x10": Setting("scipy 1e-12", engine="scipy", rtol=1e-12, atol=1e-14)}, 1e-8)
+    step = DEFAULT_TOLERANCE["max_step_s"]
+    runs = [measure(base, Setting.of(f"{newton} {tol:g}", step_s=step, newton=newton,
+                                     newton_relative_tolerance=tol), reference, repeats=3)
+            for newton in ("full", "modified") for tol in (1e-10, 1e-8)]
+    best = default_recommendation(runs)
+    assert best is not None
+    knobs = dict(best.setting.overrides)
+    sim = base["simulation"]
+    assert sim["step_s"] == step
+    assert (sim["newton"], sim["newton_relative_tolerance"]) == (
+        knobs["simulation.newton"], knobs["simulation.newton_relative_tolerance"])
