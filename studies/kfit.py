@@ -235,6 +235,21 @@ def prepare_reduction(scene: Scene) -> dict[str, Any]:
             "build_time_s": reduction.build_time_s}
 
 
+def full_scene(scene: Scene) -> Scene:
+    """The validation reference: the scene's coupler as FFRF with :data:`FULL_MODES` modes."""
+    return _with(scene, coupler__model="ffrf", coupler__modes=FULL_MODES)
+
+
+def full_geometry_key(scene: Scene) -> tuple | None:
+    """Preparation key of a validation case: its full model's reduction."""
+    return geometry_key(full_scene(scene))
+
+
+def prepare_full_reduction(scene: Scene) -> dict[str, Any]:
+    """Validation preparation: the full model's reduction (auto builds its own if FFRF)."""
+    return prepare_reduction(full_scene(scene))
+
+
 def _with(scene: Scene, **changes: Any) -> Scene:
     out = copy.deepcopy(scene)
     for dotted, value in changes.items():
@@ -381,11 +396,11 @@ def validation_case(name: str, scene: Scene, criterion_toml: str = "") -> CaseRe
                 os.environ.pop("FLEX_CRITERION", None)
             else:
                 os.environ["FLEX_CRITERION"] = previous
-    full_scene = _with(scene, coupler__model="ffrf", coupler__modes=FULL_MODES)
+    reference = full_scene(scene)
     start = time.perf_counter()
-    full_reduction = reduction_of(full_scene)
+    full_reduction = reduction_of(reference)
     full_reduction_s = time.perf_counter() - start
-    full = simulate(full_scene, "full", full_reduction)
+    full = simulate(reference, "full", full_reduction)
     auto_data, full_data = _data(auto), _data(full)
     times = criteria.deployment_times(full_data["time"], full_data["crank/angle"],
                                       full_data["crank/angular_velocity"])
@@ -465,7 +480,7 @@ def simulate_cases(scenes: dict[str, Scene],
         if val_scenes:
             second = run_sweep(val_scenes, folder,
                                functools.partial(validation_case, criterion_toml=criterion_text),
-                               prepare=prepare_reduction, prepare_key=geometry_key,
+                               prepare=prepare_full_reduction, prepare_key=full_geometry_key,
                                executor=executor, retry_failed=settings.retry_failed,
                                progress=settings.progress, study="kfit validation")
             results.update(second.results)
