@@ -7,6 +7,7 @@ printed as one line ``flex: error: ...`` and exits with status 2; no traceback.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from .errors import FlexError
@@ -31,6 +32,11 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--out", metavar="FILE.h5", help="result file (default results/STUDY.h5)")
     run.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     run.add_argument("--quiet", action="store_true", help="print nothing on success")
+    run.add_argument("--scheduler", metavar="ADDRESS",
+                     help="sweeps (kfit): 'local' (local Dask cluster), tcp://host:8786 (a Dask "
+                          "scheduler) or 'serial'; default: a process pool on all cores")
+    run.add_argument("--workers", type=int, metavar="N",
+                     help="sweeps: number of local worker processes (default: all cores)")
     scene = commands.add_parser("scene", help="print the fully resolved scene as TOML")
     scene_options(scene)
     _result_tools(commands)
@@ -142,6 +148,12 @@ def main(argv: list[str] | None = None) -> int:
         if args.command == "run":
             from .study import run_study
 
+            if args.scheduler:
+                os.environ["FLEX_SCHEDULER"] = args.scheduler
+            if args.workers is not None:
+                if args.workers < 1:
+                    raise FlexError(f"--workers {args.workers}: must be at least 1")
+                os.environ["FLEX_WORKERS"] = str(args.workers)
             output = run_study(args.study, args.scene, args.overrides, args.out,
                                figures=not args.no_figures, quiet=args.quiet)
             return 1 if any(c.status != "ok" for c in output.results.values()) else 0

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from .errors import SceneError
 from .kinematics import slider_crank
 from .scene import Scene, plate_mass_properties
 
@@ -228,6 +229,9 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
         if scene["wing"]["enabled"] else None
 
     model = scene["coupler"]["model"]
+    if model == "auto" or scene["crank"].get("model") == "auto":
+        raise SceneError('model = "auto" must be resolved before building (flex.solver.simulate '
+                         "does it with flex.criteria.resolve_fidelity)")
     if model == "ffrf":
         from .reduction import add_ffrf_coupler
 

@@ -21,7 +21,7 @@ def plate_mesh(length_m: float, thickness_m: float, width_m: float, mesh_size_m:
         if not value > 0:
             raise SceneError(f"plate {name} = {value!r}: must be a positive number of metres")
     import ngsolve as ngs
-    from netgen.occ import X, Box, OCCGeometry, Pnt
+    from netgen.occ import Box, OCCGeometry, Pnt, X
 
     box = Box(Pnt(0.0, -thickness_m / 2, -width_m / 2),
               Pnt(length_m, thickness_m / 2, width_m / 2))
