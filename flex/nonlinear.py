@@ -1,34 +1,44 @@
 """Fully nonlinear FE coupler: the accuracy reference for the FFRF reduction.
 
 The same plate mesh as :mod:`flex.reduction` (:func:`flex.plate.plate_mesh`, second-order
-tetrahedra, end faces ``end_a`` at joint B and ``end_b`` at joint C) becomes an Exudyn
-``ObjectGenericODE2`` through ``FEMinterface.CreateNonlinearFEMObjectGenericODE2NGsolve``:
-every mesh node is a ``NodePoint`` (3 displacement coordinates), the mass matrix is the
-consistent one of the mesh, and the elastic forces and their Jacobian come from NGsolve with
-the Green-Lagrange strain and a St. Venant-Kirchhoff material -- large rotations and
-geometric stiffening (the axial force of the link changing its bending stiffness) are exact,
-which the FFRF body (linear elasticity in a floating frame) leaves out. Orders of magnitude
-slower than the FFRF body (Python user functions, ~10k coordinates, sparse LU per Newton
-iteration): use it over short spans, to check the reduction.
+tetrahedra, end faces ``end_a`` at joint B and ``end_b`` at joint C, the same node numbering)
+becomes an Exudyn ``ObjectGenericODE2``: every mesh node is a ``NodePoint`` (3 displacement
+coordinates), the mass matrix is the mesh's consistent one, and the elastic forces and their
+Jacobian come from NGsolve with the Green-Lagrange strain and a St. Venant-Kirchhoff material
+-- the formulation of Exudyn's ``FEMinterface.CreateNonlinearFEMObjectGenericODE2NGsolve``.
+Large rotations and geometric stiffening (the link's axial force changing its bending
+stiffness) are exact; the FFRF body (linear elasticity in a floating frame) leaves them out.
+Orders of magnitude slower than the FFRF body (Python callbacks, ~10k coordinates, a sparse
+LU per Jacobian): use it over short spans, to check the reduction.
+
+Why not Exudyn's function itself: with ``meshOrder=2`` (needed: linear tets lock) Exudyn
+1.13.6 makes the mesh second order twice (once itself, once in ``ImportMeshFromNGsolve``),
+and the second pass adds unconnected nodes (1 mm plate: 3209 -> 4092 nodes, 883 of them
+without mass or stiffness), which leaves the system singular. This module imports once.
 
 Body coordinates (metres) are the mesh's, as in :mod:`flex.reduction`: x along the link from
 the centre of ``end_a`` (joint B) to the centre of ``end_b`` (joint C), y across the thickness
 (in the mechanism plane), z across the width.
 
-Placement: the nodes keep the mesh positions as reference coordinates, and the rigid
-placement (translation to joint B, rotation by the coupler angle about z) is the initial
-value of their displacement coordinates. The Green-Lagrange strain of a rigid motion is zero,
-so the body starts unstrained wherever it is put.
+Placement: the Exudyn nodes' reference positions are the *placed* ones (end_a's centre at
+joint B, link axis turned by the coupler angle about z), with zero initial displacement; the
+elastic forces are evaluated on the mesh with the constant offset (placed - mesh position)
+added to the displacements. The Green-Lagrange strain of a rigid motion is zero, so the body
+starts unstrained, and the face markers start with the identity rotation (below).
 
 Joints: ``marker_B`` and ``marker_C`` are ``MarkerSuperElementRigid`` markers on the end-face
-nodes (surface-area weights). On a GenericODE2 such a marker's position is the weighted mean
-of the face nodes (exact), and its rotation is the exponential map of a rotation vector that
-Exudyn computes *linearly* from the face-node displacements (``useAlternativeApproach``: an
-inertia-weighted average, RBE3-like; the face itself stays deformable). For a face turned by
-phi about z that vector points exactly along z with length ~ sin(phi) instead of phi; the
-revolute joint at B only holds the marker's z axis normal to the crank's x-y axes, i.e. the
-out-of-plane tilt of the face, so the in-plane error does not enter (the joint is free about
-z). Joint C constrains only x and y and uses the marker's position alone.
+nodes (surface-area weights; RBE3-like: the faces stay deformable, where the FFRF body's are
+rigid). On a GenericODE2 such a marker's position is the weighted mean of the face nodes
+(exact), but its rotation is the exponential map of a rotation vector that Exudyn computes
+*linearly* from the face-node displacements relative to their reference positions: for a
+face turned by phi about z it reports an angle sin(phi), and on a face whose weights are not
+symmetric (any unstructured mesh) its z axis tilts by about (1 - cos phi) x (asymmetry) --
+measured 1.8e-3 rad at phi = 0.3 on a coarse 5 mm face. The revolute joint at B holds exactly
+that z axis (it constrains the face's out-of-plane tilt; it is free about z, so the sin(phi)
+error does not enter), and would force the spurious tilt onto the face: hence the placed
+reference, which keeps phi at the coupler's rotation since t = 0 (small over the first
+deflection peaks, ~0.25 rad over the whole deployment). Joint C constrains only x and y and
+uses the marker's position alone.
 """
 
 from __future__ import annotations
@@ -43,7 +53,7 @@ import numpy as np
 
 from .errors import SceneError
 from .plate import plate_mesh
-from .reduction import END_A, END_B, _mid_set
+from .reduction import END_A, END_B, _mid_set, _ngsolve_thread_count
 
 _MESH_ORDER = 2  # as the reduction: linear tets lock in bending
 
@@ -95,13 +105,17 @@ class NonlinearPlate:
 
 def build_nonlinear_plate(length_m: float, thickness_m: float, width_m: float,
                           youngs_modulus_Pa: float, density_kg_per_m3: float,
-                          poisson_ratio: float, mesh_size_m: float) -> NonlinearPlate:
+                          poisson_ratio: float, mesh_size_m: float, *,
+                          ngsolve_threads: int | None = 1) -> NonlinearPlate:
     """Mesh the plate and find its joint and midpoint node sets.
 
     Contract: sizes in metres, E in Pa, density in kg/m^3, ``mesh_size_m`` is netgen's maxh;
     the same arguments as :func:`flex.reduction.build_reduction` (without ``modes``) give the
-    same mesh. Bad values raise :class:`flex.errors.SceneError`. Nothing is cached: meshing
-    takes about a second; the bodies are made per system by :func:`add_nonlinear_fe_coupler`.
+    same mesh, node numbering and node sets. Bad values raise
+    :class:`flex.errors.SceneError`. ``ngsolve_threads`` as in ``build_reduction`` (1: the
+    import's assembly took 0.85 s with NGsolve's default threads on the shared 2-core
+    machine, 0.05 s with one). Nothing is cached: meshing takes one to a few seconds; the
+    bodies are made per system by :func:`add_nonlinear_fe_coupler`.
     """
     start = time.perf_counter()
     sizes = {"length_m": length_m, "thickness_m": thickness_m, "width_m": width_m,
@@ -121,13 +135,15 @@ def build_nonlinear_plate(length_m: float, thickness_m: float, width_m: float,
                          f"length_m ({length_m!r})")
     from exudyn.FEM import FEMinterface
 
-    mesh = plate_mesh(length_m, thickness_m, width_m, mesh_size_m)
-    fem = FEMinterface()
-    # the reduction's import: it makes the mesh second order in place (once only: a second
-    # call adds unconnected nodes) and numbers the nodes as the reduction does
-    fem.ImportMeshFromNGsolve(mesh, density=density_kg_per_m3, youngsModulus=youngs_modulus_Pa,
-                              poissonsRatio=poisson_ratio, meshOrder=_MESH_ORDER,
-                              boundaryNamesList=[END_A, END_B])
+    with _ngsolve_thread_count(ngsolve_threads):
+        mesh = plate_mesh(length_m, thickness_m, width_m, mesh_size_m)
+        fem = FEMinterface()
+        # the reduction's import: it makes the mesh second order in place (once only: a
+        # second call adds unconnected nodes) and numbers the nodes as the reduction does
+        fem.ImportMeshFromNGsolve(mesh, density=density_kg_per_m3,
+                                  youngsModulus=youngs_modulus_Pa,
+                                  poissonsRatio=poisson_ratio, meshOrder=_MESH_ORDER,
+                                  boundaryNamesList=[END_A, END_B])
     positions = fem.GetNodePositionsAsArray()
     face_sets = {}
     for node_set in fem.nodeSets:
@@ -164,10 +180,12 @@ class _HyperelasticForces:
     second-order mesh (the formulation of Exudyn's CreateNonlinearFEMObjectGenericODE2NGsolve).
     NGsolve orders the coordinates by component (x of every node, then y, then z), Exudyn by
     node; fixed permutations map between the two, and the Jacobian's sparsity pattern is
-    permuted once and reused. Counts calls and the time spent in them.
+    permuted once and reused. ``offset_m`` (Exudyn order, metres) is added to the Exudyn
+    displacements to give the displacements from the mesh positions (the placement). Counts
+    calls and the time spent in them.
     """
 
-    def __init__(self, plate: NonlinearPlate) -> None:
+    def __init__(self, plate: NonlinearPlate, offset_m: np.ndarray) -> None:
         import ngsolve as ngs
 
         mu = plate.youngs_modulus_Pa / (2 * (1 + plate.poisson_ratio))
@@ -191,16 +209,17 @@ class _HyperelasticForces:
         # NGsolve index of Exudyn coordinate 3 i + c (node i, component c) is c n + i
         self._ngsolve_index = (coordinate % 3) * n_nodes + coordinate // 3
         self._exudyn_index = np.argsort(self._ngsolve_index)
+        self._offset_m = np.asarray(offset_m, dtype=float).ravel()  # Exudyn order
         self._jacobian_layout: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self.force_calls = 0
         self.jacobian_calls = 0
         self.time_s = 0.0
 
     def _set_state(self, q) -> None:
-        self._state.vec.FV().NumPy()[self._ngsolve_index] = np.asarray(q)
+        self._state.vec.FV().NumPy()[self._ngsolve_index] = np.asarray(q) + self._offset_m
 
     def force(self, mbs, t, item_index, q, q_t) -> np.ndarray:
-        """Minus the internal elastic forces [N] at displacements ``q`` [m], Exudyn order."""
+        """Minus the internal elastic forces [N] at Exudyn displacements ``q`` [m]."""
         start = time.perf_counter()
         self._set_state(q)
         self._form.Apply(self._state.vec, self._residual)
@@ -256,8 +275,9 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
     Contract:
       - placement as :func:`flex.reduction.add_ffrf_coupler`: the centre of ``end_a`` is put at
         ``position_B`` [m, global], the link axis (body x) turned by ``angle_rad`` about global
-        z; C's reference position is ``position_B + length * (cos, sin, 0)``. The body starts
-        unstrained (rigid placement as initial displacements, see the module doc).
+        z; C's reference position is ``position_B + length * (cos, sin, 0)``. The nodes'
+        reference positions are the placed ones (see the module doc); the body starts
+        unstrained.
       - initial velocity: the rigid-body field of point B's velocity [m/s] and the angular
         velocity about z [rad/s]; default rest.
       - markers: ``marker_B`` / ``marker_C`` are ``MarkerSuperElementRigid`` on the end faces
@@ -291,11 +311,10 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
     placed = position_B + reference @ rotation.T
     omega = np.array([0.0, 0.0, float(initial_angular_velocity_rad_per_s)])
     velocities = velocity_B + np.cross(omega, placed - position_B)
-    nodes = [mbs.AddNode(eii.NodePoint(referenceCoordinates=list(start),
-                                       initialCoordinates=list(displaced - start),
+    nodes = [mbs.AddNode(eii.NodePoint(referenceCoordinates=list(position),
                                        initialVelocities=list(velocity)))
-             for start, displaced, velocity in zip(reference, placed, velocities, strict=True)]
-    elastic = _HyperelasticForces(plate)
+             for position, velocity in zip(placed, velocities, strict=True)]
+    elastic = _HyperelasticForces(plate, placed - reference)
     mass = exu.MatrixContainer()
     mass.SetWithSparseMatrix(plate.mass_matrix)
     body = mbs.AddObject(eii.ObjectGenericODE2(
