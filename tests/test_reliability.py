@@ -99,12 +99,13 @@ def test_killed_runs_leave_the_previous_file_intact(tmp_path):
         what = f"{sig.name} at {when}: rc {result.returncode}, stderr {result.stderr[-300:]!r}"
         with open_results(out) as h5:  # never half-written: always a complete flex file
             assert "cases/constant_speed/slider/position" in h5, what
-        if out.read_bytes() != previous:
-            # only acceptable if the run got past the atomic rename: a complete new file
-            assert when != "writing", what
+        late = out.read_bytes() != previous
+        if late:
+            # the signal landed after the atomic rename (the write phase lasts only tenths of
+            # a second, so this race is real): then the new file must be complete
             assert len(read_case(out, "constant_speed")["time"]) == 10001, what
             previous = out.read_bytes()
-        if when == "writing" and sig == signal.SIGINT:
+        if when == "writing" and sig == signal.SIGINT and not late:
             assert result.returncode == 130, what
             assert result.stderr.strip() == "flex: interrupted; no result file was changed"
         others = {p.name for p in tmp_path.iterdir()} - {out.name}
