@@ -12,6 +12,13 @@ relative to the chord B-C), ``coupler/chord_change``, ``coupler/midpoint_acceler
 ``/summary/models/<model>``: the reduction's frequencies, mesh statistics and the
 deviations of the FFRF run from its rigid twin, and n = delta_t / T in both period
 conventions (thesis: T = 1/omega; physical: T = 2 pi / omega).
+
+Accuracy reference: the thinnest model also runs with the fully nonlinear FE coupler
+(:mod:`flex.nonlinear`: the same mesh, Green-Lagrange strain, no reduction) over
+``NONLINEAR_END_TIME_S`` (default: the whole deployment); ``/summary/nonlinear_reference/
+<model>`` holds its first and largest deflection peaks against the FFRF run's over the same
+span, the largest difference of the two curves, the axial load of the link against its
+Euler load (the geometric softening the linear FFRF body leaves out) and both wall times.
 """
 
 from __future__ import annotations
@@ -21,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from flex.nonlinear import nonlinear_plate_for_scene
 from flex.plotting import figure
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, validate
@@ -28,7 +36,8 @@ from flex.solver import reduction_for_scene, simulate_case
 from flex.study import Summary
 
 NAME = "flexible"
-DESCRIPTION = "FFRF coupler plates t = 1, 3, 5, 10 mm against their rigid twins"
+DESCRIPTION = ("FFRF coupler plates t = 1, 3, 5, 10 mm against their rigid twins; nonlinear FE "
+               "reference for t = 1 mm")
 OVERRIDES = ['coupler.geometry="plate"']
 
 # Table 5 models: thickness [m] and the netgen mesh size used for each (about the thickness,
@@ -36,6 +45,12 @@ OVERRIDES = ['coupler.geometry="plate"']
 MODELS = {"model0_t1mm": (0.001, 0.002), "model1_t3mm": (0.003, 0.003),
           "model2_t5mm": (0.005, 0.005), "model3_t10mm": (0.010, 0.005)}
 THESIS_DEPLOYMENT_TIME_S = 0.016128  # thesis sec. 6.2, Table 5 note
+# the nonlinear FE reference: the thinnest plate (largest deflection, lowest Euler load)
+# over the whole deployment (None: the scene's end time; 0.002 covers the first peak). It
+# costs ~0.1 s per step against ~2 ms for the FFRF body: 4.6 min of CPU, 7.4 min wall on the
+# shared 2-core machine, most of the study's time
+NONLINEAR_MODEL = "model0_t1mm"
+NONLINEAR_END_TIME_S: float | None = None
 
 
 def cases(scene: Scene) -> dict[str, Scene]:
@@ -47,6 +62,16 @@ def cases(scene: Scene) -> dict[str, Scene]:
                                            f'coupler.model="{kind}"'])
             validate(case)
             out[f"{model}_{kind}"] = case
+    if scene["coupler"]["damping_ratio"] != 0:  # the nonlinear FE body has no damping
+        return out
+    thickness_m, mesh_m = MODELS[NONLINEAR_MODEL]
+    end_time = ([] if NONLINEAR_END_TIME_S is None
+                else [f"simulation.end_time_s={NONLINEAR_END_TIME_S}"])
+    case = apply_overrides(scene, [f"coupler.thickness_m={thickness_m}",
+                                   f"coupler.mesh_size_m={mesh_m}",
+                                   'coupler.model="nonlinear_fe"', *end_time])
+    validate(case)
+    out[f"{NONLINEAR_MODEL}_nonlinear_fe"] = case
     return out
 
 
@@ -57,12 +82,21 @@ def simulate_cases(scenes: dict[str, Scene],
     for index, (name, scene) in enumerate(scenes.items()):
         if progress:
             progress(name, index, len(scenes))
-        reduction = reduction_for_scene(scene) if scene["coupler"]["model"] == "ffrf" else None
+        model = scene["coupler"]["model"]
+        reduction = None
+        if model == "ffrf":
+            reduction = reduction_for_scene(scene)
+        elif model == "nonlinear_fe":
+            reduction = nonlinear_plate_for_scene(scene)  # the mesh and its node sets
         case = simulate_case(scene, name, reduction)
-        if reduction is not None:
+        if model == "ffrf":
             case.attrs.update(reduction_key=reduction.key,
                               reduction_from_cache=reduction.from_cache,
                               reduction_build_time_s=reduction.build_time_s)
+        elif model == "nonlinear_fe":
+            case.attrs.update(fe_nodes=reduction.n_nodes, fe_dof=reduction.n_dof,
+                              fe_elements=reduction.n_elements,
+                              fe_mesh_time_s=reduction.build_time_s)
         results[name] = case
     if progress:
         progress("done", len(scenes), len(scenes))
@@ -123,7 +157,135 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
                      f"{crank_dev:13.2e} {stress / 1e6:11.2f} {wall:8.2f}")
     lines.append("  n thesis = delta_t * omega (thesis Table 5 takes T = 1/omega); "
                  "n 2pi/w = delta_t / T with the physical period; delta_t = 0.016128 s")
+    lines += nonlinear_reference(scene, results, datasets)
     return Summary(datasets, "\n".join(lines))
+
+
+def first_peak_index(deflection: np.ndarray) -> int:
+    """Index of the first extreme: the largest |deflection| of the first lobe.
+
+    The first lobe starts where |deflection| first exceeds 10 % of its largest value and
+    ends where the deflection changes sign (or with the series), so the ripple of higher
+    modes riding on the first swing does not count as a peak.
+    """
+    magnitude = np.abs(deflection)
+    start = int(np.argmax(magnitude > 0.1 * magnitude.max()))
+    sign_changes = np.flatnonzero(np.sign(deflection[start:]) != np.sign(deflection[start]))
+    end = start + int(sign_changes[0]) if len(sign_changes) else len(deflection)
+    return start + int(np.argmax(magnitude[start:end]))
+
+
+def nonlinear_reference(scene: Scene, results: dict[str, CaseResult],
+                        datasets: dict[str, Dataset]) -> list[str]:
+    """Compare the nonlinear FE run with the FFRF run of the same plate; return report lines.
+
+    Adds ``nonlinear_reference/<model>/...`` to ``datasets``. Both runs share the step and
+    the samples, so the curves are compared sample by sample over the nonlinear run's span.
+    The axial load is the compression of the link (joint C force along the chord B-C) in the
+    FFRF run; the Euler load of the pinned-pinned plate is pi^2 E I / L^2, I = w t^3 / 12.
+    """
+    model = NONLINEAR_MODEL
+    if f"{model}_nonlinear_fe" not in results:
+        return [f"nonlinear FE reference {model}: not run (coupler.damping_ratio > 0; the "
+                f"nonlinear FE body has no damping model)"]
+    nonlinear_case, flex_case = results[f"{model}_nonlinear_fe"], results[f"{model}_ffrf"]
+    if nonlinear_case.status != "ok" or flex_case.status != "ok":
+        return [f"nonlinear FE reference {model}: failed: "
+                f"{nonlinear_case.message or flex_case.message}"]
+    nonlinear = {k: v.data for k, v in nonlinear_case.datasets.items()}
+    flexible = {k: v.data for k, v in flex_case.datasets.items()}
+    samples = len(nonlinear["time"])
+    time_s = flexible["time"][:samples]
+    if len(time_s) != samples or not np.allclose(time_s, nonlinear["time"], rtol=0,
+                                                 atol=1e-12):
+        return [f"nonlinear FE reference {model}: the two runs have different time samples"]
+    curves = {"ffrf": flexible["coupler/midpoint_deflection"][:samples],
+              "nonlinear_fe": nonlinear["coupler/midpoint_deflection"]}
+    values: dict[str, tuple[object, str, str]] = {
+        "span_end_time": (float(time_s[-1]), "s", "both runs compared over 0 .. this time"),
+        "fe_dof": (nonlinear_case.attrs.get("fe_dof", -1), "1",
+                   "coordinates of the nonlinear FE body (3 per mesh node)"),
+    }
+    for name, curve in curves.items():
+        label = "FFRF" if name == "ffrf" else "nonlinear FE"
+        first, largest = first_peak_index(curve), int(np.argmax(np.abs(curve)))
+        values[f"first_peak_deflection_{name}"] = (float(curve[first]), "m",
+                                                   f"first deflection extreme (signed), {label}")
+        values[f"first_peak_time_{name}"] = (float(time_s[first]), "s",
+                                             f"time of the first extreme, {label}")
+        values[f"peak_deflection_{name}"] = (float(np.abs(curve[largest])), "m",
+                                             f"max |midpoint deflection| over the span, {label}")
+        values[f"peak_time_{name}"] = (float(time_s[largest]), "s",
+                                       f"time of that peak, {label}")
+    first_ratio = (values["first_peak_deflection_nonlinear_fe"][0]
+                   / values["first_peak_deflection_ffrf"][0])
+    peak_ratio = values["peak_deflection_nonlinear_fe"][0] / values["peak_deflection_ffrf"][0]
+    deviation = np.abs(curves["nonlinear_fe"] - curves["ffrf"])
+    worst = int(np.argmax(deviation))
+    chord = np.column_stack([np.cos(flexible["coupler/angle"][:samples]),
+                             np.sin(flexible["coupler/angle"][:samples])])
+    compression_N = np.einsum("ij,ij->i", flexible["joints/C/force_on_coupler"][:samples],
+                              -chord)  # the slider pushes C toward B
+    plate = cases(scene)[f"{model}_nonlinear_fe"]["coupler"]
+    euler_load_N = (np.pi**2 * plate["youngs_modulus_Pa"] * plate["width_m"]
+                    * plate["thickness_m"]**3 / 12 / plate["length_m"]**2)
+    walls = {name: case.counters["wall_time_s"]
+             for name, case in (("ffrf", flex_case), ("nonlinear_fe", nonlinear_case))}
+    steps = {name: max(int(case.counters["steps"]), 1)
+             for name, case in (("ffrf", flex_case), ("nonlinear_fe", nonlinear_case))}
+    values.update({
+        "first_peak_ratio": (first_ratio, "1", "first extreme, nonlinear FE / FFRF"),
+        "peak_deflection_ratio": (peak_ratio, "1", "largest peak, nonlinear FE / FFRF"),
+        "max_deflection_deviation": (float(deviation[worst]), "m",
+                                     "max |nonlinear FE - FFRF| midpoint deflection over the "
+                                     "span"),
+        "max_deflection_deviation_over_ffrf_peak": (
+            float(deviation[worst]) / values["peak_deflection_ffrf"][0], "1",
+            "that deviation / the FFRF peak"),
+        "time_of_max_deflection_deviation": (float(time_s[worst]), "s", "where it occurs"),
+        "max_crank_angle_deviation": (
+            float(np.abs(nonlinear["crank/angle"] - flexible["crank/angle"][:samples]).max()),
+            "rad", "max |nonlinear FE - FFRF| crank angle over the span"),
+        "max_midpoint_out_of_plane": (
+            float(np.abs(nonlinear["coupler/midpoint_out_of_plane"]).max()), "m",
+            "nonlinear FE: max |z| of the midpoint (face-marker tilt artefact; 0 ideal)"),
+        "max_compression_over_euler_load": (float(compression_N.max()) / euler_load_N, "1",
+                                            "max axial compression (FFRF joint C force along "
+                                            "B-C) / pinned-pinned Euler load"),
+        "euler_load": (euler_load_N, "N", "pi^2 E I / L^2 of the plate (I = w t^3 / 12)"),
+    })
+    for name, label in (("ffrf", "FFRF"), ("nonlinear_fe", "nonlinear FE")):
+        values[f"{name}_wall_time"] = (walls[name], "s", f"{label} run wall time (its whole "
+                                       "end time)")
+        values[f"{name}_wall_time_per_step"] = (walls[name] / steps[name], "s",
+                                                f"{label} wall time per step")
+    for key, (value, unit, text) in values.items():
+        datasets[f"nonlinear_reference/{model}/{key}"] = Dataset(value, unit, text)
+
+    def peak(name: str, kind: str) -> str:
+        deflection = values[f"{kind}_deflection_{name}"][0]
+        return f"{deflection * 1e6:.1f} um at {values[f'{kind}_time_{name}'][0] * 1e3:.2f} ms"
+
+    return [
+        f"nonlinear FE reference, {model} ({values['fe_dof'][0]} coordinates, the same mesh, "
+        f"0 .. {time_s[-1] * 1e3:.1f} ms):",
+        f"  first peak    FFRF {peak('ffrf', 'first_peak')}, nonlinear FE "
+        f"{peak('nonlinear_fe', 'first_peak')} (ratio {first_ratio:.3f})",
+        f"  largest peak  FFRF {peak('ffrf', 'peak')}, nonlinear FE "
+        f"{peak('nonlinear_fe', 'peak')} (ratio {peak_ratio:.3f})",
+        f"  max |difference| of the curves {deviation[worst] * 1e6:.1f} um "
+        f"({values['max_deflection_deviation_over_ffrf_peak'][0]:.1%} of the FFRF peak) at "
+        f"{time_s[worst] * 1e3:.2f} ms; crank angle "
+        f"{values['max_crank_angle_deviation'][0]:.2e} rad; midpoint out of plane "
+        f"{values['max_midpoint_out_of_plane'][0]:.1e} m",
+        f"  axial compression up to {compression_N.max():.1f} N = "
+        f"{compression_N.max() / euler_load_N:.2f} of the Euler load {euler_load_N:.0f} N "
+        f"(geometric softening, absent from the linear FFRF body)",
+        f"  wall time: FFRF {walls['ffrf']:.1f} s for {steps['ffrf']} steps "
+        f"({walls['ffrf'] / steps['ffrf'] * 1e3:.2f} ms/step), nonlinear FE "
+        f"{walls['nonlinear_fe']:.1f} s for {steps['nonlinear_fe']} steps "
+        f"({walls['nonlinear_fe'] / steps['nonlinear_fe'] * 1e3:.0f} ms/step)",
+    ]
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
@@ -151,6 +313,19 @@ def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> l
                 ax.plot(rigid_data["time"],
                         rigid_data["coupler/midpoint_acceleration"][:, column], "--",
                         label=f"rigid twin {axis}")
+        paths.append(path)
+    flex_data = ok.get(f"{NONLINEAR_MODEL}_ffrf")
+    nonlinear_data = ok.get(f"{NONLINEAR_MODEL}_nonlinear_fe")
+    if flex_data is not None and nonlinear_data is not None:
+        path = folder / "flexible-nonlinear-reference.png"
+        samples = len(nonlinear_data["time"])
+        with figure(path, f"Midpoint deflection, {NONLINEAR_MODEL}: FFRF against the "
+                    "nonlinear FE body", "time [s]", "deflection [um]") as ax:
+            ax.plot(flex_data["time"][:samples],
+                    flex_data["coupler/midpoint_deflection"][:samples] * 1e6, label="FFRF")
+            ax.plot(nonlinear_data["time"],
+                    nonlinear_data["coupler/midpoint_deflection"] * 1e6, "--",
+                    label="nonlinear FE (reference)")
         paths.append(path)
     thickness, peak = [], []
     for model in MODELS:
