@@ -75,7 +75,7 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "inertia_kgm2": Field(doc="coupler inertia about its centre of mass (lumped)", **_POS),
         "model": Field(("rigid", "ffrf", "nonlinear_fe", "auto"),
                        "rigid body, floating-frame flexible body, or fully nonlinear FE body "
-                       "(accuracy reference; orders of magnitude slower); auto: rigid or "
+                       "(accuracy reference, ~50x slower per step); auto: rigid or "
                        "ffrf (and modes) from the fitted criterion and fidelity.tolerance"),
         "geometry": Field(("lumped", "plate"),
                           "lumped: mass_kg/inertia_kgm2; plate: steel plate of the keys below"),
