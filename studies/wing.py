@@ -175,13 +175,13 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
 
 
 def _auto_decisions(scene: Scene, datasets: dict[str, Dataset]) -> list[str]:
-    """The ``auto`` fidelity decision for the coupler (as a 3 mm steel plate) in this scene."""
+    """The ``auto`` fidelity decisions for the coupler (as a 3 mm steel plate) and the crank."""
     try:
         from flex.criteria import resolve_fidelity
     except ImportError:
         return ["  auto fidelity: no fitted criterion in this installation"]
     trial = apply_overrides(scene, ['coupler.geometry="plate"', "coupler.thickness_m=0.003",
-                                    'coupler.model="auto"'])
+                                    'coupler.model="auto"', 'crank.model="auto"'])
     try:
         validate(trial)
         _, decisions = resolve_fidelity(trial)
