@@ -25,7 +25,8 @@ $(STUDIES): $(STAMP)
 	$(RUN) $@
 
 # long runs, not part of `all` (README "Speed and accuracy", "Numerical stability"); each
-# writes results/<target>.h5 and figures. Measured on 2 shared cores: see the README.
+# writes results/<target>.h5 and figures. On 2 shared cores: tradeoff 13-22 min, stability
+# 7 min, bench 12.5 min (it runs `make all` twice); `make all` itself takes 5-6 min.
 LONG := tradeoff stability bench
 .PHONY: $(LONG)
 $(LONG): $(STAMP)

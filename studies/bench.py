@@ -511,6 +511,55 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
     return Summary(datasets, "\n".join(lines))
 
 
+def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
+    """Bar charts: integration times at equal accuracy (log scale) and the Exudyn CPU shares
+    of the untuned and tuned runs."""
+    from flex.plotting import figure
+
+    data = summary.datasets
+    paths = []
+    bars = [(label, data[key].data) for label, key in (
+        ("rigid 1e-7 rad: flex untuned", "rigid/flex_untuned/wall_time"),
+        ("rigid 1e-7 rad: flex tuned", "rigid/flex_tuned/wall_time"),
+        ("rigid 1e-7 rad: scipy DAE", "rigid/scipy/wall_time"),
+        ("FFRF 1 mm 1 %: untuned", "ffrf_1mm/untuned/wall_time"),
+        ("FFRF 1 mm 1 %: tuned", "ffrf_1mm/tuned/wall_time"),
+        ("FFRF 1 mm 1 %: nonlinear FE (h = 2e-4 s)", "ffrf_1mm/nonlinear/wall_time_h2e-4"),
+    ) if key in data]
+    if bars:
+        path = folder / "bench-times.png"
+        with figure(path, "Integration wall time at equal accuracy (median)", "wall time [s]",
+                    "", size=(8.0, 4.0)) as ax:
+            ax.barh([b[0] for b in bars], [b[1] for b in bars], color="tab:blue")
+            ax.set_xscale("log")
+            ax.axvline(FFRF_TARGET_S, color="grey", ls=":", label="FFRF target 0.5 s")
+            ax.invert_yaxis()
+        paths.append(path)
+    for part in ("rigid", "ffrf_1mm"):
+        shares = {}
+        for which in ("profile_untuned", "profile_tuned"):
+            prefix = f"{part}/{which}/exudyn_"
+            shares[which] = {key[len(prefix):-len("_percent")]: value.data
+                             for key, value in data.items()
+                             if key.startswith(prefix) and key.endswith("_percent")
+                             and not key[len(prefix):].startswith("__")}
+        names = sorted(set(shares["profile_untuned"]) | set(shares["profile_tuned"]),
+                       key=lambda n: -shares["profile_untuned"].get(n, 0.0))
+        if not names:
+            continue
+        path = folder / f"bench-profile-{part}.png"
+        with figure(path, f"Exudyn CPU share per solver phase, {part}", "share [%]", "",
+                    size=(8.0, 4.5)) as ax:
+            y = np.arange(len(names))
+            for offset, which in ((-0.2, "profile_untuned"), (0.2, "profile_tuned")):
+                ax.barh(y + offset, [shares[which].get(n, 0.0) for n in names], height=0.4,
+                        label=which.replace("profile_", ""))
+            ax.set_yticks(y, names)
+            ax.invert_yaxis()
+        paths.append(path)
+    return paths
+
+
 if __name__ == "__main__":
     from flex.cli import main
 
