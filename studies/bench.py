@@ -152,7 +152,8 @@ def _case(name: str, scene: Scene, m: Measurement, extra: dict[str, Any] | None 
     except FlexError:
         scene_toml = to_toml(scene)
     attrs: dict[str, Any] = {"knobs": repr(m.setting.knobs()), "label": m.setting.label}
-    attrs.update({f"error_{k}": v for k, v in m.errors.items()})
+    attrs.update({f"error_{k}": v for k, v in m.errors.items() if k != "error"})
+    attrs["error"] = m.error
     attrs.update(extra or {})
     if not m.ok:
         return CaseResult(name, scene_toml, status="failed", message=m.message, attrs=attrs)

@@ -251,7 +251,8 @@ def _measurement_case(scene_name: str, scene: Scene, m: Measurement) -> CaseResu
                                                     "group": m.setting.group})
     attrs: dict[str, Any] = {"knobs": repr(m.setting.knobs()), "group": m.setting.group,
                              "label": m.setting.label}
-    attrs.update({f"error_{key}": value for key, value in m.errors.items()})
+    attrs.update({f"error_{key}": value for key, value in m.errors.items() if key != "error"})
+    attrs["error"] = m.error
     return CaseResult(_case_name(scene_name, m.setting.label), scene_toml,
                       {"wall_times": Dataset(np.array(m.wall_times_s), "s",
                                              "integration wall time of each repeat")},
