@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import io
 import os
+import signal
+import threading
 import time
 from contextlib import redirect_stdout
 from pathlib import Path
@@ -140,12 +142,26 @@ def run(mech: Mechanism) -> dict[str, Any]:
               else exu.MainSolverImplicitSecondOrder())
     captured = io.StringIO()
     start = time.perf_counter()
+    # Ctrl-C inside Exudyn's C++ loop may come back as a failed solve; note it ourselves so
+    # an interrupt is never mistaken for (and stored as) a diverged case
+    interrupted: list[int] = []
+    previous_handler = None
+    if threading.current_thread() is threading.main_thread():
+        def on_interrupt(signum, frame):
+            interrupted.append(signum)
+            raise KeyboardInterrupt
+        previous_handler = signal.signal(signal.SIGINT, on_interrupt)
     try:
         with redirect_stdout(captured):
             ok = solver.SolveSystem(mech.mbs, _exudyn_settings(settings))
     except Exception as exc:  # Exudyn raises RuntimeError/ValueError on Newton failure
         ok = False
         captured.write(str(exc))
+    finally:
+        if previous_handler is not None:
+            signal.signal(signal.SIGINT, previous_handler)
+    if interrupted:
+        raise KeyboardInterrupt
     wall = time.perf_counter() - start
     if not ok:
         step, now = solver.it.currentStepIndex, solver.it.currentTime

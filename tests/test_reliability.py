@@ -407,3 +407,20 @@ def test_truncated_result_files_give_one_clear_message(tmp_path):
             read_case(cut, "c")  # if the header survived, reading the data must fail clearly
         message = str(info.value)
         assert str(cut) in message and "\n" not in message, message
+
+
+def test_ctrl_c_inside_the_solver_is_an_interrupt_not_a_failed_case():
+    import threading
+
+    from flex.scene import load_scene
+    from flex.solver import simulate_case
+
+    scene = load_scene(overrides=['drive.kind="constant_speed"', "simulation.end_time_s=20.0",
+                                  "simulation.step_s=1e-4", "simulation.output_step_s=1e-2"])
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            simulate_case(scene)
+    finally:
+        timer.cancel()
