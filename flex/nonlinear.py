@@ -54,7 +54,14 @@ import numpy as np
 
 from .errors import SceneError
 from .plate import plate_mesh
-from .reduction import END_A, END_B, _mid_set, _ngsolve_thread_count
+from .reduction import (
+    END_A,
+    END_B,
+    _mid_set,
+    _ngsolve_thread_count,
+    add_plate_markers,
+    as_vector3,
+)
 
 _MESH_ORDER = 2  # as the reduction: linear tets lock in bending
 
@@ -259,12 +266,6 @@ class _HyperelasticForces:
         return container
 
 
-def _as_vector3(value: Sequence[float], name: str) -> np.ndarray:
-    vector = np.asarray(value, dtype=float)
-    if vector.shape != (3,) or not np.all(np.isfinite(vector)):
-        raise SceneError(f"{name} = {value!r}: must be 3 finite numbers (metres, global frame)")
-    return vector
-
 
 def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[float],
                              angle_rad: float,
@@ -298,8 +299,8 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
     import exudyn.itemInterface as eii
     from exudyn.rigidBodyUtilities import RotationMatrixZ
 
-    position_B = _as_vector3(position_B, "position_B")
-    velocity_B = _as_vector3(initial_velocity_B_m_per_s, "initial_velocity_B_m_per_s")
+    position_B = as_vector3(position_B, "position_B")
+    velocity_B = as_vector3(initial_velocity_B_m_per_s, "initial_velocity_B_m_per_s")
     for label, value in (("angle_rad", angle_rad),
                          ("initial_angular_velocity_rad_per_s",
                           initial_angular_velocity_rad_per_s)):
@@ -322,26 +323,10 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
         name="coupler", nodeNumbers=nodes, massMatrix=mass,
         forceUserFunction=elastic.force, jacobianUserFunction=elastic.jacobian))
 
-    marker_B = mbs.AddMarker(eii.MarkerSuperElementRigid(
-        name="coupler:B", bodyNumber=body, meshNodeNumbers=plate.nodes_end_a,
-        weightingFactors=plate.weights_end_a))
-    marker_C = mbs.AddMarker(eii.MarkerSuperElementRigid(
-        name="coupler:C", bodyNumber=body, meshNodeNumbers=plate.nodes_end_b,
-        weightingFactors=plate.weights_end_b))
-    marker_mid = mbs.AddMarker(eii.MarkerSuperElementPosition(
-        name="coupler:mid", bodyNumber=body, meshNodeNumbers=plate.nodes_mid,
-        weightingFactors=plate.weights_mid))
     return {
         "object": body,
         "nodes": nodes,
-        "marker_B": marker_B,
-        "marker_C": marker_C,
-        "marker_mid": marker_mid,
-        "position_B": position_B + rotation @ plate.centre_end_a,
-        "position_C": position_B + rotation @ plate.centre_end_b,
-        "position_mid": position_B + rotation @ plate.centre_mid,
-        "rotation_matrix": rotation,
-        "mass_kg": plate.mass_kg,
+        **add_plate_markers(mbs, body, plate, position_B, rotation),
         "n_dof": plate.n_dof,
         "elastic_forces": elastic,
     }

@@ -473,7 +473,7 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
 # ------------------------------------------------------------------------------------------
 # Exudyn body
 # ------------------------------------------------------------------------------------------
-def _as_vector3(value: Sequence[float], name: str) -> np.ndarray:
+def as_vector3(value: Sequence[float], name: str) -> np.ndarray:
     vector = np.asarray(value, dtype=float)
     if vector.shape != (3,) or not np.all(np.isfinite(vector)):
         raise SceneError(f"{name} = {value!r}: must be 3 finite numbers (metres, global frame)")
@@ -514,11 +514,10 @@ def add_ffrf_coupler(mbs, reduction: Reduction, position_B: Sequence[float], ang
       [m], global), ``rotation_matrix`` (3x3, body to global), ``mass_kg``,
       ``stiffness_proportional_damping_s`` (beta [s]).
     """
-    import exudyn.itemInterface as eii
     from exudyn.rigidBodyUtilities import RotationMatrixZ
 
-    position_B = _as_vector3(position_B, "position_B")
-    velocity_B = _as_vector3(initial_velocity_B_m_per_s, "initial_velocity_B_m_per_s")
+    position_B = as_vector3(position_B, "position_B")
+    velocity_B = as_vector3(initial_velocity_B_m_per_s, "initial_velocity_B_m_per_s")
     for label, value in (("angle_rad", angle_rad),
                          ("initial_angular_velocity_rad_per_s",
                           initial_angular_velocity_rad_per_s)):
@@ -541,28 +540,44 @@ def add_ffrf_coupler(mbs, reduction: Reduction, position_B: Sequence[float], ang
         initialAngularVelocity=[0.0, 0.0, float(initial_angular_velocity_rad_per_s)],
         stiffnessProportionalDamping=beta, name=name)
     body = added["oFFRFreducedOrder"]
-    marker_B = mbs.AddMarker(eii.MarkerSuperElementRigid(
-        name=f"{name}:B", bodyNumber=body, meshNodeNumbers=reduction.nodes_end_a,
-        weightingFactors=reduction.weights_end_a))
-    marker_C = mbs.AddMarker(eii.MarkerSuperElementRigid(
-        name=f"{name}:C", bodyNumber=body, meshNodeNumbers=reduction.nodes_end_b,
-        weightingFactors=reduction.weights_end_b))
-    marker_mid = mbs.AddMarker(eii.MarkerSuperElementPosition(
-        name=f"{name}:mid", bodyNumber=body, meshNodeNumbers=reduction.nodes_mid,
-        weightingFactors=reduction.weights_mid))
     return {
         "object": body,
         "node_frame": added["nRigidBody"],
         "node_modal": added["nGenericODE2"],
-        "marker_B": marker_B,
-        "marker_C": marker_C,
-        "marker_mid": marker_mid,
-        "position_B": position_B + rotation @ reduction.centre_end_a,
-        "position_C": position_B + rotation @ reduction.centre_end_b,
-        "position_mid": position_B + rotation @ reduction.centre_mid,
-        "rotation_matrix": rotation,
-        "mass_kg": reduction.mass_kg,
+        **add_plate_markers(mbs, body, reduction, position_B, rotation, name),
         "stiffness_proportional_damping_s": beta,
+    }
+
+
+def add_plate_markers(mbs, body, plate, position_B: np.ndarray, rotation: np.ndarray,
+                      name: str = "coupler") -> dict[str, Any]:
+    """Joint and midpoint markers on a meshed plate body (FFRF or nonlinear FE).
+
+    ``plate`` carries the node sets ``nodes_end_a/_b/_mid``, their weights and the reference
+    centres ``centre_end_a/_b/_mid`` [m, body frame] (a :class:`Reduction` or a
+    ``flex.nonlinear.NonlinearPlate``). Returns ``marker_B`` and ``marker_C``
+    (``MarkerSuperElementRigid`` on the end faces), ``marker_mid``
+    (``MarkerSuperElementPosition``), their global reference positions ``position_B/_C/_mid``
+    [m], ``rotation_matrix`` (body to global) and ``mass_kg``.
+    """
+    import exudyn.itemInterface as eii
+
+    def marker(kind, label: str, nodes, weights):
+        return mbs.AddMarker(kind(name=f"{name}:{label}", bodyNumber=body,
+                                  meshNodeNumbers=nodes, weightingFactors=weights))
+
+    return {
+        "marker_B": marker(eii.MarkerSuperElementRigid, "B", plate.nodes_end_a,
+                           plate.weights_end_a),
+        "marker_C": marker(eii.MarkerSuperElementRigid, "C", plate.nodes_end_b,
+                           plate.weights_end_b),
+        "marker_mid": marker(eii.MarkerSuperElementPosition, "mid", plate.nodes_mid,
+                             plate.weights_mid),
+        "position_B": position_B + rotation @ plate.centre_end_a,
+        "position_C": position_B + rotation @ plate.centre_end_b,
+        "position_mid": position_B + rotation @ plate.centre_mid,
+        "rotation_matrix": rotation,
+        "mass_kg": plate.mass_kg,
     }
 
 
