@@ -7,7 +7,7 @@ export EXUDYN_NO_USER_SETTINGS := 1
 export MPLBACKEND := Agg
 RUN := $(PY) -m flex run
 
-STUDIES := kinematics dynamics modal flexible spring wing kfit
+STUDIES := kinematics dynamics modal flexible spring wing crank kfit
 
 .PHONY: all test test-slow lint setup clean kfit-criterion $(STUDIES)
 

@@ -4,8 +4,9 @@ Sketch (mechanism plane x-y; rotation axes along z)::
 
                  B (revolute, crank-coupler)
                 / \\
-     crank L1  /   \\  coupler L2 (rigid body or FFRF flexible plate)
-              /     \\
+     crank L1  /   \\  coupler L2 (rigid body, FFRF plate or nonlinear FE plate)
+    (rigid or /     \\
+  FFRF plate)/       \\
     frame == A       C (x,y pinned: non-redundant loop) -- slider ==[spring]== frame
     (revolute)         prismatic joint along x, slide line y = offset
 
@@ -13,7 +14,8 @@ All three links are 3D bodies moving in the x-y plane (nodes with Tait-Bryan rot
 coordinates, so the z-rotation coordinate is the planar angle). A planar loop of 3D joints
 is redundant, so joint C constrains only x and y (17 constraints on 18 coordinates: one
 degree of freedom, as Gruebler's count in the thesis, Eq. 1). The same builder makes the
-rigid model and the flexible one: only the coupler body changes (``coupler.model``).
+rigid model and the flexible ones: only the crank and coupler bodies change
+(``crank.model``, ``coupler.model``).
 
 Drives: ``spring`` -- a linear spring (and optional damper) on the slider's x coordinate,
 compressed by ``spring_preload_m`` at t = 0 and attached throughout, released from rest;
@@ -84,6 +86,9 @@ class Mechanism:
     constraint_points: list[tuple[str, str]] = field(default_factory=list)
     rigid_bodies: dict[str, tuple[float, np.ndarray]] = field(default_factory=dict)
     coupler: dict[str, Any] = field(default_factory=dict)
+    crank: dict[str, Any] = field(default_factory=dict)
+    #: FFRF links whose energy Exudyn reports: name -> (kinetic sensor, strain sensor)
+    flexible_energy: dict[str, tuple[int, int]] = field(default_factory=dict)
     wing: dict[str, Any] = field(default_factory=dict)
 
 
@@ -149,10 +154,12 @@ def wing_mass_properties(scene: Scene) -> tuple[float, float, float]:
     return mass_kg, inertia_kgm2, wing["span_m"] / 2.0
 
 
-def _add_wing(mech: Mechanism, rigid_body, body_marker, crank_body: dict) -> int:
+def _add_wing(mech: Mechanism, rigid_body, body_marker, crank_root: int) -> int:
     """Add the wing as a rigid body welded to the crank at A; return the weld joint.
 
-    The weld's reaction torque is the wing root bending moment in the mechanism plane.
+    ``crank_root``: the crank's marker at A (a rigid-body marker, or the joint face of a
+    flexible crank). The weld's reaction torque is the wing root bending moment in the
+    mechanism plane.
     """
     import exudyn.itemInterface as eii
 
@@ -165,7 +172,6 @@ def _add_wing(mech: Mechanism, rigid_body, body_marker, crank_body: dict) -> int
                            normal * centre_m * init.crank_speed_rad_per_s,
                            init.crank_speed_rad_per_s)
     mech.wing = {"body": wing_body["bodyNumber"], "node": wing_body["nodeNumber"]}
-    crank_root = body_marker(crank_body, [0.0, 0.0, 0.0])
     wing_root = body_marker(wing_body, [0.0, 0.0, 0.0])
     crank_rotation = _rotation_z(init.crank_angle_rad)
     return mech.mbs.AddObject(eii.ObjectJointGeneric(
@@ -173,11 +179,14 @@ def _add_wing(mech: Mechanism, rigid_body, body_marker, crank_body: dict) -> int
         rotationMarker0=crank_rotation.T, rotationMarker1=crank_rotation.T))
 
 
-def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
+def build_mechanism(scene: Scene, reduction: Any = None,
+                    crank_reduction: Any = None) -> Mechanism:
     """Build and assemble the slider-crank of ``scene`` in a new Exudyn system.
 
     ``reduction`` is the Craig-Bampton reduction (:func:`flex.reduction.build_reduction`)
-    for an ``ffrf`` coupler; ``None`` for a rigid coupler. Returns a :class:`Mechanism`.
+    for an ``ffrf`` coupler (or the plate of a ``nonlinear_fe`` one; ``None``: built from the
+    scene), ``crank_reduction`` the one of an ``ffrf`` crank; ``None`` for rigid links.
+    Returns a :class:`Mechanism`.
     """
     import exudyn as exu
     import exudyn.itemInterface as eii
@@ -203,10 +212,16 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
         mech.rigid_bodies[name] = (mass_kg, np.eye(3) * inertia_kgm2)
         return body
 
+    model = scene["coupler"]["model"]
     crank = scene["crank"]
-    crank_body = rigid_body("crank", crank["mass_kg"], crank["inertia_kgm2"], init.joint_B_m / 2,
-                            init.crank_angle_rad, init.joint_B_velocity_m_per_s / 2,
-                            init.crank_speed_rad_per_s)
+    if model == "auto" or crank["model"] == "auto":
+        raise SceneError('model = "auto" must be resolved before building (flex.solver.simulate '
+                         "does it with flex.criteria.resolve_fidelity)")
+    crank_body = None
+    if crank["model"] == "rigid":
+        crank_body = rigid_body("crank", *plate_mass_properties(scene, "crank"),
+                                init.joint_B_m / 2, init.crank_angle_rad,
+                                init.joint_B_velocity_m_per_s / 2, init.crank_speed_rad_per_s)
     slider = scene["slider"]
     slider_body = rigid_body("slider", slider["mass_kg"], slider["inertia_kgm2"], init.joint_C_m,
                              0.0, init.joint_C_velocity_m_per_s, 0.0)
@@ -222,20 +237,30 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
     ground_a = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground, localPosition=[0, 0, 0]))
     ground_c = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground,
                                                  localPosition=list(init.joint_C_m)))
-    crank_a = body_marker(crank_body, [0.0, 0.0, 0.0])
-    crank_b = body_marker(crank_body, init.joint_B_m)
+    if crank_body is not None:
+        crank_a = body_marker(crank_body, [0.0, 0.0, 0.0])
+        crank_b = body_marker(crank_body, init.joint_B_m)
+    else:
+        from .reduction import add_ffrf_link
+
+        if crank_reduction is None:
+            raise SceneError('crank.model = "ffrf" needs its reduction (flex.solver.simulate '
+                             "builds it from the scene)")
+        # the plate's end_a face is the pivot A (the floating frame), end_b the joint B
+        flexible_crank = add_ffrf_link(
+            mbs, crank_reduction, [0.0, 0.0, 0.0], init.crank_angle_rad,
+            damping_ratio=crank["damping_ratio"],
+            initial_angular_velocity_rad_per_s=init.crank_speed_rad_per_s, name="crank")
+        crank_a, crank_b = flexible_crank["marker_B"], flexible_crank["marker_C"]
+        mech.crank = dict(flexible_crank, reduction=crank_reduction)
     slider_c = body_marker(slider_body, init.joint_C_m)
-    wing_joint = _add_wing(mech, rigid_body, body_marker, crank_body) \
+    wing_joint = _add_wing(mech, rigid_body, body_marker, crank_a) \
         if scene["wing"]["enabled"] else None
 
-    model = scene["coupler"]["model"]
-    if model == "auto" or scene["crank"].get("model") == "auto":
-        raise SceneError('model = "auto" must be resolved before building (flex.solver.simulate '
-                         "does it with flex.criteria.resolve_fidelity)")
     if model == "ffrf":
-        from .reduction import add_ffrf_coupler
+        from .reduction import add_ffrf_link
 
-        coupler = add_ffrf_coupler(
+        coupler = add_ffrf_link(
             mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
             damping_ratio=scene["coupler"]["damping_ratio"],
             initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
@@ -269,7 +294,8 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
     if penalty:  # explicit solvers take no joint constraints (validate: rigid coupler only)
         joint_a, joint_b, joint_c, joint_p = _add_penalty_joints(
             mbs, scene["simulation"]["penalty_stiffness_N_per_m"],
-            min(crank["mass_kg"], slider["mass_kg"], plate_mass_properties(scene)[0]),
+            min(plate_mass_properties(scene, "crank")[0], slider["mass_kg"],
+                plate_mass_properties(scene)[0]),
             [(ground_a, crank_a), (crank_b, coupler_b), (slider_c, coupler_c),
              (ground_c, slider_c)],
             [crank_body["nodeNumber"], mech.coupler["node"], slider_body["nodeNumber"]])
@@ -286,7 +312,9 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
         joint_c = mbs.AddObject(eii.ObjectJointSpherical(markerNumbers=[slider_c, coupler_c],
                                                          constrainedAxes=[1, 1, 0]))
         joint_p = mbs.AddObject(eii.ObjectJointPrismaticX(markerNumbers=[ground_c, slider_c]))
-        mech.joint_frames = {"A": None, "B": "crank", "C": None, "P": None}
+        # B's force is reported in the frame of the crank's marker at B (its joint face when
+        # the crank is flexible): collect turns it with that marker's rotation
+        mech.joint_frames = {"A": None, "B": "marker_crank_B", "C": None, "P": None}
 
     drive = scene["drive"]
     ground_node = mbs.AddNode(eii.NodePointGround())
@@ -301,7 +329,7 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
             stiffness=drive["spring_stiffness_N_per_m"],
             damping=drive["spring_damping_Ns_per_m"], offset=-drive["spring_preload_m"]))
     else:
-        crank_rotation = mbs.AddMarker(eii.MarkerNodeCoordinate(
+        crank_rotation = mbs.AddMarker(eii.MarkerNodeCoordinate(  # rigid crank (validate)
             nodeNumber=crank_body["nodeNumber"], coordinate=5))
         # velocity-level constraint: no Python callback per step, crank speed held exactly
         mbs.AddObject(eii.ObjectConnectorCoordinate(
@@ -321,6 +349,8 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
                                                       storeInternal=True,
                                                       outputVariableType=getattr(out, output)))
     for name, body in (("crank", crank_body), ("slider", slider_body)):
+        if body is None:  # a flexible crank: its markers below
+            continue
         node = body["nodeNumber"]
         for output in ("Position", "Velocity", "Acceleration", "Rotation", "AngularVelocity",
                        "AngularAcceleration"):
@@ -346,14 +376,30 @@ def build_mechanism(scene: Scene, reduction: Any = None) -> Mechanism:
                              outputVariableType=out.Position))
     mech.constraint_points = [("ground_A", "crank_A"), ("crank_B", "coupler_B"),
                               ("coupler_C", "slider_C")]
-    if model in ("ffrf", "nonlinear_fe"):
+    if not penalty:
+        add("marker_crank_B.Rotation", eii.SensorMarker(markerNumber=crank_b, storeInternal=True,
+                                                        outputVariableType=out.Rotation))
+    flexible = {"coupler": coupler} if model in ("ffrf", "nonlinear_fe") else {}
+    if mech.crank:
+        flexible["crank"] = mech.crank
+        for name, marker in (("crank_A", crank_a), ("crank_B", crank_b)):
+            add(f"marker_{name}.Velocity",
+                eii.SensorMarker(markerNumber=marker, storeInternal=True,
+                                 outputVariableType=out.Velocity))
+    for name, link in flexible.items():
         for output in ("Position", "Velocity"):
-            add(f"marker_coupler_mid.{output}",
-                eii.SensorMarker(markerNumber=coupler["marker_mid"], storeInternal=True,
+            add(f"marker_{name}_mid.{output}",
+                eii.SensorMarker(markerNumber=link["marker_mid"], storeInternal=True,
                                  outputVariableType=getattr(out, output)))
-    if model == "ffrf":
-        add("coupler.modal_coordinates",
-            eii.SensorNode(nodeNumber=coupler["node_modal"], storeInternal=True,
+        if "node_modal" not in link:  # nonlinear FE: nodal coordinates only
+            continue
+        add(f"{name}.modal_coordinates",
+            eii.SensorNode(nodeNumber=link["node_modal"], storeInternal=True,
                            outputVariableType=out.Coordinates))
+        # Exudyn's FFRF body reports its kinetic (rigid + elastic motion) and strain energy
+        sensors = [mbs.AddSensor(eii.SensorBody(bodyNumber=link["object"], storeInternal=True,
+                                                outputVariableType=kind))
+                   for kind in (out.KineticEnergy, out.PotentialEnergy)]
+        mech.flexible_energy[name] = (sensors[0], sensors[1])
     mbs.Assemble()
     return mech

@@ -275,7 +275,7 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
     """Add the plate to ``mbs`` as a fully nonlinear FE body between joints B and C.
 
     Contract:
-      - placement as :func:`flex.reduction.add_ffrf_coupler`: the centre of ``end_a`` is put at
+      - placement as :func:`flex.reduction.add_ffrf_link`: the centre of ``end_a`` is put at
         ``position_B`` [m, global], the link axis (body x) turned by ``angle_rad`` about global
         z; C's reference position is ``position_B + length * (cos, sin, 0)``. The nodes'
         reference positions are the placed ones (see the module doc); the body starts

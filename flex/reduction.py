@@ -1,10 +1,12 @@
-"""Flexible coupler: NGsolve plate mesh -> Hurty-Craig-Bampton reduction -> Exudyn FFRF body.
+"""Flexible links: NGsolve plate mesh -> Hurty-Craig-Bampton reduction -> Exudyn FFRF body.
 
-The building block of the flexible slider-crank. :func:`build_reduction` meshes a steel plate
-(:func:`flex.plate.plate_mesh`, second-order tetrahedra), reduces it with Hurty-Craig-Bampton
-modes whose two interfaces are the joint faces ``end_a`` (joint B) and ``end_b`` (joint C),
-adds stress post-processing modes and caches the result in one HDF5 file.
-:func:`add_ffrf_coupler` puts the reduced body into an Exudyn ``MainSystem`` with markers at
+The building block of the flexible slider-crank (coupler between B and C, crank between A
+and B: the same plate reduction, ``end_a`` at the link's first joint). :func:`build_reduction`
+meshes a steel plate (:func:`flex.plate.plate_mesh`, second-order tetrahedra), reduces it
+with Hurty-Craig-Bampton modes whose two interfaces are the joint faces ``end_a`` (joint B)
+and ``end_b`` (joint C), adds stress post-processing modes and caches the result in one HDF5
+file.
+:func:`add_ffrf_link` puts the reduced body into an Exudyn ``MainSystem`` with markers at
 B, C and the midpoint. :func:`midpoint_deflection` and :func:`bending_stress_history` turn
 simulation output into the elastic quantities the study reports.
 
@@ -54,11 +56,11 @@ _STATIC_MODES = 6  # of end_b: 3 translations + 3 rotations of the rigid face
 # ------------------------------------------------------------------------------------------
 @dataclass
 class Reduction:
-    """A reduced flexible plate link, ready for :func:`add_ffrf_coupler`.
+    """A reduced flexible plate link, ready for :func:`add_ffrf_link`.
 
     Node index arrays refer to ``fem``'s mesh nodes; weights sum to 1. ``centre_*`` are the
     weighted reference positions of the node sets in body coordinates [m]: the points the
-    markers of :func:`add_ffrf_coupler` report.
+    markers of :func:`add_ffrf_link` report.
     """
 
     fem: Any  #: exudyn.FEM.FEMinterface holding mesh, M, K, mode basis, stress modes
@@ -480,12 +482,15 @@ def as_vector3(value: Sequence[float], name: str) -> np.ndarray:
     return vector
 
 
-def add_ffrf_coupler(mbs, reduction: Reduction, position_B: Sequence[float], angle_rad: float,
-                     damping_ratio: float = 0.0,
-                     initial_velocity_B_m_per_s: Sequence[float] = (0.0, 0.0, 0.0),
-                     initial_angular_velocity_rad_per_s: float = 0.0,
-                     name: str = "coupler") -> dict[str, Any]:
+def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_rad: float,
+                  damping_ratio: float = 0.0,
+                  initial_velocity_B_m_per_s: Sequence[float] = (0.0, 0.0, 0.0),
+                  initial_angular_velocity_rad_per_s: float = 0.0,
+                  name: str = "coupler") -> dict[str, Any]:
     """Add the reduced plate to ``mbs`` as an ``ObjectFFRFreducedOrder`` between B and C.
+
+    Written for the coupler (``end_a`` at B, ``end_b`` at C); the crank uses it with
+    ``position_B`` = A and its markers ``marker_B`` at A and ``marker_C`` at B.
 
     Contract:
       - placement: the floating frame's origin is the centre of ``end_a`` and is put at
@@ -629,7 +634,7 @@ def bending_stress_history(reduction: Reduction, modal_coordinates: np.ndarray,
     """Peak |sigma_xx| (axial stress along the link, body frame) per sample [Pa].
 
     Contract: ``modal_coordinates`` has shape (n, 6 + modes) or (6 + modes,): the elastic
-    coordinates of the body (the ``node_modal`` of :func:`add_ffrf_coupler`, output
+    coordinates of the body (the ``node_modal`` of :func:`add_ffrf_link`, output
     ``Coordinates``). Stress is linear in them (small strains, as the FFRF model assumes),
     taken from the stress post-processing modes at the mesh nodes whose reference x lies in
     ``x_range_m``; the default (thickness, length - thickness) leaves out one thickness at

@@ -70,9 +70,8 @@ def crank_mass_properties(scene: Scene) -> tuple[float, float, float]:
     The wing is a plate in the mechanism plane from A along the crank (span), so both
     centres lie on the line A-B and the parallel-axis theorem combines them.
     """
-    crank = scene["crank"]
-    mass_kg, inertia_kgm2 = crank["mass_kg"], crank["inertia_kgm2"]
-    centre_m = crank["length_m"] / 2
+    mass_kg, inertia_kgm2 = plate_mass_properties(scene, "crank")
+    centre_m = scene["crank"]["length_m"] / 2
     wing = scene.get("wing", {})
     if not wing.get("enabled", False):
         return mass_kg, inertia_kgm2, centre_m

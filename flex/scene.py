@@ -58,16 +58,36 @@ class Field:
 
 _POS = {"kind": float, "positive": True}
 
+
+def _plate_fields(link: str) -> dict[str, Field]:
+    """The keys describing a link as a meshed plate (same for crank and coupler)."""
+    return {
+        "geometry": Field(("lumped", "plate"),
+                          f"lumped: the {link}'s mass_kg/inertia_kgm2; plate: the plate of "
+                          "the keys below (needed by ffrf and auto)"),
+        "thickness_m": Field(doc="plate thickness, in the mechanism plane", **_POS),
+        "width_m": Field(doc="plate width, out of the mechanism plane", **_POS),
+        "youngs_modulus_Pa": Field(doc="Young's modulus", **_POS),
+        "density_kg_per_m3": Field(doc="material density", **_POS),
+        "poisson_ratio": Field(float, "Poisson's ratio", positive=True, below=0.5),
+        "modes": Field(int, "fixed-interface Craig-Bampton modes", minimum=1, maximum=100),
+        "mesh_size_m": Field(doc="netgen maximum element size", **_POS),
+        "damping_ratio": Field(float, "modal damping ratio", minimum=0.0, below=1.0),
+    }
+
+
 SCHEMA: dict[str, dict[str, Field]] = {
     "crank": {
         "length_m": Field(doc="crank length L1 between joints A and B", **_POS),
-        "mass_kg": Field(doc="crank mass", **_POS),
-        "inertia_kgm2": Field(doc="crank moment of inertia about its centre of mass", **_POS),
+        "mass_kg": Field(doc="crank mass (geometry = lumped)", **_POS),
+        "inertia_kgm2": Field(doc="crank inertia about its centre of mass (lumped)", **_POS),
         "initial_angle_deg": Field(float, "crank angle at t = 0, from the slide line",
                                    minimum=-360.0, maximum=360.0),
-        "model": Field(("rigid", "auto"), "rigid body; auto: rigid if the fitted criterion "
-                       "allows it for fidelity.tolerance, else refused (flex has no flexible "
-                       "crank)"),
+        "model": Field(("rigid", "ffrf", "auto"),
+                       "rigid body or floating-frame flexible body (plate geometry); auto: "
+                       "rigid or ffrf (and modes) from the fitted criterion and "
+                       "fidelity.tolerance"),
+        **_plate_fields("crank"),
     },
     "coupler": {
         "length_m": Field(doc="coupler length L2 between joints B and C", **_POS),
@@ -77,16 +97,7 @@ SCHEMA: dict[str, dict[str, Field]] = {
                        "rigid body, floating-frame flexible body, or fully nonlinear FE body "
                        "(accuracy reference, ~50x slower per step); auto: rigid or "
                        "ffrf (and modes) from the fitted criterion and fidelity.tolerance"),
-        "geometry": Field(("lumped", "plate"),
-                          "lumped: mass_kg/inertia_kgm2; plate: steel plate of the keys below"),
-        "thickness_m": Field(doc="plate thickness, in the mechanism plane", **_POS),
-        "width_m": Field(doc="plate width, out of the mechanism plane", **_POS),
-        "youngs_modulus_Pa": Field(doc="Young's modulus", **_POS),
-        "density_kg_per_m3": Field(doc="material density", **_POS),
-        "poisson_ratio": Field(float, "Poisson's ratio", positive=True, below=0.5),
-        "modes": Field(int, "fixed-interface Craig-Bampton modes", minimum=1, maximum=100),
-        "mesh_size_m": Field(doc="netgen maximum element size", **_POS),
-        "damping_ratio": Field(float, "modal damping ratio", minimum=0.0, below=1.0),
+        **_plate_fields("coupler"),
     },
     "wing": {
         "enabled": Field(bool, "weld a wing plate to the crank at A (sec. 6.4 application)"),
@@ -323,26 +334,39 @@ def _check_geometry(scene: Scene) -> None:
     if steps > 5e7:
         raise SceneError(f"simulation needs {steps:.3g} steps (end_time_s / step_s); "
                          f"accepted: at most 5e7")
+    for link in ("crank", "coupler"):
+        _check_link(link, scene[link])
+    if scene["crank"]["model"] == "ffrf" and scene["drive"]["kind"] == "constant_speed":
+        raise SceneError('crank.model = "ffrf" needs drive.kind = "spring": the constant-speed '
+                         "drive constrains the rotation coordinate of a rigid crank, which a "
+                         'flexible crank\'s floating frame does not have; accepted: "rigid"')
     coupler = scene["coupler"]
-    if coupler["model"] in ("ffrf", "nonlinear_fe") and coupler["geometry"] != "plate":
-        raise SceneError(f'coupler.model = "{coupler["model"]}" needs coupler.geometry = '
-                         '"plate" (the flexible body is meshed from the plate\'s dimensions)')
-    if coupler["model"] == "auto" and coupler["geometry"] != "plate":
-        raise SceneError('coupler.model = "auto" needs coupler.geometry = "plate" (the '
-                         "criterion needs the plate's bending frequency; a lumped coupler has "
-                         'no stiffness): use coupler.model = "rigid" for a lumped coupler')
     if coupler["model"] == "nonlinear_fe" and coupler["damping_ratio"] != 0:
         raise SceneError(f"coupler.damping_ratio = {coupler['damping_ratio']:g}: "
                          'coupler.model = "nonlinear_fe" has no damping model; accepted: 0')
-    if coupler["geometry"] == "plate" and coupler["thickness_m"] >= coupler_m:
-        raise SceneError(f"coupler.thickness_m = {coupler['thickness_m']:g} must be smaller "
-                         f"than coupler.length_m = {coupler_m:g}")
-    if sim["integrator"] == "explicit_penalty" and (coupler["model"] != "rigid"
-                                                    or scene["drive"]["kind"] != "spring"):
-        raise SceneError('simulation.integrator = "explicit_penalty" needs coupler.model = '
-                         '"rigid" and drive.kind = "spring" (Exudyn\'s explicit solvers take no '
-                         "algebraic constraints: the flexible bodies' Euler-parameter frames and "
-                         'the crank-speed constraint have them); accepted: "generalized_alpha"')
+    if sim["integrator"] == "explicit_penalty" and (
+            coupler["model"] != "rigid" or scene["crank"]["model"] != "rigid"
+            or scene["drive"]["kind"] != "spring"):
+        raise SceneError('simulation.integrator = "explicit_penalty" needs crank.model and '
+                         'coupler.model = "rigid" and drive.kind = "spring" (Exudyn\'s explicit '
+                         "solvers take no algebraic constraints: the flexible bodies' "
+                         "Euler-parameter frames and the crank-speed constraint have them); "
+                         'accepted: "generalized_alpha"')
+
+
+def _check_link(link: str, values: dict[str, Any]) -> None:
+    """A flexible (or auto) link needs plate geometry, and the plate must fit its length."""
+    model = values["model"]
+    if model in ("ffrf", "nonlinear_fe") and values["geometry"] != "plate":
+        raise SceneError(f'{link}.model = "{model}" needs {link}.geometry = "plate" (the '
+                         "flexible body is meshed from the plate's dimensions)")
+    if model == "auto" and values["geometry"] != "plate" and link == "coupler":
+        raise SceneError('coupler.model = "auto" needs coupler.geometry = "plate" (the '
+                         "criterion needs the plate's bending frequency; a lumped coupler has "
+                         'no stiffness): use coupler.model = "rigid" for a lumped coupler')
+    if values["geometry"] == "plate" and values["thickness_m"] >= values["length_m"]:
+        raise SceneError(f"{link}.thickness_m = {values['thickness_m']:g} must be smaller "
+                         f"than {link}.length_m = {values['length_m']:g}")
 
 
 def to_toml(scene: Scene) -> str:
@@ -350,15 +374,16 @@ def to_toml(scene: Scene) -> str:
     return tomli_w.dumps(scene)
 
 
-def plate_mass_properties(scene: Scene) -> tuple[float, float]:
-    """Mass [kg] and in-plane inertia about the centre of mass [kg m^2] of the coupler.
+def plate_mass_properties(scene: Scene, link: str = "coupler") -> tuple[float, float]:
+    """Mass [kg] and in-plane inertia about the centre of mass [kg m^2] of a link.
 
-    Lumped geometry returns the scene's ``mass_kg`` and ``inertia_kgm2``; plate geometry
-    computes them from length x thickness x width and density (a cuboid: m (L^2 + t^2)/12).
+    ``link`` is ``"coupler"`` or ``"crank"``. Lumped geometry returns the scene's
+    ``mass_kg`` and ``inertia_kgm2``; plate geometry computes them from length x thickness x
+    width and density (a cuboid: m (L^2 + t^2)/12).
     """
-    coupler = scene["coupler"]
-    if coupler["geometry"] == "lumped":
-        return coupler["mass_kg"], coupler["inertia_kgm2"]
-    length_m, thickness_m = coupler["length_m"], coupler["thickness_m"]
-    mass_kg = coupler["density_kg_per_m3"] * length_m * thickness_m * coupler["width_m"]
+    values = scene[link]
+    if values["geometry"] == "lumped":
+        return values["mass_kg"], values["inertia_kgm2"]
+    length_m, thickness_m = values["length_m"], values["thickness_m"]
+    mass_kg = values["density_kg_per_m3"] * length_m * thickness_m * values["width_m"]
     return mass_kg, mass_kg * (length_m**2 + thickness_m**2) / 12.0

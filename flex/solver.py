@@ -182,21 +182,10 @@ def _sensor(mech: Mechanism, name: str) -> np.ndarray:
 def collect(mech: Mechanism) -> dict[str, Dataset]:
     """Datasets of the result layout from the stored sensor data of a solved mechanism."""
     scene, init = mech.scene, mech.initial
-    rotation = _sensor(mech, "crank.Rotation")
-    time_s = rotation[:, 0]
-    crank_angle = rotation[:, 3]
-    # the node's angle starts in (-pi, pi] (it comes from a rotation matrix): put the series on
-    # the branch of the scene's initial angle (181 deg stays 181 deg, not -179 deg)
-    crank_angle = crank_angle + 2 * np.pi * np.round((init.crank_angle_rad - crank_angle[0])
-                                                     / (2 * np.pi))
+    crank_out = _crank_datasets(mech)
+    time_s = crank_out.pop("time")
     out: dict[str, Dataset] = {"time": Dataset(time_s, "s", "simulation time")}
-    out["crank/angle"] = Dataset(crank_angle, "rad", "crank angle from the slide line (+x)")
-    out["crank/angular_velocity"] = Dataset(_sensor(mech, "crank.AngularVelocity")[:, 3],
-                                            "rad/s", "crank angular velocity")
-    out["crank/angular_acceleration"] = Dataset(
-        _sensor(mech, "crank.AngularAcceleration")[:, 3], "rad/s^2", "crank angular acceleration")
-    out["crank/midpoint_position"] = Dataset(_sensor(mech, "crank.Position")[:, 1:3], "m",
-                                             "crank midpoint (centre of mass) x, y")
+    out.update(crank_out)
     out["slider/position"] = Dataset(_sensor(mech, "slider.Position")[:, 1], "m",
                                      "slider x (joint C) along the slide line")
     out["slider/velocity"] = Dataset(_sensor(mech, "slider.Velocity")[:, 1], "m/s",
@@ -208,19 +197,20 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
 
     # joint forces: frame of marker 0 -> global axes; Exudyn reports the force acting on
     # body 0, so the force on body 1 is its negative (checked against the reference DAE)
-    def force(joint: str, frame_angle: np.ndarray | None) -> np.ndarray:
+    def force(joint: str, frame_sensor: str | None) -> np.ndarray:
         local = -_sensor(mech, f"joint_{joint}.Force")[:, 1:3]
-        if frame_angle is None:
+        if frame_sensor is None:
             return local
+        frame_angle = np.unwrap(_sensor(mech, f"{frame_sensor}.Rotation")[:, 3])
+        frame_angle = frame_angle - frame_angle[0]  # joint frames are global at t = 0
         c, s = np.cos(frame_angle), np.sin(frame_angle)
         return np.column_stack([c * local[:, 0] - s * local[:, 1],
                                 s * local[:, 0] + c * local[:, 1]])
 
-    on_crank_a = force("A", None)
-    on_coupler_b = force("B", crank_angle - init.crank_angle_rad
-                         if mech.joint_frames.get("B") == "crank" else None)
-    on_coupler_c = force("C", None)
-    on_slider_p = force("P", None)
+    on_crank_a = force("A", mech.joint_frames.get("A"))
+    on_coupler_b = force("B", mech.joint_frames.get("B"))
+    on_coupler_c = force("C", mech.joint_frames.get("C"))
+    on_slider_p = force("P", mech.joint_frames.get("P"))
     out["joints/A/force_on_crank"] = Dataset(on_crank_a, "N", "frame on crank at A, x y")
     out["joints/A/force_modulus"] = Dataset(np.hypot(*on_crank_a.T), "N", "|force| at A")
     out["joints/B/force_on_crank"] = Dataset(-on_coupler_b, "N", "coupler on crank at B, x y")
@@ -247,24 +237,90 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
     if mech.wing:
         out.update(_wing_datasets(mech))
     if scene["coupler"]["model"] == "rigid":
-        kinetic = np.zeros_like(time_s)
-        for name, (mass_kg, inertia) in mech.rigid_bodies.items():
-            velocity = _sensor(mech, f"{name}.Velocity")[:, 1:4]
-            omega = _sensor(mech, f"{name}.AngularVelocity")[:, 1:4]
-            kinetic += 0.5 * mass_kg * np.sum(velocity**2, axis=1)
-            kinetic += 0.5 * np.einsum("ij,jk,ik->i", omega, inertia, omega)
         out["coupler/angle"] = Dataset(_sensor(mech, "coupler.Rotation")[:, 3], "rad",
                                        "coupler angle from +x (B to C)")
-        drive = scene["drive"]
-        if drive["kind"] == "spring":
-            compression = drive["spring_preload_m"] - out["slider/displacement"].data
-            potential = 0.5 * drive["spring_stiffness_N_per_m"] * compression**2
-            out["energy/kinetic"] = Dataset(kinetic, "J", "kinetic energy of all links")
-            out["energy/spring_potential"] = Dataset(potential, "J", "spring strain energy")
-            out["energy/total"] = Dataset(kinetic + potential, "J",
-                                          "kinetic + spring energy (constant if undamped)")
-        else:
-            out["energy/kinetic"] = Dataset(kinetic, "J", "kinetic energy of all links")
+    out.update(_energy_datasets(mech, out["slider/displacement"].data, time_s))
+    return out
+
+
+def _crank_datasets(mech: Mechanism) -> dict[str, Any]:
+    """Crank angle, speed, acceleration and midpoint (and, if flexible, its elastic response).
+
+    A rigid crank's angle is its node's; a flexible crank's is the angle of its chord A-B
+    (the joint centres), its speed the chord's turning rate from the joint-marker
+    velocities, its acceleration the time derivative of that (second-order differences).
+    Returns ``"time"`` (an array) beside the datasets.
+    """
+    init = mech.initial
+    if not mech.crank:
+        rotation = _sensor(mech, "crank.Rotation")
+        time_s, crank_angle = rotation[:, 0], rotation[:, 3]
+        speed = _sensor(mech, "crank.AngularVelocity")[:, 3]
+        acceleration = _sensor(mech, "crank.AngularAcceleration")[:, 3]
+        midpoint = _sensor(mech, "crank.Position")[:, 1:3]
+        how = " (rigid body)"
+    else:
+        position_a = _sensor(mech, "marker_crank_A.Position")
+        time_s = position_a[:, 0]
+        chord = _sensor(mech, "marker_crank_B.Position")[:, 1:3] - position_a[:, 1:3]
+        chord_rate = (_sensor(mech, "marker_crank_B.Velocity")[:, 1:3]
+                      - _sensor(mech, "marker_crank_A.Velocity")[:, 1:3])
+        crank_angle = np.unwrap(np.arctan2(chord[:, 1], chord[:, 0]))
+        speed = (chord[:, 0] * chord_rate[:, 1] - chord[:, 1] * chord_rate[:, 0]) \
+            / np.sum(chord**2, axis=1)
+        acceleration = np.gradient(speed, time_s)
+        midpoint = None  # with the elastic datasets below
+        how = " of the chord A-B (flexible crank)"
+    # the angle starts in (-pi, pi] (from a rotation matrix or atan2): put the series on the
+    # branch of the scene's initial angle (181 deg stays 181 deg, not -179 deg)
+    crank_angle = crank_angle + 2 * np.pi * np.round((init.crank_angle_rad - crank_angle[0])
+                                                     / (2 * np.pi))
+    out: dict[str, Any] = {"time": time_s}
+    out["crank/angle"] = Dataset(crank_angle, "rad", "crank angle from the slide line (+x)"
+                                 + how)
+    out["crank/angular_velocity"] = Dataset(speed, "rad/s", "crank angular velocity" + how)
+    out["crank/angular_acceleration"] = Dataset(acceleration, "rad/s^2",
+                                                "crank angular acceleration" + how)
+    if midpoint is not None:
+        out["crank/midpoint_position"] = Dataset(midpoint, "m",
+                                                 "crank midpoint (centre of mass) x, y")
+    else:
+        out.update(_elastic_datasets(mech, "crank", "marker_crank_A", "marker_crank_B",
+                                     "A-B", time_s))
+    return out
+
+
+def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s: np.ndarray
+                     ) -> dict[str, Dataset]:
+    """Kinetic, strain, spring and total energy; none when a link's energy is unknown.
+
+    Rigid bodies from their sensed velocities; FFRF links from Exudyn's body outputs
+    (kinetic energy of rigid and elastic motion, strain energy). The nonlinear FE coupler
+    reports no energy, so its runs have no energy datasets.
+    """
+    scene = mech.scene
+    if scene["coupler"]["model"] == "nonlinear_fe":
+        return {}
+    kinetic = np.zeros_like(time_s)
+    strain = np.zeros_like(time_s)
+    for name, (mass_kg, inertia) in mech.rigid_bodies.items():
+        velocity = _sensor(mech, f"{name}.Velocity")[:, 1:4]
+        omega = _sensor(mech, f"{name}.AngularVelocity")[:, 1:4]
+        kinetic += 0.5 * mass_kg * np.sum(velocity**2, axis=1)
+        kinetic += 0.5 * np.einsum("ij,jk,ik->i", omega, inertia, omega)
+    for kinetic_sensor, strain_sensor in mech.flexible_energy.values():
+        kinetic += np.asarray(mech.mbs.GetSensorStoredData(kinetic_sensor))[:, 1]
+        strain += np.asarray(mech.mbs.GetSensorStoredData(strain_sensor))[:, 1]
+    out = {"energy/kinetic": Dataset(kinetic, "J", "kinetic energy of all links")}
+    if mech.flexible_energy:
+        out["energy/strain"] = Dataset(strain, "J", "elastic strain energy of the flexible links")
+    drive = scene["drive"]
+    if drive["kind"] == "spring":
+        compression = drive["spring_preload_m"] - slider_displacement_m
+        potential = 0.5 * drive["spring_stiffness_N_per_m"] * compression**2
+        out["energy/spring_potential"] = Dataset(potential, "J", "spring strain energy")
+        out["energy/total"] = Dataset(kinetic + strain + potential, "J",
+                                      "kinetic + strain + spring energy (constant if undamped)")
     return out
 
 
@@ -273,11 +329,11 @@ def reduction_cache_dir() -> Path:
     return Path(os.environ.get("FLEX_CACHE_DIR", ".cache/reductions"))
 
 
-def reduction_for_scene(scene: Scene):
-    """The (cached) Craig-Bampton reduction of the scene's plate coupler."""
+def reduction_for_scene(scene: Scene, link: str = "coupler"):
+    """The (cached) Craig-Bampton reduction of the scene's plate ``link`` (coupler or crank)."""
     from .reduction import build_reduction
 
-    c = scene["coupler"]
+    c = scene[link]
     return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
                            c["youngs_modulus_Pa"], c["density_kg_per_m3"], c["poisson_ratio"],
                            c["mesh_size_m"], c["modes"], reduction_cache_dir())
@@ -299,42 +355,59 @@ def _coupler_datasets(mech: Mechanism, time_s: np.ndarray) -> dict[str, Dataset]
         out["coupler/midpoint_deflection"] = Dataset(np.zeros_like(time_s), "m",
                                                      "elastic midpoint deflection (rigid: 0)")
         return out
-    from .reduction import bending_stress_history, midpoint_deflection
-
-    model = mech.scene["coupler"]["model"]
     position_b = _sensor(mech, "marker_coupler_B.Position")[:, 1:4]
     position_c = _sensor(mech, "marker_coupler_C.Position")[:, 1:4]
-    position_mid = _sensor(mech, "marker_coupler_mid.Position")[:, 1:4]
-    velocity_mid = _sensor(mech, "marker_coupler_mid.Velocity")[:, 1:3]
-    deflection = midpoint_deflection(position_b, position_c, position_mid)
     chord = position_c - position_b
     out["coupler/angle"] = Dataset(np.unwrap(np.arctan2(chord[:, 1], chord[:, 0])), "rad",
                                    "angle of the chord B-C from +x")
-    out["coupler/midpoint_position"] = Dataset(position_mid[:, :2], "m",
-                                               "coupler midpoint x, y")
-    # the superelement marker reports no acceleration: differentiate its velocity (2nd order)
-    out["coupler/midpoint_acceleration"] = Dataset(
-        np.gradient(velocity_mid, time_s, axis=0), "m/s^2",
-        "coupler midpoint acceleration x, y (thesis figs. 35-42), from the marker velocity")
-    out["coupler/midpoint_deflection"] = Dataset(
-        deflection.transverse_m, "m",
-        "transverse elastic deflection of the midpoint from the chord B-C, 0 at t = 0")
-    out["coupler/chord_change"] = Dataset(deflection.chord_change_m, "m",
-                                          "change of the distance B-C (axial strain x L2)")
-    if model == "nonlinear_fe":
+    out.update(_elastic_datasets(mech, "coupler", "marker_coupler_B", "marker_coupler_C",
+                                 "B-C", time_s))
+    if mech.scene["coupler"]["model"] == "nonlinear_fe":
         # the face markers' linearised rotation can tilt the faces out of plane (see
         # flex.nonlinear): record how far the midpoint leaves the plane
+        position_mid = _sensor(mech, "marker_coupler_mid.Position")[:, 1:4]
         out["coupler/midpoint_out_of_plane"] = Dataset(
             position_mid[:, 2] - position_mid[0, 2], "m",
             "midpoint displacement normal to the mechanism plane (z), 0 at t = 0")
-        # nodal coordinates only: no modal coordinates, and no stress output yet
+    return out
+
+
+def _elastic_datasets(mech: Mechanism, link: str, start_marker: str, end_marker: str,
+                      chord_name: str, time_s: np.ndarray) -> dict[str, Dataset]:
+    """Midpoint motion and elastic response of a flexible ``link`` (FFRF or nonlinear FE).
+
+    From its joint markers (``start_marker``, ``end_marker``: sensor names) and its midpoint
+    marker; an FFRF link adds its modal coordinates and bending stress.
+    """
+    from .reduction import bending_stress_history, midpoint_deflection
+
+    position_start = _sensor(mech, f"{start_marker}.Position")[:, 1:4]
+    position_end = _sensor(mech, f"{end_marker}.Position")[:, 1:4]
+    position_mid = _sensor(mech, f"marker_{link}_mid.Position")[:, 1:4]
+    velocity_mid = _sensor(mech, f"marker_{link}_mid.Velocity")[:, 1:3]
+    deflection = midpoint_deflection(position_start, position_end, position_mid)
+    out: dict[str, Dataset] = {}
+    out[f"{link}/midpoint_position"] = Dataset(position_mid[:, :2], "m",
+                                               f"{link} midpoint x, y")
+    # the superelement marker reports no acceleration: differentiate its velocity (2nd order)
+    out[f"{link}/midpoint_acceleration"] = Dataset(
+        np.gradient(velocity_mid, time_s, axis=0), "m/s^2",
+        f"{link} midpoint acceleration x, y (thesis figs. 35-42), from the marker velocity")
+    out[f"{link}/midpoint_deflection"] = Dataset(
+        deflection.transverse_m, "m",
+        f"transverse elastic deflection of the midpoint from the chord {chord_name}, 0 at t = 0")
+    out[f"{link}/chord_change"] = Dataset(deflection.chord_change_m, "m",
+                                          f"change of the distance {chord_name} (axial strain "
+                                          "x length)")
+    body = mech.crank if link == "crank" else mech.coupler
+    if "reduction" not in body:  # nonlinear FE: nodal coordinates, no modes, no stress yet
         return out
-    modal = _sensor(mech, "coupler.modal_coordinates")[:, 1:]
-    out["coupler/modal_coordinates"] = Dataset(modal, "1",
+    modal = _sensor(mech, f"{link}.modal_coordinates")[:, 1:]
+    out[f"{link}/modal_coordinates"] = Dataset(modal, "1",
                                                "elastic coordinates: 6 static + eigenmodes")
-    reduction = mech.coupler["reduction"]
+    reduction = body["reduction"]
     if reduction.has_stress_modes:
-        out["coupler/peak_bending_stress"] = Dataset(
+        out[f"{link}/peak_bending_stress"] = Dataset(
             bending_stress_history(reduction, modal), "Pa",
             "largest |sigma_xx| away from the end faces (bending + membrane)")
     return out
@@ -412,20 +485,24 @@ def _resolve_auto(scene: Scene) -> tuple[Scene, list[Any]]:
     return resolved, decisions
 
 
-def simulate(scene: Scene, name: str = "case", reduction: Any = None) -> CaseResult:
+def simulate(scene: Scene, name: str = "case", reduction: Any = None,
+             crank_reduction: Any = None) -> CaseResult:
     """Build, integrate and collect one case; raises on divergence (see module doc).
 
-    ``model = "auto"`` links are first resolved to concrete models (a given ``reduction``
-    is then ignored: auto picks the modes); the choice and its reason go to stderr and into
-    the result's attributes ``fidelity_<link>_*``, and ``scene_toml`` holds the resolved
-    scene.
+    ``reduction`` / ``crank_reduction``: the reductions of an ``ffrf`` coupler / crank
+    (None: :func:`reduction_for_scene`, cached on disk). ``model = "auto"`` links are first
+    resolved to concrete models (given reductions are then ignored: auto picks the modes);
+    the choice and its reason go to stderr and into the result's attributes
+    ``fidelity_<link>_*``, and ``scene_toml`` holds the resolved scene.
     """
     scene, fidelity = _resolve_auto(scene)
     if fidelity:
-        reduction = None
+        reduction = crank_reduction = None
     if scene["coupler"]["model"] == "ffrf" and reduction is None:
         reduction = reduction_for_scene(scene)
-    mech = build_mechanism(scene, reduction)
+    if scene["crank"]["model"] == "ffrf" and crank_reduction is None:
+        crank_reduction = reduction_for_scene(scene, "crank")
+    mech = build_mechanism(scene, reduction, crank_reduction)
     counters = run(mech)
     with np.errstate(all="ignore"):  # a diverged run overflows; _check_finite reports it
         datasets = collect(mech)
@@ -440,10 +517,11 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None) -> CaseRes
     return result
 
 
-def simulate_case(scene: Scene, name: str = "case", reduction: Any = None) -> CaseResult:
+def simulate_case(scene: Scene, name: str = "case", reduction: Any = None,
+                  crank_reduction: Any = None) -> CaseResult:
     """Like :func:`simulate`, but a failure becomes a ``failed`` case with its message."""
     try:
-        return simulate(scene, name, reduction)
+        return simulate(scene, name, reduction, crank_reduction)
     except FlexError as exc:
         return CaseResult(name, to_toml(scene), status="failed", message=str(exc))
 

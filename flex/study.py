@@ -31,7 +31,7 @@ from .scene import Scene, load_scene, to_toml
 from .solver import simulate_case
 
 STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring", "kfit",
-           "tradeoff", "stability", "bench", "wing")
+           "tradeoff", "stability", "bench", "wing", "crank")
 RESULTS_DIR = Path("results")
 
 

@@ -15,7 +15,7 @@ import pytest
 
 from flex.errors import SceneError
 from flex.reduction import (
-    add_ffrf_coupler,
+    add_ffrf_link,
     bending_stress_history,
     build_reduction,
     midpoint_deflection,
@@ -196,7 +196,7 @@ def test_cantilever_tip_load_deflection_and_stress(reduction):
     import exudyn.itemInterface as eii
 
     _, mbs = new_system()
-    coupler = add_ffrf_coupler(mbs, reduction, POSITION_B, ANGLE)
+    coupler = add_ffrf_link(mbs, reduction, POSITION_B, ANGLE)
     np.testing.assert_allclose(coupler["position_C"], POSITION_B + ROTATION @ [LENGTH, 0, 0],
                                atol=1e-15)
     ground = mbs.AddObject(eii.ObjectGround())
@@ -229,7 +229,7 @@ def _pinned_pinned_step_response(reduction, damping_ratio: float):
     import exudyn.itemInterface as eii
 
     _, mbs = new_system()
-    coupler = add_ffrf_coupler(mbs, reduction, POSITION_B, ANGLE, damping_ratio=damping_ratio)
+    coupler = add_ffrf_link(mbs, reduction, POSITION_B, ANGLE, damping_ratio=damping_ratio)
     ground = mbs.AddObject(eii.ObjectGround())
     mbs.CreateRevoluteJoint(itemNumbers=[ground, coupler["marker_B"]], position=[],
                             axis=[0, 0, 1])
@@ -278,7 +278,7 @@ def test_initial_angular_velocity_turns_the_frame(reduction):
 
     omega = 20.0  # rad/s about z, the coupler swinging about its pin at B
     _, mbs = new_system()
-    coupler = add_ffrf_coupler(mbs, reduction, POSITION_B, ANGLE,
+    coupler = add_ffrf_link(mbs, reduction, POSITION_B, ANGLE,
                                initial_angular_velocity_rad_per_s=omega)
     ground = mbs.AddObject(eii.ObjectGround())
     mbs.CreateRevoluteJoint(itemNumbers=[ground, coupler["marker_B"]], position=[],
