@@ -9,7 +9,7 @@ RUN := $(PY) -m flex run
 
 STUDIES := kinematics dynamics modal flexible spring wing crank kfit
 
-.PHONY: all test test-slow lint setup clean kfit-criterion $(STUDIES)
+.PHONY: all test test-slow lint setup clean kfit-criterion crank-criterion $(STUDIES)
 
 all: $(STUDIES)
 
@@ -26,7 +26,7 @@ $(STUDIES): $(STAMP)
 
 # long runs, not part of `all` (README "Speed and accuracy", "Numerical stability"); each
 # writes results/<target>.h5 and figures. On 2 shared cores: tradeoff 13-22 min, stability
-# 7 min, bench 12.5 min (it runs `make all` twice); `make all` itself takes 5-6 min.
+# 7 min, bench 12.5 min (it runs `make all` twice); `make all` itself takes 8-9 min.
 LONG := tradeoff stability bench
 .PHONY: $(LONG)
 $(LONG): $(STAMP)
@@ -35,6 +35,10 @@ $(LONG): $(STAMP)
 # after make kfit: install its fit as the criterion that model = "auto" reads (commit it)
 kfit-criterion: results/kfit-criterion.toml
 	cp results/kfit-criterion.toml flex/criteria_fit.toml
+
+# after make crank: install the crank's law that crank.model = "auto" reads (commit it)
+crank-criterion: results/crank-criterion.toml
+	cp results/crank-criterion.toml flex/crank_criteria_fit.toml
 
 test: $(STAMP)
 	$(PY) -m pytest -q
@@ -46,4 +50,5 @@ lint: $(STAMP)
 	$(PY) -m ruff check flex studies tests
 
 clean:
-	rm -rf results/*.h5 results/figures .cache results/kfit-cases results/kfit-criterion.toml
+	rm -rf results/*.h5 results/figures .cache results/kfit-cases results/kfit-criterion.toml \
+		results/crank-criterion.toml

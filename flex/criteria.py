@@ -50,6 +50,9 @@ THESIS_K = 108.0  #: thesis sec. 6.2, in the thesis convention (n = delta_t * om
 THESIS_DELTA_T_S = 0.016128  #: thesis sec. 6.2, Table 5 note (source not stated)
 CRITERION_FORMAT = "flex-criterion/1"
 DEFAULT_CRITERION = Path(__file__).with_name("criteria_fit.toml")
+#: the crank's own law (``make crank``, copied by ``make crank-criterion``): the coupler law
+#: under-predicts a crank carrying a wing (README, "The crank")
+DEFAULT_CRANK_CRITERION = Path(__file__).with_name("crank_criteria_fit.toml")
 CONVENTIONS = ("physical", "thesis")
 PRIMARY_DELTA_T = "stop"
 GOVERNING = "governing"
@@ -799,6 +802,7 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]]) -> float:
 
 def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
                      criterion: Criterion | None = None,
+                     crank_criterion: Criterion | None = None,
                      ) -> tuple[dict[str, dict[str, Any]], list[FidelityDecision]]:
     """Replace ``"auto"`` link models by concrete ones; return the scene and the decisions.
 
@@ -806,8 +810,10 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
     ``"rigid"`` when n >= k(tolerance) (conservative k, :meth:`ErrorLaw.k` ``upper``) and
     ``"ffrf"`` otherwise, with ``coupler.modes`` from :func:`modes_for_cutoff` at
     ``omega_cut = k / delta_t`` (thesis convention: every mode with n below k is kept).
-    ``crank.model = "auto"`` is decided the same way with the crank's first in-plane elastic
-    frequency in the assembled mechanism (:func:`crank_elastic_omega`; a lumped crank is
+    ``crank.model = "auto"`` is decided the same way, with the crank's own law
+    (``crank_criterion``, default ``$FLEX_CRANK_CRITERION`` or
+    :data:`DEFAULT_CRANK_CRITERION`) and its first in-plane elastic frequency in the
+    assembled mechanism (:func:`crank_elastic_omega`; a lumped crank is
     analysed as a plate of its mass, :func:`equivalent_crank_plate`): ``"rigid"``, or
     ``"ffrf"`` with its modes for a plate crank; a lumped crank the criterion calls flexible,
     or a flexible one with a constant-speed drive, is refused with a :class:`SceneError`. A
@@ -860,8 +866,10 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
         if lumped:
             how += (f"; lumped crank as a plate of its mass: {plate['width_m'] * 1e3:g} mm wide, "
                     f"{plate['thickness_m'] * 1e3:.3g} mm high")
+        crank_criterion = crank_criterion or load_criterion(
+            os.environ.get("FLEX_CRANK_CRITERION") or DEFAULT_CRANK_CRITERION)
         decision, k_phys = _decide(
-            "crank", omega, delta_t_s, how, tolerance, criterion,
+            "crank", omega, delta_t_s, how, tolerance, crank_criterion,
             float(crank["damping_ratio"]),
             omega_how="first in-plane elastic mode of the crank in the assembled mechanism, "
                       "Exudyn eigenvalues at t = 0")
@@ -882,10 +890,8 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
             crank["modes"] = decision.modes
             decision.reason += (f"; modes = {decision.modes}: every estimated fixed-interface "
                                 f"mode below omega_cut = k/delta_t = {omega_cut:.4g} rad/s")
-        if resolved["wing"]["enabled"]:
-            decision.reason += ("; caution: the criterion is fitted on couplers, and for a "
-                                "crank carrying a welded wing it under-predicts the rigid "
-                                "model's error (make crank; README, 'The crank')")
+        decision.reason += ("; crank law from "
+                            + (Path(crank_criterion.source).name or "(in memory)"))
         crank["model"] = decision.model
         decisions.append(decision)
     return resolved, decisions

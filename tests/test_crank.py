@@ -84,7 +84,7 @@ def test_auto_picks_ffrf_for_a_soft_crank_and_rigid_for_a_stiff_one():
                              "wing.enabled=true", 'crank.model="auto"', "simulation.step_s=1e-4"])
     resolved, decisions = resolve_fidelity(soft)
     assert resolved["crank"]["model"] == "ffrf" and resolved["crank"]["modes"] >= 2
-    assert "under-predicts" in decisions[0].reason  # the wing caution is stated
+    assert "crank_criteria_fit.toml" in decisions[0].reason  # the crank's own law
     stiff = load_scene(None, ['crank.model="auto"', "simulation.step_s=1e-4"])
     resolved, decisions = resolve_fidelity(stiff)
     assert resolved["crank"]["model"] == "rigid"
@@ -100,15 +100,24 @@ def test_auto_refuses_a_flexible_lumped_crank():
         resolve_fidelity(scene)
 
 
+def test_crank_law_beats_the_coupler_law_where_the_coupler_law_failed():
+    # measured: with the coupler's law, auto kept a 1.5 mm crank carrying the wing rigid
+    # at 1 % tolerance and erred by 1.8 %; the crank's own law must make it flexible
+    scene = load_scene(None, ['crank.geometry="plate"', "crank.thickness_m=0.0015",
+                              "wing.enabled=true", 'crank.model="auto"',
+                              "simulation.step_s=1e-4"])
+    resolved, _ = resolve_fidelity(scene)
+    assert resolved["crank"]["model"] == "ffrf"
+
+
 @pytest.mark.slow
-def test_crank_study_auto_holds_without_wing_and_where_it_chose_ffrf():
+def test_crank_study_fits_a_law_and_auto_holds_on_every_validation_scene():
     from flex.study import execute, load_study, study_scene
 
     module = load_study("crank")
     output = execute(module, study_scene(module))
     data = output.summary.datasets
+    assert data["fit/r_squared"].data > 0.95
+    assert data["fit/exponent"].data == pytest.approx(2.0, abs=0.3)  # as the coupler's ~1.9
     for name in module.SCENES:
-        ok = bool(data[f"validation/{name}/within_tolerance"].data)
-        chose_ffrf = str(data[f"validation/{name}/choice"].data).startswith("ffrf")
-        if chose_ffrf or not name.startswith("wing"):
-            assert ok, name
+        assert bool(data[f"validation/{name}/within_tolerance"].data), name

@@ -295,15 +295,15 @@ def test_euler_load_ratio_of_a_compressed_link():
 def test_auto_crank_is_rigid_ffrf_or_refused_with_a_reason():
     criterion = _synthetic_criterion()
     scene = load_scene(None, ['crank.model="auto"', "simulation.step_s=1e-4"])
-    resolved, decisions = resolve_fidelity(scene, criterion)
+    resolved, decisions = resolve_fidelity(scene, criterion, criterion)
     assert resolved["crank"]["model"] == "rigid"
     assert decisions[0].link == "crank" and "plate of its mass" in decisions[0].reason
     strict = _synthetic_criterion(c=1e9)  # every link flexible
     with pytest.raises(SceneError, match='set crank.geometry = "plate"'):
-        resolve_fidelity(scene, strict)  # a lumped crank has no mesh
+        resolve_fidelity(scene, strict, strict)  # a lumped crank has no mesh
     plate = load_scene(None, ['crank.model="auto"', 'crank.geometry="plate"',
                               "simulation.step_s=1e-4"])
-    resolved, decisions = resolve_fidelity(plate, strict)
+    resolved, decisions = resolve_fidelity(plate, strict, strict)
     assert resolved["crank"]["model"] == "ffrf" and resolved["crank"]["modes"] >= 2
 
 
