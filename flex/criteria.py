@@ -292,6 +292,35 @@ def error_measures(rigid: Mapping[str, np.ndarray], ffrf: Mapping[str, np.ndarra
 # ------------------------------------------------------------------------------------------
 # error laws
 # ------------------------------------------------------------------------------------------
+def errors_against_full(run: Mapping[str, np.ndarray], full: Mapping[str, np.ndarray],
+                        link: str, length_m: float) -> dict[str, float]:
+    """Relative errors of ``run`` (rigid or auto) against the ``full`` flexible model.
+
+    Contract: series of the result layout; over the full run's deployment (samples up to
+    its first crank-angle maximum): ``deflection`` = max |midpoint deflection of ``link``
+    (``"coupler"`` or ``"crank"``) difference| / ``length_m`` (a run without that dataset
+    counts as 0: a rigid link), ``crank_angle`` / swing and ``slider_position`` / travel of
+    the full run; ``governing`` the largest of the three; ``delta_t`` [s] the full run's
+    deployment time.
+    """
+    times = deployment_times(full["time"], full["crank/angle"], full["crank/angular_velocity"])
+    count = int(np.sum(np.asarray(full["time"]) <= times["stop"] * (1 + 1e-12)))
+
+    def deviation(key: str) -> float:
+        mine = np.asarray(run.get(key, np.zeros(count)))
+        return float(np.max(np.abs(mine[:count] - np.asarray(full[key])[:count])))
+
+    angle, slider = np.asarray(full["crank/angle"]), np.asarray(full["slider/position"])
+    swing = float(np.max(np.abs(angle[:count] - angle[0])))
+    travel = float(np.max(np.abs(slider[:count] - slider[0])))
+    out = {"deflection": deviation(f"{link}/midpoint_deflection") / length_m,
+           "crank_angle": deviation("crank/angle") / swing,
+           "slider_position": deviation("slider/position") / travel}
+    out[GOVERNING] = max(out.values())
+    out["delta_t"] = times["stop"]
+    return out
+
+
 @functools.lru_cache(maxsize=64)
 def _t_quantile(dof: int, level: float) -> float:
     from scipy.special import stdtrit  # scipy.stats takes seconds to import

@@ -90,27 +90,10 @@ def cases(scene: Scene) -> dict[str, Scene]:
     return out
 
 
-def errors(auto: dict[str, np.ndarray], full: dict[str, np.ndarray],
+def errors(run: dict[str, np.ndarray], full: dict[str, np.ndarray],
            crank_length_m: float) -> dict[str, float]:
-    """Relative errors of ``auto`` against ``full`` over the full run's deployment (see the
-    module doc); ``governing`` is the largest. Series of the result layout."""
-    times = criteria.deployment_times(full["time"], full["crank/angle"],
-                                      full["crank/angular_velocity"])
-    count = int(np.sum(full["time"] <= times["stop"] * (1 + 1e-12)))
-
-    def deviation(key: str) -> float:
-        mine = auto.get(key, np.zeros(count))
-        return float(np.max(np.abs(mine[:count] - full[key][:count])))
-
-    swing = float(np.max(np.abs(full["crank/angle"][:count] - full["crank/angle"][0])))
-    travel = float(np.max(np.abs(full["slider/position"][:count]
-                                 - full["slider/position"][0])))
-    out = {"deflection": deviation("crank/midpoint_deflection") / crank_length_m,
-           "crank_angle": deviation("crank/angle") / swing,
-           "slider_position": deviation("slider/position") / travel}
-    out[criteria.GOVERNING] = max(out.values())
-    out["delta_t"] = times["stop"]
-    return out
+    """Errors of ``run`` against ``full`` with the crank's deflection (see the module doc)."""
+    return criteria.errors_against_full(run, full, "crank", crank_length_m)
 
 
 def _data(case: CaseResult) -> dict[str, np.ndarray]:
