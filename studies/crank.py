@@ -47,9 +47,11 @@ OVERRIDES = ['crank.geometry="plate"', "simulation.step_s=2e-5",
              "simulation.end_time_s=0.05"]
 FULL_MODES = 12
 
-#: fit scenes (all with the wing): crank thickness [mm] x spring rate [N/m]
-FIT_THICKNESSES_MM = (0.8, 1.2, 1.8, 2.5, 3.5, 5.0)
-FIT_SPRINGS_N_PER_M = (1500.0, 6000.0)
+#: fit scenes (all with the wing): (crank thickness [mm], spring rate [N/m]). Every
+#: thickness with both springs except 0.8 mm at 6000 N/m: that full FFRF run fails Newton at
+#: 17.9 ms (h = 2e-5 s), a failed case that would stop `make all`
+FIT_CASES = ((0.8, 1500.0), *((t, k) for t in (1.2, 1.8, 2.5, 3.5, 5.0)
+                               for k in (1500.0, 6000.0)))
 #: validation scenes (not in the fit): name -> (overrides, fidelity tolerance)
 SCENES: dict[str, tuple[list[str], float]] = {
     "wing_t1mm_tol1pct": (["crank.thickness_m=0.001", "wing.enabled=true"], 0.01),
@@ -64,12 +66,11 @@ SCENES: dict[str, tuple[list[str], float]] = {
 def fit_scenes(scene: Scene) -> dict[str, Scene]:
     """``fit_t<mm>_k<N/m>`` scenes with the wing (rigid crank model; see :func:`cases`)."""
     out = {}
-    for thickness_mm in FIT_THICKNESSES_MM:
-        for spring in FIT_SPRINGS_N_PER_M:
-            name = f"fit_t{thickness_mm:g}mm_k{spring:g}".replace(".", "p")
-            out[name] = apply_overrides(scene, [f"crank.thickness_m={thickness_mm * 1e-3!r}",
-                                                f"drive.spring_stiffness_N_per_m={spring!r}",
-                                                "wing.enabled=true"])
+    for thickness_mm, spring in FIT_CASES:
+        name = f"fit_t{thickness_mm:g}mm_k{spring:g}".replace(".", "p")
+        out[name] = apply_overrides(scene, [f"crank.thickness_m={thickness_mm * 1e-3!r}",
+                                            f"drive.spring_stiffness_N_per_m={spring!r}",
+                                            "wing.enabled=true"])
     return out
 
 
