@@ -293,9 +293,18 @@ def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> l
                 ax.plot(full.datasets["time"].data * 1e3,
                         full.datasets["crank/midpoint_deflection"].data * 1e6, label=name)
     validation = folder / "crank-validation.png"
-    with figure(validation, "auto for the crank (o rigid, s ffrf; red: above tolerance)",
+    with figure(validation, "crank law and auto (validation: o rigid, s ffrf; red: above "
+                "tolerance)",
                 "n = delta_t / T (crank's first in-plane elastic mode in the mechanism)",
-                "error of auto against the full FFRF crank") as ax:
+                "error against the full FFRF crank") as ax:
+        if "fit/n" in summary.datasets:
+            n_fit = np.asarray(summary.datasets["fit/n"].data)
+            ax.loglog(n_fit, summary.datasets["fit/governing"].data, ".", color="0.5",
+                      label="fit: rigid crank with the wing")
+            grid = np.geomspace(n_fit.min(), n_fit.max(), 50)
+            law = float(summary.datasets["fit/coefficient"].data) \
+                * grid ** -float(summary.datasets["fit/exponent"].data)
+            ax.loglog(grid, law, "-", color="0.5", label="crank law (central)")
         for name in SCENES:
             key = f"validation/{name}"
             if f"{key}/n_physical" not in summary.datasets:
