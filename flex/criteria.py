@@ -32,11 +32,13 @@ statement explicit:
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
 import os
+import tempfile
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -574,6 +576,25 @@ class Criterion:
         for (ratio, measure), law in sorted(self.laws.items()):
             data["laws"].append({"damping_ratio": ratio, "measure": measure, **law.to_dict()})
         return header + tomli_w.dumps(data)
+
+
+@contextlib.contextmanager
+def criterion_in_force(text: str, variable: str = "FLEX_CRITERION") -> Iterator[Path]:
+    """Within the block, ``auto`` reads the criterion ``text`` (TOML): it is written to a
+    temporary file named by the environment ``variable`` (``FLEX_CRITERION`` or
+    ``FLEX_CRANK_CRITERION``), which is restored afterwards. Yields the file's path."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "criterion.toml"
+        path.write_text(text, encoding="utf-8")
+        previous = os.environ.get(variable)
+        os.environ[variable] = str(path)
+        try:
+            yield path
+        finally:
+            if previous is None:
+                os.environ.pop(variable, None)
+            else:
+                os.environ[variable] = previous
 
 
 def load_criterion(path: str | Path | None = None) -> Criterion:

@@ -27,8 +27,6 @@ largest (governing) is fitted and held against the tolerance.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
@@ -172,18 +170,8 @@ def simulate_cases(scenes: dict[str, Scene],
     text = criterion_toml(fit_law(table), len(table))
     CRITERION_PATH.parent.mkdir(parents=True, exist_ok=True)
     CRITERION_PATH.write_text(text, encoding="utf-8")
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / "crank-criterion.toml"
-        path.write_text(text, encoding="utf-8")
-        previous = os.environ.get("FLEX_CRANK_CRITERION")
-        os.environ["FLEX_CRANK_CRITERION"] = str(path)
-        try:
-            run([n for n in names if not n.startswith("fit_")])
-        finally:
-            if previous is None:
-                os.environ.pop("FLEX_CRANK_CRITERION", None)
-            else:
-                os.environ["FLEX_CRANK_CRITERION"] = previous
+    with criteria.criterion_in_force(text, "FLEX_CRANK_CRITERION"):
+        run([n for n in names if not n.startswith("fit_")])
     if progress:
         progress("done", len(results), len(names))
     return results

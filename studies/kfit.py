@@ -36,9 +36,7 @@ from __future__ import annotations
 import copy
 import functools
 import math
-import os
 import sys
-import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -382,20 +380,10 @@ def validation_case(name: str, scene: Scene, criterion_toml: str = "") -> CaseRe
     """
     from flex.solver import simulate
 
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / "criterion.toml"
-        path.write_text(criterion_toml, encoding="utf-8")
-        previous = os.environ.get("FLEX_CRITERION")
-        os.environ["FLEX_CRITERION"] = str(path)
-        try:
-            start = time.perf_counter()
-            auto = simulate(scene, "auto")
-            auto_total = time.perf_counter() - start
-        finally:
-            if previous is None:
-                os.environ.pop("FLEX_CRITERION", None)
-            else:
-                os.environ["FLEX_CRITERION"] = previous
+    with criteria.criterion_in_force(criterion_toml):
+        start = time.perf_counter()
+        auto = simulate(scene, "auto")
+        auto_total = time.perf_counter() - start
     reference = full_scene(scene)
     start = time.perf_counter()
     full_reduction = reduction_of(reference)
