@@ -19,10 +19,13 @@ converged :class:`Reference`:
   relative errors a scene has (the work-precision diagrams plot it).
 
 A reference is *shown* converged (:func:`converged_reference`): the finest setting is run,
-then each knob is coarsened by one level (step x 2, fewer modes, coarser mesh, looser
-tolerance) and the relative change of every error measure is stored as the evidence; the
-reference counts as converged to ``tolerance`` when every change is below it (for a
-convergent sequence the finest run's own error is then below the change).
+then each knob is coarsened. A :class:`Refinement` coarsens one knob by two levels (three
+runs at a constant ratio r: fine, medium, coarse); :func:`richardson` turns the two changes
+into the observed order p and an estimate of the fine run's own error (grid-convergence-index
+style, safety factor :data:`RICHARDSON_SAFETY`; oscillating or pre-asymptotic sequences get
+the conservative :data:`FALLBACK_FACTOR` x the largest change). A plain one-level coarsening
+(``coarsenings``) contributes its change itself. The reference's accuracy is the sum of the
+knobs' estimates; it counts as converged to ``tolerance`` when that sum is below it.
 
 :func:`pareto_front` marks the settings no other setting beats in both wall time and error;
 :func:`recommend` picks, per accuracy level, the fastest setting within it (it lies on the
@@ -51,9 +54,16 @@ from .scene import Scene, apply_overrides, validate
 #: relative accuracy levels for which a setting is recommended (1 %, 0.1 %, 0.01 %)
 ACCURACY_LEVELS = (1e-2, 1e-3, 1e-4)
 #: a reference certifies an accuracy level only if the level is at least this many times the
-#: largest change under one-level coarsening (the change estimates the *coarser* run's error;
-#: the reference's own is smaller again, by 2^p - 1 for a method of order p and halving)
+#: reference's estimated own error (:attr:`Reference.accuracy`)
 REFERENCE_MARGIN = 3.0
+#: safety factor on a Richardson error estimate from three levels in the asymptotic range
+#: (Roache's grid convergence index for three grids)
+RICHARDSON_SAFETY = 1.25
+#: an observed order below this (or an oscillating sequence) is not trusted as asymptotic
+MIN_ASYMPTOTIC_ORDER = 1.0
+#: estimate outside the asymptotic range: this factor x the larger of the two changes (the
+#: factor of safety of a study whose order is not verified; Roache, Eca & Hoekstra)
+FALLBACK_FACTOR = 3.0
 #: wall times within this fraction of the fastest count as a tie (broken by accuracy)
 TIE_FRACTION = 0.1
 #: settings whose first run takes longer than this [s] are not repeated (median of one)
@@ -178,9 +188,12 @@ class Observables:
 class Reference:
     """A converged solution of one scene and the evidence that it is converged.
 
-    ``evidence`` maps each coarsening (``"step_s x2"``, ``"modes 12 -> 8"``, ...) to the
-    largest relative change of the error measures it caused; ``tolerance`` is the relative
-    accuracy the reference claims (``accuracy`` the largest change actually seen).
+    ``evidence`` maps each coarsening (``"step_s x2"``, ``"modes 12 -> 8"``, ...) or
+    refinement sequence (``"step_s"``, ...) to its record: ``error`` is the knob's estimate of
+    the reference's own relative error (largest over the error measures: the change itself
+    for a one-level coarsening, :func:`richardson`'s estimate for a sequence, with ``order``,
+    ``change_fine``, ``change_coarse``, ``asymptotic``, ``values``); ``tolerance`` is the
+    relative accuracy the reference claims, ``accuracy`` the sum of the knobs' estimates.
     """
 
     label: str
@@ -198,10 +211,9 @@ class Reference:
 
     @property
     def accuracy(self) -> float:
-        """Largest relative change seen under one-level coarsening (the reference's error
-        is at most about this); 0 if no coarsening was run."""
-        changes = [change["error"] for change in self.evidence.values()]
-        return max(changes) if changes else 0.0
+        """Estimated relative error of the reference: the sum of every knob's estimate (the
+        knobs' errors add up in the worst case); 0 if no coarsening was run."""
+        return float(sum(change["error"] for change in self.evidence.values()))
 
     @property
     def converged(self) -> bool:
@@ -395,15 +407,93 @@ def measure(base: Scene, setting: Setting, reference: Reference, repeats: int = 
     return measurement
 
 
+MEASURES = ("crank_angle_relative", "slider_position_relative", "peak_deflection_relative")
+
+
+@dataclass(frozen=True)
+class Refinement:
+    """One knob coarsened by two levels at a constant ``ratio`` (> 1): ``levels`` = (fine,
+    medium, coarse) settings. The fine level is normally the reference's own setting (then
+    not run twice); it may be a cheaper one when the knob's error is measured at a coarser
+    value of another knob (errors of independent knobs add up). ``max_order``: the formal
+    order of the knob (generalized-alpha: 2 in the step); a larger observed order is capped
+    to it, which keeps the estimate conservative. With two levels only (fine, coarse) the
+    estimate is the change itself, as for a one-level coarsening (e.g. a Newton tolerance:
+    the change bounds the looser run's error, the finer one's is smaller)."""
+
+    knob: str
+    levels: tuple[Setting, ...]
+    ratio: float
+    max_order: float
+
+
+def richardson(change_fine: float, change_coarse: float, ratio: float, max_order: float,
+               monotone: bool = True) -> dict[str, Any]:
+    """Estimate of the fine run's own error from the changes fine -> medium
+    (``change_fine``) and medium -> coarse (``change_coarse``) of a sequence refined by
+    ``ratio``.
+
+    In the asymptotic range (``monotone``, the coarse change larger, observed order
+    p = ln(change_coarse / change_fine) / ln(ratio) at least :data:`MIN_ASYMPTOTIC_ORDER`):
+    :data:`RICHARDSON_SAFETY` x change_fine / (ratio^min(p, max_order) - 1), the
+    Richardson-extrapolated error with a safety factor (grid convergence index). Otherwise
+    (oscillating, stalling or too slow to be asymptotic): :data:`FALLBACK_FACTOR` x the
+    larger change. Returns ``estimate``, ``order`` (observed, nan if none), ``asymptotic``.
+    """
+    out: dict[str, Any] = {"change_fine": change_fine, "change_coarse": change_coarse,
+                           "order": math.nan, "asymptotic": False}
+    if not (math.isfinite(change_fine) and math.isfinite(change_coarse)):
+        out["estimate"] = math.inf
+        return out
+    if change_fine == 0.0 and change_coarse == 0.0:
+        out.update(estimate=0.0, asymptotic=True)
+        return out
+    if monotone and change_coarse > change_fine:
+        order = (math.inf if change_fine == 0.0
+                 else math.log(change_coarse / change_fine) / math.log(ratio))
+        out["order"] = order
+        if order >= MIN_ASYMPTOTIC_ORDER:
+            used = min(order, max_order)
+            out.update(estimate=RICHARDSON_SAFETY * change_fine / (ratio**used - 1.0),
+                       asymptotic=True)
+            return out
+    out["estimate"] = FALLBACK_FACTOR * max(change_fine, change_coarse)
+    return out
+
+
+def _signed_peak(observables: Observables) -> float:
+    if observables.deflection_m is None:
+        return math.nan
+    return peak_value(observables.time_s, observables.deflection_m)
+
+
 def converged_reference(base: Scene, label: str, finest: Setting,
                         coarsenings: dict[str, Setting], tolerance: float,
                         pool: ReductionPool | None = None, description: str = "",
-                        progress: Callable[[str], None] | None = None) -> Reference:
-    """Run ``finest`` and each one-knob ``coarsenings`` of it; return the reference.
+                        progress: Callable[[str], None] | None = None,
+                        refinements: Sequence[Refinement] = (),
+                        anchor: Setting | None = None) -> Reference:
+    """Run ``finest``, each one-knob ``coarsenings`` of it and each :class:`Refinement`
+    sequence; return the reference with its evidence.
 
-    The evidence of each coarsening is its :meth:`Reference.errors` against the finest run
-    (relative changes of crank angle, slider position and peak deflection, and their
-    maximum ``error``). Raises :class:`~flex.errors.FlexError` if the finest run fails.
+    A coarsening's evidence is its :meth:`Reference.errors` against the finest run (relative
+    changes of crank angle, slider position and peak deflection, and their maximum
+    ``error``, which is also its contribution to the accuracy). A refinement's evidence, per
+    error measure, is :func:`richardson` on the changes fine -> medium -> coarse (relative to
+    the fine run; the peak deflection's sequence is monotone when both changes have the same
+    sign); ``error`` is the largest estimate, ``order``, ``change_fine``, ``change_coarse``
+    and ``asymptotic`` are those of that measure, ``values`` the three peak deflections (or
+    final crank angles) and ``wall_times_s`` the runs' integration times. A failed run makes
+    its evidence infinite (the reference is then not converged).
+
+    Sequences run at cheaper values of the other knobs rest on the knobs' errors adding up.
+    ``anchor`` checks it: a setting with each knob at a value one of its sequence's levels
+    has (typically the finest level of the first sequence). The additive prediction of the
+    reference's value is the anchor's plus, per three-level sequence, its fine level minus
+    its level at the anchor's value of the knob; the relative difference between the
+    reference and that prediction is stored as the evidence ``interaction`` and counts in the
+    accuracy like a knob (the knobs' joint effect that the sequences do not see). Raises
+    :class:`~flex.errors.FlexError` if the finest run fails.
     """
     scene = scene_for(base, finest)
     if progress:
@@ -411,16 +501,112 @@ def converged_reference(base: Scene, label: str, finest: Setting,
     observables, counters = run_once(scene, finest, pool)
     reference = Reference(label, observables, finest, {}, tolerance,
                           float(counters["wall_time_s"]), description)
+    runs: dict[str, tuple[Observables, float]] = {
+        repr(finest.knobs()): (observables, float(counters["wall_time_s"]))}
+
+    def run(setting: Setting) -> tuple[Observables, float]:
+        key = repr(setting.knobs())
+        if key not in runs:
+            if progress:
+                progress(f"reference {label}: evidence {setting.label}")
+            obs, count = run_once(scene_for(base, setting), setting, pool)
+            runs[key] = (obs, float(count["wall_time_s"]))
+        return runs[key]
+
     for name, coarser in coarsenings.items():
-        if progress:
-            progress(f"reference {label}: evidence {name}")
         try:
-            coarse_observables, _ = run_once(scene_for(base, coarser), coarser, pool)
+            coarse_observables, wall = run(coarser)
         except FlexError as exc:  # no evidence: the reference then counts as not converged
             reference.evidence[name] = {"error": math.inf, "failed": str(exc)}
             continue
         reference.evidence[name] = reference.errors(coarse_observables)
+        reference.evidence[name]["wall_times_s"] = [wall]
+    for refinement in refinements:
+        try:
+            levels = [run(setting) for setting in refinement.levels]
+        except FlexError as exc:
+            reference.evidence[refinement.knob] = {"error": math.inf, "failed": str(exc)}
+            continue
+        fine_ref = Reference("fine", levels[0][0], refinement.levels[0], {}, tolerance, 0.0)
+        changes_fine = fine_ref.errors(levels[1][0])
+        three = len(levels) == 3
+        if three:
+            medium_ref = Reference("medium", levels[1][0], refinement.levels[1], {},
+                                   tolerance, 0.0)
+            changes_coarse = medium_ref.errors(levels[2][0])
+        peaks = [_signed_peak(obs) for obs, _ in levels]
+        record: dict[str, Any] = {"error": 0.0}
+        for measure_name in MEASURES:
+            d1 = changes_fine[measure_name]
+            if not math.isfinite(d1) and measure_name == "peak_deflection_relative" \
+                    and not reference.flexible:
+                continue  # a measure the scene does not have (peak of a rigid coupler)
+            if not three:
+                estimate = {"estimate": d1, "change_fine": d1, "change_coarse": math.nan,
+                            "order": math.nan, "asymptotic": False}
+            else:
+                d2 = changes_coarse[measure_name]
+                monotone = True
+                if measure_name == "peak_deflection_relative":
+                    monotone = (peaks[1] - peaks[0]) * (peaks[2] - peaks[1]) > 0
+                estimate = richardson(d1, d2, refinement.ratio, refinement.max_order,
+                                      monotone)
+            record[measure_name] = estimate["estimate"]
+            if estimate["estimate"] >= record["error"]:
+                record.update(error=estimate["estimate"], governing=measure_name,
+                              **{k: v for k, v in estimate.items() if k != "estimate"})
+        record["values"] = (peaks if reference.flexible
+                            else [float(obs.crank_angle_rad[-1]) for obs, _ in levels])
+        record["settings"] = [setting.label for setting in refinement.levels]
+        record["wall_times_s"] = [wall for _, wall in levels]
+        record["ratio"] = refinement.ratio
+        reference.evidence[refinement.knob] = record
+    if anchor is not None and refinements:
+        reference.evidence["interaction"] = _interaction(reference, refinements, anchor, run)
     return reference
+
+
+def _knob_key(knob: str) -> str:
+    return knob if "." in knob else f"simulation.{knob}"
+
+
+def _value(observables: Observables, flexible: bool) -> float:
+    return (_signed_peak(observables) if flexible
+            else float(observables.crank_angle_rad[-1]))
+
+
+def _interaction(reference: Reference, refinements: Sequence[Refinement], anchor: Setting,
+                 run: Callable[[Setting], tuple[Observables, float]]) -> dict[str, Any]:
+    """Evidence that the knobs' errors add up (see :func:`converged_reference`)."""
+    flexible = reference.flexible
+    try:
+        anchor_observables, wall = run(anchor)
+    except FlexError as exc:
+        return {"error": math.inf, "failed": str(exc)}
+    anchor_knobs = dict(anchor.overrides)
+    actual = _value(reference.observables, flexible)
+    predicted = _value(anchor_observables, flexible)
+    walls = [wall]
+    for refinement in refinements:
+        if len(refinement.levels) != 3:
+            continue
+        key = _knob_key(refinement.knob)
+        at_anchor = [setting for setting in refinement.levels
+                     if key in anchor_knobs and dict(setting.overrides).get(key)
+                     == anchor_knobs[key]]
+        if not at_anchor:
+            return {"error": math.inf, "failed": f"no level of {refinement.knob} at the "
+                                                 f"anchor's value"}
+        fine, fine_wall = run(refinement.levels[0])
+        level, level_wall = run(at_anchor[0])
+        predicted += _value(fine, flexible) - _value(level, flexible)
+        walls += [fine_wall, level_wall]
+    scale = abs(actual) if flexible else ANGLE_SCALE_RAD
+    difference = abs(actual - predicted) / scale
+    return {"error": difference, "change_fine": difference, "values": [actual, predicted],
+            "settings": [reference.setting.label, f"additive prediction from {anchor.label}"],
+            "wall_times_s": [wall], "governing": "peak_deflection_relative" if flexible
+            else "crank_angle_relative"}
 
 
 # ------------------------------------------------------------------------------------------

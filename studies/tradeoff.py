@@ -21,7 +21,9 @@ front marked), one per scene.
 
 from __future__ import annotations
 
+import math
 import re
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -37,6 +39,7 @@ from flex.tradeoff import (
     Measurement,
     ReductionPool,
     Reference,
+    Refinement,
     Setting,
     converged_reference,
     fastest,
@@ -65,6 +68,16 @@ SCENES: dict[str, list[str]] = {
 DEFAULT_TOLERANCE = {"crank_angle_rad": 1e-6, "slider_position_m": 1e-7, "max_step_s": 1e-5,
                      "max_spectral_radius": 0.95}
 
+#: what to run a 1 mm FFRF plate coupler with at the bundled scene's tolerance
+#: (``fidelity.tolerance`` = 1 %): the study's certified 1 % pick (README "Defaults");
+#: :func:`summarize` stores whether the run's pick still is this setting
+#: (``/summary/ffrf_1mm/default/matches_table``), tests/test_tradeoff.py checks that it reaches
+#: the tolerance and how much faster it is than the scene's own settings
+FFRF_DEFAULT: dict[str, Any] = {"simulation.step_s": 4e-4, "coupler.mesh_size_m": 0.004,
+                                "coupler.modes": 2, "simulation.newton": "modified",
+                                "simulation.newton_relative_tolerance": 1e-8}
+FFRF_DEFAULT_SCENE = "ffrf_1mm"
+
 S = Setting.of
 
 
@@ -73,8 +86,40 @@ def _scipy(rtol: float, method: str = "DOP853", group: str = "scipy reference DA
                    atol=rtol * 1e-2, group=group)
 
 
-def reference_plan(scene_name: str) -> tuple[Setting, dict[str, Setting], float, str]:
-    """Finest setting, its one-knob coarsenings, claimed tolerance and a description."""
+#: FFRF references: the finest step, mesh and modes, and where each knob's three-level
+#: sequence is run. The errors of independent knobs add up (measured on the 1 mm plate: the
+#: mesh change 1.5 -> 1 mm is 7.9e-4 at h = 1.25e-6 s and 8.3e-4 at 6.25e-7 s), so a knob's
+#: sequence runs at cheaper values of the other knobs (``*_base``); its finest level has the
+#: reference's value of its own knob. What limits them (measured while choosing them, peak
+#: midpoint deflection): 1 mm -- modes 12 -> 24 change it by 5.4e-4 at h = 6.25e-7 s and
+#: 6.2e-4 at 3.125e-7 s (12 -> 16: 7.9e-5, so not converging monotonically), the mesh
+#: 1.5 -> 1 -> 0.75 mm by 7.9e-4 and 2.2e-4 (order ~2.7); 10 mm -- the peak is the largest of
+#: several crests within ~1 % of each other (24.3, 24.6, 24.8 ms) and which one wins follows
+#: the phase of 20-27 kHz modes: h = 1.25e-6 -> 6.25e-7 -> 3.125e-7 s change it by 1.5e-3 and
+#: 1.8e-3 (5 mm mesh), no convergence before those phases are resolved (h ~ 1e-7 s)
+FFRF_REFERENCE: dict[str, dict[str, Any]] = {
+    "ffrf_1mm": {"step": 6.25e-7, "mesh": 0.00075, "modes": 24,
+                 "step_base": {"mesh": 0.0015, "modes": 12},
+                 "mesh_base": {"step": 1.25e-6, "modes": 12}, "mesh_ratio": 2**0.5,
+                 "modes_base": {"step": 6.25e-7, "mesh": 0.0015},
+                 "newton_base": {"step": 1.25e-6, "mesh": 0.0015, "modes": 12}},
+    "ffrf_10mm": {"step": 3.125e-7, "mesh": 0.005, "modes": 24,
+                  "step_base": {"mesh": 0.005, "modes": 12},
+                  "mesh_base": {"step": 1.25e-6, "modes": 12}, "mesh_ratio": 2**0.5,
+                  "modes_base": {"step": 1.25e-6, "mesh": 0.005},
+                  "newton_base": {"step": 1.25e-6, "mesh": 0.005, "modes": 12}},
+}
+#: formal orders that cap an observed order: generalized-alpha is second order in the step;
+#: quadratic tetrahedra converge at up to fourth order in the element size (eigenvalues,
+#: energy); the modal truncation has no formal order (2 assumed as the cap)
+MAX_ORDER = {"step": 2.0, "mesh": 4.0, "modes": 2.0}
+
+
+def reference_plan(scene_name: str) -> tuple[Setting, dict[str, Setting], float, str,
+                                             list[Refinement], Setting | None]:
+    """Finest setting, its one-level coarsenings, claimed tolerance, a description, the
+    three-level knob sequences (:class:`flex.tradeoff.Refinement`) and the anchor of the
+    check that the knobs' errors add up (the step sequence's finest level)."""
     if scene_name == "rigid":
         finest = _scipy(1e-13)
         return finest, {
@@ -82,34 +127,44 @@ def reference_plan(scene_name: str) -> tuple[Setting, dict[str, Setting], float,
             "independent model: Exudyn h = 1e-6 s": S("exudyn h=1e-6", step_s=1e-6,
                                                       newton_relative_tolerance=1e-10),
         }, 1e-8, ("scipy DOP853 on the 9-coordinate DAE, rtol 1e-13, atol 1e-15; shown "
-                  "converged by rtol 1e-12 and by flex's Exudyn model at h = 1e-6 s")
-    # the peak deflection carries the plate's higher bending modes (3.2 and 9 kHz at 1 mm,
-    # ten times that at 10 mm): the reference step resolves them
-    if scene_name == "ffrf_1mm":
-        mesh, modes, step = 0.0015, 12, 2.5e-6
-    else:
-        mesh, modes, step = 0.0025, 12, 1.25e-6
+                  "converged by rtol 1e-12 and by flex's Exudyn model at h = 1e-6 s"), [], None
+    plan = FFRF_REFERENCE[scene_name]
 
-    def ref(label: str, **knobs: Any) -> Setting:
-        values = {"step_s": step, "coupler__mesh_size_m": mesh, "coupler__modes": modes,
-                  "newton": "modified", "newton_relative_tolerance": 1e-10,
-                  "spectral_radius": 0.9}
-        values.update(knobs)
-        return S(label, **values)
+    def ref(step: float, mesh: float, modes: int, tol: float = 1e-10) -> Setting:
+        return S(f"reference h={step:g} mesh={mesh * 1e3:.3g}mm modes={modes}"
+                 + (f" tol={tol:g}" if tol != 1e-10 else ""),
+                 step_s=step, coupler__mesh_size_m=mesh, coupler__modes=modes,
+                 newton="modified", newton_relative_tolerance=tol, spectral_radius=0.9)
 
-    finest = ref(f"reference h={step:g} mesh={mesh * 1e3:g}mm modes={modes}")
-    coarsenings = {
-        f"step_s {step:g} -> {2 * step:g}": ref("coarser step", step_s=2 * step),
-        f"modes {modes} -> 8": ref("fewer modes", coupler__modes=8),
-        f"mesh_size_m {mesh:g} -> {mesh * 4 / 3:g}": ref("coarser mesh",
-                                                         coupler__mesh_size_m=mesh * 4 / 3),
-        "newton_relative_tolerance 1e-10 -> 1e-8": ref("looser Newton",
-                                                       newton_relative_tolerance=1e-8),
-    }
-    return finest, coarsenings, 1e-3, (
-        f"flex's FFRF model, generalized-alpha index 3, h = {step:g} s, mesh {mesh * 1e3:g} "
-        f"mm quadratic tetrahedra, {modes} fixed-interface modes, Newton tolerance 1e-10; "
-        f"shown converged by coarsening each knob by one level")
+    step, mesh, modes = plan["step"], plan["mesh"], plan["modes"]
+    finest = ref(step, mesh, modes)
+    base = plan["step_base"]
+    ratio = plan["mesh_ratio"]
+    refinements = [
+        Refinement("step_s", tuple(ref(step * k, base["mesh"], base["modes"])
+                                   for k in (1, 2, 4)), 2.0, MAX_ORDER["step"]),
+        Refinement("coupler.mesh_size_m", tuple(
+            ref(plan["mesh_base"]["step"], round(mesh * ratio**k, 9),
+                plan["mesh_base"]["modes"])
+            for k in (0, 1, 2)), ratio, MAX_ORDER["mesh"]),
+        Refinement("coupler.modes", tuple(
+            ref(plan["modes_base"]["step"], plan["modes_base"]["mesh"], modes // k)
+            for k in (1, 2, 4)), 2.0, MAX_ORDER["modes"]),
+    ]
+    newton = plan["newton_base"]
+    # Newton: a two-level pair (its change bounds the looser run's error)
+    refinements.append(Refinement(
+        "newton_relative_tolerance",
+        (ref(newton["step"], newton["mesh"], newton["modes"]),
+         ref(newton["step"], newton["mesh"], newton["modes"], tol=1e-8)), 100.0, 1.0))
+    description = (
+        f"flex's FFRF model, generalized-alpha index 3 (rho 0.9), h = {step:g} s, mesh "
+        f"{mesh * 1e3:g} mm quadratic tetrahedra, {modes} fixed-interface modes, modified "
+        f"Newton to 1e-10; shown converged by three-level sequences of step (x2), mesh "
+        f"(x{ratio:.3g}) and modes (/2) with Richardson error estimates, each at cheaper "
+        f"values of the other knobs (their additivity checked against the reference), and "
+        f"Newton 1e-10 -> 1e-8")
+    return finest, {}, 1e-3, description, refinements, refinements[0].levels[0]
 
 
 def settings(scene_name: str, nonlinear_available: bool) -> list[Setting]:
@@ -183,10 +238,15 @@ def settings(scene_name: str, nonlinear_available: bool) -> list[Setting]:
                      coupler__mesh_size_m=mesh, **base))
     linear = S(f"h={base_step:g} linear tets", one + "element order", **base)
     out.append(Setting(linear.label, linear.overrides, group=linear.group, element_order=1))
-    if thin and nonlinear_available:
-        out.append(S("nonlinear FE h=1e-4 mesh=4mm", one + "nonlinear FE coupler",
-                     coupler__model="nonlinear_fe", coupler__mesh_size_m=0.004,
-                     newton="modified", newton_relative_tolerance=1e-8, step_s=1e-4))
+    # the fully nonlinear FE coupler (same mesh and step as FFRF runs of the table, so the
+    # model difference can be read beside the discretization error): ~50x the FFRF cost per
+    # step at 1 mm; at 10 mm the 10 mm mesh has a few hundred nodes
+    nonlinear = ((1e-4, 0.004),) if thin else ((1e-5, 0.01), (1e-5, 0.005), (5e-6, 0.005))
+    for step, mesh in nonlinear if nonlinear_available else ():
+        out.append(S(f"nonlinear FE h={step:g} mesh={mesh * 1e3:g}mm", one
+                     + "nonlinear FE coupler", coupler__model="nonlinear_fe",
+                     coupler__mesh_size_m=mesh, newton="modified",
+                     newton_relative_tolerance=1e-8, step_s=step))
     fast = {"newton": "modified", "newton_relative_tolerance": 1e-8}
     for factor in (4, 2, 1, 0.5):
         step = base_step * factor
@@ -264,7 +324,7 @@ def _measurement_case(scene_name: str, scene: Scene, m: Measurement) -> CaseResu
 
 
 # the run's measurements and references, for summarize (same process, right after)
-_RUN: dict[str, tuple[Reference, list[Measurement]]] = {}
+_RUN: dict[str, tuple[Reference, list[Measurement], float]] = {}
 
 
 def simulate_cases(scenes: dict[str, Scene],
@@ -278,11 +338,17 @@ def simulate_cases(scenes: dict[str, Scene],
     _RUN.clear()
     for scene_name, scene in scenes.items():
         pool = ReductionPool()
-        finest, coarsenings, tolerance, description = reference_plan(scene_name)
+        finest, coarsenings, tolerance, description, refinements, anchor = reference_plan(
+            scene_name)
         if progress:
             progress(f"{scene_name}: reference", done, total)
-        reference = converged_reference(scene, scene_name, finest, coarsenings, tolerance,
-                                        pool, description)
+        started = time.perf_counter()
+        reference = converged_reference(
+            scene, scene_name, finest, coarsenings, tolerance, pool, description,
+            (lambda text, name=scene_name, at=done: progress(f"{name}: {text}", at, total))
+            if progress else None,
+            refinements, anchor)
+        reference_time = time.perf_counter() - started
         done += 1
         results[f"{scene_name}__reference"] = _reference_case(scene_name, scene, reference)
         measurements = []
@@ -294,7 +360,7 @@ def simulate_cases(scenes: dict[str, Scene],
             results[_case_name(scene_name, setting.label)] = _measurement_case(
                 scene_name, scene, measurement)
             done += 1
-        _RUN[scene_name] = (reference, measurements)
+        _RUN[scene_name] = (reference, measurements, reference_time)
     if progress:
         progress("done", total, total)
     return results
@@ -325,7 +391,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
     datasets: dict[str, Dataset] = {}
     lines = ["tradeoff: work-precision (error = largest relative error of crank angle / swing, "
              "slider / travel, peak deflection / peak; wall = median integration time)"]
-    for scene_name, (reference, measurements) in _RUN.items():
+    for scene_name, (reference, measurements, reference_time) in _RUN.items():
         group = scene_name
         points = [(m.wall_time_s, m.error) if m.ok else (np.nan, np.nan) for m in measurements]
         front = pareto_front(points)
@@ -347,18 +413,63 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
             datasets[f"{group}/reference/peak_deflection"] = Dataset(
                 reference.peak_deflection_m, "m", "reference peak |midpoint deflection|")
         names = list(reference.evidence)
-        datasets[f"{group}/reference/evidence/coarsening"] = Dataset(
-            np.array(names, dtype=object), "1", "one-knob coarsening of the reference")
-        for key, units in (("error", "1"), ("crank_angle_rad", "rad"),
-                           ("slider_position_m", "m"), ("peak_deflection_relative", "1")):
-            datasets[f"{group}/reference/evidence/{key}"] = Dataset(
-                np.array([reference.evidence[n][key] for n in names]), units,
-                f"change of {key} between the reference and the coarsening")
+        evidence = reference.evidence
+        ev = f"{group}/reference/evidence"
+        datasets[f"{ev}/coarsening"] = Dataset(
+            np.array(names, dtype=object), "1",
+            "knob sequence (three levels) or one-level coarsening of the reference")
+        datasets[f"{ev}/error"] = Dataset(
+            np.array([evidence[n]["error"] for n in names]), "1",
+            "estimated contribution to the reference's relative error (Richardson with "
+            "safety factor for an asymptotic sequence, else the conservative fallback; the "
+            "change itself for a one-level coarsening)")
+        datasets[f"{ev}/order"] = Dataset(
+            np.array([evidence[n].get("order", np.nan) for n in names]), "1",
+            "observed order of the governing measure (nan: one or two levels)")
+        datasets[f"{ev}/change_fine"] = Dataset(
+            np.array([evidence[n].get("change_fine", evidence[n]["error"]) for n in names]),
+            "1", "relative change fine -> medium (or reference -> coarsening)")
+        datasets[f"{ev}/change_coarse"] = Dataset(
+            np.array([evidence[n].get("change_coarse", np.nan) for n in names]), "1",
+            "relative change medium -> coarse")
+        datasets[f"{ev}/asymptotic"] = Dataset(
+            np.array([bool(evidence[n].get("asymptotic", False)) for n in names]), "1",
+            "monotone with observed order >= 1: Richardson estimate used")
+        datasets[f"{ev}/governing"] = Dataset(
+            np.array([evidence[n].get("governing", "") for n in names], dtype=object), "1",
+            "error measure with the largest estimate")
+        values = np.full((len(names), 3), np.nan)
+        for i, n in enumerate(names):
+            level_values = evidence[n].get("values", [])
+            values[i, :len(level_values)] = level_values
+        datasets[f"{ev}/values"] = Dataset(
+            values, "m or rad", "peak midpoint deflection [m] (rigid: final crank angle "
+            "[rad]) at the fine, medium, coarse level")
+        datasets[f"{ev}/settings"] = Dataset(
+            np.array(["; ".join(evidence[n].get("settings", [n])) for n in names],
+                     dtype=object), "1", "the levels' settings, finest first")
+        datasets[f"{ev}/wall_time"] = Dataset(
+            np.array([sum(evidence[n].get("wall_times_s", [np.nan])) for n in names]), "s",
+            "integration time of the levels (a run shared with the reference or another "
+            "sequence is counted in each)")
+        datasets[f"{group}/reference/total_time"] = Dataset(
+            reference_time, "s", "wall time of the reference and all its evidence runs "
+            "(including reduction builds)")
         verdict = "converged" if reference.converged else "NOT converged"
         lines.append(f"  {scene_name}: reference {reference.description}; accuracy "
-                     f"{reference.accuracy:.1e} ({verdict} to {reference.tolerance:g}); "
-                     f"evidence: "
-                     + ", ".join(f"{n}: {reference.evidence[n]['error']:.1e}" for n in names))
+                     f"{reference.accuracy:.1e} ({verdict} to {reference.tolerance:g}; "
+                     f"{reference_time:.0f} s in all); evidence:")
+        for n in names:
+            e = evidence[n]
+            lines.append(f"      {n}: estimate {e['error']:.2e}"
+                         + (f", changes {e['change_fine']:.2e} / {e['change_coarse']:.2e}, "
+                            f"order {e['order']:.2f}, "
+                            f"{'asymptotic' if e['asymptotic'] else 'fallback'}"
+                            if "change_coarse" in e and math.isfinite(e["change_coarse"])
+                            else "")
+                         + (f"; values {', '.join(f'{v:.7e}' for v in e['values'])}"
+                            if "values" in e else "")
+                         + (f"; failed: {e['failed'][:120]}" if "failed" in e else ""))
         recommendations = recommend(measurements, reference,
                                     eligible=lambda m: m.setting.engine == "exudyn")
         labels, walls, errors, reasons = [], [], [], []
@@ -392,6 +503,22 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
         lines.append(f"    {len(measurements)} settings, {len(failed)} failed"
                      + "".join(f"\n      failed {m.setting.label}: {m.message[:160]}"
                                for m in failed))
+        if scene_name == FFRF_DEFAULT_SCENE:
+            level = float(scene["fidelity"]["tolerance"])
+            pick = recommend(measurements, reference, [level],
+                             eligible=lambda m: m.setting.engine == "exudyn")[0]
+            knobs = dict(pick.measurement.setting.overrides) if pick.measurement else {}
+            matches = bool(knobs) and all(
+                key in knobs and np.isclose(knobs[key], value) if isinstance(value, float)
+                else knobs.get(key) == value for key, value in FFRF_DEFAULT.items())
+            datasets[f"{group}/default/level"] = Dataset(level, "1", "the scene's tolerance")
+            datasets[f"{group}/default/setting"] = Dataset(
+                pick.measurement.setting.label if pick.measurement else "", "1",
+                f"fastest certified setting within it ({pick.reason or 'certified'})")
+            datasets[f"{group}/default/matches_table"] = Dataset(
+                matches, "1", "the pick is studies/tradeoff.py FFRF_DEFAULT")
+            lines.append(f"    scene tolerance {level:g}: {_describe(pick.measurement)}; "
+                         f"FFRF_DEFAULT {'matches' if matches else 'DIFFERS'}")
         if scene_name == "rigid":
             best = default_recommendation(measurements)
             datasets["rigid/default/setting"] = Dataset(
