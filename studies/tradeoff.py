@@ -69,14 +69,20 @@ DEFAULT_TOLERANCE = {"crank_angle_rad": 1e-6, "slider_position_m": 1e-7, "max_st
                      "max_spectral_radius": 0.95}
 
 #: what to run a 1 mm FFRF plate coupler with at the bundled scene's tolerance
-#: (``fidelity.tolerance`` = 1 %): the study's certified 1 % pick (README "Defaults");
-#: :func:`summarize` stores whether the run's pick still is this setting
-#: (``/summary/ffrf_1mm/default/matches_table``), tests/test_tradeoff.py checks that it reaches
-#: the tolerance and how much faster it is than the scene's own settings
-FFRF_DEFAULT: dict[str, Any] = {"simulation.step_s": 4e-4, "coupler.mesh_size_m": 0.004,
+#: (``fidelity.tolerance`` = 1 %): the study's certified 1 % pick (README "Defaults"), on the
+#: scene's own 2 mm mesh. :func:`summarize` stores whether the run confirms it
+#: (``/summary/ffrf_1mm/default/matches_table``): certified within the tolerance and no slower
+#: than the run's pick by more than :data:`DEFAULT_TIE` (two runs of make tradeoff swapped the
+#: 2 mm and 4 mm meshes at h = 4e-4 s: 83 / 62 ms, then 63 / 70 ms);
+#: tests/test_tradeoff.py checks that it reaches the tolerance, and how much faster it is
+#: than the scene's own settings
+FFRF_DEFAULT: dict[str, Any] = {"simulation.step_s": 4e-4, "coupler.mesh_size_m": 0.002,
                                 "coupler.modes": 2, "simulation.newton": "modified",
                                 "simulation.newton_relative_tolerance": 1e-8}
 FFRF_DEFAULT_SCENE = "ffrf_1mm"
+#: timing noise between runs on the shared machine: a setting this much slower than the pick
+#: still counts as equally fast for the FFRF_DEFAULT check
+DEFAULT_TIE = 0.5
 
 S = Setting.of
 
@@ -366,6 +372,14 @@ def simulate_cases(scenes: dict[str, Scene],
     return results
 
 
+def _is_default(setting: Setting) -> bool:
+    """Whether ``setting`` runs exactly the knobs of :data:`FFRF_DEFAULT`."""
+    knobs = dict(setting.overrides)
+    return setting.engine == "exudyn" and set(knobs) == set(FFRF_DEFAULT) and all(
+        np.isclose(knobs[key], value) if isinstance(value, float) else knobs[key] == value
+        for key, value in FFRF_DEFAULT.items())
+
+
 def default_recommendation(measurements: list[Measurement]) -> Measurement | None:
     """The fastest Exudyn setting meeting :data:`DEFAULT_TOLERANCE` (rigid scene)."""
     limit = DEFAULT_TOLERANCE
@@ -507,18 +521,23 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
             level = float(scene["fidelity"]["tolerance"])
             pick = recommend(measurements, reference, [level],
                              eligible=lambda m: m.setting.engine == "exudyn")[0]
-            knobs = dict(pick.measurement.setting.overrides) if pick.measurement else {}
-            matches = bool(knobs) and all(
-                key in knobs and np.isclose(knobs[key], value) if isinstance(value, float)
-                else knobs.get(key) == value for key, value in FFRF_DEFAULT.items())
+            table = [m for m in measurements if m.ok and _is_default(m.setting)]
+            matches = bool(pick.measurement and table and table[0].error <= level
+                           and table[0].wall_time_s
+                           <= (1 + DEFAULT_TIE) * pick.measurement.wall_time_s)
             datasets[f"{group}/default/level"] = Dataset(level, "1", "the scene's tolerance")
             datasets[f"{group}/default/setting"] = Dataset(
                 pick.measurement.setting.label if pick.measurement else "", "1",
                 f"fastest certified setting within it ({pick.reason or 'certified'})")
+            datasets[f"{group}/default/table_setting"] = Dataset(
+                table[0].setting.label if table else "", "1",
+                "the run of studies/tradeoff.py FFRF_DEFAULT")
             datasets[f"{group}/default/matches_table"] = Dataset(
-                matches, "1", "the pick is studies/tradeoff.py FFRF_DEFAULT")
+                matches, "1", f"FFRF_DEFAULT is within the tolerance (certified) and at most "
+                              f"{DEFAULT_TIE:g} x slower than the pick")
             lines.append(f"    scene tolerance {level:g}: {_describe(pick.measurement)}; "
-                         f"FFRF_DEFAULT {'matches' if matches else 'DIFFERS'}")
+                         f"FFRF_DEFAULT {_describe(table[0]) if table else 'not run'}: "
+                         f"{'confirmed' if matches else 'NOT confirmed'}")
         if scene_name == "rigid":
             best = default_recommendation(measurements)
             datasets["rigid/default/setting"] = Dataset(
