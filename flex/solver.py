@@ -5,7 +5,7 @@
 - input: a validated scene (and, for an FFRF coupler, its reduction);
 - output: a :class:`~flex.results.CaseResult` whose datasets are the quantities of the
   result layout (``time``, ``crank/...``, ``slider/...``, ``joints/<A|B|C>/...``,
-  ``constraint_norm``, ``energy/...`` for rigid couplers, ``coupler/...``), each with units;
+  ``constraint_norm``, ``energy/...`` (rigid and FFRF links), ``coupler/...``), each with units;
 - status: ``ok``; a diverging run (solver failure, NaN, exploding constraint norm) raises
   :class:`~flex.errors.SimulationError` naming the step and time, and
   :func:`simulate_case` turns that into a ``failed`` case instead of data;
@@ -257,7 +257,6 @@ def _crank_datasets(mech: Mechanism) -> dict[str, Any]:
         time_s, crank_angle = rotation[:, 0], rotation[:, 3]
         speed = _sensor(mech, "crank.AngularVelocity")[:, 3]
         acceleration = _sensor(mech, "crank.AngularAcceleration")[:, 3]
-        midpoint = _sensor(mech, "crank.Position")[:, 1:3]
         how = " (rigid body)"
     else:
         position_a = _sensor(mech, "marker_crank_A.Position")
@@ -269,7 +268,6 @@ def _crank_datasets(mech: Mechanism) -> dict[str, Any]:
         speed = (chord[:, 0] * chord_rate[:, 1] - chord[:, 1] * chord_rate[:, 0]) \
             / np.sum(chord**2, axis=1)
         acceleration = np.gradient(speed, time_s)
-        midpoint = None  # with the elastic datasets below
         how = " of the chord A-B (flexible crank)"
     # the angle starts in (-pi, pi] (from a rotation matrix or atan2): put the series on the
     # branch of the scene's initial angle (181 deg stays 181 deg, not -179 deg)
@@ -281,10 +279,10 @@ def _crank_datasets(mech: Mechanism) -> dict[str, Any]:
     out["crank/angular_velocity"] = Dataset(speed, "rad/s", "crank angular velocity" + how)
     out["crank/angular_acceleration"] = Dataset(acceleration, "rad/s^2",
                                                 "crank angular acceleration" + how)
-    if midpoint is not None:
-        out["crank/midpoint_position"] = Dataset(midpoint, "m",
+    if not mech.crank:
+        out["crank/midpoint_position"] = Dataset(_sensor(mech, "crank.Position")[:, 1:3], "m",
                                                  "crank midpoint (centre of mass) x, y")
-    else:
+    else:  # midpoint and elastic response from the flexible crank's markers
         out.update(_elastic_datasets(mech, "crank", "marker_crank_A", "marker_crank_B",
                                      "A-B", time_s))
     return out
