@@ -135,6 +135,20 @@ def _print(text: str) -> None:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
 
 
+def _auto_note(scene) -> str:
+    """A TOML comment saying what the scene's "auto" solver keys resolve to (or when)."""
+    from .settings import has_auto, resolve_solver_settings
+
+    if not has_auto(scene):
+        return ""
+    if "auto" in (scene["crank"]["model"], scene["coupler"]["model"]):
+        return ('# [simulation] "auto" keys: chosen at run time, once the model = "auto" links '
+                "are decided (flex/settings.py)\n")
+    _, choice = resolve_solver_settings(scene)
+    keys = ", ".join(f"{key} = {value!r}" for key, value in choice.keys.items())
+    return f'# [simulation] "auto" keys -> {keys} ({choice.entry}: {choice.reason})\n'
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the process exit status."""
     parser = _parser()
@@ -156,13 +170,13 @@ def main(argv: list[str] | None = None) -> int:
                 os.environ["FLEX_WORKERS"] = str(args.workers)
             output = run_study(args.study, args.scene, args.overrides, args.out,
                                figures=not args.no_figures, quiet=args.quiet)
-            return 1 if any(c.status != "ok" for c in output.results.values()) else 0
+            return 0 if output.as_expected else 1
         if args.command == "scene":
             from .scene import to_toml
             from .study import load_study, study_scene
 
-            print(to_toml(study_scene(load_study(args.study), args.scene, args.overrides)),
-                  end="")
+            scene = study_scene(load_study(args.study), args.scene, args.overrides)
+            print(_auto_note(scene) + to_toml(scene), end="")
             return 0
         if args.command in ("inspect", "plot", "compare"):
             return _result_tool(args)

@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 
 from .errors import FlexError, SceneError
+from .settings import resolved_simulation
 
 TWO_PI = 2.0 * math.pi
 THESIS_K = 108.0  #: thesis sec. 6.2, in the thesis convention (n = delta_t * omega)
@@ -735,7 +736,7 @@ def deployment_probe(scene: Mapping[str, Mapping[str, Any]],
                              "drive.crank_speed_rad_per_s != 0")
         end = min(end, math.pi / speed)
     for _ in range(4):
-        step = min(rigid["simulation"]["step_s"], 1e-4, end / 200)
+        step = min(resolved_simulation(rigid)["step_s"], 1e-4, end / 200)
         rigid["simulation"].update(end_time_s=end, step_s=step, output_step_s=0.0)
         result = simulate(rigid, "fidelity_probe")
         data = {k: np.asarray(v.data) for k, v in result.datasets.items()}

@@ -64,7 +64,8 @@ def describe(path: str | Path, spec: str | None = None) -> dict[str, Any]:
                 "scene_toml": str(attrs.pop("scene_toml", "")),
                 "solver_settings_toml": str(attrs.pop("solver_settings_toml", "")),
                 "attributes": attrs, "datasets": entries}
-            info["scene_changes"] = _changes(base_scene, _parse_toml(info["scene_toml"]))
+            info["scene_changes"] = _changes(base_scene, _parse_toml(info["scene_toml"]),
+                                             str(attrs.get("solver_defaults_keys", "")))
             out["cases"][case] = info
         for name in h5:
             if name == "cases":
@@ -122,15 +123,21 @@ def _parse_toml(text: str) -> dict[str, Any] | None:
         return None
 
 
-def _changes(base: dict[str, Any] | None, scene: dict[str, Any] | None) -> dict[str, Any]:
-    """``{"section.key": value}`` where ``scene`` differs from ``base``."""
+def _changes(base: dict[str, Any] | None, scene: dict[str, Any] | None,
+             filled_by_flex: str = "") -> dict[str, Any]:
+    """``{"section.key": value}`` where ``scene`` differs from ``base``; ``"auto"`` simulation
+    keys that flex filled (``filled_by_flex``: the case's ``solver_defaults_keys``) are not
+    changes."""
     if base is None or scene is None:
         return {}
+    filled = {item.split(" = ")[0] for item in filled_by_flex.split(", ") if item}
     out = {}
     for section, table in scene.items():
         if not isinstance(table, dict):
             continue
         for key, value in table.items():
+            if section == "simulation" and key in filled:
+                continue
             if not isinstance(base.get(section), dict) or base[section].get(key) != value:
                 out[f"{section}.{key}"] = value
     return out

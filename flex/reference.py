@@ -29,6 +29,7 @@ from scipy.integrate import solve_ivp
 from .errors import SimulationError
 from .kinematics import slider_crank
 from .scene import Scene, plate_mass_properties
+from .settings import resolved_simulation
 
 
 @dataclass
@@ -202,7 +203,7 @@ def solve_reference(scene: Scene, time_s: np.ndarray | None = None, rtol: float 
     :class:`~flex.errors.SimulationError` if the integrator fails.
     """
     dae = SliderCrankDAE(scene)
-    sim = scene["simulation"]
+    sim = resolved_simulation(scene)
     if time_s is None:
         interval = sim["output_step_s"] or sim["step_s"]
         count = int(round(sim["end_time_s"] / interval))

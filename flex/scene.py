@@ -36,9 +36,14 @@ class Field:
     positive: bool = False  # strictly > 0
     maximum: float | None = None  # inclusive upper bound
     below: float | None = None  # strictly < below
+    auto: bool = False  # "auto" accepted too: flex chooses (flex.settings)
 
     def accepted(self) -> str:
         """Human-readable accepted range, used in error messages."""
+        text = self._accepted()
+        return text + ' or "auto"' if self.auto else text
+
+    def _accepted(self) -> str:
         if isinstance(self.kind, tuple):
             return "one of " + ", ".join(f'"{c}"' for c in self.kind)
         if self.kind is bool:
@@ -122,11 +127,12 @@ SCHEMA: dict[str, dict[str, Field]] = {
     },
     "simulation": {
         "end_time_s": Field(doc="simulated time span", **_POS),
-        "step_s": Field(doc="fixed time step of the integrator", **_POS),
+        "step_s": Field(doc="fixed time step of the integrator (auto: by model, flex.settings)",
+                        auto=True, **_POS),
         "output_step_s": Field(float, "interval of the stored samples (>= step_s; 0: every "
                                "step)", minimum=0.0),
         "spectral_radius": Field(float, "generalized-alpha spectral radius at infinity",
-                                 minimum=0.0, maximum=1.0),
+                                 minimum=0.0, maximum=1.0, auto=True),
         "integrator": Field(("generalized_alpha", "explicit_penalty"),
                             "implicit generalized-alpha with exact joints, or an explicit "
                             "Runge-Kutta method with penalty joints (rigid coupler, spring drive)"),
@@ -135,10 +141,11 @@ SCHEMA: dict[str, dict[str, Field]] = {
                              "velocity-level constraints (index 2, Newmark with the same "
                              "spectral_radius)"),
         "newton": Field(("full", "modified"),
-                        "Newton iteration: Jacobian every iteration, or reused while it converges"),
+                        "Newton iteration: Jacobian every iteration, or reused while it converges",
+                        auto=True),
         "newton_relative_tolerance": Field(float, "Newton residual reduction per step "
                                            "(absolute tolerance: 1e-2 of it)", positive=True,
-                                           maximum=1e-3),
+                                           maximum=1e-3, auto=True),
         "explicit_method": Field(("RK44", "RK67", "ExplicitMidpoint"),
                                  "explicit_penalty: fixed-step Runge-Kutta method (Exudyn's "
                                  "DOPRI5 needs its own step control and is not offered)"),
@@ -269,6 +276,8 @@ def validate(scene: Scene) -> None:
 
 
 def _check_value(name: str, field: Field, value: Any) -> None:
+    if field.auto and value == "auto":
+        return
     if isinstance(field.kind, tuple):
         if not isinstance(value, str) or value not in field.kind:
             raise SceneError(f"{name} = {_show(value)}: must be {field.accepted()}")
@@ -323,17 +332,7 @@ def _check_geometry(scene: Scene) -> None:
                          f"{offset_m:g} puts the slide line off the reachable range; need "
                          f"|offset_m| < coupler.length_m - crank.length_m = "
                          f"{coupler_m - crank_m:g}")
-    sim = scene["simulation"]
-    if sim["step_s"] > sim["end_time_s"]:
-        raise SceneError(f"simulation.step_s = {sim['step_s']:g} must be <= "
-                         f"simulation.end_time_s = {sim['end_time_s']:g}")
-    if 0 < sim["output_step_s"] < sim["step_s"] * (1 - 1e-9):
-        raise SceneError(f"simulation.output_step_s = {sim['output_step_s']:g} must be >= "
-                         f"simulation.step_s = {sim['step_s']:g} (or 0: every step)")
-    steps = sim["end_time_s"] / sim["step_s"]
-    if steps > 5e7:
-        raise SceneError(f"simulation needs {steps:.3g} steps (end_time_s / step_s); "
-                         f"accepted: at most 5e7")
+    check_steps(scene["simulation"])
     for link in ("crank", "coupler"):
         _check_link(link, scene[link])
     if scene["crank"]["model"] == "ffrf" and scene["drive"]["kind"] == "constant_speed":
@@ -344,7 +343,7 @@ def _check_geometry(scene: Scene) -> None:
     if coupler["model"] == "nonlinear_fe" and coupler["damping_ratio"] != 0:
         raise SceneError(f"coupler.damping_ratio = {coupler['damping_ratio']:g}: "
                          'coupler.model = "nonlinear_fe" has no damping model; accepted: 0')
-    if sim["integrator"] == "explicit_penalty" and (
+    if scene["simulation"]["integrator"] == "explicit_penalty" and (
             coupler["model"] != "rigid" or scene["crank"]["model"] != "rigid"
             or scene["drive"]["kind"] != "spring"):
         raise SceneError('simulation.integrator = "explicit_penalty" needs crank.model and '
@@ -352,6 +351,22 @@ def _check_geometry(scene: Scene) -> None:
                          "solvers take no algebraic constraints: the flexible bodies' "
                          "Euler-parameter frames and the crank-speed constraint have them); "
                          'accepted: "generalized_alpha"')
+
+
+def check_steps(sim: dict[str, Any]) -> None:
+    """Step, output interval and step count; an ``"auto"`` step is checked once resolved."""
+    if sim["step_s"] == "auto":
+        return
+    if sim["step_s"] > sim["end_time_s"]:
+        raise SceneError(f"simulation.step_s = {sim['step_s']:g} must be <= "
+                         f"simulation.end_time_s = {sim['end_time_s']:g}")
+    if 0 < sim["output_step_s"] < sim["step_s"] * (1 - 1e-9):
+        raise SceneError(f"simulation.output_step_s = {sim['output_step_s']:g} must be >= "
+                         f"simulation.step_s = {sim['step_s']:g} (or 0: every step)")
+    steps = sim["end_time_s"] / sim["step_s"]
+    if steps > 5e7:
+        raise SceneError(f"simulation needs {steps:.3g} steps (end_time_s / step_s); "
+                         f"accepted: at most 5e7")
 
 
 def _check_link(link: str, values: dict[str, Any]) -> None:

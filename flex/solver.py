@@ -36,6 +36,7 @@ from .errors import FlexError, SimulationError
 from .mechanism import Mechanism, _rotation_z, build_mechanism
 from .results import CaseResult, Dataset
 from .scene import Scene, to_toml
+from .settings import resolve_solver_settings, resolved_simulation
 
 # a constraint norm above this is a failed assembly, not a tolerance question
 CONSTRAINT_NORM_LIMIT_M = 1e-4
@@ -56,8 +57,9 @@ NONLINEAR_FE_NEWTON_ABSOLUTE_TOLERANCE = 1e-6
 
 
 def solver_settings(scene: Scene) -> dict[str, Any]:
-    """The integrator settings used for ``scene`` (stored in every result file)."""
-    sim = scene["simulation"]
+    """The integrator settings used for ``scene`` (stored in every result file); ``"auto"``
+    keys resolved as :func:`simulate` resolves them (:mod:`flex.settings`)."""
+    sim = resolved_simulation(scene)
     settings = {
         "integrator": "generalized-alpha (Exudyn, index 3)",
         "step_s": sim["step_s"],
@@ -491,9 +493,12 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     (None: :func:`reduction_for_scene`, cached on disk). ``model = "auto"`` links are first
     resolved to concrete models (given reductions are then ignored: auto picks the modes);
     the choice and its reason go to stderr and into the result's attributes
-    ``fidelity_<link>_*``, and ``scene_toml`` holds the resolved scene.
+    ``fidelity_<link>_*``. Then ``"auto"`` solver keys are filled by model
+    (:func:`flex.settings.resolve_solver_settings`; attributes ``solver_defaults_*``).
+    ``scene_toml`` holds the resolved scene.
     """
     scene, fidelity = _resolve_auto(scene)
+    scene, solver_choice = resolve_solver_settings(scene)
     if fidelity:
         reduction = crank_reduction = None
     if scene["coupler"]["model"] == "ffrf" and reduction is None:
@@ -512,6 +517,8 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
                         solver_settings_toml=tomli_w.dumps(settings))
     for decision in fidelity:
         result.attrs.update(decision.attrs())
+    if solver_choice is not None:
+        result.attrs.update(solver_choice.attrs())
     return result
 
 

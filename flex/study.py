@@ -10,7 +10,9 @@ A study is a module in ``studies/`` that declares what it runs and what it store
     def figures(results, summary, folder) -> list[Path]    # PNGs (optional)
 
 Optionally ``def simulate_cases(scenes, progress) -> dict[str, CaseResult]`` replaces the
-default one-case-at-a-time simulation (the flexible study shares reductions that way).
+default one-case-at-a-time simulation (the flexible study shares reductions that way), and
+``EXPECTED_FAILURES`` names cases built to fail (the stability study's forced divergences):
+a run succeeds (:attr:`StudyOutput.as_expected`, exit status 0) when exactly those failed.
 :func:`execute` runs a study and returns its :class:`StudyOutput`; :func:`run_study` also
 writes ``results/<study>.h5`` (atomically) and the figures.
 """
@@ -54,6 +56,18 @@ class StudyOutput:
     wall_time_s: float
     path: Path | None = None
     figures: list[Path] = field(default_factory=list)
+    expected_failures: frozenset[str] = frozenset()
+
+    def unexpected(self) -> list[str]:
+        """Cases that failed without being expected to, or were expected to fail and did
+        not (names)."""
+        return [name for name, case in self.results.items()
+                if (case.status != "ok") != (name in self.expected_failures)]
+
+    @property
+    def as_expected(self) -> bool:
+        """Whether every case ended as the study declares (ok, or failed if expected)."""
+        return not self.unexpected()
 
 
 def load_study(name: str) -> ModuleType:
@@ -115,6 +129,7 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
     if path.suffix not in (".h5", ".hdf5"):
         raise SceneError(f"--out '{path}': result files end in .h5 or .hdf5")
     output = execute(module, scene, None if quiet else progress_printer())
+    output.expected_failures = frozenset(getattr(module, "EXPECTED_FAILURES", ()))
     failed = [case for case in output.results.values() if case.status != "ok"]
     output.path = write_results(path, name, list(output.results.values()), to_toml(scene),
                                 output.summary.datasets,
@@ -128,9 +143,15 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
     if not quiet:
         print(output.summary.report)
         for case in failed:
-            print(f"FAILED case {case.name}: {case.message}")
-        print(f"wrote {output.path} ({len(output.results)} cases, {len(failed)} failed, "
-              f"{output.wall_time_s:.1f} s)")
+            expected = " (expected)" if case.name in output.expected_failures else ""
+            print(f"FAILED{expected} case {case.name}: {case.message}")
+        for name in output.unexpected():
+            if output.results[name].status == "ok":
+                print(f"NOT FAILED case {name}: it was built to fail (EXPECTED_FAILURES)")
+        expected = len([c for c in failed if c.name in output.expected_failures])
+        print(f"wrote {output.path} ({len(output.results)} cases, {len(failed)} failed"
+              + (f", {expected} of them as expected" if expected else "")
+              + f", {output.wall_time_s:.1f} s)")
         for figure in output.figures:
             print(f"wrote {figure}")
     return output

@@ -50,6 +50,7 @@ from .errors import FlexError, SceneError
 from .reference import solve_reference
 from .results import Dataset
 from .scene import Scene, apply_overrides, validate
+from .settings import resolved_simulation
 
 #: relative accuracy levels for which a setting is recommended (1 %, 0.1 %, 0.01 %)
 ACCURACY_LEVELS = (1e-2, 1e-3, 1e-4)
@@ -354,7 +355,7 @@ def run_once(scene: Scene, setting: Setting, pool: ReductionPool | None = None
     if setting.engine == "scipy":
         if flexible:
             raise SceneError("the scipy reference DAE models a rigid coupler only")
-        sim = scene["simulation"]
+        sim = resolved_simulation(scene)
         interval = sim["output_step_s"] or sim["step_s"]
         count = int(round(sim["end_time_s"] / interval))
         solution = solve_reference(scene, np.linspace(0.0, count * interval, count + 1),

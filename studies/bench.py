@@ -41,6 +41,7 @@ import numpy as np
 from flex.errors import FlexError
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
+from flex.settings import pinned_overrides
 from flex.study import Summary
 from flex.tradeoff import (
     Measurement,
@@ -56,7 +57,7 @@ from flex.tradeoff import (
 
 NAME = "bench"
 DESCRIPTION = "speed at a stated accuracy: rigid 1e-7 rad, FFRF 1 mm 1 %, cache, make all"
-OVERRIDES: list[str] = []
+OVERRIDES = pinned_overrides()
 REPEATS = 5
 RIGID_ACCURACY_RAD = 1e-7
 FFRF_ACCURACY = 1e-2  # relative error of the peak midpoint deflection

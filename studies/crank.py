@@ -36,12 +36,13 @@ from flex import criteria
 from flex.plotting import figure
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides
+from flex.settings import pinned_overrides
 from flex.solver import simulate_case
 from flex.study import RESULTS_DIR, Summary
 
 NAME = "crank"
 DESCRIPTION = "flexible FFRF crank against auto's choice, with and without the wing"
-OVERRIDES = ['crank.geometry="plate"', "simulation.step_s=2e-5",
+OVERRIDES = pinned_overrides() + ['crank.geometry="plate"', "simulation.step_s=2e-5",
              "simulation.end_time_s=0.05"]
 FULL_MODES = 12
 

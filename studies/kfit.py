@@ -56,12 +56,13 @@ from flex.criteria import (
 )
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
+from flex.settings import pinned_overrides
 from flex.study import RESULTS_DIR, Summary
 
 NAME = "kfit"
 DESCRIPTION = "fit the rigid-or-flexible threshold k from FFRF-vs-rigid sweeps"
-OVERRIDES = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.modes=6",
-             "simulation.output_step_s=0.0"]
+OVERRIDES = pinned_overrides() + ['coupler.geometry="plate"', 'coupler.model="ffrf"',
+                                   "coupler.modes=6", "simulation.output_step_s=0.0"]
 
 THESIS_SPRING_N_PER_M = 1500.0
 THESIS_PRELOAD_M = 0.022

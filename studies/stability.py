@@ -38,6 +38,7 @@ from flex.kinematics import slider_crank
 from flex.plotting import figure
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
+from flex.settings import pinned_overrides
 from flex.solver import simulate_case
 from flex.study import Summary
 from flex.tradeoff import (
@@ -50,7 +51,7 @@ from flex.tradeoff import (
 
 NAME = "stability"
 DESCRIPTION = "extremes: thickness, step, spectral radius, 1 s horizon, dead centres, stiff drives"
-OVERRIDES: list[str] = []
+OVERRIDES = pinned_overrides()
 #: verdict threshold: largest relative error (angle / swing, slider / travel, peak / peak)
 TOLERANCE = 1e-3
 PLATE = ('coupler.geometry="plate"', 'coupler.model="ffrf"')
@@ -123,12 +124,18 @@ def extremes() -> list[Extreme]:
                                           f"simulation.spectral_radius={rho!r}"), "fine:2e-06",
                            rho))
     long = ("simulation.end_time_s=1.0", "simulation.output_step_s=1e-4")
-    for label, knobs in (("rho0.9", ()), ("rho1", ("simulation.spectral_radius=1.0",)),
-                         ("index2_rho1", ('simulation.formulation="index2"',
-                                          "simulation.spectral_radius=1.0")),
-                         ("explicit_k1e8", ('simulation.integrator="explicit_penalty"',))):
+    # index 3 with rho = 1 leaves the algebraic (constraint) modes undamped: Newton fails after
+    # ~0.78 s of free motion (measured by this study, README "Numerical stability"); kept to
+    # show it is detected, and the reason the default spectral radius is below 1
+    for label, knobs, expect in (
+            ("rho0.9", (), "within"),
+            ("rho1", ("simulation.spectral_radius=1.0",), "diverges"),
+            ("index2_rho1", ('simulation.formulation="index2"', "simulation.spectral_radius=1.0"),
+             "within"),
+            ("explicit_k1e8", ('simulation.integrator="explicit_penalty"',), "within")):
         out.append(Extreme(f"long_rigid_{label}", "long_horizon",
-                           long + ("simulation.step_s=1e-5",) + knobs, "scipy", 1.0))
+                           long + ("simulation.step_s=1e-5",) + knobs, "scipy", 1.0,
+                           expect=expect))
     # FFRF: energy drift over 1 s (kinetic + strain + spring energy, undamped plate) at the
     # 1 % setting of the tradeoff study and at a 10x smaller step; the 10 mm plate at the
     # step its first bending mode (3.5 kHz) needs
@@ -160,6 +167,10 @@ def extremes() -> list[Extreme]:
                        _plate(0.3) + ("simulation.end_time_s=0.01", "simulation.step_s=1e-4"),
                        "none", 1e-4, expect="diverges"))
     return out
+
+
+#: the runs built to diverge (flex run stability exits 0 when exactly these fail)
+EXPECTED_FAILURES = frozenset(e.name for e in extremes() if e.expect == "diverges")
 
 
 def cases(scene: Scene) -> dict[str, Scene]:

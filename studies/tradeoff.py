@@ -32,7 +32,8 @@ import numpy as np
 
 from flex.plotting import figure
 from flex.results import CaseResult, Dataset
-from flex.scene import Scene, apply_overrides, to_toml, validate
+from flex.scene import Scene, apply_overrides, load_scene, to_toml, validate
+from flex.settings import AUTO_KEYS, pinned_overrides, resolve_solver_settings
 from flex.study import Summary
 from flex.tradeoff import (
     ACCURACY_LEVELS,
@@ -52,7 +53,7 @@ from flex.tradeoff import (
 
 NAME = "tradeoff"
 DESCRIPTION = "work-precision: every knob against a converged reference, rigid and FFRF 1/10 mm"
-OVERRIDES: list[str] = []
+OVERRIDES = pinned_overrides()
 REPEATS = 3
 
 PLATE = ['coupler.geometry="plate"', 'coupler.model="ffrf"']
@@ -68,17 +69,17 @@ SCENES: dict[str, list[str]] = {
 DEFAULT_TOLERANCE = {"crank_angle_rad": 1e-6, "slider_position_m": 1e-7, "max_step_s": 1e-5,
                      "max_spectral_radius": 0.95}
 
-#: what to run a 1 mm FFRF plate coupler with at the bundled scene's tolerance
-#: (``fidelity.tolerance`` = 1 %): the study's certified 1 % pick (README "Defaults"), on the
-#: scene's own 2 mm mesh. :func:`summarize` stores whether the run confirms it
-#: (``/summary/ffrf_1mm/default/matches_table``): certified within the tolerance and no slower
-#: than the run's pick by more than :data:`DEFAULT_TIE` (two runs of make tradeoff swapped the
-#: 2 mm and 4 mm meshes at h = 4e-4 s: 83 / 62 ms, then 63 / 70 ms);
+#: what a user gets: the bundled scene's "auto" solver keys, which flex/settings.py fills from
+#: flex/solver_defaults.toml (README "Defaults"). On ``ffrf_1mm`` (the bundled 2 mm mesh and 6
+#: modes) they resolve to its ``ffrf_coupler`` entry, the certified 1 % pick h = 4e-4 s,
+#: modified Newton 1e-8; on ``rigid`` to the ``rigid`` entry. :func:`summarize` stores whether
+#: the run confirms both (``/summary/<scene>/default/matches_table``): within the tolerance
+#: (certified) and no slower than the run's pick by more than :data:`DEFAULT_TIE` (two runs of
+#: make tradeoff swapped the 2 mm and 4 mm meshes at h = 4e-4 s: 83 / 62 ms, then 63 / 70 ms);
 #: tests/test_tradeoff.py checks that it reaches the tolerance, and how much faster it is
-#: than the scene's own settings
-FFRF_DEFAULT: dict[str, Any] = {"simulation.step_s": 4e-4, "coupler.mesh_size_m": 0.002,
-                                "coupler.modes": 2, "simulation.newton": "modified",
-                                "simulation.newton_relative_tolerance": 1e-8}
+#: than the rigid-model settings
+FFRF_DEFAULT: dict[str, Any] = {f"simulation.{key}": "auto" for key in AUTO_KEYS}
+DEFAULT_LABEL = "flex defaults (auto)"
 FFRF_DEFAULT_SCENE = "ffrf_1mm"
 #: timing noise between runs on the shared machine: a setting this much slower than the pick
 #: still counts as equally fast for the FFRF_DEFAULT check
@@ -216,6 +217,7 @@ def settings(scene_name: str, nonlinear_available: bool) -> list[Setting]:
         for rtol in (1e-4, 1e-6, 1e-8, 1e-10):
             out.append(_scipy(rtol))
             out.append(_scipy(rtol, "RK45"))
+        out.append(_default_setting())
         return out
 
     thin = scene_name == "ffrf_1mm"
@@ -262,7 +264,13 @@ def settings(scene_name: str, nonlinear_available: bool) -> list[Setting]:
                              "combination: step x mesh x modes (modified Newton, tol 1e-8)",
                              step_s=step, coupler__mesh_size_m=mesh, coupler__modes=modes,
                              **fast))
+    out.append(_default_setting())
     return out
+
+
+def _default_setting() -> Setting:
+    """The bundled scene's solver keys ("auto"): what a user gets."""
+    return Setting(DEFAULT_LABEL, tuple(FFRF_DEFAULT.items()), group="flex defaults")
 
 
 def _nonlinear_available() -> bool:
@@ -380,17 +388,24 @@ def _is_default(setting: Setting) -> bool:
         for key, value in FFRF_DEFAULT.items())
 
 
+#: the rigid scene as the study runs it (solver keys pinned), for reading a run's settings
+_RIGID_BASE = load_scene(None, OVERRIDES)
+
+
+def _within_default_tolerance(m: Measurement) -> bool:
+    """Whether a rigid-scene run meets :data:`DEFAULT_TOLERANCE` ("auto" keys resolved)."""
+    limit = DEFAULT_TOLERANCE
+    sim = resolve_solver_settings(scene_for(_RIGID_BASE, m.setting))[0]["simulation"]
+    return (m.ok and m.setting.engine == "exudyn"
+            and m.errors["crank_angle_rad"] <= limit["crank_angle_rad"]
+            and m.errors["slider_position_m"] <= limit["slider_position_m"]
+            and sim["step_s"] <= limit["max_step_s"] * (1 + 1e-9)
+            and sim["spectral_radius"] <= limit["max_spectral_radius"])
+
+
 def default_recommendation(measurements: list[Measurement]) -> Measurement | None:
     """The fastest Exudyn setting meeting :data:`DEFAULT_TOLERANCE` (rigid scene)."""
-    limit = DEFAULT_TOLERANCE
-    within = [m for m in measurements
-              if m.ok and m.setting.engine == "exudyn"
-              and m.errors["crank_angle_rad"] <= limit["crank_angle_rad"]
-              and m.errors["slider_position_m"] <= limit["slider_position_m"]
-              and dict(m.setting.overrides).get("simulation.step_s", np.inf)
-              <= limit["max_step_s"] * (1 + 1e-9)
-              and dict(m.setting.overrides).get("simulation.spectral_radius", 0.9)
-              <= limit["max_spectral_radius"]]
+    within = [m for m in measurements if _within_default_tolerance(m)]
     return fastest(within) if within else None
 
 
@@ -519,6 +534,8 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
                                for m in failed))
         if scene_name == FFRF_DEFAULT_SCENE:
             level = float(scene["fidelity"]["tolerance"])
+            resolved = resolve_solver_settings(scene_for(
+                apply_overrides(scene, SCENES[scene_name]), _default_setting()))[1]
             pick = recommend(measurements, reference, [level],
                              eligible=lambda m: m.setting.engine == "exudyn")[0]
             table = [m for m in measurements if m.ok and _is_default(m.setting)]
@@ -530,22 +547,30 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
                 pick.measurement.setting.label if pick.measurement else "", "1",
                 f"fastest certified setting within it ({pick.reason or 'certified'})")
             datasets[f"{group}/default/table_setting"] = Dataset(
-                table[0].setting.label if table else "", "1",
-                "the run of studies/tradeoff.py FFRF_DEFAULT")
+                f"{DEFAULT_LABEL}: {resolved.keys if resolved else ''}", "1",
+                "what the bundled scene's solver keys resolve to (flex/solver_defaults.toml)")
             datasets[f"{group}/default/matches_table"] = Dataset(
-                matches, "1", f"FFRF_DEFAULT is within the tolerance (certified) and at most "
+                matches, "1", f"the defaults are within the tolerance (certified) and at most "
                               f"{DEFAULT_TIE:g} x slower than the pick")
             lines.append(f"    scene tolerance {level:g}: {_describe(pick.measurement)}; "
-                         f"FFRF_DEFAULT {_describe(table[0]) if table else 'not run'}: "
+                         f"defaults {_describe(table[0]) if table else 'not run'}: "
                          f"{'confirmed' if matches else 'NOT confirmed'}")
         if scene_name == "rigid":
             best = default_recommendation(measurements)
+            table = [m for m in measurements if m.ok and _is_default(m.setting)]
+            matches = bool(best and table and _within_default_tolerance(table[0])
+                           and table[0].wall_time_s <= (1 + DEFAULT_TIE) * best.wall_time_s)
             datasets["rigid/default/setting"] = Dataset(
                 best.setting.label if best else "", "1",
                 "fastest setting within the default scene's tolerance (DEFAULT_TOLERANCE)")
             datasets["rigid/default/knobs"] = Dataset(repr(best.setting.knobs()) if best else "",
                                                       "1", "its knobs")
-            lines.append(f"    default scene tolerance {DEFAULT_TOLERANCE}: {_describe(best)}")
+            datasets["rigid/default/matches_table"] = Dataset(
+                matches, "1", f"the defaults are within DEFAULT_TOLERANCE and at most "
+                              f"{DEFAULT_TIE:g} x slower than the pick")
+            lines.append(f"    default scene tolerance {DEFAULT_TOLERANCE}: {_describe(best)}; "
+                         f"defaults {_describe(table[0]) if table else 'not run'}: "
+                         f"{'confirmed' if matches else 'NOT confirmed'}")
         scipy = [m for m in measurements if m.ok and m.setting.engine == "scipy"]
         if scipy:
             lines.append("    scipy reference DAE: " + "; ".join(

@@ -159,3 +159,25 @@ def test_ffrf_coupler_keeps_its_energy_over_a_long_horizon():
         assert np.ptp(energy) / energy[0] < LOSS[rho]
     assert -LOSS[0.9] < drift[0.9] <= 1e-6  # never gains energy
     assert drift[0.5] < drift[0.9]
+
+
+def test_a_run_succeeds_when_exactly_the_expected_cases_fail():
+    from flex.results import CaseResult
+    from flex.study import StudyOutput, Summary
+
+    results = {"ok": CaseResult("ok", ""),
+               "diverged": CaseResult("diverged", "", status="failed", message="NaN at step 3")}
+    output = StudyOutput("s", {}, results, Summary({}, ""), 0.0,
+                         expected_failures=frozenset({"diverged"}))
+    assert output.as_expected and output.unexpected() == []
+    output.expected_failures = frozenset()
+    assert not output.as_expected and output.unexpected() == ["diverged"]
+    output.expected_failures = frozenset({"ok", "diverged"})
+    assert output.unexpected() == ["ok"]  # built to fail, but ran
+
+
+def test_the_stability_study_declares_its_forced_divergences():
+    from studies import stability
+
+    assert stability.EXPECTED_FAILURES == {"diverge_explicit_above_limit",
+                                           "diverge_thin_plate_h1e-4", "long_rigid_rho1"}

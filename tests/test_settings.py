@@ -1,0 +1,108 @@
+"""Solver settings by model: the bundled scene's "auto" keys (flex/settings.py)."""
+
+from __future__ import annotations
+
+import pytest
+
+from flex.errors import SceneError
+from flex.scene import load_scene
+from flex.settings import (
+    AUTO_KEYS,
+    pinned_overrides,
+    resolve_solver_settings,
+    resolved_simulation,
+    solver_defaults,
+)
+from flex.solver import simulate, solver_settings
+
+PLATE = ['coupler.geometry="plate"', 'coupler.model="ffrf"']
+
+
+def test_bundled_scene_leaves_the_solver_keys_to_flex():
+    sim = load_scene()["simulation"]
+    assert all(sim[key] == "auto" for key in AUTO_KEYS)
+
+
+def test_rigid_links_get_the_rigid_entry():
+    scene, choice = resolve_solver_settings(load_scene())
+    assert choice.entry == "rigid"
+    expected = solver_defaults()["rigid"]
+    assert {key: scene["simulation"][key] for key in AUTO_KEYS} == {
+        key: expected[key] for key in AUTO_KEYS}
+    assert scene["simulation"]["step_s"] == 1e-5  # the thesis table's grid
+
+
+def test_the_certified_plate_gets_the_ffrf_entry():
+    scene, choice = resolve_solver_settings(load_scene(None, PLATE))
+    assert choice.entry == "ffrf_coupler"
+    assert scene["simulation"]["step_s"] == 4e-4
+    assert scene["simulation"]["newton"] == "modified"
+    assert "357.6 Hz" in choice.reason  # 1 mm steel plate, 80 mm pinned-pinned
+
+
+@pytest.mark.parametrize("change, why", [
+    ("coupler.thickness_m=0.003", "above the certified plate's"),
+    ("fidelity.tolerance=0.001", "finer than the FFRF coupler's certified 0.01"),
+    ('coupler.model="nonlinear_fe"', 'no certified setting for coupler.model = "nonlinear_fe"'),
+])
+def test_uncertified_flexible_scenes_fall_back_to_the_rigid_entry(change, why):
+    scene, choice = resolve_solver_settings(load_scene(None, PLATE + [change]))
+    assert choice.entry == "rigid" and why in choice.reason
+    assert scene["simulation"]["step_s"] == 1e-5
+
+
+def test_a_thinner_plate_is_covered_by_the_certification():
+    # its first period is longer, so the certified step is a smaller fraction of it
+    _, choice = resolve_solver_settings(load_scene(None, PLATE + ["coupler.thickness_m=5e-4"]))
+    assert choice.entry == "ffrf_coupler"
+
+
+def test_an_ffrf_crank_falls_back_to_the_rigid_entry():
+    _, choice = resolve_solver_settings(load_scene(None, [
+        'crank.geometry="plate"', 'crank.model="ffrf"']))
+    assert choice.entry == "rigid" and "FFRF crank" in choice.reason
+
+
+def test_explicit_values_win_and_only_auto_keys_are_filled():
+    scene, choice = resolve_solver_settings(load_scene(None, PLATE + [
+        "simulation.step_s=1e-4", "simulation.spectral_radius=0.5"]))
+    assert scene["simulation"]["step_s"] == 1e-4 and scene["simulation"]["spectral_radius"] == 0.5
+    assert set(choice.keys) == {"newton", "newton_relative_tolerance"}
+    assert scene["simulation"]["newton"] == "modified"
+
+
+def test_pinned_overrides_leave_nothing_to_resolve():
+    scene = load_scene(None, PLATE + pinned_overrides())
+    assert resolve_solver_settings(scene) == (scene, None)
+    assert scene["simulation"]["step_s"] == 1e-5
+
+
+def test_an_output_interval_below_the_chosen_step_is_one_clear_error():
+    scene = load_scene(None, PLATE + ["simulation.output_step_s=1e-5"])
+    with pytest.raises(SceneError, match=r"output_step_s = 1e-05 must be >= simulation.step_s "
+                                         r"= 0.0004.*step_s = \"auto\" chose 0.0004 s"):
+        resolve_solver_settings(scene)
+
+
+def test_auto_is_refused_where_flex_has_no_choice():
+    with pytest.raises(SceneError, match=r"simulation.end_time_s = 'auto': must be a finite "
+                                         r"number > 0$"):
+        load_scene(None, ['simulation.end_time_s="auto"'])
+    with pytest.raises(SceneError, match=r'or "auto"'):
+        load_scene(None, ["simulation.step_s=-1"])
+
+
+def test_solver_settings_report_the_resolved_values():
+    settings = solver_settings(load_scene(None, PLATE))
+    assert settings["step_s"] == 4e-4 and settings["modified_newton"] is True
+    assert settings["steps"] == 75
+
+
+def test_a_default_ffrf_run_uses_and_records_the_chosen_settings():
+    result = simulate(load_scene(None, PLATE + ["simulation.end_time_s=0.004"]), "default")
+    time_s = result.datasets["time"].data
+    assert len(time_s) == 11 and time_s[1] - time_s[0] == pytest.approx(4e-4)  # 0.004 s
+    assert result.attrs["solver_defaults_entry"] == "ffrf_coupler"
+    assert "step_s = 0.0004" in result.attrs["solver_defaults_keys"]
+    assert 'step_s = 0.0004' in result.scene_toml and '"auto"' not in result.scene_toml
+    assert resolved_simulation(load_scene(None, PLATE))["step_s"] == 4e-4
