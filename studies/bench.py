@@ -41,7 +41,7 @@ import numpy as np
 from flex.errors import FlexError
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
-from flex.settings import pinned_overrides
+from flex.settings import AUTO_KEYS, pinned_overrides
 from flex.study import Summary
 from flex.tradeoff import (
     Measurement,
@@ -83,6 +83,9 @@ FFRF_CANDIDATES = [
 FFRF_UNTUNED = S("untuned: h=1e-5 mesh=2mm modes=6 full tol=1e-10", step_s=1e-5,
                  coupler__mesh_size_m=0.002, coupler__modes=6, newton="full",
                  newton_relative_tolerance=1e-10, spectral_radius=0.9)
+#: what a user gets: the scene's "auto" solver keys (flex/settings.py) on the 2 mm mesh, 6 modes
+FFRF_DEFAULTS = Setting("flex defaults (auto)",
+                        tuple((f"simulation.{key}", "auto") for key in AUTO_KEYS))
 NONLINEAR_FINE = S("nonlinear FE h=1e-4 mesh=4mm modified tol=1e-8",
                    coupler__model="nonlinear_fe", coupler__mesh_size_m=0.004, step_s=1e-4,
                    newton="modified", newton_relative_tolerance=1e-8)
@@ -257,9 +260,13 @@ def _ffrf(scene: Scene, pool: ReductionPool, say: Callable[[str], None]
     say(f"ffrf_1mm: tuned {tuned.setting.label}: {tuned.wall_time_s:.3f} s")
     untuned = measure(scene, FFRF_UNTUNED, reference, 1, pool)
     say(f"ffrf_1mm: untuned {untuned.wall_time_s:.2f} s")
+    default = measure(scene, FFRF_DEFAULTS, reference, REPEATS, pool)
+    say(f"ffrf_1mm: flex defaults {default.wall_time_s:.3f} s")
     out["ffrf_tuned"] = _case("ffrf_tuned", scene, tuned)
     out["ffrf_untuned"] = _case("ffrf_untuned", scene, untuned)
+    out["ffrf_default"] = _case("ffrf_default", scene, default)
     results: dict[str, Any] = {"reference": reference, "tuned": tuned, "untuned": untuned,
+                               "default": default,
                                "probes": probes,
                                "profile_untuned": profile(scene_for(scene, FFRF_UNTUNED), pool),
                                "profile_tuned": profile(scene_for(scene, tuned.setting), pool)}
@@ -412,7 +419,8 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
             "largest relative change of the reference under coarsening")
         put("ffrf_1mm/reference_peak_deflection", ffrf["reference"].peak_deflection_m, "m",
             "reference peak |midpoint deflection|")
-        for name, m in (("tuned", tuned), ("untuned", untuned)):
+        default = ffrf["default"]
+        for name, m in (("tuned", tuned), ("untuned", untuned), ("default", default)):
             put(f"ffrf_1mm/{name}/wall_time", m.wall_time_s, "s", "median integration time")
             put(f"ffrf_1mm/{name}/total_time", m.total_time_s, "s",
                 "median build + integration + output")
@@ -434,6 +442,11 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
              f"{untuned.errors.get('peak_deflection_relative', np.nan) * 100:.3f} %"),
             ("FFRF 1 mm: untuned / tuned", f"{untuned.wall_time_s / tuned.wall_time_s:.1f}",
              "integration time"),
+            ("FFRF 1 mm: flex defaults", f"{default.wall_time_s:.3f} s",
+             f"the scene's \"auto\" solver keys, 2 mm mesh, 6 modes: peak error "
+             f"{default.errors.get('peak_deflection_relative', np.nan) * 100:.2f} %, "
+             f"{default.steps} steps; target < {FFRF_TARGET_S} s: "
+             f"{'met' if default.wall_time_s < FFRF_TARGET_S else 'NOT met'}"),
         ]
         nonlinear = ffrf.get("nonlinear")
         if nonlinear is not None and nonlinear["coarse"].ok:
@@ -526,6 +539,7 @@ def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> l
         ("rigid 1e-7 rad: scipy DAE", "rigid/scipy/wall_time"),
         ("FFRF 1 mm 1 %: untuned", "ffrf_1mm/untuned/wall_time"),
         ("FFRF 1 mm 1 %: tuned", "ffrf_1mm/tuned/wall_time"),
+        ("FFRF 1 mm: flex defaults", "ffrf_1mm/default/wall_time"),
         ("FFRF 1 mm 1 %: nonlinear FE (h = 2e-4 s)", "ffrf_1mm/nonlinear/wall_time_h2e-4"),
     ) if key in data]
     if bars:
