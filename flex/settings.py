@@ -12,7 +12,8 @@ a certified accuracy:
   its first pinned-pinned bending frequency at most that plate's);
 - ``rigid`` (h = 1e-5 s, full Newton): everything else -- rigid links, and flexible links for
   which no setting is certified (stiffer plates, finer tolerances, FFRF cranks, the nonlinear
-  FE coupler), where it is the conservative choice.
+  FE coupler): a 40x smaller step than the certified FFRF one, but not certified for them
+  (:data:`FALLBACK`).
 
 Contract: input a validated scene whose links are concrete (``model = "auto"`` already
 resolved, :func:`flex.criteria.resolve_fidelity`); output the scene with numbers in place of
@@ -36,6 +37,8 @@ from .scene import Scene, check_steps
 #: the ``[simulation]`` keys that may be ``"auto"``
 AUTO_KEYS = ("step_s", "spectral_radius", "newton", "newton_relative_tolerance")
 AUTO = "auto"
+#: what an uncertified flexible scene runs with, and what is known of it
+FALLBACK = ("the rigid model's 40x smaller step, not certified for it (README \"Defaults\")")
 
 
 @dataclass(frozen=True)
@@ -91,19 +94,17 @@ def choose_entry(scene: Scene) -> tuple[str, str]:
     level = entry["accuracy"]
     if coupler != "ffrf" or crank != "rigid":
         what = ("an FFRF crank" if crank == "ffrf" else f'coupler.model = "{coupler}"')
-        return "rigid", (f"no certified setting for {what}: the conservative rigid-model "
-                         f"setting")
+        return "rigid", f"no certified setting for {what}: {FALLBACK}"
     tolerance = scene["fidelity"]["tolerance"]
     if tolerance < level:
         return "rigid", (f"fidelity.tolerance = {tolerance:g} is finer than the FFRF coupler's "
-                         f"certified {level:g}: the conservative rigid-model setting")
+                         f"certified {level:g}: {FALLBACK}")
     omega = _bending_omega(scene["coupler"])
     certified = _bending_omega(entry["certified_plate"])
     if omega > certified * (1 + 1e-9):
         return "rigid", (f"the coupler's first bending frequency {omega / (2 * math.pi):.4g} Hz "
                          f"is above the certified plate's {certified / (2 * math.pi):.4g} Hz "
-                         f"(stiffer plates are not certified): the conservative rigid-model "
-                         f"setting")
+                         f"(stiffer plates are not certified): {FALLBACK}")
     return "ffrf_coupler", (f"FFRF coupler on a rigid crank, fidelity.tolerance = {tolerance:g} "
                             f">= {level:g}, first bending frequency "
                             f"{omega / (2 * math.pi):.4g} Hz <= the certified plate's "

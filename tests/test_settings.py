@@ -106,3 +106,18 @@ def test_a_default_ffrf_run_uses_and_records_the_chosen_settings():
     assert "step_s = 0.0004" in result.attrs["solver_defaults_keys"]
     assert 'step_s = 0.0004' in result.scene_toml and '"auto"' not in result.scene_toml
     assert resolved_simulation(load_scene(None, PLATE))["step_s"] == 4e-4
+
+
+def test_flex_scene_says_what_auto_resolves_to(capsys):
+    import tomllib
+
+    from flex.cli import main
+
+    assert main(["scene", "simulate", "--set", 'coupler.geometry="plate"',
+                 "--set", 'coupler.model="ffrf"']) == 0
+    out = capsys.readouterr().out
+    assert out.startswith('# [simulation] "auto" keys -> step_s = 0.0004')
+    assert tomllib.loads(out)["simulation"]["step_s"] == "auto"  # still valid TOML
+    assert main(["scene", "simulate", "--set", 'coupler.geometry="plate"',
+                 "--set", 'coupler.model="auto"']) == 0
+    assert "chosen at run time" in capsys.readouterr().out
