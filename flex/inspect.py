@@ -208,6 +208,11 @@ def format_description(info: dict[str, Any]) -> str:
         if case["scene_changes"]:
             changes = ", ".join(f"{k} = {_short(v)}" for k, v in case["scene_changes"].items())
             lines.append(f"  scene: the file's scene with {changes}")
+        attrs = case["attributes"]
+        if attrs.get("solver_defaults_keys"):
+            lines.append(f"  solver: \"auto\" -> {attrs['solver_defaults_keys']} "
+                         f"({attrs.get('solver_defaults_entry', '?')}: "
+                         f"{attrs.get('solver_defaults_reason', '')})")
         lines += _table(case["datasets"])
     for title, entries in (("summary", info["summary"]), ("other", info["other"])):
         if entries:
@@ -216,6 +221,9 @@ def format_description(info: dict[str, Any]) -> str:
     if "dataset" in info:
         lines += ["", *_statistics_lines(info["dataset"])]
     scene_toml, heading = info["scene_toml"], "scene (resolved; root attribute scene_toml)"
+    if '= "auto"' in scene_toml:
+        heading = 'scene (root attribute scene_toml; each case holds its "auto" keys resolved)'
+
     if info.get("selection") and len(cases) == 1:
         (name, case), = cases.items()
         if case["scene_toml"]:

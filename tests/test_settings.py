@@ -108,6 +108,20 @@ def test_a_default_ffrf_run_uses_and_records_the_chosen_settings():
     assert resolved_simulation(load_scene(None, PLATE))["step_s"] == 4e-4
 
 
+def test_inspect_shows_the_resolved_solver_keys_and_no_scene_change(tmp_path, capsys):
+    from flex.cli import main
+    from flex.results import write_results
+    from flex.scene import to_toml
+
+    scene = load_scene(None, PLATE + ["simulation.end_time_s=0.004"])
+    path = write_results(tmp_path / "auto.h5", "simulate", [simulate(scene, "default")],
+                         to_toml(scene))
+    assert main(["inspect", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert 'solver: "auto" -> step_s = 0.0004' in out and "(ffrf_coupler: " in out
+    assert "the file's scene with" not in out  # flex's choices are not the user's changes
+
+
 def test_flex_scene_says_what_auto_resolves_to(capsys):
     import tomllib
 
