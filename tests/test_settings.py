@@ -41,7 +41,11 @@ def test_the_certified_plate_gets_the_ffrf_entry():
 
 
 @pytest.mark.parametrize("change, why", [
-    ("coupler.thickness_m=0.003", "above the certified plate's"),
+    ("coupler.thickness_m=0.003", "thickness_m = 0.003 (certified: 0.001)"),
+    # thinner plates deflect more: 0.3 mm fails Newton at the second 4e-4 s step, 0.5 mm at
+    # 21 ms (measured with flex run simulate); they keep the rigid model's step
+    ("coupler.thickness_m=0.0005", "thickness_m = 0.0005 (certified: 0.001)"),
+    ("coupler.width_m=0.02", "width_m = 0.02 (certified: 0.01)"),
     ("fidelity.tolerance=0.001", "finer than the FFRF coupler's certified 0.01"),
     ('coupler.model="nonlinear_fe"', 'no certified setting for coupler.model = "nonlinear_fe"'),
 ])
@@ -51,9 +55,9 @@ def test_uncertified_flexible_scenes_fall_back_to_the_rigid_entry(change, why):
     assert scene["simulation"]["step_s"] == 1e-5
 
 
-def test_a_thinner_plate_is_covered_by_the_certification():
-    # its first period is longer, so the certified step is a smaller fraction of it
-    _, choice = resolve_solver_settings(load_scene(None, PLATE + ["coupler.thickness_m=5e-4"]))
+def test_mesh_and_modes_are_the_scene_s_choice():
+    _, choice = resolve_solver_settings(load_scene(None, PLATE + [
+        "coupler.mesh_size_m=0.004", "coupler.modes=2"]))
     assert choice.entry == "ffrf_coupler"
 
 
