@@ -250,11 +250,16 @@ def make_executor(scheduler: str | None = None, workers: int | None = None) -> E
 # case files
 # ------------------------------------------------------------------------------------------
 def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
-    """Identity of a case: its resolved scene and the case function's qualified name."""
+    """Identity of a case: its resolved scene and the case function's qualified name (and,
+    for a scene with ``"auto"`` solver keys, the table they resolve from)."""
+    from . import settings
+
     function, extra = case_function, ""
     if isinstance(function, functools.partial):  # bound arguments are part of the identity
         extra = repr((function.args, sorted(function.keywords.items())))
         function = function.func
+    if settings.has_auto(scene):  # a changed table must not resume stale cases
+        extra += repr(sorted(settings.solver_defaults().items()))
     label = f"{function.__module__}.{function.__qualname__}{extra}"
     return hashlib.sha256((label + "\n" + to_toml(scene)).encode()).hexdigest()[:24]
 

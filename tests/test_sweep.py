@@ -198,3 +198,18 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch):
         assert h5["summary/table/measures/deflection"].attrs["units"] == "1"
     assert {p.name for p in output.figures} == {"kfit-error-vs-n.png",
                                                  "kfit-k-vs-tolerance.png"}
+
+
+def test_case_hash_follows_the_solver_defaults_of_auto_scenes(monkeypatch):
+    # a resumed sweep must not reuse cases run with another flex/solver_defaults.toml
+    import flex.settings as settings
+    from flex.solver import simulate_case
+    from flex.sweep import case_hash
+
+    auto = load_scene()
+    pinned = load_scene(None, settings.pinned_overrides())
+    before = case_hash(auto, simulate_case), case_hash(pinned, simulate_case)
+    monkeypatch.setattr(settings, "solver_defaults",
+                        lambda: {"rigid": {"step_s": 2e-5}, "ffrf_coupler": {}})
+    assert case_hash(auto, simulate_case) != before[0]
+    assert case_hash(pinned, simulate_case) == before[1]  # nothing of it is "auto"
