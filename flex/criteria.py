@@ -598,6 +598,21 @@ def criterion_in_force(text: str, variable: str = "FLEX_CRITERION") -> Iterator[
                 os.environ[variable] = previous
 
 
+def criteria_in_force_text(scene: Mapping[str, Mapping[str, Any]]) -> str:
+    """The text of the criterion files ``scene``'s ``model = "auto"`` links would read now
+    (``""`` for none; a missing file reads as ``""``): part of a sweep case's identity."""
+    parts = []
+    for link, variable, default in (("coupler", "FLEX_CRITERION", DEFAULT_CRITERION),
+                                    ("crank", "FLEX_CRANK_CRITERION", DEFAULT_CRANK_CRITERION)):
+        if scene.get(link, {}).get("model") == "auto":
+            path = Path(os.environ.get(variable) or default)
+            try:
+                parts.append(f"{link}:{path.read_text('utf-8')}")
+            except OSError:
+                parts.append(f"{link}:missing {path}")
+    return "\n".join(parts)
+
+
 def load_criterion(path: str | Path | None = None) -> Criterion:
     """Read a criterion file: ``path``, else ``$FLEX_CRITERION``, else
     :data:`DEFAULT_CRITERION`. Raises :class:`FlexError` naming the file if it is missing

@@ -250,9 +250,11 @@ def make_executor(scheduler: str | None = None, workers: int | None = None) -> E
 # case files
 # ------------------------------------------------------------------------------------------
 def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
-    """Identity of a case: its resolved scene and the case function's qualified name (and,
-    for a scene with ``"auto"`` solver keys, the table they resolve from)."""
+    """Identity of a case: its resolved scene and the case function's qualified name (and
+    what its ``"auto"`` values resolve from: the solver defaults table, the fitted criterion
+    files)."""
     from . import settings
+    from .criteria import criteria_in_force_text
 
     function, extra = case_function, ""
     if isinstance(function, functools.partial):  # bound arguments are part of the identity
@@ -260,6 +262,7 @@ def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
         function = function.func
     if settings.has_auto(scene):  # a changed table must not resume stale cases
         extra += repr(sorted(settings.solver_defaults().items()))
+    extra += criteria_in_force_text(scene)  # a re-fit must not resume stale auto cases
     label = f"{function.__module__}.{function.__qualname__}{extra}"
     return hashlib.sha256((label + "\n" + to_toml(scene)).encode()).hexdigest()[:24]
 

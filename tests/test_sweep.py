@@ -213,3 +213,17 @@ def test_case_hash_follows_the_solver_defaults_of_auto_scenes(monkeypatch):
                         lambda: {"rigid": {"step_s": 2e-5}, "ffrf_coupler": {}})
     assert case_hash(auto, simulate_case) != before[0]
     assert case_hash(pinned, simulate_case) == before[1]  # nothing of it is "auto"
+
+
+def test_case_hash_follows_the_criterion_file_of_auto_links(tmp_path, monkeypatch):
+    from flex.solver import simulate_case
+    from flex.sweep import case_hash
+
+    auto = load_scene(None, ['coupler.geometry="plate"', 'coupler.model="auto"'])
+    rigid = load_scene(None, ['coupler.geometry="plate"'])
+    before = case_hash(auto, simulate_case), case_hash(rigid, simulate_case)
+    refit = tmp_path / "criterion.toml"
+    refit.write_text("# another fit\n")
+    monkeypatch.setenv("FLEX_CRITERION", str(refit))
+    assert case_hash(auto, simulate_case) != before[0]
+    assert case_hash(rigid, simulate_case) == before[1]
