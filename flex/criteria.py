@@ -600,7 +600,7 @@ def criterion_in_force(text: str, variable: str = "FLEX_CRITERION") -> Iterator[
 
 def criteria_in_force_text(scene: Mapping[str, Mapping[str, Any]]) -> str:
     """The text of the criterion files ``scene``'s ``model = "auto"`` links would read now
-    (``""`` for none; a missing file reads as ``""``): part of a sweep case's identity."""
+    (``""`` for none; a missing file as its path): part of a sweep case's identity."""
     parts = []
     for link, variable, default in (("coupler", "FLEX_CRITERION", DEFAULT_CRITERION),
                                     ("crank", "FLEX_CRANK_CRITERION", DEFAULT_CRANK_CRITERION)):

@@ -39,6 +39,8 @@ from .scene import Scene, check_steps
 #: the ``[simulation]`` keys that may be ``"auto"``
 AUTO_KEYS = ("step_s", "spectral_radius", "newton", "newton_relative_tolerance")
 AUTO = "auto"
+#: the ``--set`` pairs that leave every solver key to flex (what the bundled scene does)
+AUTO_OVERRIDES = tuple((f"simulation.{key}", AUTO) for key in AUTO_KEYS)
 #: what an uncertified flexible scene runs with, and what is known of it
 FALLBACK = ("the rigid model's 40x smaller step, not certified for it (README \"Defaults\")")
 

@@ -41,7 +41,7 @@ import numpy as np
 from flex.errors import FlexError
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
-from flex.settings import AUTO_KEYS, pinned_overrides
+from flex.settings import AUTO_OVERRIDES, pinned_overrides
 from flex.study import Summary
 from flex.tradeoff import (
     Measurement,
@@ -84,8 +84,7 @@ FFRF_UNTUNED = S("untuned: h=1e-5 mesh=2mm modes=6 full tol=1e-10", step_s=1e-5,
                  coupler__mesh_size_m=0.002, coupler__modes=6, newton="full",
                  newton_relative_tolerance=1e-10, spectral_radius=0.9)
 #: what a user gets: the scene's "auto" solver keys (flex/settings.py) on the 2 mm mesh, 6 modes
-FFRF_DEFAULTS = Setting("flex defaults (auto)",
-                        tuple((f"simulation.{key}", "auto") for key in AUTO_KEYS))
+FFRF_DEFAULTS = Setting("flex defaults (auto)", AUTO_OVERRIDES)
 NONLINEAR_FINE = S("nonlinear FE h=1e-4 mesh=4mm modified tol=1e-8",
                    coupler__model="nonlinear_fe", coupler__mesh_size_m=0.004, step_s=1e-4,
                    newton="modified", newton_relative_tolerance=1e-8)

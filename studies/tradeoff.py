@@ -34,7 +34,7 @@ from flex.errors import SceneError
 from flex.plotting import figure
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, load_scene, to_toml, validate
-from flex.settings import AUTO_KEYS, pinned_overrides, resolve_solver_settings
+from flex.settings import AUTO_OVERRIDES, pinned_overrides, resolve_solver_settings
 from flex.study import Summary
 from flex.tradeoff import (
     ACCURACY_LEVELS,
@@ -70,7 +70,8 @@ SCENES: dict[str, list[str]] = {
 DEFAULT_TOLERANCE = {"crank_angle_rad": 1e-6, "slider_position_m": 1e-7, "max_step_s": 1e-5,
                      "max_spectral_radius": 0.95}
 
-#: what a user gets: the bundled scene's "auto" solver keys, which flex/settings.py fills from
+#: the setting labelled DEFAULT_LABEL is what a user gets: the bundled scene's "auto" solver
+#: keys (flex.settings.AUTO_OVERRIDES), which flex/settings.py fills from
 #: flex/solver_defaults.toml (README "Defaults"). On ``ffrf_1mm`` (the bundled 2 mm mesh and 6
 #: modes) they resolve to its ``ffrf_coupler`` entry, the certified 1 % pick h = 4e-4 s,
 #: modified Newton 1e-8; on ``rigid`` to the ``rigid`` entry. :func:`summarize` stores whether
@@ -79,11 +80,10 @@ DEFAULT_TOLERANCE = {"crank_angle_rad": 1e-6, "slider_position_m": 1e-7, "max_st
 #: make tradeoff swapped the 2 mm and 4 mm meshes at h = 4e-4 s: 83 / 62 ms, then 63 / 70 ms);
 #: tests/test_tradeoff.py checks that it reaches the tolerance, and how much faster it is
 #: than the rigid-model settings
-FFRF_DEFAULT: dict[str, Any] = {f"simulation.{key}": "auto" for key in AUTO_KEYS}
 DEFAULT_LABEL = "flex defaults (auto)"
 FFRF_DEFAULT_SCENE = "ffrf_1mm"
 #: timing noise between runs on the shared machine: a setting this much slower than the pick
-#: still counts as equally fast for the FFRF_DEFAULT check
+#: still counts as equally fast for the defaults check
 DEFAULT_TIE = 0.5
 
 S = Setting.of
@@ -271,7 +271,7 @@ def settings(scene_name: str, nonlinear_available: bool) -> list[Setting]:
 
 def _default_setting() -> Setting:
     """The bundled scene's solver keys ("auto"): what a user gets."""
-    return Setting(DEFAULT_LABEL, tuple(FFRF_DEFAULT.items()), group="flex defaults")
+    return Setting(DEFAULT_LABEL, AUTO_OVERRIDES, group="flex defaults")
 
 
 def _nonlinear_available() -> bool:
@@ -393,11 +393,8 @@ def _same_discretization(plate_scene: Scene, setting: Setting) -> bool:
 
 
 def _is_default(setting: Setting) -> bool:
-    """Whether ``setting`` runs exactly the knobs of :data:`FFRF_DEFAULT`."""
-    knobs = dict(setting.overrides)
-    return setting.engine == "exudyn" and set(knobs) == set(FFRF_DEFAULT) and all(
-        np.isclose(knobs[key], value) if isinstance(value, float) else knobs[key] == value
-        for key, value in FFRF_DEFAULT.items())
+    """Whether ``setting`` is the bundled scene's solver settings (all keys "auto")."""
+    return setting.engine == "exudyn" and setting.overrides == AUTO_OVERRIDES
 
 
 #: the rigid scene as the study runs it (solver keys pinned), for reading a run's settings
@@ -407,9 +404,10 @@ _RIGID_BASE = load_scene(None, OVERRIDES)
 def _within_default_tolerance(m: Measurement) -> bool:
     """Whether a rigid-scene run meets :data:`DEFAULT_TOLERANCE` ("auto" keys resolved)."""
     limit = DEFAULT_TOLERANCE
+    if not (m.ok and m.setting.engine == "exudyn"):
+        return False
     sim = resolve_solver_settings(scene_for(_RIGID_BASE, m.setting))[0]["simulation"]
-    return (m.ok and m.setting.engine == "exudyn"
-            and m.errors["crank_angle_rad"] <= limit["crank_angle_rad"]
+    return (m.errors["crank_angle_rad"] <= limit["crank_angle_rad"]
             and m.errors["slider_position_m"] <= limit["slider_position_m"]
             and sim["step_s"] <= limit["max_step_s"] * (1 + 1e-9)
             and sim["spectral_radius"] <= limit["max_spectral_radius"])
