@@ -28,8 +28,9 @@ the conservative :data:`FALLBACK_FACTOR` x the largest change). A plain one-leve
 knobs' estimates; it counts as converged to ``tolerance`` when that sum is below it.
 
 :func:`pareto_front` marks the settings no other setting beats in both wall time and error;
-:func:`recommend` picks, per accuracy level, the fastest setting within it (it lies on the
-front), refusing levels finer than the reference can certify.
+:func:`recommend` picks, per accuracy level, the fastest setting whose measured error plus
+the reference's accuracy is within it (it lies on the front of the candidates), refusing
+levels finer than the reference can certify.
 
 Wall times are medians over repeats on a shared machine: compare ratios measured in one run.
 """
@@ -643,8 +644,9 @@ class Recommendation:
 def recommend(measurements: Iterable[Measurement], reference: Reference,
               levels: Sequence[float] = ACCURACY_LEVELS,
               eligible: Callable[[Measurement], bool] | None = None) -> list[Recommendation]:
-    """Per accuracy level the fastest ``ok`` measurement with ``error <= level`` (ties by
-    :func:`fastest`).
+    """Per accuracy level the fastest ``ok`` measurement whose error is certified within it,
+    ``error + reference.accuracy <= level`` (the reference's own error could add to the
+    measured one; ties by :func:`fastest`).
 
     Levels finer than ``REFERENCE_MARGIN`` x the reference's own accuracy are refused (the
     reference cannot tell such errors apart). ``eligible`` filters the candidates (e.g. only
@@ -659,7 +661,8 @@ def recommend(measurements: Iterable[Measurement], reference: Reference,
                                       f"{reference.accuracy:.1e} only: cannot certify "
                                       f"{level:.0e}"))
             continue
-        within = [m for m in candidates if m.error <= level]
+        # certified: the measured error plus the reference's own possible error
+        within = [m for m in candidates if m.error + reference.accuracy <= level]
         if not within:
             out.append(Recommendation(level, None, "no measured setting reaches it"))
             continue

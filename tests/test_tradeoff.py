@@ -71,6 +71,30 @@ def test_recommend_refuses_levels_the_reference_cannot_certify(rigid_reference):
     assert picks[2].measurement is None
 
 
+def test_recommend_counts_the_reference_accuracy_in_the_error(rigid_reference):
+    rough = Reference("rough", rigid_reference.observables, rigid_reference.setting,
+                      {"coarser": {"error": 2e-3}}, 1e-2, 0.0)
+    runs = [_measurement("just within if the reference were exact", 0.1, 9e-3),
+            _measurement("certified", 1.0, 7e-3)]
+    picks = recommend(runs, rough)
+    # 9e-3 + 2e-3 > 1 %: the faster run is not certified within it
+    assert picks[0].measurement.setting.label == "certified"
+
+
+def test_the_1mm_reference_sequences_run_through_the_reference():
+    import studies.tradeoff as study
+
+    finest, _, _, _, refinements, anchor = study.reference_plan("ffrf_1mm")
+    assert study.through_reference(study.FFRF_REFERENCE["ffrf_1mm"]) and anchor is None
+    for refinement in refinements[:3]:  # step, mesh, modes: the fine level is the reference
+        assert refinement.levels[0].knobs() == finest.knobs()
+        others = [dict(level.overrides) for level in refinement.levels]
+        varied = {key for key in others[0] if len({repr(o[key]) for o in others}) > 1}
+        assert len(varied) == 1  # only the sequence's own knob changes
+    # 10 mm keeps cheaper bases, so it keeps the additivity check
+    assert study.reference_plan("ffrf_10mm")[5] is not None
+
+
 def test_richardson_estimates_the_fine_error_of_a_second_order_sequence():
     # f(h) = 1 + c h^2 at h, 2h, 4h: changes 3c h^2 and 12c h^2 -> order 2, error c h^2
     c, h = 0.3, 0.01
