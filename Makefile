@@ -25,7 +25,7 @@ $(STUDIES): $(STAMP)
 	$(RUN) $@
 
 # long runs, not part of `all` (README "Speed and accuracy", "Numerical stability"); each
-# writes results/<target>.h5 and figures. On 2 shared cores: tradeoff ~30 min, stability
+# writes results/<target>.h5 and figures. On 2 shared cores: tradeoff ~65 min, stability
 # ~10 min, bench ~23 min (it runs `make all` twice); `make all` itself takes 8-11 min.
 # `flex run stability` exits 0 when exactly its runs built to diverge fail.
 LONG := tradeoff stability bench

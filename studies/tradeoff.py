@@ -94,25 +94,29 @@ def _scipy(rtol: float, method: str = "DOP853", group: str = "scipy reference DA
                    atol=rtol * 1e-2, group=group)
 
 
-#: FFRF references: the finest step, mesh and modes, and where each knob's three-level
-#: sequence is run (``*_base``: the values of the other knobs; its finest level has the
-#: reference's value of its own knob). 1 mm: every sequence runs through the reference itself
-#: (the bases are the reference's values), so each knob's estimate is its error *at the
-#: reference* and no additivity assumption is needed. An earlier plan ran the sequences at
-#: cheaper values of the other knobs and paid for the additivity check: at h = 6.25e-7 s,
-#: 0.75 mm, 24 modes the measured interaction alone was 1.1e-3, the step sequence (1.5 mm, 12
-#: modes) was not yet asymptotic (order 0.62) and modes 12 -> 24 still moved the peak by
-#: 5.4e-4 -- accurate to 2.1e-3, which certifies 1 % only. Measured while choosing this plan
-#: (1.5 mm, 12 modes): the step sequence 1.25e-6 -> 6.25e-7 -> 3.125e-7 s changes the peak by
-#: 1.5e-4 then 3.5e-5 (order 2.1, asymptotic); modes 6 -> 12 -> 24 by 2.3e-3 and 5.4e-4 (order
-#: 2.1), so 48 modes are needed for 0.1 % (the estimate at 24, ~2.3e-4, plus the mesh's,
-#: ~1.5e-4, exceeds the 3.3e-4 that 0.1 % allows); 48 modes on the 0.75 mm mesh cost ~880 s
-#: per run at 3.125e-7 s and 176 s to reduce. 10 mm: the sequences run at cheaper values of
-#: the other knobs, with the additivity check (``anchor``); the peak is the largest of several
-#: crests within ~1 % of each other (24.3, 24.6, 24.8 ms) and which one wins follows the phase
-#: of 20-27 kHz modes: h = 1.25e-6 -> 6.25e-7 -> 3.125e-7 -> 1.5625e-7 s change it by -0.15 %,
-#: -0.18 %, then +0.30 % (1.5 mm, 12 modes), no convergence before those phases are resolved
-#: (steps ~1e-8 s and frequencies converged to ~1e-5: out of this machine's run budget)
+#: FFRF references: the finest step, mesh and modes, and where each knob's three-level sequence is
+#: run (``*_base``: the values of the other knobs; its finest level has the reference's value of
+#: its own knob). 1 mm: every sequence runs through the reference itself (the bases are the
+#: reference's values), so each knob's estimate is its error *at the reference* and no additivity
+#: assumption is needed. An earlier plan ran the sequences at cheaper values of the other knobs and
+#: paid for the additivity check: at h = 6.25e-7 s, 0.75 mm, 24 modes the measured interaction
+#: alone was 1.1e-3, the step sequence (1.5 mm, 12 modes) was not yet asymptotic (order 0.62) and
+#: modes 12 -> 24 still moved the peak by 5.4e-4 -- accurate to 2.1e-3, which certifies 1 % only.
+#: Measured while choosing this plan (1.5 mm, 12 modes): the step sequence 1.25e-6 -> 6.25e-7 ->
+#: 3.125e-7 s changes the peak by 1.5e-4 then 3.5e-5 (order 2.1, asymptotic); modes 6 -> 12 -> 24
+#: by 2.3e-3 and 5.4e-4 (order 2.1), so 48 modes are needed for 0.1 % (the estimate at 24, ~2.3e-4,
+#: plus the mesh's, ~1.5e-4, exceeds the 3.3e-4 that 0.1 % allows); 48 modes on the 0.75 mm mesh
+#: cost ~880 s per run at 3.125e-7 s and 176 s to reduce. Measured by this plan (make tradeoff):
+#: modes 12 -> 24 -> 48 change the peak by 4.7e-4 then 2.4e-4, first order (the 6 -> 12 -> 24
+#: sequence was not yet asymptotic), so the reference certifies 1 % (accuracy 1.6e-3) and 0.1 %
+#: would need ~96 modes (README "Why the FFRF levels stop there"). 10 mm: the sequences run at
+#: cheaper values of the other knobs, with the additivity check (``anchor``); the peak is the
+#: largest of several crests within ~1 % of each other (24.3, 24.6, 24.8 ms) and which one wins
+#: follows the phase of 20-27 kHz modes: h = 1.25e-6 -> 6.25e-7 -> 3.125e-7 -> 1.5625e-7 s change
+#: it by -0.15 %, -0.18 %, then +0.30 % (1.5 mm, 12 modes); below 2e-7 s the step converges at
+#: second order (2e-7, 1.5625e-7, 1e-7 s: 0.737916, 0.737834, 0.737750 um), but 24 modes instead of
+#: 12 at 2e-7 s move the peak by -0.52 % to another crest: a reference needs modes and mesh
+#: converged at ~1e-7 s steps (17 min per run: out of this machine's run budget)
 FFRF_REFERENCE: dict[str, dict[str, Any]] = {
     "ffrf_1mm": {"step": 3.125e-7, "mesh": 0.00075, "modes": 48,
                  "step_base": {"mesh": 0.00075, "modes": 48},
