@@ -311,3 +311,20 @@ def test_the_study_summary_checks_the_bundled_defaults(rigid_reference):
     assert summary.datasets["rigid/default/setting"].data == study.DEFAULT_LABEL
     assert bool(summary.datasets["rigid/default/matches_table"].data)
     assert "defaults flex defaults (auto)" in summary.report
+
+
+def test_the_work_precision_figure_draws_the_front_and_the_reference_band(tmp_path):
+    import studies.tradeoff as study
+    from flex.results import Dataset
+    from flex.study import Summary
+    from flex.tradeoff import measurements_table
+
+    runs = [_measurement("coarse", 0.01, 5e-3), _measurement("fine", 1.0, 5e-5),
+            _measurement("broken", 0.001, math.nan, "failed")]
+    points = [(m.wall_time_s, m.error) if m.ok else (math.nan, math.nan) for m in runs]
+    datasets = {f"demo/runs/{key}": value
+                for key, value in measurements_table(runs, pareto_front(points)).items()}
+    datasets["demo/reference/accuracy"] = Dataset(1e-6, "1", "reference accuracy")
+    paths = study.figures({}, Summary(datasets, ""), tmp_path)
+    assert [path.name for path in paths] == ["tradeoff-demo.png"]
+    assert paths[0].stat().st_size > 10_000
