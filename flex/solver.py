@@ -325,8 +325,14 @@ def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s:
 
 
 def reduction_cache_dir() -> Path:
-    """Where reductions are cached: ``$FLEX_CACHE_DIR`` or ``.cache/reductions``."""
-    return Path(os.environ.get("FLEX_CACHE_DIR", ".cache/reductions"))
+    """Where reductions are cached: ``$FLEX_CACHE_DIR/reductions`` if set, else the user's
+    cache folder (``$XDG_CACHE_HOME/flex/reductions``, by default
+    ``~/.cache/flex/reductions``), whatever folder the command runs from."""
+    configured = os.environ.get("FLEX_CACHE_DIR")
+    if configured:
+        return Path(configured).expanduser() / "reductions"
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "flex" / "reductions"
 
 
 def reduction_for_scene(scene: Scene, link: str = "coupler"):
