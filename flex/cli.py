@@ -1,7 +1,8 @@
-"""Command line: ``python -m flex run|scene|inspect|plot|compare ...``.
+"""Command line: ``flex run|scene|inspect|plot|compare ...`` (also ``python -m flex``).
 
-Every user error (bad scene key, impossible geometry, diverged run, bad result file) is
-printed as one line ``flex: error: ...`` and exits with status 2; no traceback.
+Every user error (bad scene key, impossible geometry, bad result file, an output that
+cannot be written) is printed as one line ``flex: error: ...`` and exits with status 2; no
+traceback. The exit statuses are those of :mod:`flex.errors`.
 """
 
 from __future__ import annotations
@@ -10,14 +11,43 @@ import argparse
 import os
 import sys
 
-from .errors import FlexError
+from . import __version__
+from .errors import (
+    EXIT_BAD_INPUT,
+    EXIT_FAILED,
+    EXIT_INTERNAL,
+    EXIT_OK,
+    EXIT_SIGINT,
+    EXIT_SIGTERM,
+    EXIT_STATUSES,
+    FlexError,
+    Terminated,
+)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (``flex: error: ...``, status 2), like every other
+    refusal of flex."""
+
+    def error(self, message: str):  # noqa: D102 - argparse's contract
+        print(f"flex: error: {self.prog.removeprefix('flex').strip() or 'flex'}: {message} "
+              f"(see '{self.prog} --help')", file=sys.stderr)
+        raise SystemExit(EXIT_BAD_INPUT)
+
+
+EPILOG = "exit status:\n" + "\n".join(f"  {code:<4} {text}" for code, text in
+                                      EXIT_STATUSES.items())
 
 
 def _parser() -> argparse.ArgumentParser:
     from .study import STUDIES
 
-    parser = argparse.ArgumentParser(prog="python -m flex", description=__doc__.split("\n")[0])
-    commands = parser.add_subparsers(dest="command", required=True)
+    parser = _Parser(prog="flex", epilog=EPILOG,
+                     formatter_class=argparse.RawDescriptionHelpFormatter,
+                     description="flex: rigid and flexible (FFRF) slider-crank deployment "
+                                 "studies on Exudyn and NGsolve, results in HDF5.")
+    parser.add_argument("--version", action="version", version=f"flex {__version__}")
+    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     def scene_options(sub: argparse.ArgumentParser) -> None:
         sub.add_argument("study", choices=STUDIES, metavar="STUDY",
@@ -27,7 +57,13 @@ def _parser() -> argparse.ArgumentParser:
         sub.add_argument("--set", dest="overrides", action="append", default=[],
                          metavar="SECTION.KEY=VALUE", help="override one scene value (TOML)")
 
-    run = commands.add_parser("run", help="run a study and write results/<study>.h5")
+    run = commands.add_parser(
+        "run", help="run a study and write results/<study>.h5",
+        description="Run a study: simulate its cases, write one HDF5 result file (default "
+                    "results/STUDY.h5) and its figures (figures/<file stem>-*.png beside "
+                    "it). A run with a failed case never replaces an existing result file: "
+                    "it is written beside it as <name>.failed.h5.",
+        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
     scene_options(run)
     run.add_argument("--out", metavar="FILE.h5", help="result file (default results/STUDY.h5)")
     run.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
@@ -122,15 +158,13 @@ def _result_tool(args: argparse.Namespace) -> int:
                            args.interp)
     _print(json.dumps(report.as_dict(), indent=2) if args.json
            else report.format(args.limit))
-    return 0 if report.passed else 1
+    return EXIT_OK if report.passed else EXIT_FAILED
 
 
-def _print(text: str) -> None:
+def _print(text: str, end: str = "\n") -> None:
     """Print to stdout; a closed pipe (``| head``) ends quietly."""
-    import os
-
     try:
-        print(text, flush=True)
+        print(text, end=end, flush=True)
     except BrokenPipeError:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
 
@@ -150,7 +184,74 @@ def _auto_note(scene) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point; returns the process exit status."""
+    """Entry point; returns the process exit status (:mod:`flex.errors`). No exception
+    leaves it: a bug prints one ``flex: internal error`` line and returns 3 (``FLEX_DEBUG=1``
+    shows the traceback)."""
+    restore = _terminate_as_interrupt()
+    try:
+        return _dispatch(argv)
+    except FlexError as exc:
+        print(f"flex: error: {_one_line(str(exc))}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt as exc:
+        return _interrupted(exc)
+    except OSError as exc:  # an output or input the operating system refused
+        where = f" '{exc.filename}'" if exc.filename else ""
+        print(f"flex: error: cannot access{where}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except Exception as exc:  # noqa: BLE001 - the last line of defence: no traceback
+        if os.environ.get("FLEX_DEBUG") == "1":
+            raise
+        print(f"flex: internal error: {type(exc).__name__}: {_one_line(str(exc))} (a bug in "
+              f"flex: please report it with the command line; FLEX_DEBUG=1 shows where)",
+              file=sys.stderr)
+        return EXIT_INTERNAL
+    finally:
+        restore()
+
+
+def console() -> None:
+    """The ``flex`` console command."""
+    sys.exit(main())
+
+
+def _one_line(text: str, limit: int = 1000) -> str:
+    text = " ".join(text.split())
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _terminate_as_interrupt():
+    """SIGTERM raises :class:`~flex.errors.Terminated` (a KeyboardInterrupt), so a
+    terminated run cleans up like Ctrl-C; returns the function restoring the old handler."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+
+    def on_terminate(signum, frame):
+        raise Terminated
+
+    previous = signal.signal(signal.SIGTERM, on_terminate)
+    return lambda: signal.signal(signal.SIGTERM, previous)
+
+
+def _interrupted(exc: KeyboardInterrupt) -> int:
+    """Say what an interrupt left behind; 130 (SIGINT) or 143 (SIGTERM)."""
+    kind = getattr(exc, "kind", type(exc))
+    terminated = issubclass(kind, Terminated)
+    what = "terminated" if terminated else "interrupted"
+    written = getattr(exc, "written", [])
+    if written:
+        files = ", ".join(str(path) for path in written)
+        print(f"flex: {what}; already written: {files}; figures not yet drawn were left as "
+              f"they were", file=sys.stderr)
+    else:
+        print(f"flex: {what}; no result file was changed", file=sys.stderr)
+    return EXIT_SIGTERM if terminated else EXIT_SIGINT
+
+
+def _dispatch(argv: list[str] | None) -> int:
     parser = _parser()
     args, extra = parser.parse_known_args(argv)
     if extra:  # PATHs after options (compare A B --rtol 1e-6 PATH): argparse leaves them over
@@ -158,32 +259,27 @@ def main(argv: list[str] | None = None) -> int:
             args.paths += extra
         else:
             parser.error(f"unrecognized arguments: {' '.join(extra)}")
-    try:
-        if args.command == "run":
-            from .study import run_study
+    if args.command == "run":
+        return _run(args)
+    if args.command == "scene":
+        from .scene import to_toml
+        from .study import load_study, study_scene
 
-            if args.scheduler:
-                os.environ["FLEX_SCHEDULER"] = args.scheduler
-            if args.workers is not None:
-                if args.workers < 1:
-                    raise FlexError(f"--workers {args.workers}: must be at least 1")
-                os.environ["FLEX_WORKERS"] = str(args.workers)
-            output = run_study(args.study, args.scene, args.overrides, args.out,
-                               figures=not args.no_figures, quiet=args.quiet)
-            return 0 if output.as_expected else 1
-        if args.command == "scene":
-            from .scene import to_toml
-            from .study import load_study, study_scene
+        scene = study_scene(load_study(args.study), args.scene, args.overrides)
+        _print(_auto_note(scene) + to_toml(scene), end="")
+        return EXIT_OK
+    return _result_tool(args)
 
-            scene = study_scene(load_study(args.study), args.scene, args.overrides)
-            print(_auto_note(scene) + to_toml(scene), end="")
-            return 0
-        if args.command in ("inspect", "plot", "compare"):
-            return _result_tool(args)
-    except FlexError as exc:
-        print(f"flex: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("flex: interrupted; no result file was changed", file=sys.stderr)
-        return 130
-    return 2
+
+def _run(args: argparse.Namespace) -> int:
+    from .study import run_study
+
+    if args.workers is not None and args.workers < 1:
+        raise FlexError(f"--workers {args.workers}: must be at least 1")
+    if args.scheduler:
+        os.environ["FLEX_SCHEDULER"] = args.scheduler
+    if args.workers is not None:
+        os.environ["FLEX_WORKERS"] = str(args.workers)
+    output = run_study(args.study, args.scene, args.overrides, args.out,
+                       figures=not args.no_figures, quiet=args.quiet)
+    return EXIT_OK if output.as_expected else EXIT_FAILED

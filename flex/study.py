@@ -27,7 +27,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 
-from .errors import FlexError, SceneError
+from .errors import FlexError
+from .outputs import (
+    check_output,
+    check_writable_folder,
+    failed_path,
+    figures_folder,
+    staged_figures,
+)
 from .results import CaseResult, Dataset, write_results
 from .scene import Scene, load_scene, to_toml
 from .solver import simulate_case
@@ -122,36 +129,83 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
               out: str | Path | None = None, figures: bool = True, quiet: bool = False
               ) -> StudyOutput:
     """Run study ``name``, write its HDF5 file (default ``results/<name>.h5``) and figures
-    (``results/figures/<name>-*.png``), print its report, and return the output."""
+    (``figures/<file stem>-*.png`` beside it), print its report, and return the output.
+
+    Nothing is lost: the output is checked before any case runs (:func:`flex.outputs.
+    check_output`); a run that does not end as the study declares (an unexpected failed
+    case) does not replace an existing result file but is written beside it
+    (:func:`flex.outputs.failed_path`), and draws no figures. Failed cases are reported on
+    stderr, also with ``quiet``. An interrupt raises :class:`Interrupted` saying which files
+    were already written.
+    """
     module = load_study(name)
     scene = study_scene(module, source, overrides)
-    path = Path(out) if out else RESULTS_DIR / f"{name}.h5"
-    if path.suffix not in (".h5", ".hdf5"):
-        raise SceneError(f"--out '{path}': result files end in .h5 or .hdf5")
-    output = execute(module, scene, None if quiet else progress_printer())
-    output.expected_failures = frozenset(getattr(module, "EXPECTED_FAILURES", ()))
+    path = check_output(RESULTS_DIR / f"{name}.h5" if out is None else out,
+                        [source] if source is not None and Path(str(source)).exists() else [])
+    if figures and hasattr(module, "figures"):
+        check_writable_folder(figures_folder(path), f"figures of '{path}'")
+    written: list[Path] = []
+    try:
+        output = execute(module, scene, None if quiet else progress_printer())
+        output.expected_failures = frozenset(getattr(module, "EXPECTED_FAILURES", ()))
+        output.path = _write_output(output, path, scene)
+        written.append(output.path)
+        if figures and hasattr(module, "figures") and output.path == path:
+            with staged_figures(path, name) as (staging, placed):
+                module.figures(output.results, output.summary, staging)
+            output.figures = placed
+            written.extend(placed)
+    except KeyboardInterrupt as exc:
+        raise Interrupted(written, type(exc)) from None
+    _report(output, path, quiet)
+    return output
+
+
+class Interrupted(KeyboardInterrupt):
+    """An interrupt (SIGINT or SIGTERM) during a run; ``written`` lists the files the run had
+    already written (the rest were left as they were)."""
+
+    def __init__(self, written: list[Path], kind: type = KeyboardInterrupt) -> None:
+        super().__init__()
+        self.written = written
+        self.kind = kind
+
+
+def _write_output(output: StudyOutput, path: Path, scene: Scene) -> Path:
+    """Write the run to ``path``, or beside it when it did not end as declared and ``path``
+    holds an earlier run (which is then kept as it was)."""
     failed = [case for case in output.results.values() if case.status != "ok"]
-    output.path = write_results(path, name, list(output.results.values()), to_toml(scene),
-                                output.summary.datasets,
-                                {"wall_time_s": output.wall_time_s,
-                                 "failed_cases": len(failed)})
-    if figures and hasattr(module, "figures") and (not output.results
-                                                    or len(failed) < len(output.results)):
-        folder = path.parent / "figures"
-        folder.mkdir(parents=True, exist_ok=True)
-        output.figures = module.figures(output.results, output.summary, folder)
+    target = path
+    if not output.as_expected and path.exists():
+        target = failed_path(path)
+    return write_results(target, output.name, list(output.results.values()), to_toml(scene),
+                         output.summary.datasets,
+                         {"wall_time_s": output.wall_time_s, "failed_cases": len(failed)})
+
+
+def _report(output: StudyOutput, path: Path, quiet: bool) -> None:
+    """The report and the written files on stdout; failed cases and a kept file on stderr."""
+    failed = [case for case in output.results.values() if case.status != "ok"]
     if not quiet:
         print(output.summary.report)
-        for case in failed:
-            expected = " (expected)" if case.name in output.expected_failures else ""
-            print(f"FAILED{expected} case {case.name}: {case.message}")
-        for name in output.unexpected():
-            if output.results[name].status == "ok":
-                print(f"NOT FAILED case {name}: it was built to fail (EXPECTED_FAILURES)")
-        expected = len([c for c in failed if c.name in output.expected_failures])
-        print(f"wrote {output.path} ({len(output.results)} cases, {len(failed)} failed"
-              + (f", {expected} of them as expected" if expected else "")
-              + f", {output.wall_time_s:.1f} s)")
-        for figure in output.figures:
-            print(f"wrote {figure}")
-    return output
+    for case in failed:
+        expected = case.name in output.expected_failures
+        if not (quiet and expected):
+            print(f"flex: FAILED{' (expected)' if expected else ''} case {case.name}: "
+                  f"{case.message}", file=sys.stderr)
+    for name in output.unexpected():
+        if output.results[name].status == "ok":
+            print(f"flex: NOT FAILED case {name}: it was built to fail (EXPECTED_FAILURES)",
+                  file=sys.stderr)
+    if output.path != path:
+        print(f"flex: {len(output.unexpected())} case(s) did not end as the study declares: "
+              f"'{path}' was kept as it was (the last good run); this run was written to "
+              f"'{output.path}'", file=sys.stderr)
+    if quiet:
+        return
+    expected = len([c for c in failed if c.name in output.expected_failures])
+    print(f"wrote {output.path} ({len(output.results)} cases, {len(failed)} failed"
+          + (f", {expected} of them as expected" if expected else "")
+          + f", {output.wall_time_s:.1f} s)")
+    for figure in output.figures:
+        print(f"wrote {figure}")
