@@ -30,7 +30,8 @@ class _Parser(argparse.ArgumentParser):
     refusal of flex."""
 
     def error(self, message: str):  # noqa: D102 - argparse's contract
-        print(f"flex: error: {self.prog.removeprefix('flex').strip() or 'flex'}: {message} "
+        command = self.prog.removeprefix("flex").strip()
+        print(f"flex: error: {command + ': ' if command else ''}{message} "
               f"(see '{self.prog} --help')", file=sys.stderr)
         raise SystemExit(EXIT_BAD_INPUT)
 
@@ -47,7 +48,7 @@ def _parser() -> argparse.ArgumentParser:
                      description="flex: rigid and flexible (FFRF) slider-crank deployment "
                                  "studies on Exudyn and NGsolve, results in HDF5.")
     parser.add_argument("--version", action="version", version=f"flex {__version__}")
-    commands = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
 
     def scene_options(sub: argparse.ArgumentParser) -> None:
         sub.add_argument("study", choices=STUDIES, metavar="STUDY",
@@ -187,19 +188,24 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the process exit status (:mod:`flex.errors`). No exception
     leaves it: a bug prints one ``flex: internal error`` line and returns 3 (``FLEX_DEBUG=1``
     shows the traceback)."""
-    restore = _terminate_as_interrupt()
+    received: list[int] = []
+    restore = _catch_signals(received)
     try:
         return _dispatch(argv)
     except FlexError as exc:
         print(f"flex: error: {_one_line(str(exc))}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt as exc:
-        return _interrupted(exc)
+        return _interrupted(exc, received)
     except OSError as exc:  # an output or input the operating system refused
+        if received:  # an interrupt inside a C extension can surface as any error
+            return _interrupted(exc, received)
         where = f" '{exc.filename}'" if exc.filename else ""
         print(f"flex: error: cannot access{where}: {exc.strerror or exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except Exception as exc:  # noqa: BLE001 - the last line of defence: no traceback
+        if received:  # e.g. Ctrl-C during an import comes back as "ImportError"
+            return _interrupted(exc, received)
         if os.environ.get("FLEX_DEBUG") == "1":
             raise
         print(f"flex: internal error: {type(exc).__name__}: {_one_line(str(exc))} (a bug in "
@@ -220,26 +226,31 @@ def _one_line(text: str, limit: int = 1000) -> str:
     return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
-def _terminate_as_interrupt():
-    """SIGTERM raises :class:`~flex.errors.Terminated` (a KeyboardInterrupt), so a
-    terminated run cleans up like Ctrl-C; returns the function restoring the old handler."""
+def _catch_signals(received: list[int]):
+    """SIGINT raises KeyboardInterrupt and SIGTERM :class:`~flex.errors.Terminated` (a
+    KeyboardInterrupt, so a terminated run cleans up like Ctrl-C); each is noted in
+    ``received``. Returns the function restoring the previous handlers."""
     import signal
     import threading
 
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
 
-    def on_terminate(signum, frame):
-        raise Terminated
+    def on_signal(signum, frame):
+        received.append(signum)
+        raise Terminated if signum == signal.SIGTERM else KeyboardInterrupt
 
-    previous = signal.signal(signal.SIGTERM, on_terminate)
-    return lambda: signal.signal(signal.SIGTERM, previous)
+    previous = {sig: signal.signal(sig, on_signal) for sig in (signal.SIGINT, signal.SIGTERM)}
+    return lambda: [signal.signal(sig, handler) for sig, handler in previous.items()]
 
 
-def _interrupted(exc: KeyboardInterrupt) -> int:
+def _interrupted(exc: BaseException, received: list[int]) -> int:
     """Say what an interrupt left behind; 130 (SIGINT) or 143 (SIGTERM)."""
+    import signal
+
     kind = getattr(exc, "kind", type(exc))
-    terminated = issubclass(kind, Terminated)
+    terminated = (isinstance(kind, type) and issubclass(kind, Terminated)) or (
+        signal.SIGTERM in received)
     what = "terminated" if terminated else "interrupted"
     written = getattr(exc, "written", [])
     if written:
@@ -254,6 +265,9 @@ def _interrupted(exc: KeyboardInterrupt) -> int:
 def _dispatch(argv: list[str] | None) -> int:
     parser = _parser()
     args, extra = parser.parse_known_args(argv)
+    if args.command is None:
+        parser.error(f"unrecognized arguments: {' '.join(extra)}" if extra else
+                     "a COMMAND is required: run, scene, inspect, plot or compare")
     if extra:  # PATHs after options (compare A B --rtol 1e-6 PATH): argparse leaves them over
         if args.command in ("plot", "compare") and not any(e.startswith("-") for e in extra):
             args.paths += extra
@@ -272,10 +286,21 @@ def _dispatch(argv: list[str] | None) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from .study import run_study
+    import re
+
+    from .study import load_study, run_study
 
     if args.workers is not None and args.workers < 1:
         raise FlexError(f"--workers {args.workers}: must be at least 1")
+    sweep_options = [name for name, value in (("--scheduler", args.scheduler),
+                                              ("--workers", args.workers)) if value is not None]
+    if sweep_options and not getattr(load_study(args.study), "SWEEP", False):
+        raise FlexError(f"{' and '.join(sweep_options)}: study '{args.study}' runs its cases "
+                        f"in this process; these options apply to sweep studies (kfit)")
+    if args.scheduler is not None and not re.match(
+            r"^(processes|serial|local|(tcp|tls|inproc|ucx|ws|wss)://\S+)$", args.scheduler):
+        raise FlexError(f"--scheduler {args.scheduler!r}: expected processes (default), serial, "
+                        f"local (Dask on this machine) or a Dask address like tcp://host:8786")
     if args.scheduler:
         os.environ["FLEX_SCHEDULER"] = args.scheduler
     if args.workers is not None:

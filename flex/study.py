@@ -134,7 +134,8 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
     Nothing is lost: the output is checked before any case runs (:func:`flex.outputs.
     check_output`); a run that does not end as the study declares (an unexpected failed
     case) does not replace an existing result file but is written beside it
-    (:func:`flex.outputs.failed_path`), and draws no figures. Failed cases are reported on
+    (:func:`flex.outputs.failed_path`); figures are drawn only for a run that ended as
+    declared. Failed cases are reported on
     stderr, also with ``quiet``. An interrupt raises :class:`Interrupted` saying which files
     were already written.
     """
@@ -150,13 +151,16 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
         output.expected_failures = frozenset(getattr(module, "EXPECTED_FAILURES", ()))
         output.path = _write_output(output, path, scene)
         written.append(output.path)
-        if figures and hasattr(module, "figures") and output.path == path:
+        if figures and hasattr(module, "figures") and output.as_expected:
             with staged_figures(path, name) as (staging, placed):
                 module.figures(output.results, output.summary, staging)
             output.figures = placed
             written.extend(placed)
     except KeyboardInterrupt as exc:
         raise Interrupted(written, type(exc)) from None
+    except Exception as exc:  # an interrupt inside a C extension surfaces as another error
+        exc.written = written  # what the run had written, for the CLI's message
+        raise
     _report(output, path, quiet)
     return output
 

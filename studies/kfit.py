@@ -59,6 +59,7 @@ from flex.scene import Scene, apply_overrides, to_toml, validate
 from flex.settings import pinned_overrides
 from flex.study import RESULTS_DIR, Summary
 
+SWEEP = True  # cases run on the sweep engine: --scheduler and --workers apply
 NAME = "kfit"
 DESCRIPTION = "fit the rigid-or-flexible threshold k from FFRF-vs-rigid sweeps"
 OVERRIDES = pinned_overrides() + ['coupler.geometry="plate"', 'coupler.model="ffrf"',
