@@ -277,9 +277,12 @@ def _dispatch(argv: list[str] | None) -> int:
         return _run(args)
     if args.command == "scene":
         from .scene import to_toml
-        from .study import load_study, study_scene
+        from .study import check_cases, load_study, study_scene
+        from .usage import explicit_keys
 
-        scene = study_scene(load_study(args.study), args.scene, args.overrides)
+        module = load_study(args.study)
+        scene = study_scene(module, args.scene, args.overrides)
+        check_cases(module, module.cases(scene), explicit_keys(args.scene, args.overrides))
         _print(_auto_note(scene) + to_toml(scene), end="")
         return EXIT_OK
     return _result_tool(args)

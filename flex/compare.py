@@ -13,7 +13,9 @@ column by column. A curve (or column) **passes** when
 ``a`` from the first file (A, the run under test) and ``b`` from the second (B, the
 reference). A NaN in either curve, different units, or time ranges that do not overlap fail.
 Datasets without a time axis (``/summary`` tables, scalars) are compared element by element
-with the same rule; text must be equal.
+with the same rule; text must be equal. A case that failed (status ``"failed"``) in either
+file, among the cases compared, is a failure of its own: its row reads ``case X failed in A:
+<the case's message> (<file>)``, and a PATH into it selects nothing instead of being an error.
 
 Which datasets: the PATHs given (see :func:`flex.results.select_datasets` for the forms,
 including the case shorthand and wildcards). A PATH that names one dataset missing from
@@ -160,6 +162,9 @@ class Comparison:
 
         Every failure is shown; passing rows up to ``limit`` in all (0: every row).
         """
+        if not isinstance(limit, int) or limit < 0:
+            raise FlexError(f"--limit {limit}: must be a whole number >= 0 (0 shows every "
+                            f"row)")
         lines = [f"A: {self.file_a}", f"B: {self.file_b}",
                  f"pass if max|a - b| <= atol + rtol * max|b| for each curve (and column): "
                  f"rtol = {self.rtol:g}, atol = {self.atol:g}"]
@@ -245,13 +250,18 @@ def resample(time_s: np.ndarray, values: np.ndarray, base: np.ndarray,
     """
     values = np.asarray(values, dtype=float)
     base = np.clip(base, time_s[0], time_s[-1])
-    if interpolation == "cubic" and len(time_s) >= 4:
-        from scipy.interpolate import CubicSpline
+    with np.errstate(all="ignore"):
+        if interpolation == "cubic" and len(time_s) >= 4 and np.isfinite(values).all():
+            from scipy.interpolate import CubicSpline
 
-        return CubicSpline(time_s, values, axis=0)(base)
-    if values.ndim == 1:
-        return np.interp(base, time_s, values)
-    return np.stack([np.interp(base, time_s, column) for column in values.T], axis=1)
+            try:
+                return CubicSpline(time_s, values, axis=0)(base)
+            except ValueError:  # slopes overflow (values near the float limit): linear
+                pass
+        # linear: a NaN or inf stays where it is, and the comparison reports it
+        if values.ndim == 1:
+            return np.interp(base, time_s, values)
+        return np.stack([np.interp(base, time_s, column) for column in values.T], axis=1)
 
 
 def compare_arrays(a: np.ndarray, b: np.ndarray, rtol: float, atol: float,
@@ -330,7 +340,7 @@ def compare_files(file_a: str | Path, file_b: str | Path, specs: Sequence[str] =
                         list(specs))
     with reading(file_a) as h5a, reading(file_b) as h5b:
         pairs = _pairs(h5a, h5b, report, specs)
-        if not pairs:
+        if not pairs and not report.deviations:
             raise ResultPathError(f"nothing to compare: '{file_a}' and '{file_b}' have no "
                                   f"dataset in common" + (f" under {', '.join(specs)}"
                                                           if specs else ""))
@@ -348,13 +358,16 @@ def _pairs(h5a, h5b, report: Comparison, specs: Sequence[str]
     pairs: list[tuple[str, str, int | None]] = []
     if not specs:
         groups = [(_comparable(h5a, report), _comparable(h5b, report), None, False)]
-        _case_status(h5a, h5b, report)
+        _case_status(h5a, h5b, report, case_names(h5a) + case_names(h5b))
     else:
         groups = []
         for spec in specs:
             path, column = parse_spec(spec)
-            in_a = select_datasets(h5a, path, report.file_a)
-            in_b = select_datasets(h5b, path, report.file_b)
+            named = _cases_named(h5a, path) + _cases_named(h5b, path)
+            failed = _failed_cases(h5a, named) | _failed_cases(h5b, named)
+            in_a = _select(h5a, path, report.file_a, failed)
+            in_b = _select(h5b, path, report.file_b, failed)
+            _case_status(h5a, h5b, report, named)
             groups.append((in_a, in_b, column, len(in_a) == 1 and len(in_b) == 1))
     for in_a, in_b, column, single in groups:
         cases_a = {split_case_path(p)[0] for p in in_a}
@@ -395,17 +408,89 @@ def _comparable(h5, report: Comparison) -> list[str]:
     return out
 
 
-def _case_status(h5a, h5b, report: Comparison) -> None:
-    """A case that ran in one file and failed in the other is a failure of its own."""
-    for case in case_names(h5a):
-        if case not in case_names(h5b):
+def _case_status(h5a, h5b, report: Comparison, cases: Sequence[str]) -> set[str]:
+    """A case that failed in A or in B is a row of its own (not a missing dataset): a
+    failure when it failed in one file only, a passing row when it failed in both.
+
+    Adds one failed :class:`Deviation` per such case among ``cases``, its note naming the
+    case, the file and the case's message (``case X failed in A: <message> (file)``);
+    returns the names of the failed cases (each reported once per comparison).
+    """
+    failed = set()
+    for case in dict.fromkeys(cases):
+        notes: list[str] = []
+        sides = 0
+        for side, h5, label in (("A", h5a, report.file_a), ("B", h5b, report.file_b)):
+            if case not in _failed_cases(h5, [case]):
+                continue
+            sides += 1
+            attrs = h5[f"cases/{case}"].attrs
+            message = " ".join(_text(attrs.get("message", "")).split()) or "no message"
+            if notes and notes[0].endswith(f": {message} ({report.file_a})"):
+                notes.append(f"and in B ({label})")
+            else:
+                notes.append(f"case {case} failed in {side}: {message} ({label})")
+        if not notes:
             continue
-        status_a = _text(h5a[f"cases/{case}"].attrs.get("status", "ok"))
-        status_b = _text(h5b[f"cases/{case}"].attrs.get("status", "ok"))
-        if status_a != status_b:
-            report.deviations.append(Deviation(
-                f"cases/{case}", f"cases/{case}", None, "status", math.nan, 0.0, False,
-                note=f"case status {status_a} in A, {status_b} in B"))
+        failed.add(case)
+        path = f"cases/{case}"
+        if any(d.path == path and d.units == "" and d.note.startswith(f"case {case} failed")
+               for d in report.deviations):
+            continue
+        # failed in both files: the same outcome, not a difference (a stability file
+        # compared with itself passes); failed in one only: a difference
+        report.deviations.append(Deviation(path, path, None, "", math.nan, 0.0, sides == 2,
+                                           note="; ".join(notes)))
+    return failed
+
+
+def _failed_cases(h5, cases: Sequence[str]) -> set[str]:
+    """Those of ``cases`` that are in ``h5`` with a status other than ``"ok"``."""
+    present = set(case_names(h5))
+    return {case for case in cases if case in present
+            and _text(h5[f"cases/{case}"].attrs.get("status", "ok")) != "ok"}
+
+
+def _cases_named(h5, spec: str) -> list[str]:
+    """The cases of ``h5`` a PATH (without ``[column]``) refers to, in the forms of
+    :func:`select_datasets`: ``cases/<case>/...``, ``<case>/...`` (wildcards allowed),
+    every case for an empty PATH or ``cases``, or the only case for a path inside it."""
+    import fnmatch
+
+    cases = case_names(h5)
+    spec = spec.strip().strip("/")
+    parts = spec.split("/")
+    if not spec or spec == "cases":
+        return cases
+    wild = any(char in spec for char in "*?")
+    if parts[0] == "cases":
+        pattern = parts[1]
+    elif not wild and _contains(h5, spec):
+        return []  # a path outside the cases (/summary/...)
+    else:
+        pattern = parts[0]
+    named = [case for case in cases if fnmatch.fnmatchcase(case, pattern)]
+    if not named and len(cases) == 1 and parts[0] != "cases":
+        return cases  # the one-case shorthand: crank/angle
+    return named
+
+
+def _contains(h5, path: str) -> bool:
+    try:
+        return path in h5
+    except (KeyError, ValueError, TypeError):
+        return False
+
+
+def _select(h5, path: str, label: str, failed: set[str]) -> list[str]:
+    """:func:`select_datasets`, except that a PATH into a failed case (named without
+    wildcards) selects nothing, instead of raising: the failure is reported instead."""
+    try:
+        return select_datasets(h5, path, label)
+    except ResultPathError:
+        if not any(char in path for char in "*?") and failed & set(_cases_named(h5, path)):
+            return []
+        raise
 
 
 def _text(value: Any) -> str:

@@ -156,7 +156,8 @@ def _statistics(h5, path: str) -> dict[str, Any]:
     time_s = None
     if case is not None and f"cases/{case}/time" in h5:
         candidate = h5[f"cases/{case}/time"][()]
-        if values.ndim in (1, 2) and len(candidate) == values.shape[0]:
+        if (values.ndim in (1, 2) and np.ndim(candidate) == 1
+                and len(candidate) == values.shape[0]):
             time_s = candidate
     columns = values.reshape(len(values), -1).T if values.ndim in (1, 2) else [values.ravel()]
     stats = []
@@ -205,6 +206,8 @@ def format_description(info: dict[str, Any]) -> str:
         lines.append(f"cases/{name}  {_case_line(case)}")
         if case["message"]:
             lines.append(f"  message: {case['message']}")
+        if case["attributes"].get("validity_warning"):
+            lines.append(f"  WARNING: {case['attributes']['validity_warning']}")
         if case["scene_changes"]:
             changes = ", ".join(f"{k} = {_short(v)}" for k, v in case["scene_changes"].items())
             lines.append(f"  scene: the file's scene with {changes}")
@@ -245,7 +248,9 @@ def _case_line(case: dict[str, Any]) -> str:
     text = ", ".join(f"{_short(counters[key])} {label}" for key, label in named
                      if key in counters)
     if "wall_time_s" in counters:
-        text += f", {counters['wall_time_s']:.3g} s wall time"
+        wall = counters["wall_time_s"]
+        wall = f"{wall:.3g}" if isinstance(wall, int | float) else _short(wall)
+        text += f", {wall} s wall time"
     if text:
         parts.append(text.lstrip(", "))
     return "; ".join(parts)

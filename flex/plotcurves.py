@@ -7,12 +7,17 @@ crank/midpoint_position[0]`` with ``crank/midpoint_position[1]``: the trajectory
 labels carry the datasets' units; curves of a second unit go on a right-hand axis, a third
 unit is refused. Every file in ``others`` (``--vs``: another run, or a reference curve file
 such as ``tests/reference_curves/*.h5``) overlays the same PATHs, dashed, in the same colour.
-Datasets without a time axis are drawn against their index. The figure is written atomically
-(PNG, PDF or SVG by the extension) and its path returned.
+Datasets without a time axis are drawn against their index. ``--x`` naming a dataset of
+another case (sampled on another time base) is refused, naming both cases. The figure is
+written atomically (PNG, PDF or SVG by the extension; a temporary file renamed when complete,
+so a failure leaves a previous figure intact) and its path returned; a figure path that is
+one of the files being read, a folder, or inside a file or an unwritable folder is refused
+(:class:`~flex.errors.OutputError`) before anything is read.
 """
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -20,9 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import FlexError
+from .errors import FlexError, OutputError
 from .results import (
     ResultPathError,
+    _os_reason,
     atomic_path,
     parse_spec,
     reading,
@@ -97,11 +103,11 @@ def _abscissa(h5, full: str, case: str | None, x_spec: str | None, count: int, l
     """x values, label and units for a dataset of ``count`` rows."""
     if x_spec:
         name, column = parse_spec(x_spec)
-        candidates = [f"cases/{case}/{name}", name] if case else [name]
-        target = next((c for c in candidates if c in h5 and hasattr(h5[c], "shape")), None)
-        if target is None:
-            target = select_datasets(h5, name, label)[0]
+        target = _x_dataset(h5, name, case, full, x_spec, label)
         values = h5[target][()]
+        if not isinstance(values, np.ndarray) or values.dtype.kind not in "biuf":
+            raise FlexError(f"--x {x_spec}: {target} in '{label}' is text or a scalar; it "
+                            f"must be a numeric column of {count} values like {full}")
         if column is not None:
             if np.ndim(values) != 2 or column >= np.shape(values)[1]:
                 raise ResultPathError(f"--x {x_spec}: {target} in '{label}' has no column "
@@ -117,6 +123,31 @@ def _abscissa(h5, full: str, case: str | None, x_spec: str | None, count: int, l
     if time_path and time_path in h5 and len(h5[time_path]) == count:
         return h5[time_path][()].astype(float), "time", "s"
     return np.arange(count, dtype=float), "index", ""
+
+
+def _x_dataset(h5, name: str, case: str | None, full: str, x_spec: str, label) -> str:
+    """The dataset ``--x`` names for the curve ``full`` (of ``case``): looked up first inside
+    that case; a dataset of another case (or outside the cases) is refused, since it was
+    sampled on another time base."""
+    if case is not None and not any(char in name for char in "*?"):
+        candidate = f"cases/{case}/{name}"
+        if candidate in h5 and hasattr(h5[candidate], "shape"):
+            return candidate
+    found = select_datasets(h5, name, label)
+    same = [path for path in found if split_case_path(path)[0] == case]
+    if len(same) == 1:
+        return same[0]
+    if len(same) > 1:
+        raise FlexError(f"--x {x_spec}: names {len(same)} datasets in '{label}' ("
+                        f"{', '.join(same[:3])}{', ...' if len(same) > 3 else ''}); "
+                        f"name one dataset")
+    def owner(name: str | None) -> str:
+        return f"belongs to case {name}" if name is not None else "is outside the cases"
+
+    other = split_case_path(found[0])[0]
+    raise FlexError(f"--x {x_spec}: {found[0]} in '{label}' {owner(other)}, but {full} "
+                    f"{owner(case)}; --x must name a dataset of the same case (each case "
+                    f"has its own time samples)")
 
 
 def _attr(dataset, key: str) -> str:
@@ -143,11 +174,13 @@ def plot_curves(path: str | Path, specs: Sequence[str], others: Sequence[str | P
     if not specs:
         raise FlexError("plot needs at least one PATH, e.g. crank/angle")
     target = Path(out) if out else default_output(path, specs)
-    if target.suffix.lower() not in FORMATS:
-        raise FlexError(f"--out '{target}': figures end in {', '.join(FORMATS)}")
     files = [path, *others]
+    _check_output(target, files, "--out" if out else "the default figure")
     curves_by_file = [load_curves(f, specs, x_spec) for f in files]
     curves = [c for group in curves_by_file for c in group]
+    if not curves:
+        raise FlexError(f"nothing to plot: {' '.join(specs)} in '{path}' names only time "
+                        f"bases or empty datasets")
     x_units = list(dict.fromkeys((c.x_label if c.x_label in ("time", "index") else "x",
                                   c.x_units) for c in curves))
     if len(x_units) > 1:
@@ -158,11 +191,20 @@ def plot_curves(path: str | Path, specs: Sequence[str], others: Sequence[str | P
     if len(y_units) > 2:
         raise FlexError(f"the curves have {len(y_units)} units ({', '.join(y_units)}); "
                         f"one plot shows at most two (left and right axis)")
+    import warnings
+
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    with warnings.catch_warnings(), np.errstate(all="ignore"):
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _draw(plt, path, specs, files, curves_by_file, curves, y_units, title, target)
+
+
+def _draw(plt, path, specs, files, curves_by_file, curves, y_units, title, target) -> Path:
+    """Draw the curves and write the figure atomically (see :func:`plot_curves`)."""
     fig, left = plt.subplots(figsize=(7.5, 4.5), layout="constrained")
     axes = {y_units[0]: left}
     if len(y_units) == 2:
@@ -178,15 +220,16 @@ def plot_curves(path: str | Path, specs: Sequence[str], others: Sequence[str | P
         for curve in group:
             label = f"{file_labels[curve.file]}: {curve.label}" if several else curve.label
             colour = colours[keys.index(curve.key) % len(colours)]
-            axes[curve.y_units].plot(curve.x, curve.y, style, color=colour, label=label,
+            axes[curve.y_units].plot(curve.x, curve.y, style, color=colour, label=_plain(label),
                                      linewidth=1.4 if file_index == 0 else 1.2)
     first = curves[0]
-    left.set_xlabel(f"{first.x_label} [{first.x_units}]" if first.x_units else first.x_label)
+    left.set_xlabel(_plain(f"{first.x_label} [{first.x_units}]" if first.x_units
+                           else first.x_label))
     for units, ax in axes.items():
         names = list(dict.fromkeys(c.label.split("/", 1)[-1] if "/" in c.label else c.label
                                    for c in curves if c.y_units == units))
         name = ", ".join(names) if len(names) <= 2 else "value"
-        ax.set_ylabel(f"{name} [{units}]" if units else name)
+        ax.set_ylabel(_plain(f"{name} [{units}]" if units else name))
     left.grid(True, alpha=0.3)
     handles, labels = [], []
     for ax in axes.values():
@@ -195,9 +238,60 @@ def plot_curves(path: str | Path, specs: Sequence[str], others: Sequence[str | P
         labels += lab
     if len(labels) > 1:
         left.legend(handles, labels, fontsize="small")
-    left.set_title(title or " vs ".join(Path(f).name for f in files))
-    target.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(target) as tmp:
-        fig.savefig(tmp, dpi=120, format=target.suffix.lower()[1:])
-    plt.close(fig)
+    left.set_title(_plain(title or " vs ".join(Path(f).name for f in files)))
+    try:
+        fig.canvas.draw()  # drawing errors (values out of range) before any file is made
+        target.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_path(target) as tmp:
+            fig.savefig(tmp, dpi=120, format=target.suffix.lower()[1:])
+    except OSError as exc:
+        raise OutputError(f"cannot write figure '{target}': {_os_reason(exc)}; the previous "
+                          f"figure (if any) is unchanged") from None
+    except (ValueError, OverflowError, ArithmeticError) as exc:
+        reason = " ".join(str(exc).split())[:120]
+        raise FlexError(f"cannot draw {', '.join(specs)} of '{path}': {reason} (values too "
+                        f"large to draw? python -m flex inspect shows their range)") from None
+    finally:
+        plt.close(fig)
     return target
+
+
+def _plain(text: str) -> str:
+    """``text`` shown as written: a ``$`` does not start matplotlib's math mode (a lone or
+    malformed ``$...$`` in a file name, path or title would fail at drawing time)."""
+    return str(text).replace("$", r"\$")
+
+
+def _check_output(target: Path, inputs: Sequence[str | Path], what: str) -> None:
+    """Refuse, before anything is read or drawn, a figure path that would overwrite an input
+    file or that cannot be written (a folder, a parent that is a file, no permission)."""
+    for source in inputs:
+        if _same_file(target, Path(source)):
+            raise OutputError(f"{what} '{target}' is the result file '{source}' being read; "
+                              f"it would be overwritten (choose another figure name)")
+    if target.suffix.lower() not in FORMATS:
+        raise OutputError(f"{what} '{target}': figures end in {', '.join(FORMATS)}")
+    if target.is_dir():
+        raise OutputError(f"{what} '{target}' is a directory; name a figure file inside it "
+                          f"(e.g. '{target / 'figure.png'}')")
+    if target.is_symlink() and not target.exists():
+        raise OutputError(f"{what} '{target}' is a symbolic link to nothing")
+    folder = target.parent
+    while not folder.exists() and not folder.is_symlink() and folder != folder.parent:
+        folder = folder.parent
+    if folder.is_symlink() and not folder.exists():
+        raise OutputError(f"{what} '{target}': '{folder}' is a symbolic link to nothing")
+    if not folder.is_dir():
+        raise OutputError(f"{what} '{target}': '{folder}' is a file, not a folder; the "
+                          f"figure cannot be written there")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise OutputError(f"{what} '{target}': folder '{folder}' is not writable")
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        if a.exists() and b.exists():
+            return os.path.samefile(a, b)
+        return a.resolve() == b.resolve()
+    except (OSError, RuntimeError, ValueError):
+        return False

@@ -177,16 +177,29 @@ def load_scene(source: str | Path | None = None, overrides: list[str] | None = N
     ``"section.key=value"`` strings, the value in TOML syntax (``1e-3``, ``"ffrf"``,
     ``true``); a bare word is read as a string. Returns the validated scene.
     """
-    scene = _read_toml(_scene_path(DEFAULT_SCENE), DEFAULT_SCENE)
-    if source is not None and str(source) != DEFAULT_SCENE:
-        path = Path(source)
-        user = _read_toml(path if path.suffix == ".toml" or path.exists()
-                          else _scene_path(str(source)), str(source))
+    scene = default_scene()
+    user = read_source(source)
+    if user is not None:
         scene = merge(scene, user)
     if overrides:
         scene = apply_overrides(scene, overrides)
     validate(scene)
     return scene
+
+
+def default_scene() -> Scene:
+    """The bundled default parameter set (:data:`DEFAULT_SCENE`), as read from its file."""
+    return _read_toml(_scene_path(DEFAULT_SCENE), DEFAULT_SCENE)
+
+
+def read_source(source: str | Path | None) -> Scene | None:
+    """The tables of a user scene file or bundled parameter set, as written (not merged,
+    not validated); None for no source or the default parameter set."""
+    if source is None or str(source) == DEFAULT_SCENE:
+        return None
+    path = Path(source)
+    return _read_toml(path if path.suffix == ".toml" or path.exists()
+                      else _scene_path(str(source)), str(source))
 
 
 def _scene_path(name: str) -> Path:
@@ -204,8 +217,8 @@ def _read_toml(path: Path, label: str) -> Scene:
         raise SceneError(f"scene file '{label}' does not exist") from None
     except OSError as exc:
         raise SceneError(f"scene file '{label}' cannot be read: {exc.strerror}") from None
-    try:
-        parsed = tomllib.loads(data.decode("utf-8"))
+    try:  # a UTF-8 byte-order mark (some Windows editors write one) is not content
+        parsed = tomllib.loads(data.decode("utf-8").removeprefix("\ufeff"))
     except UnicodeDecodeError:
         raise SceneError(f"scene file '{label}' is not UTF-8 text") from None
     except RecursionError:
@@ -235,13 +248,20 @@ def apply_overrides(scene: Scene, overrides: list[str]) -> Scene:
     """Apply ``"section.key=value"`` overrides (TOML values; bare words are strings)."""
     changes: Scene = {}
     for item in overrides:
-        if "=" not in item or "." not in item.split("=", 1)[0]:
-            raise SceneError(f"--set {_show(item)}: expected section.key=value, "
-                             f"e.g. coupler.thickness_m=0.003")
-        dotted, text = item.split("=", 1)
-        section, key = (part.strip() for part in dotted.split(".", 1))
-        changes.setdefault(section, {})[key] = _parse_value(text.strip())
+        section, key, value = parse_override(item)
+        changes.setdefault(section, {})[key] = value
     return merge(scene, changes)
+
+
+def parse_override(item: str) -> tuple[str, str, Any]:
+    """``"section.key=value"`` -> ``(section, key, value)`` (value in TOML syntax; a bare
+    word is a string); SceneError if it is not of that form."""
+    if "=" not in item or "." not in item.split("=", 1)[0]:
+        raise SceneError(f"--set {_show(item)}: expected section.key=value, "
+                         f"e.g. coupler.thickness_m=0.003")
+    dotted, text = item.split("=", 1)
+    section, key = (part.strip() for part in dotted.split(".", 1))
+    return section, key, _parse_value(text.strip())
 
 
 def _parse_value(text: str) -> Any:
@@ -255,8 +275,11 @@ def validate(scene: Scene) -> None:
     """Raise :class:`SceneError` naming the first problem; return ``None`` if valid.
 
     Checks: known sections and keys, every key present, types, finiteness, ranges, and the
-    geometry: the crank must be able to turn (``L1 + |offset| < L2``), the slider's step
-    settings consistent, and FFRF couplers need plate geometry.
+    geometry: the crank must be able to turn (``L1 + |offset| < L2``), the step settings
+    consistent (an explicit step: :func:`check_steps`, :func:`check_drive_steps`; an
+    ``"auto"`` one is checked once resolved, :func:`flex.settings.check_runnable`), FFRF
+    couplers need plate geometry, and plates that will be meshed must make sense and fit
+    this machine (:func:`check_meshed_plate`).
     """
     for section, table in scene.items():
         if section not in SCHEMA:
@@ -333,6 +356,7 @@ def _check_geometry(scene: Scene) -> None:
                          f"|offset_m| < coupler.length_m - crank.length_m = "
                          f"{coupler_m - crank_m:g}")
     check_steps(scene["simulation"])
+    check_drive_steps(scene)
     for link in ("crank", "coupler"):
         _check_link(link, scene[link])
     if scene["crank"]["model"] == "ffrf" and scene["drive"]["kind"] == "constant_speed":
@@ -353,24 +377,85 @@ def _check_geometry(scene: Scene) -> None:
                          'accepted: "generalized_alpha"')
 
 
+#: most integration steps of one run: ~25 min of the rigid model (0.03 ms per step), days of
+#: an FFRF one, and 5e7 samples x ~40 datasets is ~16 GB of output at output_step_s = 0
+MAX_STEPS = 5e7
+#: largest crank rotation per integration step of the constant-speed drive [rad]: 63 steps
+#: per crank turn, 31 per period of the slider's second harmonic (the largest after the
+#: first for L1 / L2 = 1/2), where the generalized-alpha period error (omega h)^2 / 12 is
+#: 3e-3. At 10 rad per step (1e6 rad/s, 1e-5 s) the motion is aliased: the crank turns
+#: 1.6 times between steps. The studies reach 6.3e-3 rad (100 turns per second, 1e-5 s).
+MAX_CRANK_TURN_PER_STEP_RAD = 0.1
+#: largest crank rotation between stored samples [rad]: the stored slider curve is sampled
+#: at least 4 times per period of its second harmonic (Nyquist: 2; the studies store at
+#: 6.3e-3 rad per sample)
+MAX_CRANK_TURN_PER_SAMPLE_RAD = math.pi / 4
+
+
 def check_steps(sim: dict[str, Any]) -> None:
-    """Step, output interval and step count; an ``"auto"`` step is checked once resolved."""
+    """Step, output interval and step count; an ``"auto"`` step is checked once resolved.
+
+    The output interval must be 0 (every step) or an integer multiple of the step: Exudyn
+    stores a sample at the first step at or after each interval, so another interval gives
+    irregularly spaced samples (e.g. 2.5e-5 s at 1e-5 s: 3e-5, 5e-5, 8e-5, ...).
+    """
     if sim["step_s"] == "auto":
         return
-    if sim["step_s"] > sim["end_time_s"]:
-        raise SceneError(f"simulation.step_s = {sim['step_s']:g} must be <= "
+    step, output = sim["step_s"], sim["output_step_s"]
+    if step > sim["end_time_s"]:
+        raise SceneError(f"simulation.step_s = {step:g} must be <= "
                          f"simulation.end_time_s = {sim['end_time_s']:g}")
-    if 0 < sim["output_step_s"] < sim["step_s"] * (1 - 1e-9):
-        raise SceneError(f"simulation.output_step_s = {sim['output_step_s']:g} must be >= "
-                         f"simulation.step_s = {sim['step_s']:g} (or 0: every step)")
-    steps = sim["end_time_s"] / sim["step_s"]
-    if steps > 5e7:
-        raise SceneError(f"simulation needs {steps:.3g} steps (end_time_s / step_s); "
-                         f"accepted: at most 5e7")
+    if 0 < output < step * (1 - 1e-9):
+        raise SceneError(f"simulation.output_step_s = {output:g} must be >= "
+                         f"simulation.step_s = {step:g} (or 0: every step)")
+    steps = sim["end_time_s"] / step
+    if steps > MAX_STEPS:
+        raise SceneError(f"simulation.end_time_s = {sim['end_time_s']:g} at simulation.step_s "
+                         f"= {step:g} needs {steps:.3g} steps; accepted: at most "
+                         f"{MAX_STEPS:g} steps (end_time_s <= {MAX_STEPS * step:.3g} at this "
+                         f"step)")
+    if output > 0:
+        ratio = output / step
+        if abs(ratio - round(ratio)) > 1e-6 + 1e-9 * ratio:  # float noise only
+            below, above = math.floor(ratio) * step, math.ceil(ratio) * step
+            raise SceneError(f"simulation.output_step_s = {output:g} must be an integer "
+                             f"multiple of simulation.step_s = {step:g} (it is {ratio:.6g} "
+                             f"steps: the samples would be irregular); nearest valid: "
+                             f"{below:.6g} or {above:.6g} (or 0: every step)")
+
+
+def check_drive_steps(scene: Scene) -> None:
+    """A constant-speed crank must turn at most :data:`MAX_CRANK_TURN_PER_STEP_RAD` per step
+    and :data:`MAX_CRANK_TURN_PER_SAMPLE_RAD` between stored samples (an ``"auto"`` step is
+    checked once resolved)."""
+    sim, drive = scene["simulation"], scene["drive"]
+    if drive["kind"] != "constant_speed" or sim["step_s"] == "auto":
+        return
+    speed = abs(drive["crank_speed_rad_per_s"])
+    step = sim["step_s"]
+    if speed * step > MAX_CRANK_TURN_PER_STEP_RAD * (1 + 1e-9):
+        raise SceneError(f"drive.crank_speed_rad_per_s = {drive['crank_speed_rad_per_s']:g} "
+                         f"turns the crank {speed * step:.3g} rad per step of {step:g} s: the "
+                         f"motion is aliased; accepted: at most "
+                         f"{MAX_CRANK_TURN_PER_STEP_RAD:g} rad per step, i.e. "
+                         f"|crank_speed_rad_per_s| <= "
+                         f"{MAX_CRANK_TURN_PER_STEP_RAD / step:.4g} at this step, or "
+                         f"simulation.step_s <= {MAX_CRANK_TURN_PER_STEP_RAD / speed:.3g}")
+    sample = sim["output_step_s"] or step
+    if speed * sample > MAX_CRANK_TURN_PER_SAMPLE_RAD * (1 + 1e-9):
+        raise SceneError(f"simulation.output_step_s = {sample:g} stores a sample every "
+                         f"{speed * sample:.3g} rad of crank rotation at "
+                         f"drive.crank_speed_rad_per_s = {drive['crank_speed_rad_per_s']:g}: "
+                         f"the stored curves are aliased; accepted: at most "
+                         f"{MAX_CRANK_TURN_PER_SAMPLE_RAD:.3g} rad per sample, i.e. "
+                         f"output_step_s <= {MAX_CRANK_TURN_PER_SAMPLE_RAD / speed:.3g} "
+                         f"(or 0: every step)")
 
 
 def _check_link(link: str, values: dict[str, Any]) -> None:
-    """A flexible (or auto) link needs plate geometry, and the plate must fit its length."""
+    """A flexible (or auto) link needs plate geometry, and the plate must fit its length;
+    a plate that will be meshed must make sense as a meshed link (:func:`check_meshed_plate`).
+    """
     model = values["model"]
     if model in ("ffrf", "nonlinear_fe") and values["geometry"] != "plate":
         raise SceneError(f'{link}.model = "{model}" needs {link}.geometry = "plate" (the '
@@ -382,6 +467,175 @@ def _check_link(link: str, values: dict[str, Any]) -> None:
     if values["geometry"] == "plate" and values["thickness_m"] >= values["length_m"]:
         raise SceneError(f"{link}.thickness_m = {values['thickness_m']:g} must be smaller "
                          f"than {link}.length_m = {values['length_m']:g}")
+    check_meshed_plate(link, values)
+
+
+# ------------------------------------------------------------------------------------------
+# meshed plates: what makes sense, and what this machine can mesh
+# ------------------------------------------------------------------------------------------
+#: largest mesh_size_m / min(thickness_m, width_m) of a meshed plate. Quadratic tetrahedra
+#: bend well with one element across the thickness while the elements are not much longer
+#: than thick: measured first pinned-pinned bending frequency against Euler-Bernoulli
+#: (80 x 10 mm steel plates): ratio 2 (1 mm, 2 mm elements) +0.08 %; ratio 20: +1.8 %
+#: (0.1 mm, 2 mm) and +6.4 % (0.3 mm, 6 mm: also only 13 elements along the length); ratio
+#: 50: +13 %; ratio 100: +14 %; ratio 200: +20 %. The studies mesh at ratios 2-20.
+MESH_ASPECT_LIMIT = 20.0
+#: largest length_m / thickness_m of a meshed plate link (smallest thickness: L / 1000).
+#: Slenderness L / r = 3464 (r = t / sqrt(12)): Euler buckling at pi^2 E / (L/r)^2 =
+#: 8e-7 E, e.g. 0.16 MPa in steel; such a strip is a foil that buckles under any load the
+#: mechanism carries, not a link the linear FFRF body (or a solid mesh) describes. The studies
+#: reach L / t = 267 (0.3 mm coupler).
+PLATE_SLENDERNESS_LIMIT = 1000.0
+#: smallest length_m / thickness_m of a meshed plate link: the rigid joint faces disturb
+#: the plate over about one thickness from each end (Saint-Venant), so below 2 no part of the
+#: link is free of them: its midpoint deflection and bending stress (evaluated away from
+#: the end faces, one thickness from each) would mean nothing. The studies reach 4 (20 mm).
+PLATE_STUBBINESS_LIMIT = 2.0
+#: largest estimated memory of a plate reduction (or nonlinear FE body) [bytes]: two thirds
+#: of this machine's 24 GiB, the rest for the simulation, the operating system and the
+#: other process of a 2-core run (about 870k DOF by :func:`estimate_mesh`, ~30 min to build).
+MESH_MEMORY_LIMIT_BYTES = 16 * 2**30
+
+
+@dataclass(frozen=True)
+class MeshEstimate:
+    """Estimated size and cost of meshing and reducing one plate (before any meshing).
+
+    Calibrated on netgen meshes of steel plates 80 mm long (second-order tetrahedra, as
+    :mod:`flex.reduction` builds them), one process, 2-core machine:
+
+    ==========================  ========  =======  ======  ===========  =========
+    t x w, maxh [mm]            elements  DOF      est.    build [s]    peak RSS
+    ==========================  ========  =======  ======  ===========  =========
+    1 x 10, 2                   1463      9627     10.7k   2.6          0.24 GB
+    1 x 10, 1                   5711      35805    42.9k   13.7         0.50 GB
+    1 x 10, 0.5                 23403     143670   177k    77.5         1.56 GB
+    3 x 10, 0.7                 36065     175212   194k    154          2.07 GB
+    2 x 10, 0.3 (mesh only)     333045    --       --      23 (mesh)    --
+    1 x 100, 2 (mesh only)      13895     --       --      2.3 (mesh)   --
+    ==========================  ========  =======  ======  ===========  =========
+
+    Elements: ``max(5.6 V / h^3, 3.65 S / h^2)`` (V volume, S surface area, h = maxh):
+    netgen fills a plate thicker than h with ~5.6 elements per h^3 and meshes a thinner one
+    from its two large faces (~3.65 elements per h^2 of surface), within +-25 % on the
+    meshes above (1.5x high on the 1 mm, 0.5 mm mesh). Nodes of the quadratic mesh: 2.2
+    per element when the surface term dominates, 1.65 when the volume does; DOF = 3 x
+    nodes. Memory: 0.15 GB + 11.5 kB per DOF, the sparse factorisation's share growing as
+    DOF^(1/3) beyond the largest mesh measured (175k DOF); build time: 154 s x (DOF /
+    175k)^1.5 (Craig-Bampton eigenmodes dominate). Estimates: within a factor 2 of what a
+    build takes.
+    """
+
+    elements: float
+    dof: float
+    memory_bytes: float
+    build_time_s: float
+
+    def text(self) -> str:
+        """One-line description, e.g. ``~1.5e+03 elements, ~1.1e+04 DOF, ~0.26 GiB, ~2 s``."""
+        return (f"~{self.elements:.2g} quadratic tetrahedra, ~{self.dof:.2g} DOF, "
+                f"~{self.memory_bytes / 2**30:.2g} GiB, ~{_duration(self.build_time_s)} to "
+                f"mesh and reduce")
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.2g} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.2g} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.2g} h"
+    return f"{seconds / 86400:.2g} days"
+
+
+def estimate_mesh(length_m: float, thickness_m: float, width_m: float,
+                  mesh_size_m: float) -> MeshEstimate:
+    """Elements, DOF, memory and build time of a plate mesh before meshing (see
+    :class:`MeshEstimate` for the calibration). Pure arithmetic: never meshes."""
+    h = mesh_size_m
+    volume = length_m * thickness_m * width_m
+    surface = 2.0 * (length_m * thickness_m + length_m * width_m + thickness_m * width_m)
+    from_volume, from_surface = 5.6 * volume / h**3, 3.65 * surface / h**2
+    elements = max(from_volume, from_surface, 6.0)
+    nodes = elements * (2.2 if from_surface >= from_volume else 1.65)
+    dof = 3.0 * nodes
+    memory = 0.15e9 + 11.5e3 * dof * max(1.0, dof / 175e3) ** (1.0 / 3.0)
+    return MeshEstimate(elements, dof, memory, 154.0 * (dof / 175e3) ** 1.5)
+
+
+def meshed_plate(link: str, values: dict[str, Any]) -> tuple[float, str, str] | None:
+    """Whether the scene meshes ``link``'s plate: ``(thickness_m meshed, its name, why)`` or
+    None.
+
+    ``ffrf`` and ``nonlinear_fe`` links are meshed; an ``auto`` crank always is (its
+    frequency is computed on the mesh; a lumped crank as the plate of its mass, of thickness
+    mass / (density x length x width), as :func:`flex.criteria.equivalent_crank_plate`); an
+    ``auto`` coupler is when the criterion chooses ``ffrf``.
+    """
+    model = values["model"]
+    name = f"{link}.thickness_m"
+    if model in ("ffrf", "nonlinear_fe"):
+        return values["thickness_m"], name, f'{link}.model = "{model}"'
+    if model != "auto":
+        return None
+    if link == "crank" and values["geometry"] == "lumped":
+        thickness = values["mass_kg"] / (values["density_kg_per_m3"] * values["length_m"]
+                                         * values["width_m"])
+        return (thickness, "the thickness of the plate of crank.mass_kg (mass / (density_kg_"
+                "per_m3 x length_m x width_m))", 'crank.model = "auto" meshes a lumped crank '
+                "as the plate of its mass")
+    if link == "crank":
+        return values["thickness_m"], name, 'crank.model = "auto" meshes the crank plate'
+    return (values["thickness_m"], name,
+            'coupler.model = "auto" meshes the plate if it chooses "ffrf"')
+
+
+def check_meshed_plate(link: str, values: dict[str, Any]) -> None:
+    """Refuse a plate that will be meshed but cannot mean anything, or that this machine
+    cannot mesh (the estimate is in the message); nothing is meshed here."""
+    meshed = meshed_plate(link, values)
+    if meshed is None:
+        return
+    thickness, name, why = meshed
+    length, width, mesh = values["length_m"], values["width_m"], values["mesh_size_m"]
+
+    def as_mass(relation: str, bound: float) -> str:  # a lumped auto crank: on its mass_kg
+        if values["geometry"] != "lumped":
+            return ""
+        mass = bound * values["density_kg_per_m3"] * length * width
+        return (f"; i.e. {link}.mass_kg {relation} {mass:g} kg at its density_kg_per_m3, "
+                f"length_m and width_m")
+
+    thinnest, thickest = length / PLATE_SLENDERNESS_LIMIT, length / PLATE_STUBBINESS_LIMIT
+    if thickness < thinnest * (1 - 1e-9):
+        raise SceneError(f"{name} = {thickness:g}: a meshed plate link must be at "
+                         f"least {link}.length_m / {PLATE_SLENDERNESS_LIMIT:g} = "
+                         f"{thinnest:g} m thick ({why}){as_mass('>=', thinnest)}; "
+                         "thinner, it is a foil that buckles under any load the mechanism "
+                         "carries")
+    if thickness > thickest * (1 + 1e-9):
+        raise SceneError(f"{name} = {thickness:g}: a meshed plate link must be at "
+                         f"most {link}.length_m / {PLATE_STUBBINESS_LIMIT:g} = "
+                         f"{thickest:g} m thick ({why}){as_mass('<=', thickest)}; "
+                         "thicker, the rigid joint faces reach its midpoint (Saint-Venant) "
+                         "and its deflection and stress mean nothing")
+    if mesh > length * (1 + 1e-9):
+        raise SceneError(f"{link}.mesh_size_m = {mesh:g} must be <= {link}.length_m = "
+                         f"{length:g} ({why}); about 1-2 x thickness_m is accurate")
+    smallest = min(thickness, width)
+    limit = MESH_ASPECT_LIMIT * smallest
+    if mesh > limit * (1 + 1e-9):
+        side = name if thickness <= width else f"{link}.width_m"
+        raise SceneError(f"{link}.mesh_size_m = {mesh:g} must be <= {MESH_ASPECT_LIMIT:g} x "
+                         f"{side} = {limit:g} ({why}): longer elements than that make "
+                         f"the plate too stiff in bending (+13 % at 50 x); about 1-2 x "
+                         f"thickness is accurate")
+    estimate = estimate_mesh(length, thickness, width, mesh)
+    if estimate.memory_bytes > MESH_MEMORY_LIMIT_BYTES:
+        raise SceneError(f"{link}.mesh_size_m = {mesh:g} on a {length:g} x {thickness:g} x "
+                         f"{width:g} m plate needs {estimate.text()} (estimate); this machine "
+                         f"takes at most {MESH_MEMORY_LIMIT_BYTES / 2**30:g} GiB ({why}): use "
+                         f"a coarser mesh_size_m or a smaller plate")
 
 
 def to_toml(scene: Scene) -> str:

@@ -6,9 +6,15 @@
 - output: a :class:`~flex.results.CaseResult` whose datasets are the quantities of the
   result layout (``time``, ``crank/...``, ``slider/...``, ``joints/<A|B|C>/...``,
   ``constraint_norm``, ``energy/...`` (rigid and FFRF links), ``coupler/...``), each with units;
+- refused before anything is built: what :func:`flex.settings.check_runnable` refuses
+  (:class:`~flex.errors.SceneError`, a ``failed`` case from :func:`simulate_case`);
 - status: ``ok``; a diverging run (solver failure, NaN, exploding constraint norm) raises
-  :class:`~flex.errors.SimulationError` naming the step and time, and
-  :func:`simulate_case` turns that into a ``failed`` case instead of data;
+  :class:`~flex.errors.SimulationError` naming the step and time and what may help
+  (:func:`divergence_advice`: a smaller step only where the step does not resolve the
+  scene's fastest time scale; the extreme inputs), and :func:`simulate_case` turns that
+  into a ``failed`` case instead of data; an ``ok`` run whose validity is in doubt (a
+  linear FFRF link deflecting beyond 1 % of its length) carries the case attribute
+  ``validity_warning`` (:func:`validity_warning`);
 - counters: steps, Newton iterations, Jacobian updates, wall time [s].
 
 The integrator follows the scene's ``[simulation]`` knobs (:func:`solver_settings`): Exudyn's
@@ -32,11 +38,11 @@ from typing import Any
 
 import numpy as np
 
-from .errors import FlexError, SimulationError
+from .errors import FlexError, SimulationError, Terminated
 from .mechanism import Mechanism, _rotation_z, build_mechanism
 from .results import CaseResult, Dataset
-from .scene import Scene, to_toml
-from .settings import resolve_solver_settings, resolved_simulation
+from .scene import Scene, check_meshed_plate, estimate_mesh, to_toml
+from .settings import check_runnable, resolve_solver_settings, resolved_simulation
 
 # a constraint norm above this is a failed assembly, not a tolerance question
 CONSTRAINT_NORM_LIMIT_M = 1e-4
@@ -144,15 +150,16 @@ def run(mech: Mechanism) -> dict[str, Any]:
               else exu.MainSolverImplicitSecondOrder())
     captured = io.StringIO()
     start = time.perf_counter()
-    # Ctrl-C inside Exudyn's C++ loop may come back as a failed solve; note it ourselves so
-    # an interrupt is never mistaken for (and stored as) a diverged case
+    # Ctrl-C (or SIGTERM) inside Exudyn's C++ loop may come back as a failed solve; note it
+    # ourselves so an interrupt is never mistaken for (and stored as) a diverged case
     interrupted: list[int] = []
-    previous_handler = None
+    previous: dict[int, Any] = {}
     if threading.current_thread() is threading.main_thread():
         def on_interrupt(signum, frame):
             interrupted.append(signum)
-            raise KeyboardInterrupt
-        previous_handler = signal.signal(signal.SIGINT, on_interrupt)
+            raise Terminated if signum == signal.SIGTERM else KeyboardInterrupt
+        previous = {sig: signal.signal(sig, on_interrupt)
+                    for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
         with redirect_stdout(captured):
             ok = solver.SolveSystem(mech.mbs, _exudyn_settings(settings))
@@ -160,18 +167,21 @@ def run(mech: Mechanism) -> dict[str, Any]:
         ok = False
         captured.write(str(exc))
     finally:
-        if previous_handler is not None:
-            signal.signal(signal.SIGINT, previous_handler)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
     if interrupted:
-        raise KeyboardInterrupt
+        if previous.get(interrupted[0]) not in (None, signal.SIG_DFL, signal.SIG_IGN,
+                                                signal.default_int_handler):
+            previous[interrupted[0]](interrupted[0], None)  # the caller's handler notes it
+        raise Terminated if interrupted[0] == signal.SIGTERM else KeyboardInterrupt
     wall = time.perf_counter() - start
     if not ok:
         step, now = solver.it.currentStepIndex, solver.it.currentTime
         failure = "explicit solver failed" if _is_explicit(settings) else "Newton failed"
         detail = " ".join(captured.getvalue().split())[-300:]
         raise SimulationError(f"solver diverged at step {step} (t = {now:.6g} s, step "
-                              f"{settings['step_s']:g} s): {detail or failure}; try a "
-                              f"smaller simulation.step_s")
+                              f"{settings['step_s']:g} s): {detail or failure}; "
+                              f"{divergence_advice(mech.scene, _reductions(mech))}")
     return {"steps": int(solver.it.currentStepIndex), "newton_iterations":
             int(solver.it.newtonStepsCount), "jacobian_updates": int(solver.it.newtonJacobiCount),
             "wall_time_s": wall}
@@ -340,9 +350,27 @@ def reduction_for_scene(scene: Scene, link: str = "coupler"):
     from .reduction import build_reduction
 
     c = scene[link]
+    check_meshed_plate(link, dict(c, model="ffrf"))  # refused before any meshing
+    _announce_mesh(link, c, "reduction (instant if cached)")
     return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
                            c["youngs_modulus_Pa"], c["density_kg_per_m3"], c["poisson_ratio"],
                            c["mesh_size_m"], c["modes"], reduction_cache_dir())
+
+
+#: a mesh whose estimated build takes longer than this is announced on stderr first [s]
+ANNOUNCE_MESH_S = 30.0
+
+
+def _announce_mesh(link: str, values: dict[str, Any], what: str) -> None:
+    """Say on stderr what a long meshing job will cost before it starts (so a big mesh is
+    not a silent hang)."""
+    estimate = estimate_mesh(values["length_m"], values["thickness_m"], values["width_m"],
+                             values["mesh_size_m"])
+    if estimate.build_time_s > ANNOUNCE_MESH_S:
+        import sys
+
+        print(f"flex: meshing the {link} plate for its {what}: {estimate.text()} "
+              f"(estimate)", file=sys.stderr, flush=True)
 
 
 def _coupler_datasets(mech: Mechanism, time_s: np.ndarray) -> dict[str, Dataset]:
@@ -444,12 +472,15 @@ def _wing_datasets(mech: Mechanism) -> dict[str, Dataset]:
     }
 
 
-def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any]) -> None:
+def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any],
+                  scene: Scene | None = None, reductions: dict[str, Any] | None = None
+                  ) -> None:
     """Raise :class:`SimulationError` at the earliest sample where the solution diverged.
 
     Diverged: any dataset not finite (NaN, inf), or the constraint norm above
     :data:`CONSTRAINT_NORM_LIMIT_M` (an exploding or torn-apart assembly). The message names
-    the integration step (time / step_s), the time [s] and what went wrong.
+    the integration step (time / step_s), the time [s] and what went wrong, and, given the
+    ``scene`` (and its ``reductions`` by link), what may help (:func:`divergence_advice`).
     """
     time_s = np.asarray(datasets["time"].data, dtype=float)
     problems: list[tuple[int, str]] = []
@@ -469,9 +500,9 @@ def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any]) -> Non
     index, what = min(problems, key=lambda problem: problem[0])
     now = time_s[index] if np.isfinite(time_s[index]) else float("nan")
     step = int(round(now / settings["step_s"])) if np.isfinite(now) else index
+    advice = "" if scene is None else f"; {divergence_advice(scene, reductions or {})}"
     raise SimulationError(f"solution diverged at step {step} (t = {now:.6g} s, step "
-                          f"{settings['step_s']:g} s): {what}; try a smaller "
-                          f"simulation.step_s")
+                          f"{settings['step_s']:g} s): {what}{advice}")
 
 
 def _resolve_auto(scene: Scene) -> tuple[Scene, list[Any]]:
@@ -503,20 +534,24 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     (:func:`flex.settings.resolve_solver_settings`; attributes ``solver_defaults_*``).
     ``scene_toml`` holds the resolved scene.
     """
+    check_runnable(scene)  # before anything is built: SceneError, a failed case
     scene, fidelity = _resolve_auto(scene)
     scene, solver_choice = resolve_solver_settings(scene)
+    check_runnable(scene)  # the concrete models and steps
     if fidelity:
         reduction = crank_reduction = None
     if scene["coupler"]["model"] == "ffrf" and reduction is None:
         reduction = reduction_for_scene(scene)
     if scene["crank"]["model"] == "ffrf" and crank_reduction is None:
         crank_reduction = reduction_for_scene(scene, "crank")
+    if scene["coupler"]["model"] == "nonlinear_fe" and reduction is None:
+        _announce_mesh("coupler", scene["coupler"], "nonlinear FE body")
     mech = build_mechanism(scene, reduction, crank_reduction)
     counters = run(mech)
     with np.errstate(all="ignore"):  # a diverged run overflows; _check_finite reports it
         datasets = collect(mech)
     settings = solver_settings(scene)
-    _check_finite(datasets, settings)
+    _check_finite(datasets, settings, scene, _reductions(mech))
     import tomli_w
 
     result = CaseResult(name, to_toml(scene), datasets, counters=counters,
@@ -525,7 +560,218 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
         result.attrs.update(decision.attrs())
     if solver_choice is not None:
         result.attrs.update(solver_choice.attrs())
+    warning = validity_warning(scene, datasets)
+    if warning:
+        result.attrs[VALIDITY_WARNING] = warning
     return result
+
+
+# ------------------------------------------------------------------------------------------
+# validity of a finished run
+# ------------------------------------------------------------------------------------------
+#: case attribute holding why a finished (``ok``) run may not mean what it says
+VALIDITY_WARNING = "validity_warning"
+#: largest peak elastic midpoint deflection of a linear FFRF link, as a fraction of its
+#: length, within which its results are trusted: the FFRF body is linear elasticity in a
+#: floating frame (small strains and elastic rotations, no geometric stiffening by the
+#: axial force); beyond ~1 % of the length the stability study's comparison with the
+#: nonlinear FE coupler (README "Numerical stability") shows the two models part
+FFRF_DEFLECTION_LIMIT = 0.01
+
+
+def validity_warning(scene: Scene, datasets: dict[str, Dataset]) -> str:
+    """Why the results of a finished run may not be valid ("" if nothing is known against
+    them): an FFRF link whose peak elastic midpoint deflection exceeds
+    :data:`FFRF_DEFLECTION_LIMIT` of its length (linear FFRF validity)."""
+    warnings = []
+    for link in ("crank", "coupler"):
+        name = f"{link}/midpoint_deflection"
+        if scene[link]["model"] != "ffrf" or name not in datasets:
+            continue
+        peak = float(np.max(np.abs(datasets[name].data)))
+        length = scene[link]["length_m"]
+        if peak > FFRF_DEFLECTION_LIMIT * length:
+            warnings.append(
+                f"{link}: peak elastic midpoint deflection {peak:.3g} m is "
+                f"{100 * peak / length:.3g} % of {link}.length_m = {length:g} m, beyond the "
+                f"{100 * FFRF_DEFLECTION_LIMIT:g} % within which the linear FFRF body (small "
+                f"elastic deformation in its floating frame) is trusted; "
+                + ('compare with coupler.model = "nonlinear_fe" or use a stiffer coupler'
+                   if link == "coupler" else "use a stiffer crank"))
+    return "; ".join(warnings)
+
+
+# ------------------------------------------------------------------------------------------
+# divergence advice: is a smaller step the answer?
+# ------------------------------------------------------------------------------------------
+#: steps per period that resolve a time scale with the implicit integrator (generalized-
+#: alpha period error (2 pi / 20)^2 / 12 = 0.8 %)
+STEPS_PER_PERIOD = 20.0
+#: an input this far (factor) from the bundled scene's value is named as extreme
+EXTREME_FACTOR = 100.0
+#: keys the step advice speaks of itself (not "extreme inputs")
+_STEP_KEYS = ("simulation.end_time_s", "simulation.step_s", "simulation.output_step_s")
+
+
+def _reductions(mech: Mechanism) -> dict[str, Any]:
+    return {link: body["reduction"] for link, body in (("crank", mech.crank),
+                                                       ("coupler", mech.coupler))
+            if "reduction" in body}
+
+
+def mechanism_mass_at_slider(scene: Scene) -> float:
+    """Smallest inertia of the rigid mechanism reduced to the slider coordinate [kg].
+
+    Kinetic energy 2 T = m_eff(theta) v_slider^2 (crank about A with the wing, coupler,
+    slider; links with their lumped or plate mass properties), minimised over the crank
+    angle (away from the dead centres, where the slider stops and m_eff is infinite).
+    """
+    from .kinematics import slider_crank
+    from .mechanism import wing_mass_properties
+    from .scene import plate_mass_properties
+
+    l1, l2 = scene["crank"]["length_m"], scene["coupler"]["length_m"]
+    theta = np.linspace(-np.pi, np.pi, 721)
+    state = slider_crank(l1, l2, theta, 1.0, 0.0, scene["slider"]["offset_m"])
+    m1, j1 = plate_mass_properties(scene, "crank")
+    m2, j2 = plate_mass_properties(scene, "coupler")
+    inertia_a = j1 + m1 * (l1 / 2) ** 2
+    if scene["wing"]["enabled"]:
+        mass_w, inertia_w, centre_w = wing_mass_properties(scene)
+        inertia_a += inertia_w + mass_w * centre_w**2
+    v_slider = state.slider_velocity_m_per_s
+    centre_x = (-l1 * np.sin(theta) + v_slider) / 2
+    centre_y = l1 * np.cos(theta) / 2
+    energy = (inertia_a + m2 * (centre_x**2 + centre_y**2)
+              + j2 * state.coupler_angular_velocity_rad_per_s**2
+              + scene["slider"]["mass_kg"] * v_slider**2)
+    moving = np.abs(v_slider) > 1e-3 * np.max(np.abs(v_slider))
+    return float(np.min(energy[moving] / v_slider[moving] ** 2))
+
+
+def time_scales(scene: Scene, reductions: dict[str, Any] | None = None
+                ) -> list[tuple[float, float, str]]:
+    """The scene's time scales a fixed step must resolve: ``(period [s], steps per period
+    needed, what)``, shortest first. ``reductions``: the built reductions by link (their
+    highest retained mode is then known, else estimated from the plate)."""
+    from .criteria import clamped_plate_frequencies, pinned_pinned_omega
+    from .scene import plate_mass_properties
+
+    reductions = reductions or {}
+    out: list[tuple[float, float, str]] = []
+    drive, sim = scene["drive"], scene["simulation"]
+    with np.errstate(all="ignore"):
+        if drive["kind"] == "spring" and drive["spring_stiffness_N_per_m"] > 0:
+            mass = mechanism_mass_at_slider(scene)
+            out.append((2 * np.pi * np.sqrt(mass / drive["spring_stiffness_N_per_m"]),
+                        STEPS_PER_PERIOD, "period of the spring on the mechanism's inertia"))
+        elif drive["kind"] == "constant_speed" and drive["crank_speed_rad_per_s"] != 0:
+            out.append((2 * np.pi / abs(drive["crank_speed_rad_per_s"]),
+                        STEPS_PER_PERIOD, "crank turn (constant speed)"))
+        for link in ("crank", "coupler"):
+            values = scene[link]
+            if values["model"] == "ffrf":
+                if link in reductions:
+                    hertz = float(np.max(reductions[link].fixed_interface_frequencies_Hz))
+                    omega, how = 2 * np.pi * hertz, "highest retained mode"
+                else:
+                    omega = clamped_plate_frequencies(
+                        values["length_m"], values["thickness_m"], values["width_m"],
+                        values["youngs_modulus_Pa"], values["density_kg_per_m3"],
+                        values["poisson_ratio"], count=values["modes"])[-1][0]
+                    how = "highest retained mode (beam estimate)"
+                out.append((2 * np.pi / omega, STEPS_PER_PERIOD, f"period of the {link}'s {how}"))
+            elif values["model"] == "nonlinear_fe":
+                omega = pinned_pinned_omega(values["length_m"], values["thickness_m"],
+                                            values["youngs_modulus_Pa"],
+                                            values["density_kg_per_m3"])
+                out.append((2 * np.pi / omega, STEPS_PER_PERIOD,
+                            f"period of the {link}'s first bending mode"))
+        if sim["integrator"] == "explicit_penalty":
+            # lightest inertia a joint spring moves: body masses and J / (L/2)^2; two
+            # bodies on one spring: 2 k / m. Explicit Runge-Kutta is stable up to
+            # omega h ~ 2.8 (RK44): omega h <= 1 keeps a margin (measured limit 1.6e-5 s at
+            # 1e8 N/m on the thesis links: omega h = 2.8)
+            m1, j1 = plate_mass_properties(scene, "crank")
+            m2, j2 = plate_mass_properties(scene, "coupler")
+            lightest = min(m1, m2, scene["slider"]["mass_kg"],
+                           j1 / (scene["crank"]["length_m"] / 2) ** 2,
+                           j2 / (scene["coupler"]["length_m"] / 2) ** 2)
+            omega = np.sqrt(2 * sim["penalty_stiffness_N_per_m"] / lightest)
+            out.append((2 * np.pi / omega, 2 * np.pi,
+                        "period of the penalty joints (explicit_penalty)"))
+    return sorted((float(period), need, what) for period, need, what in out)
+
+
+def extreme_inputs(scene: Scene) -> list[str]:
+    """The inputs the scene's models use that are not finite or lie :data:`EXTREME_FACTOR`
+    or more from the bundled scene's values (``"auto"`` solver keys: the rigid entry of
+    ``flex/solver_defaults.toml``), most extreme first, as ``key = value (bundled: x)``."""
+    from .scene import DEFAULT_SCENE, SCHEMA, _read_toml, _scene_path
+    from .settings import AUTO, solver_defaults
+    from .usage import unused_keys
+
+    bundled = _read_toml(_scene_path(DEFAULT_SCENE), DEFAULT_SCENE)
+    unused = unused_keys(scene)
+    found: list[tuple[float, str]] = []
+    for section, fields in SCHEMA.items():
+        for key, field in fields.items():
+            name = f"{section}.{key}"
+            value = scene.get(section, {}).get(key)
+            default = bundled.get(section, {}).get(key)
+            if default == AUTO:
+                default = solver_defaults()["rigid"].get(key)
+            if (name in unused or name in _STEP_KEYS or field.kind is not float
+                    or isinstance(value, bool) or not isinstance(value, int | float)
+                    or not isinstance(default, int | float) or default <= 0):
+                continue
+            if not np.isfinite(value):
+                found.append((np.inf, f"{name} = {value!r}"))
+            elif value > 0:
+                factor = abs(np.log10(value / default))
+                if factor >= np.log10(EXTREME_FACTOR):
+                    found.append((factor, f"{name} = {value:g} (bundled: {default:g})"))
+    return [text for _, text in sorted(found, key=lambda item: -item[0])]
+
+
+def divergence_advice(scene: Scene, reductions: dict[str, Any] | None = None) -> str:
+    """What may help a diverged run, in one line: a smaller step only where the step does
+    not resolve the scene's fastest time scale (:func:`time_scales`); the extreme inputs
+    (:func:`extreme_inputs`) always."""
+    try:
+        step = float(scene["simulation"]["step_s"])
+        scales = time_scales(scene, reductions)
+        extremes = extreme_inputs(scene)
+    except Exception:  # noqa: BLE001 - advice must never hide the divergence itself
+        return "check the scene's extreme inputs and simulation.step_s"
+    parts = []
+    unresolved = [(period, need, what) for period, need, what in scales
+                  if not (np.isfinite(period) and step <= period / need)]
+    if unresolved:
+        period, need, what = unresolved[0]
+        if np.isfinite(period):
+            parts.append(f"try a smaller simulation.step_s: h = {step:g} s is "
+                         f"{period / step:.3g} steps per {what} ({period:.3g} s); it needs "
+                         f"h <= {period / need:.3g} s")
+        else:
+            parts.append(f"the {what} is not finite")
+    elif scales:
+        period, need, what = scales[0]
+        parts.append(f"the step already resolves the fastest time scale flex knows of "
+                     f"({what}, {period:.3g} s: {period / step:.3g} steps), so a smaller "
+                     f"simulation.step_s is unlikely to help")
+    if extremes:
+        parts.append("extreme inputs: " + ", ".join(extremes[:3]))
+    elif not unresolved:
+        sim = scene["simulation"]
+        if (sim["integrator"] == "generalized_alpha" and sim["formulation"] == "index3"
+                and sim["spectral_radius"] == 1.0):
+            parts.append("simulation.spectral_radius = 1 leaves the index-3 constraint modes "
+                         "undamped: try 0.9 or less")
+        else:
+            parts.append(f"no input is {EXTREME_FACTOR:g}x from the bundled scene: check the "
+                         f"solver settings ([simulation])")
+    return "; ".join(parts)
 
 
 def simulate_case(scene: Scene, name: str = "case", reduction: Any = None,
@@ -537,4 +783,5 @@ def simulate_case(scene: Scene, name: str = "case", reduction: Any = None,
         return CaseResult(name, to_toml(scene), status="failed", message=str(exc))
 
 
-__all__ = ["simulate", "simulate_case", "solver_settings", "run", "collect", "_rotation_z"]
+__all__ = ["simulate", "simulate_case", "solver_settings", "run", "collect", "_rotation_z",
+           "divergence_advice", "time_scales", "validity_warning", "VALIDITY_WARNING"]

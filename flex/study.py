@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
 
-from .errors import FlexError
+from .errors import FlexError, SceneError
 from .outputs import (
     check_output,
     check_writable_folder,
@@ -37,7 +37,9 @@ from .outputs import (
 )
 from .results import CaseResult, Dataset, write_results
 from .scene import Scene, load_scene, to_toml
+from .settings import check_runnable
 from .solver import simulate_case
+from .usage import explicit_keys, unused_keys
 
 STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring", "kfit",
            "tradeoff", "stability", "bench", "wing", "crank")
@@ -106,11 +108,41 @@ def progress_printer(stream=None) -> Callable[[str, int, int], None]:
     return report
 
 
+def check_cases(module: ModuleType, scenes: dict[str, Scene],
+                given: dict[str, object] | None = None) -> None:
+    """Refuse (:class:`SceneError`), before any case runs, a case scene that cannot run or
+    would mean nothing (:func:`flex.settings.check_runnable`), and a value the user gave
+    (``given``: ``{"section.key": value}``, :func:`flex.usage.explicit_keys`) that no case
+    uses: one the study sets itself in each case, or one no case's models read
+    (:func:`flex.usage.unused_keys`, minus the keys the study declares it reads itself in
+    ``READS``)."""
+    for scene in scenes.values():
+        check_runnable(scene)
+    reads = set(getattr(module, "READS", ()))
+    for name, value in (given or {}).items():
+        if name in reads:
+            continue
+        section, key = name.split(".", 1)
+        values = [case[section][key] for case in scenes.values()]
+        if values and all(case_value != value for case_value in values):
+            shown = ", ".join(dict.fromkeys(f"{v:g}" if isinstance(v, float) else repr(v)
+                                            for v in values))
+            raise SceneError(f"{name} = {value!r}: study '{module.NAME}' sets this key itself "
+                             f"in each of its cases ({shown}), so the value given would be "
+                             f"ignored; use 'flex run simulate' to run a scene of your own")
+        reasons = [unused_keys(case).get(name) for case in scenes.values()]
+        if all(reasons):
+            why = reasons[0] if reasons else f"study '{module.NAME}' runs no simulation"
+            raise SceneError(f"{name} = {value!r} would be ignored: {why}")
+
+
 def execute(module: ModuleType, scene: Scene,
-            progress: Callable[[str, int, int], None] | None = None) -> StudyOutput:
-    """Run every case of a study and summarize; nothing is written."""
+            progress: Callable[[str, int, int], None] | None = None,
+            scenes: dict[str, Scene] | None = None) -> StudyOutput:
+    """Run every case of a study and summarize; nothing is written. ``scenes``: the cases
+    (default ``module.cases(scene)``)."""
     start = time.perf_counter()
-    scenes = module.cases(scene)
+    scenes = module.cases(scene) if scenes is None else scenes
     if hasattr(module, "simulate_cases"):
         results = module.simulate_cases(scenes, progress)
     else:
@@ -141,13 +173,15 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
     """
     module = load_study(name)
     scene = study_scene(module, source, overrides)
+    scenes = module.cases(scene)
+    check_cases(module, scenes, explicit_keys(source, overrides))
     path = check_output(RESULTS_DIR / f"{name}.h5" if out is None else out,
                         [source] if source is not None and Path(str(source)).exists() else [])
     if figures and hasattr(module, "figures"):
         check_writable_folder(figures_folder(path), f"figures of '{path}'")
     written: list[Path] = []
     try:
-        output = execute(module, scene, None if quiet else progress_printer())
+        output = execute(module, scene, None if quiet else progress_printer(), scenes)
         output.expected_failures = frozenset(getattr(module, "EXPECTED_FAILURES", ()))
         output.path = _write_output(output, path, scene)
         written.append(output.path)
@@ -197,6 +231,10 @@ def _report(output: StudyOutput, path: Path, quiet: bool) -> None:
         if not (quiet and expected):
             print(f"flex: FAILED{' (expected)' if expected else ''} case {case.name}: "
                   f"{case.message}", file=sys.stderr)
+    for case in output.results.values():
+        if case.status == "ok" and case.attrs.get("validity_warning"):
+            print(f"flex: WARNING case {case.name}: {case.attrs['validity_warning']}",
+                  file=sys.stderr)
     for name in output.unexpected():
         if output.results[name].status == "ok":
             print(f"flex: NOT FAILED case {name}: it was built to fail (EXPECTED_FAILURES)",

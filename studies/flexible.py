@@ -40,6 +40,10 @@ NAME = "flexible"
 DESCRIPTION = ("FFRF coupler plates t = 1, 3, 5, 10 mm against their rigid twins; nonlinear FE "
                "reference for t = 1 mm")
 OVERRIDES = pinned_overrides() + ['coupler.geometry="plate"']
+# keys the study reads itself (its plates and their rigid twins), beside its cases
+READS = ("coupler.length_m", "coupler.thickness_m", "coupler.width_m",
+         "coupler.youngs_modulus_Pa", "coupler.density_kg_per_m3",
+         "coupler.poisson_ratio", "coupler.damping_ratio")
 
 # Table 5 models: thickness [m] and the netgen mesh size used for each (about the thickness,
 # at most 2t; quadratic tetrahedra converge within 0.1 % there, see the modal study)

@@ -64,6 +64,12 @@ NAME = "kfit"
 DESCRIPTION = "fit the rigid-or-flexible threshold k from FFRF-vs-rigid sweeps"
 OVERRIDES = pinned_overrides() + ['coupler.geometry="plate"', 'coupler.model="ffrf"',
                                    "coupler.modes=6", "simulation.output_step_s=0.0"]
+# keys the study reads itself (its fit grid and criterion), beside its cases
+READS = ("coupler.length_m", "coupler.thickness_m", "coupler.width_m",
+         "coupler.youngs_modulus_Pa", "coupler.density_kg_per_m3",
+         "coupler.poisson_ratio", "coupler.damping_ratio", "coupler.mesh_size_m",
+         "coupler.modes", "drive.spring_stiffness_N_per_m", "drive.spring_preload_m",
+         "fidelity.tolerance")
 
 THESIS_SPRING_N_PER_M = 1500.0
 THESIS_PRELOAD_M = 0.022

@@ -26,6 +26,9 @@ from flex.study import Summary
 NAME = "modal"
 DESCRIPTION = "link eigenmodes: FE vs beam theory, Tables 5, 7, 9, mesh convergence"
 OVERRIDES: list[str] = []
+# keys the study reads itself (its modal analyses), beside what its cases simulate
+READS = ("coupler.length_m", "coupler.width_m", "coupler.youngs_modulus_Pa",
+         "coupler.density_kg_per_m3", "coupler.poisson_ratio", "crank.length_m")
 CONVERGENCE_TOLERANCE = 0.001  # relative, on the first pinned-pinned in-plane frequency
 CRANK_SECTION_M = (0.010, 0.010)  # flex's reading of the thesis's ANSYS section (Table 7)
 

@@ -25,6 +25,8 @@ from flex.study import Summary
 NAME = "spring"
 DESCRIPTION = "helical spring: rate, stress (Wahl, FE), surge and the rigid criterion"
 OVERRIDES: list[str] = []
+# keys the study reads itself (the spring design), beside what its cases simulate
+READS = ("drive.spring_preload_m", "drive.spring_stiffness_N_per_m", "slider.mass_kg")
 
 
 def cases(scene: Scene) -> dict[str, Scene]:

@@ -55,6 +55,8 @@ from flex.tradeoff import (
 NAME = "tradeoff"
 DESCRIPTION = "work-precision: every knob against a converged reference, rigid and FFRF 1/10 mm"
 OVERRIDES = pinned_overrides()
+# keys the study reads itself (the accuracy levels), beside its cases
+READS = ("fidelity.tolerance",)
 REPEATS = 3
 
 PLATE = ['coupler.geometry="plate"', 'coupler.model="ffrf"']

@@ -33,6 +33,10 @@ from flex.study import Summary
 NAME = "wing"
 DESCRIPTION = "wing deployment (sec. 6.4): fitted spring, loads, wing flexibility"
 OVERRIDES = ["wing.enabled=true", "simulation.end_time_s=0.025"]
+# keys the study reads itself (the wing's frequency and tip deflection, the spring fit)
+READS = ("wing.span_m", "wing.chord_m", "wing.thickness_m", "wing.density_kg_per_m3",
+         "wing.youngs_modulus_Pa", "drive.spring_preload_m",
+         "drive.spring_stiffness_N_per_m")
 THESIS_PEAK_RATE_DEG_PER_S = 7219.0  # sec. 6.4, fig. 60
 THESIS_PEAK_TIME_S = 0.008  # sec. 6.4, fig. 60 ("approx.")
 THESIS_DEPLOYMENT_TIME_S = 0.017  # sec. 6.4 ("approx.")
