@@ -218,7 +218,8 @@ def _write_output(output: StudyOutput, path: Path, scene: Scene) -> Path:
         target = failed_path(path)
     return write_results(target, output.name, list(output.results.values()), to_toml(scene),
                          output.summary.datasets,
-                         {"wall_time_s": output.wall_time_s, "failed_cases": len(failed)})
+                         {"wall_time_s": output.wall_time_s, "failed_cases": len(failed),
+                          "summary_report": output.summary.report})
 
 
 def _report(output: StudyOutput, path: Path, quiet: bool) -> None:
