@@ -27,18 +27,15 @@ statement explicit:
   ``rigid`` if the scene's n is at least the conservative k for ``[fidelity] tolerance``,
   otherwise ``ffrf`` with the number of fixed-interface modes from the same criterion
   (:func:`modes_for_cutoff`). The fitted laws are read from :data:`DEFAULT_CRITERION`
-  (``flex/criteria_fit.toml``, written by ``make kfit``), or from ``$FLEX_CRITERION``.
+  (``flex/criteria_fit.toml``, written by ``make kfit``), or passed as a :class:`Criterion`.
 """
 
 from __future__ import annotations
 
-import contextlib
 import functools
 import math
-import os
-import tempfile
 import tomllib
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -46,9 +43,14 @@ from typing import Any
 import numpy as np
 
 from .errors import FlexError, SceneError
+from .physics import (  # noqa: F401 - part of this module's face
+    TWO_PI,
+    clamped_plate_frequencies,
+    n_values,
+    pinned_pinned_omega,
+)
 from .settings import resolved_simulation
 
-TWO_PI = 2.0 * math.pi
 THESIS_K = 108.0  #: thesis sec. 6.2, in the thesis convention (n = delta_t * omega)
 THESIS_DELTA_T_S = 0.016128  #: thesis sec. 6.2, Table 5 note (source not stated)
 CRITERION_FORMAT = "flex-criterion/1"
@@ -85,30 +87,6 @@ MEASURES: dict[str, str] = {
 # ------------------------------------------------------------------------------------------
 # frequencies and n
 # ------------------------------------------------------------------------------------------
-def pinned_pinned_omega(length_m: float, height_m: float, youngs_modulus_Pa: float,
-                        density_kg_per_m3: float) -> float:
-    """First bending circular frequency [rad/s] of a pinned-pinned rectangular beam.
-
-    Euler-Bernoulli: ``omega = (pi / L)^2 sqrt(E I / (rho A))`` with ``I / A = h^2 / 12``
-    (``h`` the bending height, the plate thickness in the mechanism plane; the width
-    cancels). Thesis Table 5's "Frequency" column is this value. The finite-element value
-    of :class:`flex.reduction.Reduction` is within 2.4 % of it up to t = 10 mm (L/t = 8).
-    """
-    for name, value in (("length_m", length_m), ("height_m", height_m),
-                        ("youngs_modulus_Pa", youngs_modulus_Pa),
-                        ("density_kg_per_m3", density_kg_per_m3)):
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{name} = {value!r}: must be a finite number > 0")
-    return (math.pi / length_m) ** 2 * math.sqrt(youngs_modulus_Pa * height_m**2
-                                                 / (12.0 * density_kg_per_m3))
-
-
-def n_values(delta_t_s: float, omega_rad_per_s: float) -> dict[str, float]:
-    """``{"thesis": delta_t * omega, "physical": delta_t * omega / (2 pi)}`` (dimensionless)."""
-    n_thesis = float(delta_t_s) * float(omega_rad_per_s)
-    return {"thesis": n_thesis, "physical": n_thesis / TWO_PI}
-
-
 def convert_n(n: Any, source: str, target: str) -> Any:
     """Convert n (scalar or array) between the ``physical`` and ``thesis`` conventions."""
     for name in (source, target):
@@ -579,33 +557,13 @@ class Criterion:
         return header + tomli_w.dumps(data)
 
 
-@contextlib.contextmanager
-def criterion_in_force(text: str, variable: str = "FLEX_CRITERION") -> Iterator[Path]:
-    """Within the block, ``auto`` reads the criterion ``text`` (TOML): it is written to a
-    temporary file named by the environment ``variable`` (``FLEX_CRITERION`` or
-    ``FLEX_CRANK_CRITERION``), which is restored afterwards. Yields the file's path."""
-    with tempfile.TemporaryDirectory() as folder:
-        path = Path(folder) / "criterion.toml"
-        path.write_text(text, encoding="utf-8")
-        previous = os.environ.get(variable)
-        os.environ[variable] = str(path)
-        try:
-            yield path
-        finally:
-            if previous is None:
-                os.environ.pop(variable, None)
-            else:
-                os.environ[variable] = previous
-
-
 def criteria_in_force_text(scene: Mapping[str, Mapping[str, Any]]) -> str:
-    """The text of the criterion files ``scene``'s ``model = "auto"`` links would read now
-    (``""`` for none; a missing file as its path): part of a sweep case's identity."""
+    """The text of the installed criterion files ``scene``'s ``model = "auto"`` links read
+    when no law is passed (``""`` for none; a missing file as its path): part of a sweep
+    case's identity."""
     parts = []
-    for link, variable, default in (("coupler", "FLEX_CRITERION", DEFAULT_CRITERION),
-                                    ("crank", "FLEX_CRANK_CRITERION", DEFAULT_CRANK_CRITERION)):
+    for link, path in (("coupler", DEFAULT_CRITERION), ("crank", DEFAULT_CRANK_CRITERION)):
         if scene.get(link, {}).get("model") == "auto":
-            path = Path(os.environ.get(variable) or default)
             try:
                 parts.append(f"{link}:{path.read_text('utf-8')}")
             except OSError:
@@ -614,64 +572,40 @@ def criteria_in_force_text(scene: Mapping[str, Mapping[str, Any]]) -> str:
 
 
 def load_criterion(path: str | Path | None = None) -> Criterion:
-    """Read a criterion file: ``path``, else ``$FLEX_CRITERION``, else
-    :data:`DEFAULT_CRITERION`. Raises :class:`FlexError` naming the file if it is missing
-    or malformed."""
-    path = Path(path or os.environ.get("FLEX_CRITERION") or DEFAULT_CRITERION)
+    """Read a criterion file: ``path``, else :data:`DEFAULT_CRITERION`. Raises
+    :class:`FlexError` naming the file if it is missing or malformed."""
+    path = Path(path or DEFAULT_CRITERION)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-        if data["criterion"]["format"] != CRITERION_FORMAT:
-            raise FlexError(f"criterion file '{path}': format {data['criterion']['format']!r}"
-                            f", expected {CRITERION_FORMAT!r}")
-        laws = {(float(entry["damping_ratio"]), str(entry["measure"])): ErrorLaw.from_dict(entry)
-                for entry in data["laws"]}
+        text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise FlexError(f"criterion file '{path}' does not exist; run 'make kfit' and "
                         f"'make kfit-criterion' to create it") from None
+    return parse_criterion(text, str(path))
+
+
+def parse_criterion(text: str, source: str = "") -> Criterion:
+    """A criterion from its TOML text (what :meth:`Criterion.to_toml` writes); ``source``
+    names it in messages and decisions. Raises :class:`FlexError` if it is malformed."""
+    label = source or "(in memory)"
+    try:
+        data = tomllib.loads(text)
+        if data["criterion"]["format"] != CRITERION_FORMAT:
+            raise FlexError(f"criterion {label}: format {data['criterion']['format']!r}"
+                            f", expected {CRITERION_FORMAT!r}")
+        laws = {(float(entry["damping_ratio"]), str(entry["measure"])): ErrorLaw.from_dict(entry)
+                for entry in data["laws"]}
     except (KeyError, TypeError, ValueError, tomllib.TOMLDecodeError) as exc:
-        raise FlexError(f"criterion file '{path}' is malformed: {exc}") from None
+        raise FlexError(f"criterion file '{label}' is malformed: {exc}") from None
     meta = {k: v for k, v in data["criterion"].items()
             if k not in ("format", "delta_t_definition", "omega", "n_convention")}
-    return Criterion(laws, data["criterion"]["delta_t_definition"], str(path), meta)
+    return Criterion(laws, data["criterion"]["delta_t_definition"], source, meta)
 
 
 # ------------------------------------------------------------------------------------------
 # auto fidelity
 # ------------------------------------------------------------------------------------------
-_CLAMPED_BETA_L = (4.730040745, 7.853204624, 10.99560784, 14.13716549, 17.27875966)
 MAX_AUTO_MODES = 24
 MIN_AUTO_MODES = 2
-
-
-def _clamped_beta_l(index: int) -> float:
-    return _CLAMPED_BETA_L[index] if index < len(_CLAMPED_BETA_L) else (index + 1.5) * math.pi
-
-
-def clamped_plate_frequencies(length_m: float, thickness_m: float, width_m: float,
-                              youngs_modulus_Pa: float, density_kg_per_m3: float,
-                              poisson_ratio: float, count: int = 40) -> list[tuple[float, str]]:
-    """Beam-theory estimates of the fixed-interface (both ends clamped) modes of a plate.
-
-    Returns the ``count`` lowest ``(omega [rad/s], kind)`` with kind ``in_plane`` (bending
-    height t), ``out_of_plane`` (height w), ``torsion`` (St. Venant, J = b h^3 (1/3 - 0.21
-    h/b (1 - h^4/(12 b^4)))) or ``axial``: the order in which the Craig-Bampton
-    fixed-interface modes of :func:`flex.reduction.build_reduction` appear (estimates;
-    shear and warping shift them by some per cent).
-    """
-    e, rho, length = youngs_modulus_Pa, density_kg_per_m3, length_m
-    shear = e / (2 * (1 + poisson_ratio))
-    b, h = max(width_m, thickness_m), min(width_m, thickness_m)
-    torsion_j = b * h**3 * (1 / 3 - 0.21 * h / b * (1 - h**4 / (12 * b**4)))
-    polar = width_m * thickness_m * (width_m**2 + thickness_m**2) / 12
-    modes: list[tuple[float, str]] = []
-    for index in range(count):
-        beta = _clamped_beta_l(index) / length
-        modes.append((beta**2 * math.sqrt(e * thickness_m**2 / (12 * rho)), "in_plane"))
-        modes.append((beta**2 * math.sqrt(e * width_m**2 / (12 * rho)), "out_of_plane"))
-        modes.append(((index + 1) * math.pi / length * math.sqrt(shear * torsion_j
-                                                                 / (rho * polar)), "torsion"))
-        modes.append(((index + 1) * math.pi / length * math.sqrt(e / rho), "axial"))
-    return sorted(modes)[:count]
 
 
 def modes_for_cutoff(scene: Mapping[str, Mapping[str, Any]], omega_cut_rad_per_s: float,
@@ -736,7 +670,7 @@ def deployment_probe(scene: Mapping[str, Mapping[str, Any]],
     """
     import copy
 
-    from .solver import simulate
+    from .solver import integrate
 
     rigid = copy.deepcopy({k: dict(v) for k, v in scene.items()})
     rigid["coupler"]["model"] = "rigid"
@@ -753,7 +687,7 @@ def deployment_probe(scene: Mapping[str, Mapping[str, Any]],
     for _ in range(4):
         step = min(resolved_simulation(rigid)["step_s"], 1e-4, end / 200)
         rigid["simulation"].update(end_time_s=end, step_s=step, output_step_s=0.0)
-        result = simulate(rigid, "fidelity_probe")
+        result = integrate(rigid, "fidelity_probe")
         data = {k: np.asarray(v.data) for k, v in result.datasets.items()}
         if constant_speed:
             return math.pi / speed, "constant-speed drive: delta_t = half a crank turn", data
@@ -877,7 +811,7 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
     ``"ffrf"`` otherwise, with ``coupler.modes`` from :func:`modes_for_cutoff` at
     ``omega_cut = k / delta_t`` (thesis convention: every mode with n below k is kept).
     ``crank.model = "auto"`` is decided the same way, with the crank's own law
-    (``crank_criterion``, default ``$FLEX_CRANK_CRITERION`` or
+    (``crank_criterion``, default
     :data:`DEFAULT_CRANK_CRITERION`) and its first in-plane elastic frequency in the
     assembled mechanism (:func:`crank_elastic_omega`; a lumped crank is
     analysed as a plate of its mass, :func:`equivalent_crank_plate`): ``"rigid"``, or
@@ -932,8 +866,7 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
         if lumped:
             how += (f"; lumped crank as a plate of its mass: {plate['width_m'] * 1e3:g} mm wide, "
                     f"{plate['thickness_m'] * 1e3:.3g} mm high")
-        crank_criterion = crank_criterion or load_criterion(
-            os.environ.get("FLEX_CRANK_CRITERION") or DEFAULT_CRANK_CRITERION)
+        crank_criterion = crank_criterion or load_criterion(DEFAULT_CRANK_CRITERION)
         decision, k_phys = _decide(
             "crank", omega, delta_t_s, how, tolerance, crank_criterion,
             float(crank["damping_ratio"]),

@@ -85,7 +85,7 @@ def has_auto(scene: Scene) -> bool:
 
 
 def _bending_omega(plate: dict[str, Any]) -> float:
-    from .criteria import pinned_pinned_omega
+    from .physics import pinned_pinned_omega
 
     return pinned_pinned_omega(plate["length_m"], plate["thickness_m"],
                                plate["youngs_modulus_Pa"], plate["density_kg_per_m3"])

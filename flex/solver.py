@@ -505,41 +505,24 @@ def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any],
                           f"{settings['step_s']:g} s): {what}{advice}")
 
 
-def _resolve_auto(scene: Scene) -> tuple[Scene, list[Any]]:
-    """Resolve ``model = "auto"`` links (:func:`flex.criteria.resolve_fidelity`); print the
-    choice and its reason to stderr. Scenes without ``auto`` are returned as they are."""
-    if scene["coupler"]["model"] != "auto" and scene["crank"].get("model") != "auto":
-        return scene, []
-    import sys
+def integrate(scene: Scene, name: str = "case", reduction: Any = None,
+              crank_reduction: Any = None) -> CaseResult:
+    """Build, integrate and collect one case of a scene whose links have concrete models
+    (rigid, ffrf, nonlinear_fe); raises on divergence (see module doc).
 
-    from .criteria import resolve_fidelity
-
-    resolved, decisions = resolve_fidelity(scene)
-    for decision in decisions:
-        modes = f" ({decision.modes} modes)" if decision.modes else ""
-        print(f"flex: fidelity: {decision.link}.model = auto -> {decision.model}{modes}: "
-              f"{decision.reason}", file=sys.stderr)
-    return resolved, decisions
-
-
-def simulate(scene: Scene, name: str = "case", reduction: Any = None,
-             crank_reduction: Any = None) -> CaseResult:
-    """Build, integrate and collect one case; raises on divergence (see module doc).
-
-    ``reduction`` / ``crank_reduction``: the reductions of an ``ffrf`` coupler / crank
-    (None: :func:`reduction_for_scene`, cached on disk). ``model = "auto"`` links are first
-    resolved to concrete models (given reductions are then ignored: auto picks the modes);
-    the choice and its reason go to stderr and into the result's attributes
-    ``fidelity_<link>_*``. Then ``"auto"`` solver keys are filled by model
-    (:func:`flex.settings.resolve_solver_settings`; attributes ``solver_defaults_*``).
-    ``scene_toml`` holds the resolved scene.
+    ``model = "auto"`` links are resolved a layer above (:func:`flex.simulation.simulate`);
+    here they are refused. ``reduction`` / ``crank_reduction``: the reductions of an
+    ``ffrf`` coupler / crank (None: :func:`reduction_for_scene`, cached on disk).
+    ``"auto"`` solver keys are filled by model (:func:`flex.settings.
+    resolve_solver_settings`; attributes ``solver_defaults_*``). ``scene_toml`` holds the
+    resolved scene.
     """
-    check_runnable(scene)  # before anything is built: SceneError, a failed case
-    scene, fidelity = _resolve_auto(scene)
+    for link in ("crank", "coupler"):
+        if scene[link]["model"] == "auto":
+            raise FlexError(f'{link}.model = "auto" is resolved by flex.simulation.simulate, '
+                            f"not by flex.solver.integrate")
     scene, solver_choice = resolve_solver_settings(scene)
-    check_runnable(scene)  # the concrete models and steps
-    if fidelity:
-        reduction = crank_reduction = None
+    check_runnable(scene)  # the concrete models and steps, before anything is built
     if scene["coupler"]["model"] == "ffrf" and reduction is None:
         reduction = reduction_for_scene(scene)
     if scene["crank"]["model"] == "ffrf" and crank_reduction is None:
@@ -556,8 +539,6 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
 
     result = CaseResult(name, to_toml(scene), datasets, counters=counters,
                         solver_settings_toml=tomli_w.dumps(settings))
-    for decision in fidelity:
-        result.attrs.update(decision.attrs())
     if solver_choice is not None:
         result.attrs.update(solver_choice.attrs())
     warning = validity_warning(scene, datasets)
@@ -654,7 +635,7 @@ def time_scales(scene: Scene, reductions: dict[str, Any] | None = None
     """The scene's time scales a fixed step must resolve: ``(period [s], steps per period
     needed, what)``, shortest first. ``reductions``: the built reductions by link (their
     highest retained mode is then known, else estimated from the plate)."""
-    from .criteria import clamped_plate_frequencies, pinned_pinned_omega
+    from .physics import clamped_plate_frequencies, pinned_pinned_omega
     from .scene import plate_mass_properties
 
     reductions = reductions or {}
@@ -774,14 +755,5 @@ def divergence_advice(scene: Scene, reductions: dict[str, Any] | None = None) ->
     return "; ".join(parts)
 
 
-def simulate_case(scene: Scene, name: str = "case", reduction: Any = None,
-                  crank_reduction: Any = None) -> CaseResult:
-    """Like :func:`simulate`, but a failure becomes a ``failed`` case with its message."""
-    try:
-        return simulate(scene, name, reduction, crank_reduction)
-    except FlexError as exc:
-        return CaseResult(name, to_toml(scene), status="failed", message=str(exc))
-
-
-__all__ = ["simulate", "simulate_case", "solver_settings", "run", "collect", "_rotation_z",
+__all__ = ["integrate", "solver_settings", "run", "collect", "_rotation_z",
            "divergence_advice", "time_scales", "validity_warning", "VALIDITY_WARNING"]

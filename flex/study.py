@@ -26,6 +26,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
+from typing import Any
 
 from .errors import FlexError, SceneError
 from .outputs import (
@@ -38,7 +39,7 @@ from .outputs import (
 from .results import CaseResult, Dataset, write_results
 from .scene import Scene, load_scene, to_toml
 from .settings import check_runnable
-from .solver import simulate_case
+from .simulation import simulate_case
 from .usage import explicit_keys, unused_keys
 
 STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring", "kfit",
@@ -138,12 +139,15 @@ def check_cases(module: ModuleType, scenes: dict[str, Scene],
 
 def execute(module: ModuleType, scene: Scene,
             progress: Callable[[str, int, int], None] | None = None,
-            scenes: dict[str, Scene] | None = None) -> StudyOutput:
+            scenes: dict[str, Scene] | None = None, sweep: Any = None) -> StudyOutput:
     """Run every case of a study and summarize; nothing is written. ``scenes``: the cases
-    (default ``module.cases(scene)``)."""
+    (default ``module.cases(scene)``); ``sweep``: where and how a sweep study (``SWEEP =
+    True``) runs its cases (:class:`flex.sweep.SweepSettings`; None: its defaults)."""
     start = time.perf_counter()
     scenes = module.cases(scene) if scenes is None else scenes
-    if hasattr(module, "simulate_cases"):
+    if getattr(module, "SWEEP", False):
+        results = module.simulate_cases(scenes, progress, sweep)
+    elif hasattr(module, "simulate_cases"):
         results = module.simulate_cases(scenes, progress)
     else:
         results = {}
@@ -158,10 +162,11 @@ def execute(module: ModuleType, scene: Scene,
 
 
 def run_study(name: str, source: str | Path | None = None, overrides: list[str] | None = None,
-              out: str | Path | None = None, figures: bool = True, quiet: bool = False
-              ) -> StudyOutput:
+              out: str | Path | None = None, figures: bool = True, quiet: bool = False,
+              sweep: Any = None) -> StudyOutput:
     """Run study ``name``, write its HDF5 file (default ``results/<name>.h5``) and figures
     (``figures/<file stem>-*.png`` beside it), print its report, and return the output.
+    ``sweep``: where and how a sweep study runs (:class:`flex.sweep.SweepSettings`).
 
     Nothing is lost: the output is checked before any case runs (:func:`flex.outputs.
     check_output`); a run that does not end as the study declares (an unexpected failed
@@ -181,7 +186,8 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
         check_writable_folder(figures_folder(path), f"figures of '{path}'")
     written: list[Path] = []
     try:
-        output = execute(module, scene, None if quiet else progress_printer(), scenes)
+        output = execute(module, scene, None if quiet else progress_printer(), scenes,
+                         sweep)
         output.expected_failures = frozenset(getattr(module, "EXPECTED_FAILURES", ()))
         output.path = _write_output(output, path, scene)
         written.append(output.path)

@@ -22,11 +22,17 @@ sweep and returns the results. Contract:
 - **shared preparation**: ``prepare_key(scene)`` groups cases that need the same expensive
   preparation (e.g. a reduction per plate geometry, cached on disk); ``prepare(scene)`` runs
   once per group before its cases are submitted (a failed preparation fails its cases).
-- **progress**: a ``tqdm`` bar on stderr shows cases done, failed and remaining.
+- **progress**: on stderr: a ``tqdm`` bar (cases done, failed, remaining) when stderr is
+  a terminal; otherwise (a log, a pipe) plain lines without carriage returns, at most
+  one per :data:`PROGRESS_MIN_INTERVAL_S` as cases finish, at least one per
+  :data:`PROGRESS_MAX_SILENCE_S` while they run, and one at each phase change (start,
+  every preparation done, end).
 
-The environment selects the executor for sweeps started by studies (``python -m flex run
-kfit``): ``FLEX_SCHEDULER`` (as ``scheduler``), ``FLEX_WORKERS``, ``FLEX_SWEEP_DIR`` and
-``FLEX_RETRY_FAILED=1``; ``python -m flex.sweep STUDY --scheduler ...`` sets them.
+A sweep study gets its :class:`SweepSettings` as an argument. The command lines read them
+once, at the edge (:func:`settings_from_environment`): ``flex run kfit --scheduler ...
+--workers N`` and ``python -m flex.sweep STUDY --scheduler ... --folder DIR
+--retry-failed``, each over the environment's ``FLEX_SCHEDULER``, ``FLEX_WORKERS``,
+``FLEX_SWEEP_DIR``, ``FLEX_RETRY_FAILED=1`` and ``FLEX_PROGRESS=0``.
 """
 
 from __future__ import annotations
@@ -61,7 +67,7 @@ SWEEP_FORMAT = "flex-sweep-case/1"
 def simulate_scene_case(name: str, scene: Scene) -> CaseResult:
     """The default case: :func:`flex.solver.simulate_case` of the scene (never raises for a
     diverged run: that is a ``failed`` case)."""
-    from .solver import simulate_case
+    from .simulation import simulate_case
 
     return simulate_case(scene, name)
 
@@ -347,29 +353,78 @@ class _Job:
     started: float = 0.0
 
 
+#: plain progress lines (stderr not a terminal): at most one per this many seconds as cases
+#: finish, and at least one per PROGRESS_MAX_SILENCE_S while the sweep runs
+PROGRESS_MIN_INTERVAL_S = 5.0
+PROGRESS_MAX_SILENCE_S = 10.0
+
+
+def _is_terminal(stream: Any) -> bool:
+    try:
+        return bool(stream.isatty())
+    except (AttributeError, ValueError, OSError):  # no isatty, or a closed stream
+        return False
+
+
+def duration_text(seconds: float) -> str:
+    """``40 s``, ``4 min``, ``1.5 h``: a rounded duration for progress lines."""
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 90 * 60:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
 class _Progress:
+    """Cases done, failed and remaining on stderr: a ``tqdm`` bar on a terminal, plain lines
+    otherwise (see the module doc); nothing when not ``enabled``."""
+
     def __init__(self, total: int, resumed: int, description: str, enabled: bool) -> None:
         self.done = self.failed = 0
         self.total = total
         self.prepared = self.to_prepare = 0
         self.bar = None
-        if enabled:
+        self.description = description
+        self.stream = sys.stderr
+        self.plain = enabled and not _is_terminal(self.stream)
+        self.start = self.last_line = time.monotonic()
+        if enabled and not self.plain:
             from tqdm import tqdm
 
-            self.bar = tqdm(total=total, desc=description, unit="case", file=sys.stderr,
+            self.bar = tqdm(total=total, desc=description, unit="case", file=self.stream,
                             mininterval=0.5, dynamic_ncols=True, leave=True)
             if resumed:
                 self.bar.write(f"{description}: {resumed} cases resumed from their files, "
                                f"{total} to run")
+        elif self.plain:
+            self._line(f"{description}: {total} cases to run"
+                       + (f", {resumed} resumed from their files" if resumed else ""))
         self._update()
+
+    def _counts(self) -> str:
+        shared = (f" prepared={self.prepared}/{self.to_prepare}" if self.to_prepare else "")
+        return (f"done={self.done} failed={self.failed} "
+                f"remaining={self.total - self.done - self.failed}" + shared)
 
     def _update(self) -> None:
         if self.bar is not None:
-            shared = (f" prepared={self.prepared}/{self.to_prepare}" if self.to_prepare
-                      else "")
-            self.bar.set_postfix_str(f"done={self.done} failed={self.failed} "
-                                     f"remaining={self.total - self.done - self.failed}"
-                                     + shared, refresh=False)
+            self.bar.set_postfix_str(self._counts(), refresh=False)
+
+    def _line(self, text: str) -> None:
+        print(text, file=self.stream, flush=True)
+        self.last_line = time.monotonic()
+
+    def _status(self, final: bool = False) -> None:
+        """One plain line: cases finished of all, the counts, time elapsed and left."""
+        finished = self.done + self.failed
+        elapsed = time.monotonic() - self.start
+        text = (f"{self.description}: {finished}/{self.total} cases ({self._counts()}), "
+                f"{duration_text(elapsed)} elapsed")
+        if final:
+            text += ", finished"
+        elif finished:
+            text += f", ~{duration_text(elapsed / finished * (self.total - finished))} left"
+        self._line(text)
 
     def case(self, ok: bool) -> None:
         if ok:
@@ -379,6 +434,8 @@ class _Progress:
         if self.bar is not None:
             self._update()
             self.bar.update(1)
+        elif self.plain and time.monotonic() - self.last_line >= PROGRESS_MIN_INTERVAL_S:
+            self._status()
 
     def preparation(self, done: bool = False) -> None:
         if done:
@@ -388,14 +445,25 @@ class _Progress:
         if self.bar is not None:
             self._update()
             self.bar.refresh()
+        elif self.plain and done and self.prepared == self.to_prepare:
+            self._status()  # a phase change: every shared preparation is done
+
+    def tick(self) -> None:
+        """Called while waiting: a plain line if none was printed for a while."""
+        if self.plain and time.monotonic() - self.last_line >= PROGRESS_MAX_SILENCE_S:
+            self._status()
 
     def note(self, text: str) -> None:
         if self.bar is not None:
             self.bar.write(text)
+        elif self.plain:
+            self._line(text)
 
     def close(self) -> None:
         if self.bar is not None:
             self.bar.close()
+        elif self.plain:
+            self._status(final=True)
 
 
 def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
@@ -489,6 +557,7 @@ def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
             # who was running before this wait: if the pool breaks now, they are the suspects
             running = {id(job) for future, job in pending.items() if _is_running(future)}
             done = executor.wait_first(list(pending), timeout=0.5)
+            bar.tick()
             broken: list[_Job] = []
             for future in done:
                 job = pending.pop(future)
@@ -606,17 +675,17 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-figures", action="store_true")
     parser.add_argument("--quiet", action="store_true")
     args = parser.parse_args(argv)
-    for variable, value in (("FLEX_SCHEDULER", args.scheduler),
-                            ("FLEX_WORKERS", args.workers and str(args.workers)),
-                            ("FLEX_SWEEP_DIR", args.folder),
-                            ("FLEX_RETRY_FAILED", "1" if args.retry_failed else None)):
-        if value:
-            os.environ[variable] = value
     from .study import run_study
 
     try:
+        base = settings_from_environment()  # the environment, read once at this edge
+        sweep = SweepSettings(scheduler=args.scheduler or base.scheduler,
+                              workers=args.workers or base.workers,
+                              folder=Path(args.folder) if args.folder else base.folder,
+                              retry_failed=args.retry_failed or base.retry_failed,
+                              progress=base.progress)
         output = run_study(args.study, args.scene, args.overrides, args.out,
-                           figures=not args.no_figures, quiet=args.quiet)
+                           figures=not args.no_figures, quiet=args.quiet, sweep=sweep)
     except FlexError as exc:
         print(f"flex: error: {exc}", file=sys.stderr)
         return 2

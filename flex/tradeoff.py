@@ -366,7 +366,7 @@ def run_once(scene: Scene, setting: Setting, pool: ReductionPool | None = None
                     "newton_iterations": 0, "jacobian_updates": 0,
                     "function_evaluations": solution.function_evaluations}
     else:
-        from .solver import simulate
+        from .simulation import simulate
 
         reduction = (pool or ReductionPool()).for_scene(scene, setting.element_order)
         result = simulate(scene, setting.label, reduction)

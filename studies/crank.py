@@ -37,7 +37,7 @@ from flex.plotting import figure
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides
 from flex.settings import pinned_overrides
-from flex.solver import simulate_case
+from flex.simulation import simulate_case
 from flex.study import RESULTS_DIR, Summary
 
 NAME = "crank"
@@ -157,24 +157,24 @@ CRITERION_PATH = RESULTS_DIR / "crank-criterion.toml"
 def simulate_cases(scenes: dict[str, Scene],
                    progress: Callable[[str, int, int], None] | None) -> dict[str, CaseResult]:
     """Phase 1: fit cases; fit the law, write :data:`CRITERION_PATH`; phase 2: validation
-    cases, ``auto`` reading the law just fitted (``FLEX_CRANK_CRITERION``)."""
+    cases, ``auto`` reading the law just fitted (passed as an argument)."""
     results: dict[str, CaseResult] = {}
     names = list(scenes)
     fit_names = [n for n in names if n.startswith("fit_")]
 
-    def run(batch: list[str]) -> None:
+    def run(batch: list[str], law: criteria.Criterion | None = None) -> None:
         for name in batch:
             if progress:
                 progress(name, len(results), len(names))
-            results[name] = simulate_case(scenes[name], name)
+            results[name] = simulate_case(scenes[name], name, crank_criterion=law)
 
     run(fit_names)
     table = fit_table(scenes, results)
     text = criterion_toml(fit_law(table), len(table))
     CRITERION_PATH.parent.mkdir(parents=True, exist_ok=True)
     CRITERION_PATH.write_text(text, encoding="utf-8")
-    with criteria.criterion_in_force(text, "FLEX_CRANK_CRITERION"):
-        run([n for n in names if not n.startswith("fit_")])
+    law = criteria.parse_criterion(text, "crank (this run's fit)")
+    run([n for n in names if not n.startswith("fit_")], law)
     if progress:
         progress("done", len(results), len(names))
     return results

@@ -33,7 +33,8 @@ from flex.plotting import figure
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, validate
 from flex.settings import pinned_overrides
-from flex.solver import reduction_for_scene, simulate_case
+from flex.simulation import simulate_case
+from flex.solver import reduction_for_scene
 from flex.study import Summary
 
 NAME = "flexible"

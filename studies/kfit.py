@@ -28,7 +28,7 @@ T/h = 48 0.5 %; T/h = 28 keeps the 1 mm peak within 0.3 %). Mesh: maxh = 3 t, wi
 Every case's file is ``<sweep folder>/cases/<case>.h5`` (default ``results/kfit-cases``);
 the sweep resumes from them. The fit (``results/kfit-criterion.toml``) is what
 ``make kfit-criterion`` copies to ``flex/criteria_fit.toml`` for ``auto``. Executor:
-``FLEX_SCHEDULER`` / ``python -m flex.sweep kfit --scheduler ...`` (see :mod:`flex.sweep`).
+``flex run kfit --scheduler ...`` / ``python -m flex.sweep kfit ...`` (see :mod:`flex.sweep`).
 """
 
 from __future__ import annotations
@@ -274,7 +274,7 @@ def _data(result: CaseResult) -> dict[str, np.ndarray]:
 
 def _run_pair(scene: Scene, reduction: Any) -> tuple[dict, dict, dict[str, float], dict]:
     """Rigid twin (long enough to stop), then the FFRF run to just past delta_t_stop."""
-    from flex.solver import simulate
+    from flex.simulation import simulate
 
     rigid_scene = _with(scene, coupler__model="rigid")
     for _ in range(3):
@@ -382,16 +382,16 @@ def kfit_case(name: str, scene: Scene) -> CaseResult:
 def validation_case(name: str, scene: Scene, criterion_toml: str = "") -> CaseResult:
     """``auto`` against the full FFRF model (12 modes) on a scene outside the fit.
 
-    The ``auto`` run goes through :func:`flex.solver.simulate` with ``FLEX_CRITERION``
-    pointing at ``criterion_toml`` (the law just fitted). Stores the decision, the error
-    measures of the auto run against the full FFRF run and both wall times.
+    The ``auto`` run goes through :func:`flex.simulation.simulate` with the law just fitted
+    (``criterion_toml``, passed as an argument). Stores the decision, the error measures of
+    the auto run against the full FFRF run and both wall times.
     """
-    from flex.solver import simulate
+    from flex.simulation import simulate
 
-    with criteria.criterion_in_force(criterion_toml):
-        start = time.perf_counter()
-        auto = simulate(scene, "auto")
-        auto_total = time.perf_counter() - start
+    law = criteria.parse_criterion(criterion_toml, "kfit (this run's fit)")
+    start = time.perf_counter()
+    auto = simulate(scene, "auto", criterion=law)
+    auto_total = time.perf_counter() - start
     reference = full_scene(scene)
     start = time.perf_counter()
     full_reduction = reduction_of(reference)
@@ -425,24 +425,26 @@ def validation_case(name: str, scene: Scene, criterion_toml: str = "") -> CaseRe
 # ------------------------------------------------------------------------------------------
 # the sweep (study hook)
 # ------------------------------------------------------------------------------------------
-def sweep_folder() -> Path:
-    """``$FLEX_SWEEP_DIR`` or ``results/kfit-cases``."""
-    from flex.sweep import settings_from_environment
-
-    return settings_from_environment().folder or RESULTS_DIR / "kfit-cases"
+def sweep_folder(settings: Any = None) -> Path:
+    """The sweep's folder of per-case files: ``settings.folder`` (a
+    :class:`flex.sweep.SweepSettings`) or ``results/kfit-cases``."""
+    return (settings.folder if settings is not None else None) or RESULTS_DIR / "kfit-cases"
 
 
 LAST_SWEEP: dict[str, Any] = {}
 
 
 def simulate_cases(scenes: dict[str, Scene],
-                   progress: Callable[[str, int, int], None] | None) -> dict[str, CaseResult]:
+                   progress: Callable[[str, int, int], None] | None,
+                   sweep: Any = None) -> dict[str, CaseResult]:
     """Phase 1: the fit cases (one reduction per geometry, then its cases); fit; write
-    ``<folder>/../kfit-criterion.toml``; phase 2: the ``val_*`` cases with that fit."""
-    from flex.sweep import make_executor, run_sweep, settings_from_environment
+    ``<folder>/../kfit-criterion.toml``; phase 2: the ``val_*`` cases with that fit.
+    ``sweep``: where and how the cases run (:class:`flex.sweep.SweepSettings`, from the
+    command line; None: a process pool on all cores, ``results/kfit-cases``)."""
+    from flex.sweep import SweepSettings, make_executor, run_sweep
 
-    settings = settings_from_environment()
-    folder = sweep_folder()
+    settings = sweep or SweepSettings()
+    folder = sweep_folder(settings)
     fit_scenes = {n: s for n, s in scenes.items() if not n.startswith("val_")}
     val_scenes = {n: s for n, s in scenes.items() if n.startswith("val_")}
     executor = make_executor(settings.scheduler, settings.workers)
@@ -455,11 +457,14 @@ def simulate_cases(scenes: dict[str, Scene],
         LAST_SWEEP.update(executor=executor.description, workers=executor.workers,
                           fit_wall_time_s=first.wall_time_s, ran=first.ran,
                           resumed=first.resumed, failed=first.failed)
+        _phase(settings, f"kfit: fitting the error laws to {len(results)} fit cases")
         analysis = analyse(results)
         criterion_text = criterion_toml(analysis, provenance=False)
         path = criterion_path(folder)
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_text(criterion_toml(analysis), encoding="utf-8")
+        _phase(settings, f"kfit: wrote {path}" + (f"; next: {len(val_scenes)} validation "
+                                                  f"cases" if val_scenes else ""))
         if val_scenes:
             second = run_sweep(val_scenes, folder,
                                functools.partial(validation_case, criterion_toml=criterion_text),
@@ -473,7 +478,14 @@ def simulate_cases(scenes: dict[str, Scene],
                               failed=LAST_SWEEP["failed"] + second.failed)
     finally:
         executor.close()
+    _phase(settings, "kfit: cases done; next: the summary and the figures")
     return results
+
+
+def _phase(settings: Any, text: str) -> None:
+    """A phase-change line on stderr (progress only; ``FLEX_PROGRESS=0`` hides it)."""
+    if settings.progress:
+        print(text, file=sys.stderr, flush=True)
 
 
 def criterion_path(folder: Path) -> Path:

@@ -39,7 +39,7 @@ from flex.plotting import figure
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
 from flex.settings import pinned_overrides
-from flex.solver import simulate_case
+from flex.simulation import simulate_case
 from flex.study import Summary
 from flex.tradeoff import (
     Observables,

@@ -27,7 +27,7 @@ from flex.plotting import figure
 from flex.reference import solve_reference
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, validate
-from flex.solver import simulate_case
+from flex.simulation import simulate_case
 from flex.study import Summary
 
 NAME = "wing"

@@ -6,7 +6,7 @@ import pytest
 from flex.criteria import crank_elastic_omega, pinned_pinned_omega, resolve_fidelity
 from flex.errors import SceneError
 from flex.scene import load_scene
-from flex.solver import simulate
+from flex.simulation import simulate
 
 PLATE = ['crank.geometry="plate"', "simulation.step_s=2e-5", "simulation.end_time_s=0.01"]
 

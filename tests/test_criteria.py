@@ -317,7 +317,7 @@ def test_auto_needs_a_plate_and_a_tolerance_in_range():
 
 
 def test_simulate_resolves_auto_prints_and_stores_the_choice(tmp_path, monkeypatch, capsys):
-    from flex.solver import simulate
+    from flex.simulation import simulate
 
     path = tmp_path / "criterion.toml"
     path.write_text(_synthetic_criterion().to_toml())

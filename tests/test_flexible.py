@@ -42,7 +42,7 @@ from flex.compare import compare_files
 from flex.results import CaseResult, Dataset, write_results
 from flex.scene import load_scene, to_toml
 from flex.settings import pinned_overrides
-from flex.solver import simulate
+from flex.simulation import simulate
 
 FOLDER = Path(__file__).resolve().parent / "reference_curves"
 REFERENCE = FOLDER / "ffrf_t1mm_midpoint_deflection.h5"

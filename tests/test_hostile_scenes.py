@@ -26,13 +26,8 @@ from flex.errors import SceneError, SimulationError
 from flex.results import CaseResult, Dataset, write_results
 from flex.scene import SCHEMA, estimate_mesh, load_scene
 from flex.settings import check_runnable
-from flex.solver import (
-    VALIDITY_WARNING,
-    _check_finite,
-    divergence_advice,
-    simulate_case,
-    validity_warning,
-)
+from flex.simulation import simulate_case
+from flex.solver import VALIDITY_WARNING, _check_finite, divergence_advice, validity_warning
 from flex.usage import explicit_keys, unused_keys
 
 PLATE = ["--set", 'coupler.geometry="plate"', "--set", 'coupler.model="ffrf"']

@@ -5,7 +5,7 @@ import pytest
 
 from flex.kinematics import slider_crank
 from flex.scene import load_scene
-from flex.solver import simulate
+from flex.simulation import simulate
 
 
 def test_closed_form_is_self_consistent():

@@ -24,7 +24,7 @@ from flex.cli import main
 from flex.compare import compare_files
 from flex.results import write_results
 from flex.scene import load_scene, to_toml
-from flex.solver import simulate
+from flex.simulation import simulate
 
 FOLDER = Path(__file__).resolve().parent / "reference_curves"
 REFERENCE = FOLDER / "deployment_preload_22mm.h5"

@@ -413,7 +413,7 @@ def test_ctrl_c_inside_the_solver_is_an_interrupt_not_a_failed_case():
     import threading
 
     from flex.scene import load_scene
-    from flex.solver import simulate_case
+    from flex.simulation import simulate_case
 
     scene = load_scene(overrides=['drive.kind="constant_speed"', "simulation.end_time_s=20.0",
                                   "simulation.step_s=1e-4", "simulation.output_step_s=1e-2"])

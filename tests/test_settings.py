@@ -13,7 +13,8 @@ from flex.settings import (
     resolved_simulation,
     solver_defaults,
 )
-from flex.solver import simulate, solver_settings
+from flex.simulation import simulate
+from flex.solver import solver_settings
 
 PLATE = ['coupler.geometry="plate"', 'coupler.model="ffrf"']
 

@@ -21,7 +21,8 @@ from flex.errors import SimulationError
 from flex.reference import SliderCrankDAE, solve_reference
 from flex.results import Dataset, write_results
 from flex.scene import load_scene
-from flex.solver import _check_finite, simulate, simulate_case
+from flex.simulation import simulate, simulate_case
+from flex.solver import _check_finite
 
 SHORT = ["simulation.end_time_s=0.01"]
 #: largest energy range over E0 (the spring's energy at the start) of the long FFRF run, per

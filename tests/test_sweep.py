@@ -183,9 +183,10 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch):
     monkeypatch.setattr(kfit, "DAMPING_RATIOS", (0.0,))
     monkeypatch.setattr(kfit, "VALIDATION", {"val_t7mm_tol1pct": (
         ["coupler.thickness_m=0.007"], 0.01)})
-    monkeypatch.setenv("FLEX_SWEEP_DIR", str(tmp_path / "cases"))
-    monkeypatch.setenv("FLEX_PROGRESS", "0")
-    output = run_study("kfit", out=tmp_path / "kfit.h5", figures=True, quiet=True)
+    from flex.sweep import SweepSettings
+
+    sweep = SweepSettings(folder=tmp_path / "cases", progress=False)
+    output = run_study("kfit", out=tmp_path / "kfit.h5", figures=True, quiet=True, sweep=sweep)
     assert all(c.status == "ok" for c in output.results.values())
     law = kfit.analyse(output.results)["fits"][(0.0, "stop", "deflection")]
     assert 1.5 < law.exponent < 3.0  # quasi-static expectation: 2
@@ -197,13 +198,13 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch):
         assert "summary/k/zeta_0/stop/governing/central_thesis" in h5
         assert h5["summary/table/measures/deflection"].attrs["units"] == "1"
     assert {p.name for p in output.figures} == {"kfit-error-vs-n.png",
-                                                 "kfit-k-vs-tolerance.png"}
+                                                 "kfit-k-vs-tolerance.png"}  # named after kfit.h5
 
 
 def test_case_hash_follows_the_solver_defaults_of_auto_scenes(monkeypatch):
     # a resumed sweep must not reuse cases run with another flex/solver_defaults.toml
     import flex.settings as settings
-    from flex.solver import simulate_case
+    from flex.simulation import simulate_case
     from flex.sweep import case_hash
 
     auto = load_scene()
@@ -215,15 +216,24 @@ def test_case_hash_follows_the_solver_defaults_of_auto_scenes(monkeypatch):
     assert case_hash(pinned, simulate_case) == before[1]  # nothing of it is "auto"
 
 
-def test_case_hash_follows_the_criterion_file_of_auto_links(tmp_path, monkeypatch):
-    from flex.solver import simulate_case
+def test_case_hash_follows_the_criterion_of_auto_links(tmp_path, monkeypatch):
+    import functools
+
+    import flex.criteria as criteria
+    from flex.simulation import simulate_case
     from flex.sweep import case_hash
 
     auto = load_scene(None, ['coupler.geometry="plate"', 'coupler.model="auto"'])
     rigid = load_scene(None, ['coupler.geometry="plate"'])
     before = case_hash(auto, simulate_case), case_hash(rigid, simulate_case)
+    # a re-fit installed as the default criterion file
     refit = tmp_path / "criterion.toml"
     refit.write_text("# another fit\n")
-    monkeypatch.setenv("FLEX_CRITERION", str(refit))
+    monkeypatch.setattr(criteria, "DEFAULT_CRITERION", refit)
     assert case_hash(auto, simulate_case) != before[0]
     assert case_hash(rigid, simulate_case) == before[1]
+    # a law passed as an argument is part of the case function's identity
+    law = criteria.load_criterion(criteria.Path(__file__).parent.parent / "flex"
+                                  / "criteria_fit.toml")
+    with_law = functools.partial(simulate_case, criterion=law)
+    assert case_hash(auto, with_law) != case_hash(auto, simulate_case)

@@ -10,7 +10,8 @@ import pytest
 from flex.errors import SceneError
 from flex.scene import load_scene
 from flex.settings import pinned_overrides, resolved_simulation
-from flex.solver import simulate, solver_settings
+from flex.simulation import simulate
+from flex.solver import solver_settings
 from flex.tradeoff import (
     Measurement,
     Observables,

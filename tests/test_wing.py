@@ -5,7 +5,7 @@ import pytest
 
 from flex.reference import crank_mass_properties, solve_reference
 from flex.scene import load_scene
-from flex.solver import simulate
+from flex.simulation import simulate
 from studies import wing
 
 
