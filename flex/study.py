@@ -6,11 +6,12 @@ A study is a module in ``studies/`` that declares what it runs and what it store
     DESCRIPTION = "one line"
     OVERRIDES = ["drive.kind=\"constant_speed\"", ...]   # applied to the base scene
     def cases(scene) -> dict[str, Scene]                   # the scenes it simulates
-    def summarize(scene, results) -> Summary               # tables, report text
+    def summarize(scene, results, notes) -> Summary        # tables, report text
     def figures(results, summary, folder) -> list[Path]    # PNGs (optional)
 
-Optionally ``def simulate_cases(scenes, progress) -> dict[str, CaseResult]`` replaces the
-default one-case-at-a-time simulation (the flexible study shares reductions that way), and
+Optionally ``def simulate_cases(scenes, run: StudyRun) -> dict[str, CaseResult]`` replaces
+the default one-case-at-a-time simulation (the flexible study shares reductions that way;
+what it measures beside its cases goes to ``run.notes``, which ``summarize`` gets), and
 ``EXPECTED_FAILURES`` names cases built to fail (the stability study's forced divergences):
 a run succeeds (:attr:`StudyOutput.as_expected`, exit status 0) when exactly those failed.
 :func:`execute` runs a study and returns its :class:`StudyOutput`; :func:`run_study` also
@@ -53,6 +54,21 @@ class Summary:
 
     datasets: dict[str, Dataset] = field(default_factory=dict)
     report: str = ""
+    #: what the study's figures draw beyond the stored datasets (not written to the file)
+    figure_data: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class StudyRun:
+    """What a study's ``simulate_cases`` gets beside its scenes, and hands on to
+    ``summarize``: the progress callback, the sweep settings (sweep studies:
+    :class:`flex.sweep.SweepSettings`, None for their defaults), and ``notes``: what the
+    run measured beside its cases (references, verdicts, executor figures), read by
+    ``summarize(scene, results, notes)``. One per run: nothing is kept in a study module."""
+
+    progress: Callable[[str, int, int], None] | None = None
+    sweep: Any = None
+    notes: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass
@@ -145,10 +161,9 @@ def execute(module: ModuleType, scene: Scene,
     True``) runs its cases (:class:`flex.sweep.SweepSettings`; None: its defaults)."""
     start = time.perf_counter()
     scenes = module.cases(scene) if scenes is None else scenes
-    if getattr(module, "SWEEP", False):
-        results = module.simulate_cases(scenes, progress, sweep)
-    elif hasattr(module, "simulate_cases"):
-        results = module.simulate_cases(scenes, progress)
+    run = StudyRun(progress, sweep)
+    if hasattr(module, "simulate_cases"):
+        results = module.simulate_cases(scenes, run)
     else:
         results = {}
         for index, (name, case_scene) in enumerate(scenes.items()):
@@ -157,7 +172,7 @@ def execute(module: ModuleType, scene: Scene,
             results[name] = simulate_case(case_scene, name)
         if progress:
             progress("done", len(scenes), len(scenes))
-    summary = module.summarize(scene, results)
+    summary = module.summarize(scene, results, run.notes)
     return StudyOutput(module.NAME, scene, results, summary, time.perf_counter() - start)
 
 

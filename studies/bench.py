@@ -42,7 +42,7 @@ from flex.errors import FlexError
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
 from flex.settings import AUTO_OVERRIDES, pinned_overrides
-from flex.study import Summary
+from flex.study import StudyRun, Summary
 from flex.tradeoff import (
     Measurement,
     ReductionPool,
@@ -169,11 +169,8 @@ def _case(name: str, scene: Scene, m: Measurement, extra: dict[str, Any] | None 
                                 "repeats": len(m.wall_times_s)}, attrs=attrs)
 
 
-_RESULTS: dict[str, Any] = {}
-
-
-def _rigid(scene: Scene, pool: ReductionPool, say: Callable[[str], None]
-           ) -> dict[str, CaseResult]:
+def _rigid(scene: Scene, pool: ReductionPool, say: Callable[[str], None],
+           notes: dict[str, Any]) -> dict[str, CaseResult]:
     reference = converged_reference(
         scene, "rigid", Setting("scipy DOP853 rtol=1e-13", engine="scipy", rtol=1e-13,
                                 atol=1e-15),
@@ -208,10 +205,10 @@ def _rigid(scene: Scene, pool: ReductionPool, say: Callable[[str], None]
         raise FlexError("no scipy tolerance reached 1e-7 rad")
     scipy_run = measure(scene, scipy_pick, reference, REPEATS)
     say(f"rigid: scipy reaches 1e-7 rad at {scipy_pick.label}")
-    _RESULTS["rigid"] = {"reference": reference, "tuned": tuned, "untuned": untuned,
-                         "scipy": scipy_run,
-                         "profile_untuned": profile(scene_for(scene, untuned.setting), pool),
-                         "profile_tuned": profile(scene_for(scene, tuned.setting), pool)}
+    notes["rigid"] = {"reference": reference, "tuned": tuned, "untuned": untuned,
+                      "scipy": scipy_run,
+                      "profile_untuned": profile(scene_for(scene, untuned.setting), pool),
+                      "profile_tuned": profile(scene_for(scene, tuned.setting), pool)}
     return {"rigid_tuned": _case("rigid_tuned", scene, tuned),
             "rigid_untuned": _case("rigid_untuned", scene, untuned),
             "rigid_scipy": _case("rigid_scipy", scene, scipy_run)}
@@ -239,8 +236,8 @@ def _nonlinear_available() -> bool:
     return True
 
 
-def _ffrf(scene: Scene, pool: ReductionPool, say: Callable[[str], None]
-          ) -> dict[str, CaseResult]:
+def _ffrf(scene: Scene, pool: ReductionPool, say: Callable[[str], None],
+          notes: dict[str, Any]) -> dict[str, CaseResult]:
     reference = _ffrf_reference(scene, pool)
     say(f"ffrf_1mm reference: accuracy {reference.accuracy:.1e}, peak "
         f"{reference.peak_deflection_m * 1e6:.2f} um")
@@ -268,7 +265,7 @@ def _ffrf(scene: Scene, pool: ReductionPool, say: Callable[[str], None]
                                "default": default,
                                "probes": probes,
                                "profile_untuned": profile(scene_for(scene, FFRF_UNTUNED), pool),
-                               "profile_tuned": profile(scene_for(scene, tuned.setting), pool)}
+                            "profile_tuned": profile(scene_for(scene, tuned.setting), pool)}
     if _nonlinear_available() and os.environ.get("FLEX_BENCH_NONLINEAR", "1") != "0":
         # the nonlinear FE coupler is another model (it keeps the axial force's effect on
         # bending): its accuracy is judged against its own run at half the step, and its
@@ -288,11 +285,11 @@ def _ffrf(scene: Scene, pool: ReductionPool, say: Callable[[str], None]
             out["nonlinear_fe"] = _case("nonlinear_fe", scene, coarse, {
                 "fine_wall_time_s": own.wall_time_s,
                 "note": "errors against the nonlinear FE run at h = 1e-4 s"})
-    _RESULTS["ffrf_1mm"] = results
+    notes["ffrf_1mm"] = results
     return out
 
 
-def _reduction(scene: Scene, say: Callable[[str], None]) -> None:
+def _reduction(scene: Scene, say: Callable[[str], None], notes: dict[str, Any]) -> None:
     from flex.reduction import build_reduction
 
     c = scene["coupler"]
@@ -312,7 +309,7 @@ def _reduction(scene: Scene, say: Callable[[str], None]) -> None:
             start = time.perf_counter()
             reduction.ffrf_interface()  # what the first mechanism build of a loaded one costs
             interface.append(time.perf_counter() - start)
-    _RESULTS["reduction"] = {"cold_s": statistics.median(cold),
+    notes["reduction"] = {"cold_s": statistics.median(cold),
                              "cached_s": statistics.median(cached),
                              "ffrf_interface_s": statistics.median(interface),
                              "cold_runs": cold, "cached_runs": cached}
@@ -320,9 +317,9 @@ def _reduction(scene: Scene, say: Callable[[str], None]) -> None:
         f"{statistics.median(cached):.3f} s")
 
 
-def _make_all(say: Callable[[str], None]) -> None:
+def _make_all(say: Callable[[str], None], notes: dict[str, Any]) -> None:
     if os.environ.get("FLEX_BENCH_MAKE", "1") == "0":
-        _RESULTS["make_all"] = {"skipped": "FLEX_BENCH_MAKE=0"}
+        notes["make_all"] = {"skipped": "FLEX_BENCH_MAKE=0"}
         return
     root = Path(__file__).resolve().parent.parent
     subprocess.run(["make", "-s", "setup"], cwd=root, capture_output=True, check=False)
@@ -338,19 +335,19 @@ def _make_all(say: Callable[[str], None]) -> None:
             out[f"{label}_returncode"] = done.returncode
             if done.returncode:
                 out[f"{label}_error"] = (done.stderr or done.stdout)[-400:]
-    _RESULTS["make_all"] = out
+    notes["make_all"] = out
 
 
-def simulate_cases(scenes: dict[str, Scene],
-                   progress: Callable[[str, int, int], None] | None) -> dict[str, CaseResult]:
+def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Run the four parts in order; each part's failure is stored, the others still run."""
+    progress = run.progress
     pool = ReductionPool()
-    _RESULTS.clear()
+    notes = run.notes  # each part's measurements, read by summarize
     results: dict[str, CaseResult] = {}
-    parts = [("rigid", lambda say: _rigid(scenes["rigid"], pool, say)),
-             ("ffrf_1mm", lambda say: _ffrf(scenes["ffrf_1mm"], pool, say)),
-             ("reduction", lambda say: _reduction(scenes["ffrf_1mm"], say)),
-             ("make_all", _make_all)]
+    parts = [("rigid", lambda say: _rigid(scenes["rigid"], pool, say, notes)),
+             ("ffrf_1mm", lambda say: _ffrf(scenes["ffrf_1mm"], pool, say, notes)),
+             ("reduction", lambda say: _reduction(scenes["ffrf_1mm"], say, notes)),
+             ("make_all", lambda say: _make_all(say, notes))]
     for index, (name, part) in enumerate(parts):
         if progress:
             progress(name, index, len(parts))
@@ -362,7 +359,7 @@ def simulate_cases(scenes: dict[str, Scene],
         try:
             results.update(part(say) or {})
         except FlexError as exc:
-            _RESULTS[f"{name}_failed"] = str(exc)
+            notes[f"{name}_failed"] = str(exc)
             results[f"{name}_failed"] = CaseResult(f"{name}_failed", "", status="failed",
                                                    message=str(exc))
     if progress:
@@ -373,14 +370,16 @@ def simulate_cases(scenes: dict[str, Scene],
 # ------------------------------------------------------------------------------------------
 # summary
 # ------------------------------------------------------------------------------------------
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
+    notes = notes or {}
     datasets: dict[str, Dataset] = {}
     rows: list[tuple[str, str, str]] = []
 
     def put(key: str, value: Any, units: str, text: str) -> None:
         datasets[key] = Dataset(value, units, text)
 
-    rigid = _RESULTS.get("rigid")
+    rigid = notes.get("rigid")
     if rigid:
         tuned, untuned, scipy = rigid["tuned"], rigid["untuned"], rigid["scipy"]
         ratio = tuned.wall_time_s / scipy.wall_time_s
@@ -411,7 +410,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
             ("rigid: flex / scipy", f"{ratio:.1f}",
              f"integration; end to end {ratio_total:.1f}"),
         ]
-    ffrf = _RESULTS.get("ffrf_1mm")
+    ffrf = notes.get("ffrf_1mm")
     if ffrf:
         tuned, untuned = ffrf["tuned"], ffrf["untuned"]
         put("ffrf_1mm/reference_accuracy", ffrf["reference"].accuracy, "1",
@@ -475,7 +474,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
             why = ffrf.get("nonlinear_failed", "not run (not installed or FLEX_BENCH_NONLINEAR=0)")
             rows.append(("FFRF 1 mm: nonlinear FE", "-", why[:150]))
     for part in ("rigid", "ffrf_1mm"):
-        data = _RESULTS.get(part)
+        data = notes.get(part)
         if not data:
             continue
         for which in ("profile_untuned", "profile_tuned"):
@@ -492,7 +491,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
                          + f"; {prof['newton_iterations'] / max(prof['steps'], 1):.1f} Newton "
                          f"iterations and {prof['jacobian_updates'] / max(prof['steps'], 1):.2f}"
                          f" Jacobians per step"))
-    reduction = _RESULTS.get("reduction")
+    reduction = notes.get("reduction")
     if reduction:
         put("reduction/cold", reduction["cold_s"], "s", "build, empty cache (median of 2)")
         put("reduction/cached", reduction["cached_s"], "s", "load from cache (median of 6)")
@@ -501,7 +500,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
         rows += [("reduction 1 mm plate: cold", f"{reduction['cold_s']:.2f} s", "empty cache"),
                  ("reduction 1 mm plate: from cache", f"{reduction['cached_s']:.3f} s",
                   f"+ {reduction['ffrf_interface_s']:.2f} s projection at the first build")]
-    make_all = _RESULTS.get("make_all", {})
+    make_all = notes.get("make_all", {})
     for label in ("cold", "warm"):
         if f"{label}_s" in make_all:
             put(f"make_all/{label}", make_all[f"{label}_s"], "s", f"make all, {label} cache")
@@ -513,7 +512,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
                          status))
     if "skipped" in make_all:
         rows.append(("make all", "-", make_all["skipped"]))
-    for key, value in _RESULTS.items():
+    for key, value in notes.items():
         if key.endswith("_failed"):
             rows.append((key, "failed", value[:150]))
     put("table/what", np.array([r[0] for r in rows], dtype=object), "1", "measurement")

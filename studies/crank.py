@@ -27,8 +27,8 @@ largest (governing) is fitted and held against the tolerance.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -38,7 +38,7 @@ from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides
 from flex.settings import pinned_overrides
 from flex.simulation import simulate_case
-from flex.study import RESULTS_DIR, Summary
+from flex.study import RESULTS_DIR, StudyRun, Summary
 
 NAME = "crank"
 DESCRIPTION = "flexible FFRF crank against auto's choice, with and without the wing"
@@ -154,35 +154,36 @@ def criterion_toml(law: criteria.ErrorLaw, cases_fitted: int) -> str:
 CRITERION_PATH = RESULTS_DIR / "crank-criterion.toml"
 
 
-def simulate_cases(scenes: dict[str, Scene],
-                   progress: Callable[[str, int, int], None] | None) -> dict[str, CaseResult]:
+def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Phase 1: fit cases; fit the law, write :data:`CRITERION_PATH`; phase 2: validation
     cases, ``auto`` reading the law just fitted (passed as an argument)."""
+    progress = run.progress
     results: dict[str, CaseResult] = {}
     names = list(scenes)
     fit_names = [n for n in names if n.startswith("fit_")]
 
-    def run(batch: list[str], law: criteria.Criterion | None = None) -> None:
+    def simulate_batch(batch: list[str], law: criteria.Criterion | None = None) -> None:
         for name in batch:
             if progress:
                 progress(name, len(results), len(names))
             results[name] = simulate_case(scenes[name], name, crank_criterion=law)
 
-    run(fit_names)
-    table = fit_table(scenes, results)
+    simulate_batch(fit_names)
+    table = run.notes["fit_table"] = fit_table(scenes, results)  # summarize reuses it
     text = criterion_toml(fit_law(table), len(table))
     CRITERION_PATH.parent.mkdir(parents=True, exist_ok=True)
     CRITERION_PATH.write_text(text, encoding="utf-8")
     law = criteria.parse_criterion(text, "crank (this run's fit)")
-    run([n for n in names if not n.startswith("fit_")], law)
+    simulate_batch([n for n in names if not n.startswith("fit_")], law)
     if progress:
         progress("done", len(results), len(names))
     return results
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
     datasets: dict[str, Dataset] = {}
-    lines = _fit_report(cases(scene), results, datasets)
+    lines = _fit_report(cases(scene), results, datasets, (notes or {}).get("fit_table"))
     lines += ["crank: auto against a full FFRF crank (12 modes); errors over the deployment",
              f"  {'scene':24s} {'tol':>6s} {'choice':>8s} {'omega':>9s} {'n':>6s} {'k':>6s} "
              f"{'predicted':>9s} {'error':>9s} {'ok':>3s} {'auto s':>7s} {'full s':>7s}"]
@@ -239,9 +240,10 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
 
 
 def _fit_report(scenes: dict[str, Scene], results: dict[str, CaseResult],
-                datasets: dict[str, Dataset]) -> list[str]:
-    """Fit table, the crank law and k(tolerance) beside the coupler law's."""
-    table = fit_table(scenes, results)
+                datasets: dict[str, Dataset], table: Any = None) -> list[str]:
+    """Fit table (``table``: the one the run fitted, else built again), the crank law and
+    k(tolerance) beside the coupler law's."""
+    table = fit_table(scenes, results) if table is None else table
     if len(table) < 3:
         return [f"crank: only {len(table)} fit cases succeeded; no law"]
     law = fit_law(table)

@@ -16,6 +16,7 @@ deviation stored; the thesis comparison table is printed and stored under ``/sum
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -83,7 +84,8 @@ def measures(data: dict[str, np.ndarray]) -> dict[str, float]:
             "half_swing_time": half_time}
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
     datasets: dict[str, Dataset] = {}
     table = {}
     lines = []

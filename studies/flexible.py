@@ -23,8 +23,8 @@ Euler load (the geometric softening the linear FFRF body leaves out) and both wa
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -35,7 +35,7 @@ from flex.scene import Scene, apply_overrides, validate
 from flex.settings import pinned_overrides
 from flex.simulation import simulate_case
 from flex.solver import reduction_for_scene
-from flex.study import Summary
+from flex.study import StudyRun, Summary
 
 NAME = "flexible"
 DESCRIPTION = ("FFRF coupler plates t = 1, 3, 5, 10 mm against their rigid twins; nonlinear FE "
@@ -81,9 +81,9 @@ def cases(scene: Scene) -> dict[str, Scene]:
     return out
 
 
-def simulate_cases(scenes: dict[str, Scene],
-                   progress: Callable[[str, int, int], None] | None) -> dict[str, CaseResult]:
+def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Simulate every case; each model's reduction is built (or loaded) once."""
+    progress = run.progress
     results = {}
     for index, (name, scene) in enumerate(scenes.items()):
         if progress:
@@ -109,7 +109,8 @@ def simulate_cases(scenes: dict[str, Scene],
     return results
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
     datasets: dict[str, Dataset] = {}
     lines = ["flexible: FFRF coupler plates against their rigid twins (22 mm preload)",
              f"  {'model':14s} {'t [mm]':>6s} {'f_pp [Hz]':>10s} {'n thesis':>9s} "

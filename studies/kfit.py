@@ -38,7 +38,6 @@ import functools
 import math
 import sys
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -57,7 +56,7 @@ from flex.criteria import (
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
 from flex.settings import pinned_overrides
-from flex.study import RESULTS_DIR, Summary
+from flex.study import RESULTS_DIR, StudyRun, Summary
 
 SWEEP = True  # cases run on the sweep engine: --scheduler and --workers apply
 NAME = "kfit"
@@ -431,19 +430,15 @@ def sweep_folder(settings: Any = None) -> Path:
     return (settings.folder if settings is not None else None) or RESULTS_DIR / "kfit-cases"
 
 
-LAST_SWEEP: dict[str, Any] = {}
-
-
-def simulate_cases(scenes: dict[str, Scene],
-                   progress: Callable[[str, int, int], None] | None,
-                   sweep: Any = None) -> dict[str, CaseResult]:
+def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Phase 1: the fit cases (one reduction per geometry, then its cases); fit; write
     ``<folder>/../kfit-criterion.toml``; phase 2: the ``val_*`` cases with that fit.
     ``sweep``: where and how the cases run (:class:`flex.sweep.SweepSettings`, from the
     command line; None: a process pool on all cores, ``results/kfit-cases``)."""
     from flex.sweep import SweepSettings, make_executor, run_sweep
 
-    settings = sweep or SweepSettings()
+    settings = run.sweep or SweepSettings()
+    sweep_notes = run.notes.setdefault("sweep", {})
     folder = sweep_folder(settings)
     fit_scenes = {n: s for n, s in scenes.items() if not n.startswith("val_")}
     val_scenes = {n: s for n, s in scenes.items() if n.startswith("val_")}
@@ -454,11 +449,12 @@ def simulate_cases(scenes: dict[str, Scene],
                           retry_failed=settings.retry_failed, progress=settings.progress,
                           study="kfit fit cases")
         results = dict(first.results)
-        LAST_SWEEP.update(executor=executor.description, workers=executor.workers,
+        sweep_notes.update(executor=executor.description, workers=executor.workers,
                           fit_wall_time_s=first.wall_time_s, ran=first.ran,
                           resumed=first.resumed, failed=first.failed)
         _phase(settings, f"kfit: fitting the error laws to {len(results)} fit cases")
         analysis = analyse(results)
+        run.notes["analysis"] = analysis  # summarize and figures reuse it: fitted once
         criterion_text = criterion_toml(analysis, provenance=False)
         path = criterion_path(folder)
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -472,10 +468,10 @@ def simulate_cases(scenes: dict[str, Scene],
                                executor=executor, retry_failed=settings.retry_failed,
                                progress=settings.progress, study="kfit validation")
             results.update(second.results)
-            LAST_SWEEP.update(validation_wall_time_s=second.wall_time_s,
-                              ran=LAST_SWEEP["ran"] + second.ran,
-                              resumed=LAST_SWEEP["resumed"] + second.resumed,
-                              failed=LAST_SWEEP["failed"] + second.failed)
+            sweep_notes.update(validation_wall_time_s=second.wall_time_s,
+                              ran=sweep_notes["ran"] + second.ran,
+                              resumed=sweep_notes["resumed"] + second.resumed,
+                              failed=sweep_notes["failed"] + second.failed)
     finally:
         executor.close()
     _phase(settings, "kfit: cases done; next: the summary and the figures")
@@ -594,8 +590,10 @@ def _k_table(analysis: dict[str, Any]) -> dict[tuple, float]:
     return out
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
-    analysis = analyse(results)
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
+    notes = notes or {}
+    analysis = notes.get("analysis") or analyse(results)
     data, fits = analysis["table"], analysis["fits"]
     datasets: dict[str, Dataset] = {}
     lines = [f"kfit: rigid-or-flexible threshold from {len(data['name'])} FFRF/rigid pairs "
@@ -692,7 +690,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
         lines.append(f"    {definition:10s} n_physical {thesis_k[definition]:7.3g}  n_thesis "
                      f"{thesis_k[definition] * TWO_PI:7.3g}  error there {float(implied):.3g}")
     lines.extend(_validation_report(results, datasets))
-    sweep = LAST_SWEEP
+    sweep = notes.get("sweep", {})
     if sweep:
         lines.append(f"  sweep: {sweep.get('executor')}; ran {sweep.get('ran')}, resumed "
                      f"{sweep.get('resumed')}, failed {sweep.get('failed')}; fit cases "
@@ -702,7 +700,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
             datasets[f"sweep/{key}"] = Dataset(value if not isinstance(value, str)
                                                else np.array(value), "s" if "time" in key
                                                else "1", f"sweep {key.replace('_', ' ')}")
-    return Summary(datasets, "\n".join(lines))
+    return Summary(datasets, "\n".join(lines), {"analysis": analysis})
 
 
 def _validation_report(results: dict[str, CaseResult], datasets: dict[str, Dataset]
@@ -747,7 +745,7 @@ def _validation_report(results: dict[str, CaseResult], datasets: dict[str, Datas
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
     import matplotlib.pyplot as plt
 
-    analysis = analyse(results)
+    analysis = summary.figure_data.get("analysis") or analyse(results)
     data, fits = analysis["table"], analysis["fits"]
     if not fits:
         return []

@@ -9,6 +9,7 @@ the crank midpoint must trace a circle of radius L1/2; the constraint norm stays
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -41,7 +42,8 @@ def closed_form(scene: Scene, time_s: np.ndarray):
                         0.0, scene["slider"]["offset_m"])
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
     case = results["constant_speed"]
     if case.status != "ok":
         return Summary(report=f"kinematics: case failed: {case.message}")

@@ -14,6 +14,7 @@ each refinement level, and the production mesh (coarsest level within tolerance)
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -52,7 +53,8 @@ def _store(datasets: dict[str, Dataset], prefix: str, table: dict) -> None:
         datasets[f"{prefix}/{key}"] = Dataset(array, _unit(key), key.replace("_", " "))
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
     datasets: dict[str, Dataset] = {}
     coupler = scene["coupler"]
     material = modal.Material(coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"],

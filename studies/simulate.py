@@ -8,6 +8,7 @@ Any drive and coupler model; nothing is compared. Stores ``/cases/case/...``.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from flex.plotting import figure
 from flex.results import CaseResult
@@ -22,7 +23,8 @@ def cases(scene: Scene) -> dict[str, Scene]:
     return {"case": scene}
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
     case = results["case"]
     if case.status != "ok":
         return Summary(report=f"simulate: case failed: {case.message}")

@@ -13,6 +13,7 @@ the peak stress, compared with Wahl. No mechanism is simulated.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -33,7 +34,8 @@ def cases(scene: Scene) -> dict[str, Scene]:
     return {}
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
     design = sp.CONSISTENT_THESIS_SPRING
     press_m = scene["drive"]["spring_preload_m"]
     rows = sp.rate_reproduction_table()

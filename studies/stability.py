@@ -26,7 +26,6 @@ the closed-form slider-crank (exact).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -40,7 +39,7 @@ from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
 from flex.settings import pinned_overrides
 from flex.simulation import simulate_case
-from flex.study import Summary
+from flex.study import StudyRun, Summary
 from flex.tradeoff import (
     Observables,
     ReductionPool,
@@ -285,7 +284,6 @@ class References:
 # ------------------------------------------------------------------------------------------
 KEEP = ("time", "crank/angle", "crank/angular_velocity", "slider/position", "constraint_norm",
         "energy/total", "energy/strain", "coupler/midpoint_deflection")
-_VERDICTS: dict[str, dict[str, Any]] = {}
 
 
 def _nonlinear_available() -> bool:
@@ -374,15 +372,15 @@ def _judge(extreme: Extreme, scene: Scene, case: CaseResult, references: Referen
     return verdict
 
 
-def simulate_cases(scenes: dict[str, Scene],
-                   progress: Callable[[str, int, int], None] | None) -> dict[str, CaseResult]:
+def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Run every extreme, judge it against its reference; keep the main curves only."""
+    progress = run.progress
     pool = ReductionPool()
     references = References(pool)
     by_name = {extreme.name: extreme for extreme in extremes()}
     nonlinear = _nonlinear_available()
     results: dict[str, CaseResult] = {}
-    _VERDICTS.clear()
+    verdicts: dict[str, dict[str, Any]] = run.notes.setdefault("verdicts", {})  # by case
     for index, (name, scene) in enumerate(scenes.items()):
         if progress:
             progress(name, index, len(scenes))
@@ -390,7 +388,7 @@ def simulate_cases(scenes: dict[str, Scene],
         if extreme.reference == "nonlinear_fe" and not nonlinear:
             results[name] = CaseResult(name, to_toml(scene), status="failed",
                                        message="nonlinear FE coupler not available")
-            _VERDICTS[name] = {"group": extreme.group, "parameter": extreme.parameter,
+            verdicts[name] = {"group": extreme.group, "parameter": extreme.parameter,
                                "status": "failed", "verdict": "pending: no nonlinear FE",
                                "within_tolerance": False, "expect": extreme.expect}
             continue
@@ -409,7 +407,7 @@ def simulate_cases(scenes: dict[str, Scene],
                        "expect": extreme.expect, "status": case.status,
                        "message": case.message, "within_tolerance": False,
                        "verdict": f"internal error while judging: {type(exc).__name__}: {exc}"}
-        _VERDICTS[name] = verdict
+        verdicts[name] = verdict
         if case.status == "ok":
             case.datasets = {k: v for k, v in case.datasets.items() if k in KEEP}
         case.attrs.update({key: value for key, value in verdict.items()
@@ -444,12 +442,14 @@ def _trust_boundary(verdicts: dict[str, dict[str, Any]]) -> tuple[float, str]:
     return math.inf, f"linear FFRF differs by more than 1 % at every thickness run: {measured}"
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
+    judged: dict[str, dict[str, Any]] = (notes or {}).get("verdicts", {})
     datasets: dict[str, Dataset] = {}
     lines = [f"stability: every extreme against its converged reference (tolerance "
              f"{TOLERANCE:g}, largest relative error)"]
-    names = [name for name in results if name in _VERDICTS]
-    verdicts = [_VERDICTS[name] for name in names]
+    names = [name for name in results if name in judged]
+    verdicts = [judged[name] for name in names]
 
     def column(key: str, default: Any, units: str, text: str, dtype: Any = float) -> Dataset:
         return Dataset(np.array([v.get(key, default) for v in verdicts], dtype=dtype), units,
@@ -487,7 +487,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
     datasets["runs/axial_force_over_euler_load"] = column(
         "axial_force_over_euler_load", np.nan, "1",
         "largest coupler compression / pinned-pinned Euler load (flexible couplers)")
-    boundary, text = _trust_boundary(_VERDICTS)
+    boundary, text = _trust_boundary(judged)
     datasets["nonlinear/trust_thickness"] = Dataset(boundary, "mm", text)
     groups: dict[str, list[str]] = {}
     for name, verdict in zip(names, verdicts, strict=True):
@@ -495,7 +495,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
     for group, members in groups.items():
         lines.append(f"  {group}:")
         for name in members:
-            v = _VERDICTS[name]
+            v = judged[name]
             extra = ""
             if "energy_drift" in v:
                 extra += (f", energy drift {v['energy_drift']:+.1e} "

@@ -24,7 +24,6 @@ from __future__ import annotations
 import math
 import re
 import time
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -35,7 +34,7 @@ from flex.plotting import figure
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, load_scene, to_toml, validate
 from flex.settings import AUTO_OVERRIDES, pinned_overrides, resolve_solver_settings
-from flex.study import Summary
+from flex.study import StudyRun, Summary
 from flex.tradeoff import (
     ACCURACY_LEVELS,
     Measurement,
@@ -376,19 +375,17 @@ def _measurement_case(scene_name: str, scene: Scene, m: Measurement) -> CaseResu
                       attrs=attrs)
 
 
-# the run's measurements and references, for summarize (same process, right after)
-_RUN: dict[str, tuple[Reference, list[Measurement], float]] = {}
-
-
-def simulate_cases(scenes: dict[str, Scene],
-                   progress: Callable[[str, int, int], None] | None) -> dict[str, CaseResult]:
+def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """References first, then every setting, per scene; returns one case per run."""
+    progress = run.progress
     nonlinear = _nonlinear_available()
     plans = {name: settings(name, nonlinear) for name in scenes}
     total = sum(len(plan) + 1 for plan in plans.values())
     done = 0
     results: dict[str, CaseResult] = {}
-    _RUN.clear()
+    # per scene: (reference, measurements, reference time [s]), read by summarize
+    runs: dict[str, tuple[Reference, list[Measurement], float]] = run.notes.setdefault(
+        "runs", {})
     for scene_name, scene in scenes.items():
         pool = ReductionPool()
         finest, coarsenings, tolerance, description, refinements, anchor = reference_plan(
@@ -413,7 +410,7 @@ def simulate_cases(scenes: dict[str, Scene],
             results[_case_name(scene_name, setting.label)] = _measurement_case(
                 scene_name, scene, measurement)
             done += 1
-        _RUN[scene_name] = (reference, measurements, reference_time)
+        runs[scene_name] = (reference, measurements, reference_time)
     if progress:
         progress("done", total, total)
     return results
@@ -464,11 +461,13 @@ def _describe(m: Measurement | None) -> str:
             f"{m.steps} steps, {m.newton_iterations} Newton iterations)")
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
     datasets: dict[str, Dataset] = {}
     lines = ["tradeoff: work-precision (error = largest relative error of crank angle / swing, "
              "slider / travel, peak deflection / peak; wall = median integration time)"]
-    for scene_name, (reference, measurements, reference_time) in _RUN.items():
+    for scene_name, (reference, measurements, reference_time) in (notes or {}).get(
+            "runs", {}).items():
         group = scene_name
         points = [(m.wall_time_s, m.error) if m.ok else (np.nan, np.nan) for m in measurements]
         front = pareto_front(points)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import tomllib
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -28,7 +29,7 @@ from flex.reference import solve_reference
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, validate
 from flex.simulation import simulate_case
-from flex.study import Summary
+from flex.study import StudyRun, Summary
 
 NAME = "wing"
 DESCRIPTION = "wing deployment (sec. 6.4): fitted spring, loads, wing flexibility"
@@ -79,7 +80,8 @@ def cases(scene: Scene) -> dict[str, Scene]:
     return {"wing_deployment": fitted}
 
 
-def simulate_cases(scenes, progress):
+def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
+    progress = run.progress
     results = {}
     for index, (name, scene) in enumerate(scenes.items()):
         if progress:
@@ -114,7 +116,8 @@ def wing_flexibility(scene: Scene, peak_angular_acceleration_rad_per_s2: float,
             "tip_deflection_over_span": tip_m / wing["span_m"]}
 
 
-def summarize(scene: Scene, results: dict[str, CaseResult]) -> Summary:
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
     case = results["wing_deployment"]
     if case.status != "ok":
         return Summary(report=f"wing: case failed: {case.message}")

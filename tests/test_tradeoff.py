@@ -303,12 +303,8 @@ def test_the_study_summary_checks_the_bundled_defaults(rigid_reference):
     coarse = measure(base, Setting.of("h=1e-4", step_s=1e-4), rigid_reference, repeats=1)
     assert study._within_default_tolerance(default)
     assert not study._within_default_tolerance(coarse)  # its step is above 1e-5 s
-    study._RUN.clear()
-    study._RUN["rigid"] = (rigid_reference, [default, coarse], 0.0)
-    try:
-        summary = study.summarize(base, {})
-    finally:
-        study._RUN.clear()
+    summary = study.summarize(base, {}, {"runs": {"rigid": (rigid_reference, [default, coarse],
+                                                          0.0)}})
     assert summary.datasets["rigid/default/setting"].data == study.DEFAULT_LABEL
     assert bool(summary.datasets["rigid/default/matches_table"].data)
     assert "defaults flex defaults (auto)" in summary.report
