@@ -1,4 +1,4 @@
-"""Command line: ``flex run|scene|inspect|plot|compare ...`` (also ``python -m flex``).
+"""Command line: ``flex run|scene|inspect|plot|compare|report ...`` (also ``python -m flex``).
 
 Every user error (bad scene key, impossible geometry, bad result file, an output that
 cannot be written) is printed as one line ``flex: error: ...`` and exits with status 2; no
@@ -135,11 +135,27 @@ def _result_tools(commands) -> None:
                          help="show the N largest deviations (failures always; 0: all)")
     compare.add_argument("--json", action="store_true", help="print JSON (for scripts)")
 
+    report = commands.add_parser(
+        "report", help="write a Markdown report generated from a result file",
+        description="Write a Markdown report of a result file: the study's report, "
+                    "provenance, cases, every /summary table with units, and links to its "
+                    "figures; every number is read from the file. Default output: "
+                    "reports/<file stem>.md beside FILE. Exit status: 0 written, 2 a bad "
+                    "file or output (nothing written).")
+    report.add_argument("file", metavar="FILE.h5")
+    report.add_argument("--out", metavar="REPORT.md",
+                        help="report file, ending in .md (default: reports/ beside FILE)")
+
 
 def _result_tool(args: argparse.Namespace) -> int:
     """Run ``inspect``, ``plot`` or ``compare``; returns the exit status."""
     import json
 
+    if args.command == "report":
+        from .report import write_report
+
+        _print(f"wrote {write_report(args.file, args.out)}")
+        return EXIT_OK
     if args.command == "inspect":
         from .inspect import describe, format_description
 
@@ -267,7 +283,7 @@ def _dispatch(argv: list[str] | None) -> int:
     args, extra = parser.parse_known_args(argv)
     if args.command is None:
         parser.error(f"unrecognized arguments: {' '.join(extra)}" if extra else
-                     "a COMMAND is required: run, scene, inspect, plot or compare")
+                     "a COMMAND is required: run, scene, inspect, plot, compare or report")
     if extra:  # PATHs after options (compare A B --rtol 1e-6 PATH): argparse leaves them over
         if args.command in ("plot", "compare") and not any(e.startswith("-") for e in extra):
             args.paths += extra
@@ -304,10 +320,16 @@ def _run(args: argparse.Namespace) -> int:
             r"^(processes|serial|local|(tcp|tls|inproc|ucx|ws|wss)://\S+)$", args.scheduler):
         raise FlexError(f"--scheduler {args.scheduler!r}: expected processes (default), serial, "
                         f"local (Dask on this machine) or a Dask address like tcp://host:8786")
-    if args.scheduler:
-        os.environ["FLEX_SCHEDULER"] = args.scheduler
-    if args.workers is not None:
-        os.environ["FLEX_WORKERS"] = str(args.workers)
+    sweep = None
+    if getattr(load_study(args.study), "SWEEP", False):
+        import dataclasses
+
+        from .sweep import settings_from_environment
+
+        # the environment is read here, once, at the edge; the library gets arguments
+        sweep = settings_from_environment()
+        sweep = dataclasses.replace(sweep, scheduler=args.scheduler or sweep.scheduler,
+                                    workers=args.workers or sweep.workers)
     output = run_study(args.study, args.scene, args.overrides, args.out,
-                       figures=not args.no_figures, quiet=args.quiet)
+                       figures=not args.no_figures, quiet=args.quiet, sweep=sweep)
     return EXIT_OK if output.as_expected else EXIT_FAILED

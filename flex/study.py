@@ -37,6 +37,7 @@ from .outputs import (
     figures_folder,
     staged_figures,
 )
+from .report import default_report_path, write_report
 from .results import CaseResult, Dataset, write_results
 from .scene import Scene, load_scene, to_toml
 from .settings import check_runnable
@@ -82,6 +83,7 @@ class StudyOutput:
     wall_time_s: float
     path: Path | None = None
     figures: list[Path] = field(default_factory=list)
+    report: Path | None = None
     expected_failures: frozenset[str] = frozenset()
 
     def unexpected(self) -> list[str]:
@@ -180,7 +182,9 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
               out: str | Path | None = None, figures: bool = True, quiet: bool = False,
               sweep: Any = None) -> StudyOutput:
     """Run study ``name``, write its HDF5 file (default ``results/<name>.h5``) and figures
-    (``figures/<file stem>-*.png`` beside it), print its report, and return the output.
+    (``figures/<file stem>-*.png`` beside it) and its report (``reports/<file stem>.md``
+    beside it, generated from the file: :func:`flex.report.write_report`), print the
+    study's report, and return the output.
     ``sweep``: where and how a sweep study runs (:class:`flex.sweep.SweepSettings`).
 
     Nothing is lost: the output is checked before any case runs (:func:`flex.outputs.
@@ -199,6 +203,7 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
                         [source] if source is not None and Path(str(source)).exists() else [])
     if figures and hasattr(module, "figures"):
         check_writable_folder(figures_folder(path), f"figures of '{path}'")
+    check_writable_folder(default_report_path(path).parent, f"report of '{path}'")
     written: list[Path] = []
     try:
         output = execute(module, scene, None if quiet else progress_printer(), scenes,
@@ -211,6 +216,8 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
                 module.figures(output.results, output.summary, staging)
             output.figures = placed
             written.extend(placed)
+        output.report = write_report(output.path)  # generated from the file just written
+        written.append(output.report)
     except KeyboardInterrupt as exc:
         raise Interrupted(written, type(exc)) from None
     except Exception as exc:  # an interrupt inside a C extension surfaces as another error
@@ -273,3 +280,5 @@ def _report(output: StudyOutput, path: Path, quiet: bool) -> None:
           + f", {output.wall_time_s:.1f} s)")
     for figure in output.figures:
         print(f"wrote {figure}")
+    if output.report is not None:
+        print(f"wrote {output.report}")

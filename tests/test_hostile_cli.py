@@ -152,7 +152,7 @@ def test_a_failed_run_keeps_the_last_good_file_and_says_so(workspace):
     after = fingerprint([folder])
     failed = folder / "good.failed.h5"
     assert {path: after[path] for path in before} == before  # nothing existing changed
-    assert set(after) - set(before) == {failed}
+    assert set(after) - set(before) == {failed, folder / "reports" / "good.failed.md"}
     with open_results(failed) as h5:
         assert h5["cases/case"].attrs["status"] == "failed"
 
