@@ -108,7 +108,7 @@ def test_killed_runs_leave_the_previous_file_intact(tmp_path):
         if when == "writing" and sig == signal.SIGINT and not late:
             assert result.returncode == 130, what
             assert result.stderr.strip() == "flex: interrupted; no result file was changed"
-        others = {p.name for p in tmp_path.iterdir()} - {out.name}
+        others = {p.name for p in tmp_path.iterdir()} - {out.name, "reports"}
         # SIGKILL cannot clean up: at most its own hidden part, never a *.h5 file
         assert all(name.startswith(f".{out.name}.") and name.endswith(".part")
                    for name in others), what
@@ -116,7 +116,7 @@ def test_killed_runs_leave_the_previous_file_intact(tmp_path):
             assert parts_of(out, pid) == [], what
     # the next write of the same path removes the parts the killed runs left
     write_previous(out)
-    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+    assert [p.name for p in tmp_path.iterdir() if p.name != "reports"] == [out.name]
 
 
 def test_full_disk_keeps_the_previous_file_and_says_so(tmp_path):
@@ -136,7 +136,7 @@ def test_full_disk_keeps_the_previous_file_and_says_so(tmp_path):
         f"flex: error: cannot write result file '{out}': File too large; the previous file "
         f"(if any) is unchanged"]
     assert out.read_bytes() == previous
-    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+    assert [p.name for p in tmp_path.iterdir() if p.name != "reports"] == [out.name]
 
 
 def test_stale_parts_of_dead_writers_are_removed_live_ones_kept(tmp_path):
@@ -193,7 +193,7 @@ def test_two_writers_at_once_last_complete_writer_wins(tmp_path):
         writer, round_ = int(h5.attrs["writer"]), int(h5.attrs["round"])
         assert round_ == rounds - 1  # the final file is some writer's last, complete round
         assert np.all(h5["cases/c/value"][()] == writer * 1000.0 + round_)
-    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+    assert [p.name for p in tmp_path.iterdir() if p.name != "reports"] == [out.name]
     assert reads > 0
 
 
@@ -209,7 +209,7 @@ def test_two_flex_runs_on_one_path(tmp_path):
             for speed in speeds.values()]
     for run in runs:
         assert run.wait(timeout=120) == 0, run.stderr.read().decode()
-    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+    assert [p.name for p in tmp_path.iterdir() if p.name != "reports"] == [out.name]
     with open_results(out) as h5:
         scene = h5.attrs["scene_toml"]
     winner = next(name for name, speed in speeds.items()

@@ -1,0 +1,269 @@
+"""The public face of flex for scripts and notebooks: five functions with written contracts.
+
+Import them from the package (``from flex import load_scene, simulate``); ``import flex``
+itself loads nothing heavy (no Exudyn, NGsolve or h5py until a function needs it)::
+
+    scene = load_scene()                                          # bundled cavezza2012
+    soft = derive_scene(scene, {"drive.spring_preload_m": 0.011})  # a derived scene
+    case = simulate(soft)                                         # one case, in memory
+    out = run_study("simulate", overrides={"drive.spring_preload_m": 0.011},
+                    out="runs/soft.h5")                           # a file, as the CLI writes
+    ds = open_result("runs/soft.h5")                              # xarray.Dataset
+
+Conventions shared by every function here:
+
+- A **scene** is a nested ``dict`` ``{section: {key: value}}`` whose keys carry their unit
+  (``length_m`` [m], ``mass_kg`` [kg], ``inertia_kgm2`` [kg m^2], ``initial_angle_deg``
+  [deg], ``spring_stiffness_N_per_m`` [N/m], ``end_time_s`` [s], ``youngs_modulus_Pa``
+  [Pa], ...; no suffix: dimensionless or a choice). The accepted keys, types and ranges are
+  :data:`flex.scene.SCHEMA`; ``python -m flex scene simulate`` prints a full scene.
+- **Overrides** are either a list of ``"section.key=value"`` strings (the value in TOML
+  syntax, as ``--set`` takes them: ``"coupler.model=ffrf"``, ``"simulation.end_time_s=0.01"``)
+  or a ``dict``, flat (``{"drive.spring_preload_m": 0.011}``) or by section
+  (``{"drive": {"spring_preload_m": 0.011}}``), with Python values (str, int, float, bool;
+  numpy scalars accepted).
+- Every problem a user can fix raises a :class:`flex.errors.FlexError` subclass whose message
+  is one line naming the key or file and the accepted range: :class:`~flex.errors.SceneError`
+  (a scene or override), :class:`~flex.errors.SimulationError` (a run diverged; the message
+  names the step and the time), :class:`~flex.errors.ResultFileError` (a result file),
+  :class:`~flex.errors.OutputError` (an output that cannot be written).
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from .errors import SceneError
+
+if TYPE_CHECKING:  # type names only; nothing heavy is imported at run time
+    import xarray
+
+    from .results import CaseResult
+    from .scene import Scene
+    from .study import StudyOutput
+
+Overrides = list[str] | tuple[str, ...] | Mapping[str, Any]
+
+
+def override_strings(overrides: Overrides | None) -> list[str]:
+    """``overrides`` (see the module doc) as ``"section.key=value"`` strings (TOML values).
+
+    Raises :class:`~flex.errors.SceneError` for a key that is not ``section.key`` or a value
+    TOML cannot hold (``None``, an object), :class:`TypeError` when ``overrides`` is neither
+    a list of strings nor a mapping.
+    """
+    if overrides is None:
+        return []
+    if isinstance(overrides, str):
+        raise TypeError("overrides: a list of 'section.key=value' strings or a dict, not one "
+                        f"string (write [{overrides!r}])")
+    if not isinstance(overrides, Mapping):
+        items = list(overrides)
+        for item in items:
+            if not isinstance(item, str):
+                raise TypeError(f"overrides: expected 'section.key=value' strings, got "
+                                f"{type(item).__name__} {item!r}")
+        return items
+    import tomli_w
+
+    strings = []
+    for name, value in _flat(overrides):
+        if hasattr(value, "item") and not isinstance(value, str | bytes):
+            value = value.item()  # numpy scalar -> Python scalar
+        try:
+            text = tomli_w.dumps({"v": value}).strip().removeprefix("v = ")
+        except (TypeError, ValueError):
+            raise SceneError(f"override {name}: {value!r} is not a scene value (a string, "
+                             f"number or boolean)") from None
+        strings.append(f"{name}={text}")
+    return strings
+
+
+def _flat(overrides: Mapping[str, Any]) -> list[tuple[str, Any]]:
+    """``{"a.b": v}`` and ``{"a": {"b": v}}`` -> ``[("a.b", v)]``."""
+    pairs = []
+    for key, value in overrides.items():
+        if not isinstance(key, str):
+            raise SceneError(f"override key {key!r}: expected 'section.key' or a section name")
+        if isinstance(value, Mapping):
+            if "." in key:
+                raise SceneError(f"override {key}: a table goes under a section name, e.g. "
+                                 f"{{'drive': {{'spring_preload_m': 0.011}}}}")
+            pairs.extend((f"{key}.{inner}", item) for inner, item in value.items())
+        elif "." not in key:
+            raise SceneError(f"override {key}: expected 'section.key' (e.g. "
+                             f"'drive.spring_preload_m') or a section with a table of keys")
+        else:
+            pairs.append((key, value))
+    return pairs
+
+
+def load_scene(source: str | Path | None = None, overrides: Overrides | None = None) -> Scene:
+    """Read a scene: a TOML file or a bundled parameter set, with overrides, validated.
+
+    Inputs:
+        source: a TOML file path, or the name of a bundled parameter set (``None``: the
+            thesis's ``"cavezza2012"``, ``flex/scenes/cavezza2012.toml``). A file needs only
+            the keys it changes; the rest come from the bundled set.
+        overrides: ``"section.key=value"`` strings or a dict (module doc), applied on top.
+    Output:
+        the validated scene (a new nested dict; values in the units their keys name).
+        ``"auto"`` values (``coupler.model``, ``simulation.step_s``, ...) are kept as
+        written; :func:`simulate` resolves them.
+    Errors:
+        :class:`~flex.errors.SceneError`: the file is missing, unreadable, not UTF-8 or not
+        TOML; an unknown section or key; a wrong type; a non-finite or out-of-range number;
+        a linkage that cannot assemble (crank not shorter than coupler, slide line too far);
+        inconsistent step settings; a plate that cannot be meshed sensibly.
+    """
+    from .scene import load_scene as _load
+
+    return _load(source, override_strings(overrides))
+
+
+def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
+    """A new scene: ``scene`` with ``overrides`` applied, validated as a whole.
+
+    The one way to edit a scene in a script: the same parsing as ``--set``
+    (:func:`flex.scene.apply_overrides`) and the same checks as :func:`load_scene`
+    (:func:`flex.scene.validate`), so a derived scene is exactly what the command line would
+    run with ``--set``.
+
+    Inputs:
+        scene: a scene (from :func:`load_scene` or an earlier :func:`derive_scene`); it is
+            not modified.
+        overrides: ``"section.key=value"`` strings or a dict (module doc), e.g.
+            ``{"drive.spring_preload_m": 0.011}`` [m] or ``["coupler.model=ffrf",
+            "coupler.geometry=plate", "coupler.thickness_m=0.003"]``.
+    Output:
+        the derived scene (a deep copy; ``"auto"`` values kept as written).
+    Errors:
+        :class:`~flex.errors.SceneError` as :func:`load_scene` (unknown key, type, range,
+        linkage, ...), or for an override that is not ``section.key=value``;
+        :class:`TypeError` when ``overrides`` is neither a list of strings nor a mapping.
+    """
+    from .scene import apply_overrides, validate
+
+    derived = apply_overrides(scene, override_strings(overrides))
+    validate(derived)
+    return derived
+
+
+def _implementation():
+    """The simulate function of this version of flex: :func:`flex.simulation.simulate` when
+    that module exists (``model = "auto"`` resolved, then integrated), else the older
+    :func:`flex.solver.simulate`."""
+    if importlib.util.find_spec("flex.simulation") is not None:
+        return importlib.import_module("flex.simulation").simulate
+    solver = importlib.import_module("flex.solver")
+    if not hasattr(solver, "simulate"):
+        raise ImportError("flex.simulate: neither flex.simulation.simulate nor "
+                          "flex.solver.simulate exists in this copy of flex")
+    return solver.simulate
+
+
+def simulate(scene: Scene, name: str = "case", **options: Any) -> CaseResult:
+    """Simulate one scene in memory and return its curves (nothing is written to disk
+    except the reduction cache).
+
+    What runs is exactly the scene: ``model = "auto"`` links are decided first (a rigid probe
+    run and the fitted criterion; the choice and its reason are printed to stderr), then
+    ``"auto"`` solver keys are filled by model (``flex/solver_defaults.toml``), then the
+    mechanism is built in Exudyn and integrated at a fixed step from t = 0 to
+    ``simulation.end_time_s``. A flexible (``ffrf``) link's Craig-Bampton reduction is built
+    with NGsolve or read from the cache (``~/.cache/flex/reductions``, ``FLEX_CACHE_DIR``).
+
+    Inputs:
+        scene: a validated scene (:func:`load_scene`, :func:`derive_scene`).
+        name: the case name stored with the result (default ``"case"``).
+        options: passed on to :func:`flex.simulation.simulate` (``reduction=``,
+            ``crank_reduction=``: prebuilt reductions; ``criterion=``, ``crank_criterion=``:
+            another fitted law for ``auto``, :func:`flex.criteria.load_criterion`); not
+            needed for ordinary use.
+    Output:
+        a :class:`flex.results.CaseResult`: ``status == "ok"``; ``datasets`` maps paths of
+        the result layout to :class:`flex.results.Dataset` (``.data`` a numpy array,
+        ``.units``, ``.description``): ``"time"`` [s], ``"crank/angle"`` [rad],
+        ``"crank/angular_velocity"`` [rad/s], ``"slider/position"`` [m],
+        ``"joints/B/force_on_coupler"`` [N] (n, 2), ``"energy/total"`` [J], ...
+        (``docs/results.md``); ``attrs`` hold the ``auto`` decisions (``fidelity_<link>_*``),
+        the solver defaults used (``solver_defaults_*``) and a ``validity_warning`` when a
+        linear FFRF link deflects too far to be trusted; ``scene_toml`` is the resolved
+        scene; ``counters`` steps, Newton iterations and wall time [s].
+    Errors:
+        :class:`~flex.errors.SceneError`: the scene cannot run as given (too many steps, an
+        output interval that is not a multiple of the step, a plate too large to mesh,
+        ``auto`` refused: a lumped link, compression near buckling, ...);
+        :class:`~flex.errors.SimulationError`: the run diverged (Newton failure, NaN,
+        exploding constraint norm; the message names the step and the time and what may
+        help); :class:`ImportError` only in a broken installation.
+    """
+    return _implementation()(scene, name, **options)
+
+
+def run_study(name: str, source: str | Path | None = None, overrides: Overrides | None = None,
+              out: str | Path | None = None, figures: bool = True, quiet: bool = False,
+              **options: Any) -> StudyOutput:
+    """Run a study as ``flex run`` does: its cases, its HDF5 file, its figures and report
+    (``reports/<stem>.md`` beside the file, :mod:`flex.report`).
+
+    Inputs:
+        name: a study, one of :data:`flex.study.STUDIES` (``"simulate"`` runs exactly the
+            given scene as one case; ``"dynamics"``, ``"kfit"``, ...: README "Studies").
+        source: scene file or bundled parameter set (as :func:`load_scene`).
+        overrides: ``"section.key=value"`` strings or a dict (module doc), as ``--set``.
+        out: result file, ending in ``.h5`` (default ``results/<name>.h5``).
+        figures: draw the study's PNG figures into ``figures/`` beside the result file.
+        quiet: print nothing on success (failed cases still go to stderr).
+        options: passed on to :func:`flex.study.run_study` (e.g. ``sweep=``, a
+            :class:`flex.sweep.SweepSettings` saying where a sweep study's cases run).
+    Output:
+        a :class:`flex.study.StudyOutput`: ``results`` (case name -> CaseResult, as
+        :func:`simulate` returns), ``summary`` (``datasets`` stored under ``/summary``,
+        ``report`` the printed text), ``path`` (the file written), ``figures``,
+        ``wall_time_s`` [s] and ``as_expected`` (every case ended as the study declares).
+        The file is written atomically; with a failed case that the study does not expect
+        and an existing file at ``out``, it goes beside it as ``<name>.failed.h5``. Failed
+        cases do not raise: check ``as_expected`` or each case's ``status``.
+    Errors:
+        :class:`~flex.errors.FlexError` before anything runs: an unknown study, a bad scene
+        or override (:class:`~flex.errors.SceneError`, also for a key the study would not
+        use), an output that cannot be written or would overwrite an input
+        (:class:`~flex.errors.OutputError`); :class:`flex.study.Interrupted` (a
+        :class:`KeyboardInterrupt`) on Ctrl-C, naming the files already written.
+    """
+    from .study import run_study as _run
+
+    return _run(name, source, override_strings(overrides), out, figures, quiet, **options)
+
+
+def open_result(path: str | Path, case: str | None = None) -> xarray.Dataset:
+    """One case of a flex result file as an ``xarray.Dataset`` (read into memory, file
+    closed on return).
+
+    Inputs:
+        path: a result file written by flex (``results/<study>.h5``, a ``--out`` file, a
+            reference-curve file).
+        case: the case name (``"preload_22mm"``); may be omitted when the file has one case.
+    Output:
+        an ``xarray.Dataset`` with coordinate ``time`` [s]; variables named by their path in
+        the case (``ds["crank/angle"]``), each with ``units``, ``description`` and
+        ``long_name`` attributes (so ``.plot()`` labels its axes); two-column curves have a
+        dimension ``xy`` (``"x"``, ``"y"``). ``ds.attrs`` hold the case's attributes and
+        the file's provenance (prefixed ``file_``). See :func:`flex.results.to_xarray`.
+    Errors:
+        :class:`~flex.errors.ResultFileError`: the file is missing, truncated, not HDF5 or
+        not written by flex, or xarray is not installed (``pip install xarray``);
+        :class:`flex.results.ResultPathError` (a ResultFileError): no such case, or no
+        ``case`` given for a file with several cases (the message lists them).
+    """
+    from .results import to_xarray
+
+    return to_xarray(path, case)
+
+
+__all__ = ["load_scene", "derive_scene", "simulate", "run_study", "open_result"]
