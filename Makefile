@@ -8,10 +8,29 @@ export MPLBACKEND := Agg
 RUN := $(PY) -m flex run
 
 STUDIES := kinematics dynamics modal flexible spring wing crank kfit
+# long runs, not part of `all` (README "Speed and accuracy", "Numerical stability"). On 2
+# shared cores: tradeoff ~65 min, stability ~10 min, bench ~23 min (it times `make all FORCE=1`
+# twice); `make all` itself takes 8-11 min when every study reruns.
+# `flex run stability` exits 0 when exactly its runs built to diverge fail.
+LONG := tradeoff stability bench
 
-.PHONY: all test test-slow lint setup clean kfit-criterion crank-criterion $(STUDIES)
+# A study's result, results/<study>.h5 (and its figures, results/figures/<study>-*.png),
+# is remade only when one of its inputs is newer: its module studies/<study>.py, or one of
+# INPUTS -- the library (flex/**/*.py), its bundled scenes and data files (flex/scenes/*.toml;
+# flex/*.toml: the fitted criteria and the solver defaults), studies/__init__.py and
+# pyproject.toml. `make <study>` is an alias of `make results/<study>.h5`. FORCE=1 reruns
+# the studies asked for anyway (`make all FORCE=1`, `make kfit FORCE=1`).
+INPUTS := $(shell find flex -type f \( -name '*.py' -o -name '*.toml' \) \
+	-not -path '*/__pycache__/*' | LC_ALL=C sort) studies/__init__.py pyproject.toml
+RESULTS := $(STUDIES:%=results/%.h5)
+LONG_RESULTS := $(LONG:%=results/%.h5)
+MAKEFLAGS += --no-builtin-rules
+.SUFFIXES:
 
-all: $(STUDIES)
+.PHONY: all test test-slow lint setup clean kfit-criterion crank-criterion $(STUDIES) $(LONG) \
+	force-rerun
+
+all: $(RESULTS)
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -21,25 +40,53 @@ $(STAMP): pyproject.toml
 
 setup: $(STAMP)
 
-$(STUDIES): $(STAMP)
-	$(RUN) $@
+$(STUDIES) $(LONG): %: results/%.h5
 
-# long runs, not part of `all` (README "Speed and accuracy", "Numerical stability"); each
-# writes results/<target>.h5 and figures. On 2 shared cores: tradeoff ~65 min, stability
-# ~10 min, bench ~23 min (it runs `make all` twice); `make all` itself takes 8-11 min.
-# `flex run stability` exits 0 when exactly its runs built to diverge fail.
-LONG := tradeoff stability bench
-.PHONY: $(LONG)
-$(LONG): $(STAMP)
-	$(RUN) $@
+# the .venv is order-only: (re)creating it reruns nothing; pyproject.toml is in INPUTS
+$(RESULTS) $(LONG_RESULTS): results/%.h5: studies/%.py $(INPUTS) $(if $(FORCE),force-rerun) \
+		| $(STAMP)
+	$(run-study)
 
-# after make kfit: install its fit as the criterion that model = "auto" reads (commit it)
+force-rerun: ;
+
+# Run study $* for $@. A run that does not end as its study declares exits non-zero (flex
+# run: 1 failed cases, 2 bad input, 3 internal error, 130/143 interrupted) and make stops;
+# the target must then stay out of date for the next make. flex keeps an earlier result
+# file as it was and writes the failed run beside it (<study>.failed.h5); only a first run
+# (no earlier file) writes a failed run to $@ itself: it is moved to <study>.failed.h5 here.
+# Whatever else changed $@ in a failed run (an interrupt while drawing figures) gets $@'s
+# earlier time stamp back, kept in results/.<study>.h5.before during the run.
+define run-study
+@before=$(@D)/.$(@F).before; mkdir -p $(@D); \
+if [ -e $@ ]; then touch -r $@ $$before; else rm -f $$before; fi; \
+echo "$(RUN) $*"; \
+$(RUN) $* || { status=$$?; \
+	if [ -e $$before ]; then touch -r $$before $@; \
+	elif [ -e $@ ]; then mv -f $@ $(@:.h5=.failed.h5); \
+		echo "make: $@ came from a failed run: moved to $(@:.h5=.failed.h5)" >&2; fi; \
+	rm -f $$before; exit $$status; }; \
+rm -f $$before
+endef
+
+# kfit and crank write their fitted laws beside their results, before their validation
+# phase: a law is installed only from an up-to-date run that did not fail afterwards
+results/kfit-criterion.toml results/crank-criterion.toml: results/%-criterion.toml: \
+		results/%.h5
+	@test -f $@ || { echo "make: $@ is missing although $< is up to date;" \
+		"rerun with 'make $* FORCE=1'" >&2; exit 1; }
+	@if [ $(<:.h5=.failed.h5) -nt $< ]; then echo "make: the last $* run failed" \
+		"($(<:.h5=.failed.h5)): its law $@ is not installed" >&2; exit 1; fi
+
+# after make kfit: install its fit as the criterion that model = "auto" reads (commit it).
+# Every study reads it: they are all out of date after a new law is installed.
 kfit-criterion: results/kfit-criterion.toml
-	cp results/kfit-criterion.toml flex/criteria_fit.toml
+	@cmp -s $< flex/criteria_fit.toml && echo "flex/criteria_fit.toml is already $<" \
+		|| { cp $< flex/criteria_fit.toml && echo "cp $< flex/criteria_fit.toml"; }
 
 # after make crank: install the crank's law that crank.model = "auto" reads (commit it)
 crank-criterion: results/crank-criterion.toml
-	cp results/crank-criterion.toml flex/crank_criteria_fit.toml
+	@cmp -s $< flex/crank_criteria_fit.toml && echo "flex/crank_criteria_fit.toml is already $<" \
+		|| { cp $< flex/crank_criteria_fit.toml && echo "cp $< flex/crank_criteria_fit.toml"; }
 
 test: $(STAMP)
 	$(PY) -m pytest -q
@@ -51,5 +98,5 @@ lint: $(STAMP)
 	$(PY) -m ruff check flex studies tests
 
 clean:
-	rm -rf results/*.h5 results/figures .cache results/kfit-cases results/kfit-criterion.toml \
-		results/crank-criterion.toml
+	rm -rf results/*.h5 results/.*.h5.before results/figures results/reports .cache \
+		results/kfit-cases results/kfit-criterion.toml results/crank-criterion.toml

@@ -40,11 +40,18 @@ error does not enter), and would force the spurious tilt onto the face: hence th
 reference, which keeps phi at the coupler's rotation since t = 0 (small over the first
 deflection peaks, ~0.25 rad over the whole deployment). Joint C constrains only x and y and
 uses the marker's position alone.
+
+Progress: an integration of this body takes minutes (the flexible study's reference: ~5 min).
+The elastic-force callback, which Exudyn calls with the simulated time, prints a line on
+stderr every :data:`PROGRESS_INTERVAL_S` of wall time (simulated time of the end time, steps,
+elapsed and estimated remaining time, callback counts); it only reads clocks and counters,
+so no computed number changes.
 """
 
 from __future__ import annotations
 
 import math
+import sys
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -64,6 +71,8 @@ from .reduction import (
 )
 
 _MESH_ORDER = 2  # as the reduction: linear tets lock in bending
+#: wall-time seconds between two progress lines of an integration (see the module doc)
+PROGRESS_INTERVAL_S = 10.0
 
 
 @dataclass
@@ -99,6 +108,7 @@ class NonlinearPlate:
     mass_kg: float  #: from the consistent mass matrix
     n_elements: int  #: second-order tetrahedra
     build_time_s: float  #: meshing and node sets
+    end_time_s: float | None = None  #: the scene's end time [s], for progress lines only
 
     @property
     def n_nodes(self) -> int:
@@ -222,6 +232,7 @@ class _HyperelasticForces:
         self.force_calls = 0
         self.jacobian_calls = 0
         self.time_s = 0.0
+        self._progress = _IntegrationProgress(plate.end_time_s)
 
     def _set_state(self, q) -> None:
         self._state.vec.FV().NumPy()[self._ngsolve_index] = np.asarray(q) + self._offset_m
@@ -234,6 +245,7 @@ class _HyperelasticForces:
         force = -self._residual.FV().NumPy()[self._ngsolve_index]
         self.force_calls += 1
         self.time_s += time.perf_counter() - start
+        self._progress.update(float(t), self.force_calls, self.jacobian_calls)
         return force
 
     def jacobian(self, mbs, t, item_index, q, q_t, f_ode2, f_ode2_t):
@@ -265,6 +277,48 @@ class _HyperelasticForces:
         self.time_s += time.perf_counter() - start
         return container
 
+
+class _IntegrationProgress:
+    """Progress lines of one integration on stderr, from the force callback's time ``t``:
+    one per :data:`PROGRESS_INTERVAL_S` of wall time since the first call (none for a run
+    shorter than that). Steps are counted as the increasing values of ``t`` after the
+    first (each step's Newton iterations share its time)."""
+
+    def __init__(self, end_time_s: float | None) -> None:
+        self.end_time_s = end_time_s
+        self.start: float | None = None
+        self.last_line = 0.0
+        self.first_t = self.last_t = 0.0
+        self.steps = 0
+
+    def update(self, t: float, force_calls: int, jacobian_calls: int) -> None:
+        now = time.monotonic()
+        if self.start is None:
+            self.start = self.last_line = now
+            self.first_t = self.last_t = t
+            return
+        if t > self.last_t:
+            self.steps += 1
+            self.last_t = t
+        if now - self.last_line < PROGRESS_INTERVAL_S:
+            return
+        self.last_line = now
+        elapsed = now - self.start
+        done = t - self.first_t
+        span = f"t = {t * 1e3:.3g} ms"
+        left = ""
+        if self.end_time_s and self.end_time_s > self.first_t:
+            total = self.end_time_s - self.first_t
+            span += f" of {self.end_time_s * 1e3:.3g} ms ({100 * done / total:.0f} %)"
+            if done > 0:
+                left = f", ~{_duration(elapsed * max(total - done, 0.0) / done)} left"
+        print(f"nonlinear FE coupler: {span}, step {self.steps}, {_duration(elapsed)} "
+              f"elapsed{left} ({force_calls} force, {jacobian_calls} Jacobian evaluations)",
+              file=sys.stderr, flush=True)
+
+
+def _duration(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 90 else f"{seconds / 60:.1f} min"
 
 
 def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[float],
@@ -335,6 +389,10 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
 def nonlinear_plate_for_scene(scene: dict[str, dict[str, Any]]) -> NonlinearPlate:
     """The meshed plate of the scene's coupler (``coupler.geometry = "plate"``)."""
     c = scene["coupler"]
-    return build_nonlinear_plate(c["length_m"], c["thickness_m"], c["width_m"],
-                                 c["youngs_modulus_Pa"], c["density_kg_per_m3"],
-                                 c["poisson_ratio"], c["mesh_size_m"])
+    plate = build_nonlinear_plate(c["length_m"], c["thickness_m"], c["width_m"],
+                                  c["youngs_modulus_Pa"], c["density_kg_per_m3"],
+                                  c["poisson_ratio"], c["mesh_size_m"])
+    end = scene.get("simulation", {}).get("end_time_s")
+    if isinstance(end, int | float) and not isinstance(end, bool):
+        plate.end_time_s = float(end)  # for progress lines only
+    return plate

@@ -434,7 +434,8 @@ class _Progress:
         if self.bar is not None:
             self._update()
             self.bar.update(1)
-        elif self.plain and time.monotonic() - self.last_line >= PROGRESS_MIN_INTERVAL_S:
+        elif (self.plain and self.done + self.failed < self.total  # the last: close() says it
+              and time.monotonic() - self.last_line >= PROGRESS_MIN_INTERVAL_S):
             self._status()
 
     def preparation(self, done: bool = False) -> None:
