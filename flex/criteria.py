@@ -46,13 +46,18 @@ from .errors import FlexError, SceneError
 from .physics import (  # noqa: F401 - part of this module's face
     TWO_PI,
     clamped_plate_frequencies,
+    euler_buckling_load_N,
     n_values,
     pinned_pinned_omega,
+    plate_thickness_for_mass_m,
 )
 from .settings import resolved_simulation
+from .thesis import (  # noqa: F401 - part of this module's face
+    THESIS_DELTA_T_S,  # thesis sec. 6.2, Table 5 note (source not stated)
+    THESIS_K,  # thesis sec. 6.2, in the thesis convention (n = delta_t * omega)
+    THESIS_YOUNGS_MODULUS_PA,
+)
 
-THESIS_K = 108.0  #: thesis sec. 6.2, in the thesis convention (n = delta_t * omega)
-THESIS_DELTA_T_S = 0.016128  #: thesis sec. 6.2, Table 5 note (source not stated)
 CRITERION_FORMAT = "flex-criterion/1"
 DEFAULT_CRITERION = Path(__file__).with_name("criteria_fit.toml")
 #: the crank's own law (``make crank``, copied by ``make crank-criterion``): the coupler law
@@ -69,7 +74,8 @@ DELTA_T_DEFINITIONS: dict[str, str] = {
     "half_swing": "time at which the crank has covered half its swing (angle midway between "
                   "start and first maximum)",
     "peak_speed": "time of the largest crank speed (the spring passes its free length)",
-    "thesis": "the thesis's constant 0.016128 s (sec. 6.2; how it was measured is not stated)",
+    "thesis": f"the thesis's constant {THESIS_DELTA_T_S:g} s (sec. 6.2; how it was measured is "
+              "not stated)",
 }
 
 #: error measures, FFRF against its rigid twin over [0, delta_t_stop]; all dimensionless
@@ -111,6 +117,18 @@ def first_maximum_index(values: np.ndarray) -> int | None:
     return int(falling[0])
 
 
+def half_swing_time(time_s: np.ndarray, angle_rad: np.ndarray, stop: int) -> float:
+    """Time [s] at which ``angle_rad`` first covers half its rise from sample 0 to sample
+    ``stop`` (its maximum, :func:`first_maximum_index`), interpolated linearly."""
+    time_s, angle = np.asarray(time_s, dtype=float), np.asarray(angle_rad, dtype=float)
+    half = angle[0] + 0.5 * (angle[stop] - angle[0])
+    i = int(np.argmax(angle[:stop + 1] >= half))
+    if i == 0:
+        return float(time_s[0])
+    fraction = (half - angle[i - 1]) / (angle[i] - angle[i - 1])
+    return float(time_s[i - 1] + fraction * (time_s[i] - time_s[i - 1]))
+
+
 def deployment_times(time_s: np.ndarray, crank_angle_rad: np.ndarray,
                      crank_speed_rad_per_s: np.ndarray) -> dict[str, float]:
     """Deployment time [s] by every definition of :data:`DELTA_T_DEFINITIONS`.
@@ -127,14 +145,7 @@ def deployment_times(time_s: np.ndarray, crank_angle_rad: np.ndarray,
     if stop is None:
         raise ValueError(f"the crank angle has no maximum before t = {time_s[-1]:.6g} s: the "
                          f"deployment is not complete; simulate longer")
-    half = angle[0] + 0.5 * (angle[stop] - angle[0])
-    i = int(np.argmax(angle[:stop + 1] >= half))
-    if i == 0:
-        t_half = float(time_s[0])
-    else:
-        fraction = (half - angle[i - 1]) / (angle[i] - angle[i - 1])
-        t_half = float(time_s[i - 1] + fraction * (time_s[i] - time_s[i - 1]))
-    return {"stop": float(time_s[stop]), "half_swing": t_half,
+    return {"stop": float(time_s[stop]), "half_swing": half_swing_time(time_s, angle, stop),
             "peak_speed": float(time_s[int(np.argmax(np.abs(speed[:stop + 1])))]),
             "thesis": THESIS_DELTA_T_S}
 
@@ -200,8 +211,8 @@ def euler_load_ratio(force_B_N: np.ndarray, force_C_N: np.ndarray,
     axis = np.column_stack([np.cos(angle), np.sin(angle)])
     compression = max(float(np.max(np.sum(np.asarray(force_B_N) * axis, axis=1))),
                       float(np.max(-np.sum(np.asarray(force_C_N) * axis, axis=1))), 0.0)
-    euler = math.pi**2 * youngs_modulus_Pa * width_m * thickness_m**3 / 12 / length_m**2
-    return compression / euler
+    return compression / euler_buckling_load_N(length_m, thickness_m, width_m,
+                                               youngs_modulus_Pa)
 
 
 def _window(data: Mapping[str, np.ndarray], end_s: float) -> np.ndarray:
@@ -210,7 +221,8 @@ def _window(data: Mapping[str, np.ndarray], end_s: float) -> np.ndarray:
 
 def error_measures(rigid: Mapping[str, np.ndarray], ffrf: Mapping[str, np.ndarray],
                    length_m: float, thickness_m: float, width_m: float,
-                   window_end_s: float, youngs_modulus_Pa: float = 200e9) -> dict[str, float]:
+                   window_end_s: float, youngs_modulus_Pa: float = THESIS_YOUNGS_MODULUS_PA
+                   ) -> dict[str, float]:
     """The error measures of :data:`MEASURES` plus their absolute values.
 
     Contract: ``rigid`` and ``ffrf`` map result paths (``time``, ``crank/angle``,
@@ -740,8 +752,9 @@ def equivalent_crank_plate(scene: Mapping[str, Mapping[str, Any]]) -> dict[str, 
     out = copy.deepcopy({k: dict(v) for k, v in scene.items()})
     crank = out["crank"]
     if crank["geometry"] == "lumped":
-        crank["thickness_m"] = crank["mass_kg"] / (crank["density_kg_per_m3"]
-                                                   * crank["length_m"] * crank["width_m"])
+        crank["thickness_m"] = plate_thickness_for_mass_m(crank["mass_kg"], crank["length_m"],
+                                                          crank["width_m"],
+                                                          crank["density_kg_per_m3"])
         crank["geometry"] = "plate"
     return out
 

@@ -61,3 +61,24 @@ def slider_crank(crank_length_m: float, coupler_length_m: float, crank_angle_rad
     a = (-crank_length_m * (np.cos(theta) * omega**2 + np.sin(theta) * alpha)
          - coupler_length_m * (np.cos(phi) * phi_dot**2 + np.sin(phi) * phi_ddot))
     return SliderCrankState(x, v, a, phi, phi_dot, phi_ddot)
+
+
+def crank_pin(crank_length_m: float, crank_angle_rad: float, crank_speed_rad_per_s: float = 0.0
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """Position [m] and velocity [m/s] of the crank pin B, (x, y) each:
+    ``L1 (cos theta, sin theta)`` and ``omega L1 (-sin theta, cos theta)``."""
+    position = np.array([crank_length_m * np.cos(crank_angle_rad),
+                         crank_length_m * np.sin(crank_angle_rad)])
+    velocity = crank_speed_rad_per_s * crank_length_m * np.array([-np.sin(crank_angle_rad),
+                                                                   np.cos(crank_angle_rad)])
+    return position, velocity
+
+
+def constant_speed_motion(crank_length_m: float, coupler_length_m: float,
+                          initial_angle_rad: float, crank_speed_rad_per_s: float, time_s,
+                          offset_m: float = 0.0) -> tuple[np.ndarray, SliderCrankState]:
+    """Crank angle ``theta0 + omega t`` [rad] at the times ``time_s`` [s] and the exact motion
+    (:func:`slider_crank`) of a crank turning at the constant speed ``omega`` [rad/s]."""
+    theta = initial_angle_rad + crank_speed_rad_per_s * np.asarray(time_s, dtype=float)
+    return theta, slider_crank(crank_length_m, coupler_length_m, theta, crank_speed_rad_per_s,
+                               0.0, offset_m)

@@ -31,7 +31,8 @@ from typing import Any
 import numpy as np
 
 from .errors import SceneError
-from .kinematics import slider_crank
+from .kinematics import crank_pin, slider_crank
+from .physics import cuboid_inertia_kgm2, cuboid_mass_kg
 from .scene import Scene, plate_mass_properties
 
 os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
@@ -59,9 +60,10 @@ def initial_configuration(scene: Scene) -> InitialConfiguration:
     drive = scene["drive"]
     omega = drive["crank_speed_rad_per_s"] if drive["kind"] == "constant_speed" else 0.0
     state = slider_crank(l1, l2, theta, omega, 0.0, offset_m)
-    joint_b = np.array([l1 * np.cos(theta), l1 * np.sin(theta), 0.0])
+    pin, pin_velocity = crank_pin(l1, theta, omega)
+    joint_b = np.array([*pin, 0.0])
     joint_c = np.array([float(state.slider_position_m), offset_m, 0.0])
-    vel_b = omega * l1 * np.array([-np.sin(theta), np.cos(theta), 0.0])
+    vel_b = np.array([*pin_velocity, 0.0])
     vel_c = np.array([float(state.slider_velocity_m_per_s), 0.0, 0.0])
     return InitialConfiguration(float(theta), float(state.coupler_angle_rad), joint_b, joint_c,
                                 float(omega), float(state.coupler_angular_velocity_rad_per_s),
@@ -149,9 +151,10 @@ def wing_mass_properties(scene: Scene) -> tuple[float, float, float]:
     pivot A, span along the crank direction, chord across it, thickness out of plane.
     """
     wing = scene["wing"]
-    mass_kg = wing["density_kg_per_m3"] * wing["span_m"] * wing["chord_m"] * wing["thickness_m"]
-    inertia_kgm2 = mass_kg * (wing["span_m"] ** 2 + wing["chord_m"] ** 2) / 12.0
-    return mass_kg, inertia_kgm2, wing["span_m"] / 2.0
+    mass_kg = cuboid_mass_kg(wing["span_m"], wing["chord_m"], wing["thickness_m"],
+                             wing["density_kg_per_m3"])
+    return mass_kg, cuboid_inertia_kgm2(mass_kg, wing["span_m"], wing["chord_m"]), \
+        wing["span_m"] / 2.0
 
 
 def _add_wing(mech: Mechanism, rigid_body, body_marker, crank_root: int) -> int:

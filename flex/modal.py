@@ -42,7 +42,23 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import physics
 from .errors import SceneError
+from .physics import BEAM_END_CONDITIONS  # noqa: F401 - part of this module's face
+from .thesis import (  # noqa: F401 - part of this module's face
+    THESIS_COUPLER_LENGTH_M,
+    THESIS_CRANK_LENGTH_M,
+    THESIS_DELTA_T_S,
+    THESIS_DENSITY_KG_PER_M3,
+    THESIS_K,
+    THESIS_K_COUPLER,
+    THESIS_K_CRANK,
+    THESIS_TABLE5,
+    THESIS_TABLE5_WIDTH_M,
+    THESIS_TABLE7_CRANK,
+    THESIS_TABLE9_COUPLER,
+    THESIS_YOUNGS_MODULUS_PA,
+)
 
 # ---------------------------------------------------------------------------------------------
 # Constants and thesis data
@@ -54,16 +70,11 @@ MODE_KINDS: tuple[str, ...] = ("axial", "in-plane bending", "out-of-plane bendin
 LINK_BOUNDARY_CONDITIONS: tuple[str, ...] = ("free-free", "pinned-pinned", "pinned-roller")
 """Boundary conditions of a whole link (3D FE model and :func:`beam_link_modes`)."""
 
-BEAM_END_CONDITIONS: tuple[str, ...] = (
-    "free-free", "pinned-pinned", "clamped-clamped", "clamped-free", "clamped-pinned")
-"""End conditions of one beam bending plane (first end - second end)."""
-
 ROD_END_CONDITIONS: tuple[str, ...] = ("free-free", "fixed-fixed", "fixed-free")
 """End conditions of axial and torsional (rod) vibration."""
 
-DEPLOYMENT_TIME_S = 0.016128
-"""Deployment time delta_t of the mechanism used in the thesis's criterion (Cavezza 2012,
-sec. 6.2, below Table 5), seconds."""
+DEPLOYMENT_TIME_S = THESIS_DELTA_T_S
+"""Deployment time delta_t of the thesis's criterion, s (:data:`flex.thesis.THESIS_DELTA_T_S`)."""
 
 SHEAR_CORRECTION_RECTANGLE = 5.0 / 6.0
 """Timoshenko shear correction factor of a rectangular cross-section (Poisson-independent
@@ -86,7 +97,7 @@ class Material:
     @property
     def shear_modulus_Pa(self) -> float:
         """G = E / (2 (1 + nu)), Pa."""
-        return self.youngs_modulus_Pa / (2.0 * (1.0 + self.poissons_ratio))
+        return physics.shear_modulus_Pa(self.youngs_modulus_Pa, self.poissons_ratio)
 
     def check(self) -> None:
         """Raise :class:`SceneError` unless E > 0, rho > 0 and -1 < nu < 0.5."""
@@ -100,60 +111,15 @@ class Material:
                 f"poissons_ratio = {self.poissons_ratio!r}: must lie in (-1, 0.5)")
 
 
-THESIS_STEEL = Material(youngs_modulus_Pa=200e9, density_kg_per_m3=7850.0, poissons_ratio=0.3)
+THESIS_STEEL = Material(youngs_modulus_Pa=THESIS_YOUNGS_MODULUS_PA,
+                        density_kg_per_m3=THESIS_DENSITY_KG_PER_M3, poissons_ratio=0.3)
 """Steel ASTM A36 of Cavezza 2012, Tables 6 and 8: E = 200 GPa, rho = 7850 kg/m^3. The thesis
 does not state Poisson's ratio; nu = 0.3 is our assumption (it enters only through G: shear
 deformation, torsion and 3D effects)."""
 
-THESIS_COUPLER_LENGTH_M = 0.080
-"""Coupler length L2 (Cavezza 2012, sec. 4), m. Also the length of the Table 5 plates."""
-
-THESIS_CRANK_LENGTH_M = 0.040
-"""Crank length L1 (Cavezza 2012, sec. 4), m."""
-
-THESIS_TABLE5_WIDTH_M = 0.010
-"""Width of the Table 5 plates ("0.08 x 0.01 x t"), m: out of the mechanism plane (z)."""
-
-# Cavezza 2012, Table 5 "Models Description", verbatim. "Frequency" has no unit in the thesis;
-# it equals the Euler-Bernoulli pinned-pinned circular frequency in rad/s (bending height t in
-# the mechanism plane), and the thesis's period is 1/Frequency (not 2 pi/omega).
-THESIS_TABLE5: dict[str, np.ndarray] = {
-    "model": np.array([0, 1, 2, 3]),
-    "coupler_length_m": np.array([0.08, 0.08, 0.08, 0.08]),
-    "coupler_width_m": np.array([0.01, 0.01, 0.01, 0.01]),
-    "coupler_thickness_m": np.array([0.001, 0.003, 0.005, 0.010]),
-    "frequency_as_published": np.array([2247.04282, 6741.12847, 11235.2141, 22470.4282]),
-    "period_as_published_s": np.array([0.00044503, 0.00014834, 0.000089006, 0.000044503]),
-    "n_as_published": np.array([36, 108, 181, 362]),
-    "verdict_as_published": np.array(["flexible", "rigid", "rigid", "rigid"]),
-}
-"""Cavezza 2012, Table 5: the four plate couplers 0.08 x 0.01 x t m, as published."""
-
-# Cavezza 2012, Table 7 "Modal Results" (crank, ANSYS BEAM188, 5 modes), verbatim. Units are
-# not stated ("TIME/FREQ"; ANSYS lists Hz there); the period column is 1/value, rounded.
-THESIS_TABLE7_CRANK: dict[str, np.ndarray] = {
-    "mode": np.array([1, 2, 3, 4, 5]),
-    "frequency_as_published": np.array([13254.0, 24536.0, 31598.0, 36431.0, 45426.0]),
-    "period_as_published_s": np.array([0.000075, 0.000040, 0.000031, 0.000027, 0.000022]),
-}
-"""Cavezza 2012, Table 7 (crank). The thesis derives k = 733 = 0.016128 / 0.000022 (Eq. 66)."""
-
-# Cavezza 2012, Table 9 "Modal Results" (coupler, ANSYS BEAM188, 5 modes), verbatim.
-THESIS_TABLE9_COUPLER: dict[str, np.ndarray] = {
-    "mode": np.array([1, 2, 3, 4, 5]),
-    "frequency_as_published": np.array([3548.4, 7631.5, 13922.0, 15799.0, 18215.0]),
-    "period_as_published_s": np.array([0.000281, 0.000131, 0.000071, 0.000063, 0.000054]),
-}
-"""Cavezza 2012, Table 9 (coupler). The thesis derives k = 299 = 0.016128 / 0.000054 (Eq. 67)."""
-
-THESIS_K_CRANK = 733
-"""Cavezza 2012, Eq. 66: k of the crank, delta_t over its fifth-mode "period"."""
-
-THESIS_K_COUPLER = 299
-"""Cavezza 2012, Eq. 67: k of the coupler, delta_t over its fifth-mode "period"."""
-
-THESIS_K_CRITERION = 108
-"""Cavezza 2012, sec. 6.2: the k chosen for the criterion (model 1 of Table 5)."""
+# The thesis's lengths, Tables 5, 7 and 9 and their k's live in flex.thesis (imported above).
+THESIS_K_CRITERION = int(THESIS_K)
+"""Cavezza 2012, sec. 6.2: the k chosen for the criterion (model 1 of Table 5), 108."""
 
 
 # ---------------------------------------------------------------------------------------------
@@ -205,17 +171,11 @@ class RectangleSection:
 
 def rectangle_torsion_constant_m4(height_m: float, width_m: float, series_terms: int = 50
                                   ) -> float:
-    """St-Venant torsion constant J of a solid rectangle, m^4.
-
-    J = a b^3 / 3 * (1 - 192 b / (pi^5 a) * sum_{n odd} tanh(n pi a / (2 b)) / n^5) with
-    a >= b the long and short sides (Timoshenko & Goodier). Square: J = 0.1406 a^4.
+    """St-Venant torsion constant J of a solid rectangle, m^4: the series of
+    :func:`flex.physics.rectangle_torsion_constant_m4` (Timoshenko & Goodier), sizes checked.
     """
     _check_positive(height_m=height_m, width_m=width_m)
-    long_side_m, short_side_m = max(height_m, width_m), min(height_m, width_m)
-    odd = np.arange(1, 2 * series_terms, 2, dtype=float)
-    series = np.sum(np.tanh(odd * math.pi * long_side_m / (2.0 * short_side_m)) / odd**5)
-    return (long_side_m * short_side_m**3 / 3.0
-            * (1.0 - 192.0 * short_side_m / (math.pi**5 * long_side_m) * series))
+    return physics.rectangle_torsion_constant_m4(height_m, width_m, series_terms)
 
 
 def rectangle_section(height_m: float, width_m: float) -> RectangleSection:
@@ -230,7 +190,7 @@ def rectangle_section(height_m: float, width_m: float) -> RectangleSection:
     return RectangleSection(
         height_m=height_m, width_m=width_m, area_m2=area_m2,
         second_moment_m4=second_moment_m4, second_moment_other_m4=second_moment_other_m4,
-        polar_moment_m4=second_moment_m4 + second_moment_other_m4,
+        polar_moment_m4=physics.rectangle_polar_moment_m4(height_m, width_m),
         torsion_constant_m4=rectangle_torsion_constant_m4(height_m, width_m))
 
 
@@ -242,33 +202,14 @@ def _brent_root(function, lower: float, upper: float) -> float:
 def euler_bernoulli_beta_l(end_condition: str, mode_count: int = 5) -> np.ndarray:
     """Dimensionless wave numbers beta_n L of an Euler-Bernoulli beam, n = 1..mode_count.
 
-    omega_n = (beta_n L)^2 / L^2 * sqrt(E I / (rho A)). Roots of: free-free and
-    clamped-clamped cos(bL) cosh(bL) = 1 (4.7300, 7.8532, ...; rigid modes excluded);
-    pinned-pinned bL = n pi; clamped-free cos cosh = -1 (1.8751, 4.6941, ...); clamped-pinned
-    tan(bL) = tanh(bL) (3.9266, 7.0686, ...).
+    omega_n = (beta_n L)^2 / L^2 * sqrt(E I / (rho A)). The roots of
+    :func:`flex.physics.euler_bernoulli_beta_l` (free-free and clamped-clamped 4.7300,
+    7.8532, ...; pinned-pinned n pi; clamped-free 1.8751, 4.6941, ...; clamped-pinned
+    3.9266, 7.0686, ...), inputs checked.
     """
     _check_choice("end_condition", end_condition, BEAM_END_CONDITIONS)
     _check_count("mode_count", mode_count)
-    modes = np.arange(1, mode_count + 1, dtype=float)
-    if end_condition == "pinned-pinned":
-        return modes * math.pi
-    roots = []
-    for n in modes:
-        if end_condition in ("free-free", "clamped-clamped"):
-            # cos x cosh x - 1 changes sign once in ((n + 0.5) pi - 0.5, (n + 0.5) pi + 0.5);
-            # cosh grows fast, so the root is within 0.02 of (n + 1/2) pi.
-            guess = (n + 0.5) * math.pi
-            roots.append(_brent_root(lambda x: math.cos(x) * math.cosh(x) - 1.0,
-                                     guess - 0.5, guess + 0.5))
-        elif end_condition == "clamped-free":
-            guess = (n - 0.5) * math.pi
-            roots.append(_brent_root(lambda x: math.cos(x) * math.cosh(x) + 1.0,
-                                     max(guess - 0.5, 1.0), guess + 0.5))
-        else:  # clamped-pinned
-            guess = (n + 0.25) * math.pi
-            roots.append(_brent_root(lambda x: math.tan(x) - math.tanh(x),
-                                     guess - 0.3, guess + 0.3))
-    return np.array(roots)
+    return np.array(physics.euler_bernoulli_beta_l(end_condition, int(mode_count)))
 
 
 def euler_bernoulli_bending_rad_per_s(
@@ -283,11 +224,9 @@ def euler_bernoulli_bending_rad_per_s(
     """
     _check_positive(length_m=length_m, height_m=height_m, width_m=width_m)
     material.check()
-    section = rectangle_section(height_m, width_m)
     beta_l = euler_bernoulli_beta_l(end_condition, mode_count)
-    return beta_l**2 / length_m**2 * math.sqrt(
-        material.youngs_modulus_Pa * section.second_moment_m4
-        / (material.density_kg_per_m3 * section.area_m2))
+    return physics.euler_bernoulli_omega(beta_l, length_m, height_m,
+                                         material.youngs_modulus_Pa, material.density_kg_per_m3)
 
 
 def _timoshenko_state_matrix(frequency_parameter: float, slenderness_sq: float,
@@ -424,8 +363,8 @@ def axial_rad_per_s(length_m: float, end_condition: str, mode_count: int = 5,
     modes = np.arange(1, mode_count + 1, dtype=float)
     if end_condition == "fixed-free":
         modes = modes - 0.5
-    return modes * math.pi / length_m * math.sqrt(
-        material.youngs_modulus_Pa / material.density_kg_per_m3)
+    return physics.axial_omega(modes, length_m, material.youngs_modulus_Pa,
+                               material.density_kg_per_m3)
 
 
 def torsion_rad_per_s(length_m: float, height_m: float, width_m: float, end_condition: str,
@@ -444,9 +383,9 @@ def torsion_rad_per_s(length_m: float, height_m: float, width_m: float, end_cond
     modes = np.arange(1, mode_count + 1, dtype=float)
     if end_condition == "fixed-free":
         modes = modes - 0.5
-    return modes * math.pi / length_m * math.sqrt(
-        material.shear_modulus_Pa * section.torsion_constant_m4
-        / (material.density_kg_per_m3 * section.polar_moment_m4))
+    return physics.torsion_omega(modes, length_m, material.shear_modulus_Pa,
+                                 section.torsion_constant_m4, section.polar_moment_m4,
+                                 material.density_kg_per_m3)
 
 
 @dataclass(frozen=True)
@@ -1269,8 +1208,8 @@ def _periods_and_counts(prefix: str, omega_rad_per_s: np.ndarray, deployment_tim
     the physical T = 2 pi / omega; n = delta_t / T; verdict "rigid" if n > k (Eq. 64-65)."""
     period_thesis_s = 1.0 / omega_rad_per_s
     period_physical_s = 2.0 * math.pi / omega_rad_per_s
-    n_thesis = deployment_time_s / period_thesis_s
-    n_physical = deployment_time_s / period_physical_s
+    n = physics.n_values(deployment_time_s, omega_rad_per_s)
+    n_thesis, n_physical = n["thesis"], n["physical"]
     return {
         f"{prefix}_period_thesis_convention_s": period_thesis_s,
         f"{prefix}_period_physical_s": period_physical_s,
@@ -1432,10 +1371,12 @@ def thesis_link_modal_reproduction(
         "thesis_value_as_published": values.copy(),
         "thesis_period_as_published_s": published["period_as_published_s"].copy(),
         "thesis_n_reading_Hz": deployment_time_s * values,
-        "thesis_n_reading_rad_per_s": deployment_time_s * values / (2 * math.pi),
+        "thesis_n_reading_rad_per_s": physics.n_values(deployment_time_s,
+                                                       values)["physical"],
         "thesis_k_as_published": np.array(thesis_k),
         "k_reading_Hz": np.array(deployment_time_s * values[-1]),
-        "k_reading_rad_per_s": np.array(deployment_time_s * values[-1] / (2 * math.pi)),
+        "k_reading_rad_per_s": np.array(physics.n_values(deployment_time_s,
+                                                         values[-1])["physical"]),
     }
     models: dict[str, tuple[np.ndarray, tuple[str, ...]]] = {}
     emulation = beam_element_modes(length_m, section_side_m, section_side_m,

@@ -1,14 +1,142 @@
 """Closed forms of beam and plate theory used across flex (numpy and math only).
 
-Each formula exists once, here; the library and the studies import it. Units are in the
-names; frequencies are circular [rad/s].
+Each formula exists once, here; the library and the studies import it (:mod:`flex.modal`
+adds the input checks of its public functions, Timoshenko beams and finite elements). Units
+are in the names; frequencies are circular [rad/s]. The thesis's own numbers are in
+:mod:`flex.thesis`.
+
+Theory: Euler-Bernoulli beams, elementary rods and St-Venant torsion as tabulated in
+Blevins, *Formulas for Natural Frequency and Mode Shape* (1979), ch. 8 (straight beams:
+the characteristic equations of the end conditions and their roots beta_n L); the torsion
+constant of a rectangle from Timoshenko & Goodier, *Theory of Elasticity* (3rd ed. 1970),
+ch. 10 (torsion of a rectangular bar); Euler buckling from Timoshenko & Gere, *Theory of
+Elastic Stability* (2nd ed. 1961), ch. 2 (Euler's column).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
 
 TWO_PI = 2.0 * math.pi
+
+BEAM_END_CONDITIONS: tuple[str, ...] = (
+    "free-free", "pinned-pinned", "clamped-clamped", "clamped-free", "clamped-pinned")
+"""End conditions of one beam bending plane (first end - second end)."""
+
+
+def _check_positive(**values: float) -> None:
+    for name, value in values.items():
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{name} = {value!r}: must be a finite number > 0")
+
+
+def shear_modulus_Pa(youngs_modulus_Pa: float, poisson_ratio: float) -> float:
+    """Shear modulus of an isotropic material, ``G = E / (2 (1 + nu))`` [Pa]."""
+    return youngs_modulus_Pa / (2.0 * (1.0 + poisson_ratio))
+
+
+def cuboid_mass_kg(length_m: float, thickness_m: float, width_m: float,
+                   density_kg_per_m3: float) -> float:
+    """Mass [kg] of a solid rectangular block (a plate link, the wing): ``rho L t w``."""
+    return density_kg_per_m3 * length_m * thickness_m * width_m
+
+
+def cuboid_inertia_kgm2(mass_kg: float, length_m: float, thickness_m: float) -> float:
+    """Moment of inertia [kg m^2] of a solid rectangular block about the axis through its
+    centre normal to its ``length x thickness`` face: ``m (L^2 + t^2) / 12``."""
+    return mass_kg * (length_m**2 + thickness_m**2) / 12.0
+
+
+def plate_thickness_for_mass_m(mass_kg: float, length_m: float, width_m: float,
+                               density_kg_per_m3: float) -> float:
+    """Thickness [m] of the plate of a given mass: ``m / (rho L w)`` (:func:`cuboid_mass_kg`
+    solved for t)."""
+    return mass_kg / (density_kg_per_m3 * length_m * width_m)
+
+
+def euler_buckling_load_N(length_m: float, thickness_m: float, width_m: float,
+                          youngs_modulus_Pa: float) -> float:
+    """Euler buckling load [N] of a pinned-pinned rectangular strut, buckling in-plane.
+
+    ``P_cr = pi^2 E I / L^2`` with ``I = w t^3 / 12`` (Timoshenko & Gere 1961, ch. 2; ``t``
+    the thickness in the mechanism plane, ``w`` the width across it).
+    """
+    _check_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
+                    youngs_modulus_Pa=youngs_modulus_Pa)
+    return math.pi**2 * youngs_modulus_Pa * width_m * thickness_m**3 / 12 / length_m**2
+
+
+def _bisect(function: Callable[[float], float], lower: float, upper: float) -> float:
+    """Root of ``function`` in [lower, upper] (it must change sign there), to the last bit."""
+    f_lower = function(lower)
+    if f_lower * function(upper) > 0:
+        raise ValueError(f"no sign change in [{lower!r}, {upper!r}]")
+    while True:
+        middle = 0.5 * (lower + upper)
+        if middle <= lower or middle >= upper:
+            return middle
+        f_middle = function(middle)
+        if f_middle == 0.0:
+            return middle
+        if (f_middle < 0.0) == (f_lower < 0.0):
+            lower, f_lower = middle, f_middle
+        else:
+            upper = middle
+
+
+def _sech(x: float) -> float:
+    """1 / cosh(x) without overflow for large x."""
+    decay = math.exp(-abs(x))
+    return 2.0 * decay / (1.0 + decay * decay)
+
+
+def euler_bernoulli_beta_l(end_condition: str, mode_count: int) -> list[float]:
+    """Wave numbers ``beta_n L`` of an Euler-Bernoulli beam, n = 1..mode_count (rad).
+
+    Roots of the characteristic equations (Blevins 1979, ch. 8): pinned-pinned
+    ``beta L = n pi``; free-free and clamped-clamped ``cos(bL) cosh(bL) = 1`` (4.7300,
+    7.8532, ...; the rigid-body root 0 of free-free excluded); clamped-free
+    ``cos(bL) cosh(bL) = -1`` (1.8751, 4.6941, ...); clamped-pinned ``tan(bL) = tanh(bL)``
+    (3.9266, 7.0686, ...). Solved by bisection to the last bit, as
+    ``cos x -+ sech x = 0`` and ``sin x - cos x tanh x = 0`` (no overflow, no poles).
+    """
+    if end_condition not in BEAM_END_CONDITIONS:
+        raise ValueError(f"end_condition = {end_condition!r}: must be one of "
+                         f"{', '.join(BEAM_END_CONDITIONS)}")
+    roots: list[float] = []
+    for n in range(1, mode_count + 1):
+        if end_condition == "pinned-pinned":
+            roots.append(float(n) * math.pi)
+        elif end_condition in ("free-free", "clamped-clamped"):
+            # one sign change within 0.5 of (n + 1/2) pi (the root is within 0.02 of it)
+            guess = (n + 0.5) * math.pi
+            roots.append(_bisect(lambda x: math.cos(x) - _sech(x), guess - 0.5, guess + 0.5))
+        elif end_condition == "clamped-free":
+            guess = (n - 0.5) * math.pi
+            roots.append(_bisect(lambda x: math.cos(x) + _sech(x), max(guess - 0.5, 1.0),
+                                 guess + 0.5))
+        else:  # clamped-pinned
+            guess = (n + 0.25) * math.pi
+            roots.append(_bisect(lambda x: math.sin(x) - math.cos(x) * math.tanh(x),
+                                 guess - 0.3, guess + 0.3))
+    return roots
+
+
+def euler_bernoulli_omega(beta_l: Any, length_m: float, height_m: float,
+                          youngs_modulus_Pa: float, density_kg_per_m3: float) -> Any:
+    """Bending circular frequency [rad/s] of a rectangular Euler-Bernoulli beam.
+
+    ``omega = (beta L / L)^2 sqrt(E I / (rho A))`` with ``I / A = h^2 / 12`` (Blevins 1979,
+    ch. 8; ``h`` the section's side along the bending displacement, the other side
+    cancels). ``beta_l``: a wave number of :func:`euler_bernoulli_beta_l` (a float or an
+    array of them).
+    """
+    return (beta_l / length_m) ** 2 * math.sqrt(youngs_modulus_Pa * height_m**2
+                                                / (12.0 * density_kg_per_m3))
 
 
 def pinned_pinned_omega(length_m: float, height_m: float, youngs_modulus_Pa: float,
@@ -17,29 +145,71 @@ def pinned_pinned_omega(length_m: float, height_m: float, youngs_modulus_Pa: flo
 
     Euler-Bernoulli: ``omega = (pi / L)^2 sqrt(E I / (rho A))`` with ``I / A = h^2 / 12``
     (``h`` the bending height, the plate thickness in the mechanism plane; the width
-    cancels). Thesis Table 5's "Frequency" column is this value. The finite-element value
-    of :class:`flex.reduction.Reduction` is within 2.4 % of it up to t = 10 mm (L/t = 8).
+    cancels). Thesis Table 5's "Frequency" column is this value (4.7e-6 higher: the thesis
+    took pi = 3.1416). The finite-element value of :class:`flex.reduction.Reduction` is
+    within 2.4 % of it up to t = 10 mm (L/t = 8).
     """
-    for name, value in (("length_m", length_m), ("height_m", height_m),
-                        ("youngs_modulus_Pa", youngs_modulus_Pa),
-                        ("density_kg_per_m3", density_kg_per_m3)):
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{name} = {value!r}: must be a finite number > 0")
-    return (math.pi / length_m) ** 2 * math.sqrt(youngs_modulus_Pa * height_m**2
-                                                 / (12.0 * density_kg_per_m3))
+    _check_positive(length_m=length_m, height_m=height_m,
+                    youngs_modulus_Pa=youngs_modulus_Pa, density_kg_per_m3=density_kg_per_m3)
+    return euler_bernoulli_omega(math.pi, length_m, height_m, youngs_modulus_Pa,
+                                 density_kg_per_m3)
 
 
-def n_values(delta_t_s: float, omega_rad_per_s: float) -> dict[str, float]:
-    """``{"thesis": delta_t * omega, "physical": delta_t * omega / (2 pi)}`` (dimensionless)."""
-    n_thesis = float(delta_t_s) * float(omega_rad_per_s)
+def rectangle_torsion_constant_m4(height_m: float, width_m: float, series_terms: int = 50
+                                  ) -> float:
+    """St-Venant torsion constant J [m^4] of a solid rectangle.
+
+    ``J = a b^3 / 3 (1 - 192 b / (pi^5 a) sum_{n odd} tanh(n pi a / (2 b)) / n^5)``, ``a >= b``
+    the long and short sides (Timoshenko & Goodier 1970, ch. 10, the exact series).
+    Square: ``J = 0.1406 a^4``.
+    """
+    long_side_m, short_side_m = max(height_m, width_m), min(height_m, width_m)
+    odd = np.arange(1, 2 * series_terms, 2, dtype=float)
+    series = np.sum(np.tanh(odd * math.pi * long_side_m / (2.0 * short_side_m)) / odd**5)
+    return float(long_side_m * short_side_m**3 / 3.0
+                 * (1.0 - 192.0 * short_side_m / (math.pi**5 * long_side_m) * series))
+
+
+def rectangle_polar_moment_m4(height_m: float, width_m: float) -> float:
+    """Polar moment of area [m^4] of a rectangle about its centre: ``w h^3/12 + h w^3/12``."""
+    return width_m * height_m**3 / 12.0 + height_m * width_m**3 / 12.0
+
+
+def torsion_omega(mode_number: Any, length_m: float, shear_modulus_Pa: float,
+                  torsion_constant_m4: float, polar_moment_m4: float,
+                  density_kg_per_m3: float) -> Any:
+    """St-Venant torsion circular frequency [rad/s] of a uniform bar (warping neglected).
+
+    ``omega = m pi / L sqrt(G J / (rho I_p))`` (Blevins 1979, ch. 8; the torsion constant J
+    in the stiffness, the polar moment I_p in the inertia): ``m = n`` for fixed-fixed and
+    free-free ends, ``m = n - 1/2`` for fixed-free (a float or an array).
+    """
+    return mode_number * math.pi / length_m * math.sqrt(
+        shear_modulus_Pa * torsion_constant_m4 / (density_kg_per_m3 * polar_moment_m4))
+
+
+def axial_omega(mode_number: Any, length_m: float, youngs_modulus_Pa: float,
+                density_kg_per_m3: float) -> Any:
+    """Axial (rod) circular frequency [rad/s]: ``omega = m pi / L sqrt(E / rho)``.
+
+    Elementary rod theory, no lateral inertia (Blevins 1979, ch. 8): ``m = n`` for fixed-fixed
+    and free-free ends, ``m = n - 1/2`` for fixed-free (a float or an array).
+    """
+    return mode_number * math.pi / length_m * math.sqrt(youngs_modulus_Pa / density_kg_per_m3)
+
+
+def n_values(delta_t_s: Any, omega_rad_per_s: Any) -> dict[str, Any]:
+    """The thesis's rigid-or-flexible count n = delta_t / T in both period conventions.
+
+    ``{"thesis": delta_t * omega, "physical": delta_t * omega / (2 pi)}`` (dimensionless):
+    the thesis (Cavezza 2012, sec. 6.2, Eq. 64-65, Table 5) takes T = 1/omega; the period
+    is T = 2 pi / omega. Scalars give floats, arrays arrays.
+    """
+    if np.ndim(delta_t_s) == 0 and np.ndim(omega_rad_per_s) == 0:
+        n_thesis = float(delta_t_s) * float(omega_rad_per_s)
+    else:
+        n_thesis = np.asarray(delta_t_s, dtype=float) * np.asarray(omega_rad_per_s, dtype=float)
     return {"thesis": n_thesis, "physical": n_thesis / TWO_PI}
-
-
-_CLAMPED_BETA_L = (4.730040745, 7.853204624, 10.99560784, 14.13716549, 17.27875966)
-
-
-def _clamped_beta_l(index: int) -> float:
-    return _CLAMPED_BETA_L[index] if index < len(_CLAMPED_BETA_L) else (index + 1.5) * math.pi
 
 
 def clamped_plate_frequencies(length_m: float, thickness_m: float, width_m: float,
@@ -48,22 +218,20 @@ def clamped_plate_frequencies(length_m: float, thickness_m: float, width_m: floa
     """Beam-theory estimates of the fixed-interface (both ends clamped) modes of a plate.
 
     Returns the ``count`` lowest ``(omega [rad/s], kind)`` with kind ``in_plane`` (bending
-    height t), ``out_of_plane`` (height w), ``torsion`` (St. Venant, J = b h^3 (1/3 - 0.21
-    h/b (1 - h^4/(12 b^4)))) or ``axial``: the order in which the Craig-Bampton
+    height t), ``out_of_plane`` (height w), ``torsion`` (St-Venant,
+    :func:`rectangle_torsion_constant_m4`) or ``axial``: the order in which the Craig-Bampton
     fixed-interface modes of :func:`flex.reduction.build_reduction` appear (estimates;
     shear and warping shift them by some per cent).
     """
     e, rho, length = youngs_modulus_Pa, density_kg_per_m3, length_m
-    shear = e / (2 * (1 + poisson_ratio))
-    b, h = max(width_m, thickness_m), min(width_m, thickness_m)
-    torsion_j = b * h**3 * (1 / 3 - 0.21 * h / b * (1 - h**4 / (12 * b**4)))
-    polar = width_m * thickness_m * (width_m**2 + thickness_m**2) / 12
+    shear = shear_modulus_Pa(e, poisson_ratio)
+    torsion_j = rectangle_torsion_constant_m4(thickness_m, width_m)
+    polar = rectangle_polar_moment_m4(thickness_m, width_m)
     modes: list[tuple[float, str]] = []
-    for index in range(count):
-        beta = _clamped_beta_l(index) / length
-        modes.append((beta**2 * math.sqrt(e * thickness_m**2 / (12 * rho)), "in_plane"))
-        modes.append((beta**2 * math.sqrt(e * width_m**2 / (12 * rho)), "out_of_plane"))
-        modes.append(((index + 1) * math.pi / length * math.sqrt(shear * torsion_j
-                                                                 / (rho * polar)), "torsion"))
-        modes.append(((index + 1) * math.pi / length * math.sqrt(e / rho), "axial"))
+    for index, beta_l in enumerate(euler_bernoulli_beta_l("clamped-clamped", count)):
+        modes.append((euler_bernoulli_omega(beta_l, length, thickness_m, e, rho), "in_plane"))
+        modes.append((euler_bernoulli_omega(beta_l, length, width_m, e, rho), "out_of_plane"))
+        modes.append((torsion_omega(index + 1, length, shear, torsion_j, polar, rho),
+                      "torsion"))
+        modes.append((axial_omega(index + 1, length, e, rho), "axial"))
     return sorted(modes)[:count]

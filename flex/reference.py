@@ -27,7 +27,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .errors import SimulationError
-from .kinematics import slider_crank
+from .kinematics import crank_pin, slider_crank
+from .physics import cuboid_inertia_kgm2, cuboid_mass_kg
 from .scene import Scene, plate_mass_properties
 from .settings import resolved_simulation
 
@@ -76,9 +77,9 @@ def crank_mass_properties(scene: Scene) -> tuple[float, float, float]:
     wing = scene.get("wing", {})
     if not wing.get("enabled", False):
         return mass_kg, inertia_kgm2, centre_m
-    wing_mass_kg = wing["density_kg_per_m3"] * wing["span_m"] * wing["chord_m"] \
-        * wing["thickness_m"]
-    wing_inertia_kgm2 = wing_mass_kg * (wing["span_m"] ** 2 + wing["chord_m"] ** 2) / 12
+    wing_mass_kg = cuboid_mass_kg(wing["span_m"], wing["chord_m"], wing["thickness_m"],
+                                  wing["density_kg_per_m3"])
+    wing_inertia_kgm2 = cuboid_inertia_kgm2(wing_mass_kg, wing["span_m"], wing["chord_m"])
     total_kg = mass_kg + wing_mass_kg
     combined_m = (mass_kg * centre_m + wing_mass_kg * wing["span_m"] / 2) / total_kg
     inertia = (inertia_kgm2 + mass_kg * (centre_m - combined_m) ** 2 + wing_inertia_kgm2
@@ -114,8 +115,7 @@ class SliderCrankDAE:
         th1, w1 = self.initial_crank_angle_rad, self.crank_speed_rad_per_s
         s = slider_crank(l1, l2, th1, w1, 0.0, self.offset_m)
         th2, w2 = float(s.coupler_angle_rad), float(s.coupler_angular_velocity_rad_per_s)
-        b = np.array([l1 * np.cos(th1), l1 * np.sin(th1)])
-        vb = w1 * l1 * np.array([-np.sin(th1), np.cos(th1)])
+        b, vb = crank_pin(l1, th1, w1)
         c = np.array([float(s.slider_position_m), self.offset_m])
         vc = np.array([float(s.slider_velocity_m_per_s), 0.0])
         share = self.crank_centre_m / l1  # crank centre of mass on the line A-B

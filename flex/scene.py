@@ -579,8 +579,10 @@ def meshed_plate(link: str, values: dict[str, Any]) -> tuple[float, str, str] | 
     if model != "auto":
         return None
     if link == "crank" and values["geometry"] == "lumped":
-        thickness = values["mass_kg"] / (values["density_kg_per_m3"] * values["length_m"]
-                                         * values["width_m"])
+        from .physics import plate_thickness_for_mass_m
+
+        thickness = plate_thickness_for_mass_m(values["mass_kg"], values["length_m"],
+                                               values["width_m"], values["density_kg_per_m3"])
         return (thickness, "the thickness of the plate of crank.mass_kg (mass / (density_kg_"
                 "per_m3 x length_m x width_m))", 'crank.model = "auto" meshes a lumped crank '
                 "as the plate of its mass")
@@ -650,9 +652,12 @@ def plate_mass_properties(scene: Scene, link: str = "coupler") -> tuple[float, f
     ``mass_kg`` and ``inertia_kgm2``; plate geometry computes them from length x thickness x
     width and density (a cuboid: m (L^2 + t^2)/12).
     """
+    from .physics import cuboid_inertia_kgm2, cuboid_mass_kg
+
     values = scene[link]
     if values["geometry"] == "lumped":
         return values["mass_kg"], values["inertia_kgm2"]
     length_m, thickness_m = values["length_m"], values["thickness_m"]
-    mass_kg = values["density_kg_per_m3"] * length_m * thickness_m * values["width_m"]
-    return mass_kg, mass_kg * (length_m**2 + thickness_m**2) / 12.0
+    mass_kg = cuboid_mass_kg(length_m, thickness_m, values["width_m"],
+                             values["density_kg_per_m3"])
+    return mass_kg, cuboid_inertia_kgm2(mass_kg, length_m, thickness_m)

@@ -20,12 +20,26 @@ from dataclasses import dataclass
 from typing import Literal
 
 from .errors import SceneError
+from .physics import TWO_PI, n_values
+from .thesis import (  # noqa: F401 - part of this module's face
+    THESIS_ACTIVE_COILS,
+    THESIS_ANGLE_MAX_TIME_S,
+    THESIS_COMPRESSION_M,
+    THESIS_DELTA_T_S,
+    THESIS_FREE_LENGTH_M,
+    THESIS_K,
+    THESIS_MUSIC_WIRE_DENSITY_KG_PER_M3,
+    THESIS_MUSIC_WIRE_YOUNGS_MODULUS_PA,
+    THESIS_SPRING_DIAMETER_M,
+    THESIS_SPRING_RATE_N_PER_M,
+    THESIS_WIRE_DIAMETER_M,
+)
 
 # --- Material: music wire, ASTM A228 --------------------------------------------------------
 #: Young's modulus, thesis Table 3 (206 842 710 000 Pa = 30.0 Mpsi).
-MUSIC_WIRE_YOUNGS_MODULUS_PA = 206.84e9
+MUSIC_WIRE_YOUNGS_MODULUS_PA = THESIS_MUSIC_WIRE_YOUNGS_MODULUS_PA
 #: Density, thesis Table 3.
-MUSIC_WIRE_DENSITY_KG_PER_M3 = 7861.09
+MUSIC_WIRE_DENSITY_KG_PER_M3 = THESIS_MUSIC_WIRE_DENSITY_KG_PER_M3
 #: Shear modulus: 79.3 GPa (11.5 Mpsi), the steel value of the project's datasheet check.
 #: Shigley table 10-5 lists 80-82.7 GPa for A228 depending on wire size; 79.3 GPa keeps the
 #: datasheet's numbers (367 N/m, 94 mm) reproducible. Implied Poisson ratio E/(2G) - 1 = 0.304.
@@ -44,18 +58,14 @@ MUSIC_WIRE_ALLOWABLE_TORSION_FRACTION_SET_NOT_REMOVED = 0.45
 MUSIC_WIRE_ALLOWABLE_TORSION_FRACTION_SET_REMOVED = 0.60
 
 # --- The thesis's spring (sec. 6.1, Table 2) and its use -------------------------------------
-THESIS_SPRING_RATE_N_PER_M = 1500.0  # Table 2 (unit printed as N/m^2, a typo)
-THESIS_FREE_LENGTH_M = 0.043  # sec. 6.1
-THESIS_WIRE_DIAMETER_M = 0.0044  # sec. 6.1
-THESIS_SPRING_DIAMETER_M = 0.150  # sec. 6.1 "spring diameter" (D_max); read as mean diameter
-THESIS_ACTIVE_COILS = 3.0  # sec. 6.1 "minimum number of coils"
-THESIS_COMPRESSION_M = 0.022  # sec. 6.1: top plate pressed 0.022 m, then released
-#: Deployment time used in the rigid-or-flexible criterion (sec. 6.3); its origin is unstated.
-THESIS_DEPLOYMENT_TIME_S = 0.016128
+# THESIS_SPRING_RATE_N_PER_M, THESIS_FREE_LENGTH_M, THESIS_WIRE_DIAMETER_M,
+# THESIS_SPRING_DIAMETER_M, THESIS_ACTIVE_COILS, THESIS_COMPRESSION_M: see flex.thesis.
+#: Deployment time used in the rigid-or-flexible criterion (sec. 6.2); its origin is unstated.
+THESIS_DEPLOYMENT_TIME_S = THESIS_DELTA_T_S
 #: Half swing of the spring-driven mechanism: crank angle maximum at ~0.0265 s (sec. 5.5.1).
-MECHANISM_HALF_SWING_TIME_S = 0.0265
+MECHANISM_HALF_SWING_TIME_S = THESIS_ANGLE_MAX_TIME_S
 #: Criterion constant of the thesis (Eq. 64-65): rigid if n = delta_t / T > 108.
-THESIS_RIGID_CRITERION_RATIO = 108.0
+THESIS_RIGID_CRITERION_RATIO = THESIS_K
 
 #: Shigley sec. 10-7: recommended design ranges (not enforced; reported by the checks).
 RECOMMENDED_SPRING_INDEX_RANGE = (4.0, 12.0)
@@ -487,10 +497,8 @@ def rigid_or_flexible_ratio(event_duration_s: float, frequency_Hz: float,
     """
     dt = _require_positive("event_duration_s", event_duration_s, "s")
     f = _require_positive("frequency_Hz", frequency_Hz, "Hz")
-    if period_convention == "physical":
-        return dt * f
-    if period_convention == "thesis":
-        return dt * 2.0 * math.pi * f
+    if period_convention in ("physical", "thesis"):
+        return n_values(dt, TWO_PI * f)[period_convention]
     raise SceneError(f"spring period_convention = {period_convention!r}: must be "
                      "'physical' (T = 1/f) or 'thesis' (T = 1/omega)")
 

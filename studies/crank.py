@@ -33,12 +33,13 @@ from typing import Any
 import numpy as np
 
 from flex import criteria
-from flex.plotting import figure
+from flex.plotting import MICRO, decade_ticks, legend_below, log_ticks, panels
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides
 from flex.settings import pinned_overrides
 from flex.simulation import simulate_case
 from flex.study import RESULTS_DIR, StudyRun, Summary
+from flex.thesis import THESIS_SPRING_RATE_N_PER_M
 
 NAME = "crank"
 DESCRIPTION = "flexible FFRF crank against auto's choice, with and without the wing"
@@ -51,8 +52,9 @@ FULL_MODES = 12
 #: fit scenes (all with the wing): (crank thickness [mm], spring rate [N/m]). Every
 #: thickness with both springs except 0.8 mm at 6000 N/m: that full FFRF run fails Newton at
 #: 17.9 ms (h = 2e-5 s), a failed case that would stop `make all`
-FIT_CASES = ((0.8, 1500.0), *((t, k) for t in (1.2, 1.8, 2.5, 3.5, 5.0)
-                               for k in (1500.0, 6000.0)))
+FIT_CASES = ((0.8, THESIS_SPRING_RATE_N_PER_M),
+             *((t, k) for t in (1.2, 1.8, 2.5, 3.5, 5.0)
+               for k in (THESIS_SPRING_RATE_N_PER_M, 6000.0)))
 #: validation scenes (not in the fit): name -> (overrides, fidelity tolerance)
 SCENES: dict[str, tuple[list[str], float]] = {
     "wing_t1mm_tol1pct": (["crank.thickness_m=0.001", "wing.enabled=true"], 0.01),
@@ -116,7 +118,7 @@ def fit_table(scenes: dict[str, Scene], results: dict[str, CaseResult]
                                           rigid_data["crank/angular_velocity"])
         omega = criteria.crank_elastic_omega(scene)
         row = errors(rigid_data, _data(full), scene["crank"]["length_m"])
-        row.update(n=times["stop"] * omega / (2 * np.pi), omega=omega,
+        row.update(n=criteria.n_values(times["stop"], omega)["physical"], omega=omega,
                    thickness=scene["crank"]["thickness_m"],
                    spring=scene["drive"]["spring_stiffness_N_per_m"])
         table[name] = row
@@ -276,28 +278,57 @@ def _fit_report(scenes: dict[str, Scene], results: dict[str, CaseResult],
     return lines
 
 
+def _scene_label(name: str) -> str:
+    """``wing_t1p5mm_tol0p1pct`` -> ``wing, t = 1.5 mm, tol. 0.1 %`` (legends spell names)."""
+    parts = name.replace("p", ".").split("_")
+    words = ["with wing" if part == "wing" else
+             f"t = {part[1:-2]} mm" if part.startswith("t") and part.endswith("mm") else
+             f"tolerance {part[3:-3]} %" if part.startswith("tol") else part
+             for part in parts]
+    if "with wing" not in words:
+        words.insert(0, "no wing")
+    return ", ".join(words)
+
+
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
+    drawn = [name for name in SCENES if results.get(f"{name}__full") is not None
+             and results[f"{name}__full"].status == "ok"]
     deflection = folder / "crank-deflection.png"
-    with figure(deflection, "full FFRF crank (12 modes): elastic midpoint deflection",
-                "time [ms]", "crank midpoint deflection [um]") as ax:
-        for name in SCENES:
+    # one panel per scene: the peaks differ by two orders of magnitude (700 um for the 1 mm
+    # crank carrying the wing, a few um for the thick ones)
+    rows = max(1, (len(drawn) + 1) // 2)
+    with panels(deflection, f"Elastic midpoint deflection of the full FFRF crank "
+                f"({FULL_MODES} modes): one panel, with its own scale, per validation scene",
+                rows=rows, cols=2, size=(10.0, 1.2 + 2.1 * rows), sharex=True) as (_, axes):
+        for index, (ax, name) in enumerate(zip(axes, drawn, strict=False)):
             full = results[f"{name}__full"]
-            if full.status == "ok":
-                ax.plot(full.datasets["time"].data * 1e3,
-                        full.datasets["crank/midpoint_deflection"].data * 1e6, label=name)
+            values = np.asarray(full.datasets["crank/midpoint_deflection"].data) * 1e6
+            ax.plot(np.asarray(full.datasets["time"].data) * 1e3, values, color=f"C{index}",
+                    lw=1.0)
+            ax.axhline(0.0, color="k", lw=0.5)
+            ax.set_title(f"{_scene_label(name)}: peak {np.abs(values).max():.3g} {MICRO}m",
+                         fontsize="small")
+            ax.set_ylabel(f"deflection [{MICRO}m]")
+        for ax in axes[len(drawn):]:
+            ax.set_visible(False)
+        for ax in axes[-2:]:
+            ax.set_xlabel("time [ms]")
+            ax.xaxis.set_tick_params(labelbottom=True)
     validation = folder / "crank-validation.png"
-    with figure(validation, "crank law and auto (validation: o rigid, s ffrf; red: above "
-                "tolerance)",
-                "n = delta_t / T (crank's first in-plane elastic mode in the mechanism)",
-                "error against the full FFRF crank") as ax:
+    with panels(validation, "Crank error law (fit: rigid crank carrying the wing) and the "
+                "validation of auto's rigid-or-FFRF choice on scenes outside the fit",
+                size=(8.5, 6.2)) as (fig, (ax,)):
         if "fit/n" in summary.datasets:
             n_fit = np.asarray(summary.datasets["fit/n"].data)
-            ax.loglog(n_fit, summary.datasets["fit/governing"].data, ".", color="0.5",
-                      label="fit: rigid crank with the wing")
+            ax.loglog(n_fit, summary.datasets["fit/governing"].data, ".", color="0.5", ms=7,
+                      label="fit cases: rigid crank against the full FFRF crank")
             grid = np.geomspace(n_fit.min(), n_fit.max(), 50)
-            law = float(summary.datasets["fit/coefficient"].data) \
-                * grid ** -float(summary.datasets["fit/exponent"].data)
-            ax.loglog(grid, law, "-", color="0.5", label="crank law (central)")
+            exponent = float(summary.datasets["fit/exponent"].data)
+            coefficient = float(summary.datasets["fit/coefficient"].data)
+            ax.loglog(grid, coefficient * grid ** -exponent, "-", color="0.5",
+                      label=f"crank law (central fit): e = {coefficient:.3g} "
+                            f"$n^{{-{exponent:.3g}}}$")
+        tolerances, numbered = set(), []
         for name in SCENES:
             key = f"validation/{name}"
             if f"{key}/n_physical" not in summary.datasets:
@@ -305,8 +336,28 @@ def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> l
             n = float(summary.datasets[f"{key}/n_physical"].data)
             error = max(float(summary.datasets[f"{key}/errors/governing"].data), 1e-9)
             tolerance = float(summary.datasets[f"{key}/tolerance"].data)
+            tolerances.add(tolerance)
             rigid = str(summary.datasets[f"{key}/choice"].data) == "rigid"
-            ax.loglog([n], [error], "o" if rigid else "s",
+            ax.loglog([n], [error], "o" if rigid else "s", ms=8,
                       color="C0" if error <= tolerance else "C3")
-            ax.annotate(f" {name}", (n, error), fontsize=7)
+            numbered.append((_scene_label(name),
+                             {"marker": f"${len(numbered) + 1}$", "ms": 7}))
+            ax.annotate(str(len(numbered)), (n, error), fontsize=8, xytext=(6, 5),
+                        textcoords="offset points", fontweight="bold")
+        for tolerance, style in zip(sorted(tolerances, reverse=True), ("--", ":", "-."),
+                                    strict=False):
+            ax.axhline(tolerance, color="k", lw=0.8, ls=style,
+                       label=f"tolerance {tolerance:.2g} ({tolerance * 100:g} %)")
+        ax.margins(x=0.12, y=0.15)
+        decade_ticks(ax, "y")
+        log_ticks(ax, "x")
+        ax.set_xlabel("n = \u0394t / T [-] (T: period of the crank's first in-plane elastic "
+                      "mode in the mechanism)")
+        ax.set_ylabel("governing relative error against the full FFRF crank [-]")
+        legend_below(fig, [("auto chose rigid", {"marker": "o", "color": "0.3", "ms": 7}),
+                           ("auto chose FFRF", {"marker": "s", "color": "0.3", "ms": 7}),
+                           ("blue: within the scene's tolerance",
+                            {"marker": "o", "color": "C0", "ms": 7}),
+                           ("red: above the scene's tolerance",
+                            {"marker": "o", "color": "C3", "ms": 7}), *numbered])
     return [deflection, validation]

@@ -20,28 +20,43 @@ from typing import Any
 
 import numpy as np
 
+from flex.criteria import first_maximum_index, half_swing_time
 from flex.plotting import figure
 from flex.reference import solve_reference
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, validate
 from flex.study import Summary
+from flex.thesis import (
+    THESIS_ANGLE_MAX_TIME_S,
+    THESIS_COMPRESSION_M,
+    THESIS_CONSTRAINT_NORM_MAX_M,
+    THESIS_CRANK_ANGLE_MAX_RAD,
+    THESIS_CRANK_SPEED_MAX_RAD_PER_S,
+    THESIS_CRANK_SPEED_MAX_TIME_S,
+    THESIS_DELTA_T_S,
+    THESIS_SLIDER_INITIAL_POSITION_M,
+    THESIS_SLIDER_TRAVEL_M,
+)
 
 NAME = "dynamics"
 DESCRIPTION = "spring-driven deployment, both preload readings, against the reference DAE"
 OVERRIDES: list[str] = []
-PRELOADS_M = {"preload_22mm": 0.022, "preload_11mm": 0.011}
+# sec. 6.1: the compression; sec. 5.5.1: half of it, so the slider travels 0.022 m
+PRELOADS_M = {"preload_22mm": THESIS_COMPRESSION_M, "preload_11mm": THESIS_SLIDER_TRAVEL_M / 2}
 
 # thesis sec. 5.5 (values read off its figures, "approx."); delta_t from sec. 6.2
 THESIS_ROWS = [
     # key, label, thesis value, unit
-    ("angle_max", "crank angle maximum", 1.09, "rad"),
-    ("angle_max_time", "time of crank angle maximum", 0.0265, "s"),
-    ("speed_max", "crank speed maximum", 29.0, "rad/s"),
-    ("speed_max_time", "time of crank speed maximum", 0.013, "s"),
-    ("slider_travel_at_angle_max", "slider displacement at angle maximum", 0.022, "m"),
-    ("slider_initial_position", "slider position at t = 0", 0.11, "m"),
-    ("constraint_norm_max", "norm of constraint equations", 1e-8, "m"),
-    ("half_swing_time", "deployment time delta_t (sec. 6.2)", 0.016128, "s"),
+    ("angle_max", "crank angle maximum", THESIS_CRANK_ANGLE_MAX_RAD, "rad"),
+    ("angle_max_time", "time of crank angle maximum", THESIS_ANGLE_MAX_TIME_S, "s"),
+    ("speed_max", "crank speed maximum", THESIS_CRANK_SPEED_MAX_RAD_PER_S, "rad/s"),
+    ("speed_max_time", "time of crank speed maximum", THESIS_CRANK_SPEED_MAX_TIME_S, "s"),
+    ("slider_travel_at_angle_max", "slider displacement at angle maximum",
+     THESIS_SLIDER_TRAVEL_M, "m"),
+    ("slider_initial_position", "slider position at t = 0", THESIS_SLIDER_INITIAL_POSITION_M,
+     "m"),
+    ("constraint_norm_max", "norm of constraint equations", THESIS_CONSTRAINT_NORM_MAX_M, "m"),
+    ("half_swing_time", "deployment time delta_t (sec. 6.2)", THESIS_DELTA_T_S, "s"),
 ]
 REASONS = {
     "angle_max": "22 mm: the spring stays attached and overshoots its free length, so the "
@@ -73,9 +88,9 @@ def cases(scene: Scene) -> dict[str, Scene]:
 def measures(data: dict[str, np.ndarray]) -> dict[str, float]:
     """The thesis's reported quantities, computed from one case's stored curves."""
     time_s, angle, speed = data["time"], data["crank/angle"], data["crank/angular_velocity"]
-    peak = int(np.argmax(angle))
-    half = angle[0] + 0.5 * (angle[peak] - angle[0])
-    half_time = float(np.interp(half, angle[:peak + 1], time_s[:peak + 1]))
+    peak = first_maximum_index(angle)
+    peak = len(angle) - 1 if peak is None else peak  # still rising: its last sample
+    half_time = half_swing_time(time_s, angle, peak)
     return {"angle_max": float(angle[peak]), "angle_max_time": float(time_s[peak]),
             "speed_max": float(speed.max()), "speed_max_time": float(time_s[np.argmax(speed)]),
             "slider_travel_at_angle_max": float(data["slider/displacement"][peak]),
@@ -155,56 +170,121 @@ def _fmt(value: float) -> str:
     return f"{value:.2e}" if abs(value) < 1e-3 else f"{value:.4g}"
 
 
+def _case_label(name: str) -> str:
+    """``preload_22mm`` -> ``preload 22 mm`` (figure legends spell case names out)."""
+    return name.replace("preload_", "spring preload ").replace("mm", " mm")
+
+
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
+    from flex.plotting import legend_below, panels, relative_drift, sparse_ticks
+
     ok = {n: {k: v.data for k, v in c.datasets.items()} for n, c in results.items()
           if c.status == "ok"}
+    colour = {name: f"C{index}" for index, name in enumerate(ok)}
     paths = []
 
-    def each(path, title, ylabel, key, column=None, xkey="time", xlabel="time [s]"):
-        with figure(folder / path, title, xlabel, ylabel) as ax:
+    def each(path, title, ylabel, key, scale=1.0):
+        with figure(folder / path, title, "time [s]", ylabel) as ax:
             for name, data in ok.items():
-                values = data[key] if column is None else data[key][:, column]
-                ax.plot(data[xkey] if xkey != key else values, values, label=name)
+                ax.plot(data["time"], np.asarray(data[key]) * scale, color=colour[name],
+                        label=_case_label(name))
         paths.append(folder / path)
 
-    with figure(folder / "dynamics-crank-angle.png", "Crank angle (thesis fig. 14)",
-                "time [s]", "crank angle [rad]") as ax:
+    with panels(folder / "dynamics-crank-angle.png",
+                "Crank angle: Exudyn against the reference DAE (thesis fig. 14)", rows=2,
+                size=(7.0, 6.0), sharex=True, gridspec_kw={"height_ratios": [3, 1.4]}
+                ) as (fig, (ax, difference)):
         for name, data in ok.items():
-            ax.plot(data["time"], data["crank/angle"], label=f"{name} (Exudyn)")
+            ax.plot(data["time"], data["crank/angle"], color=colour[name], lw=2.2,
+                    label=_case_label(name))
             reference = summary.datasets.get(f"reference/{name}/crank_angle")
             if reference is not None:
-                ax.plot(data["time"], reference.data, "k:", label=f"{name} (reference DAE)")
+                ax.plot(data["time"], reference.data, "k:", lw=1.2)
+                difference.plot(data["time"], (np.asarray(data["crank/angle"])
+                                               - np.asarray(reference.data)) * 1e6,
+                                color=colour[name], lw=1.0)
+        ax.set_ylabel("crank angle [rad]")
+        difference.set_ylabel("Exudyn \u2212\nreference [\u00b5rad]")
+        difference.set_xlabel("time [s]")
+        legend_below(fig, [("flex (Exudyn): solid, case colour",
+                            {"color": "0.5", "lw": 2.2, "linestyle": "-"}),
+                           ("reference DAE (9 coordinates, scipy): dotted",
+                            {"linestyle": ":", "lw": 1.2})])
     paths.append(folder / "dynamics-crank-angle.png")
     each("dynamics-crank-speed.png", "Crank angular velocity (thesis fig. 15)",
-         "angular velocity [rad/s]", "crank/angular_velocity")
+         "crank angular velocity [rad/s]", "crank/angular_velocity")
     each("dynamics-crank-acceleration.png", "Crank angular acceleration (thesis fig. 16)",
-         "angular acceleration [rad/s^2]", "crank/angular_acceleration")
-    each("dynamics-constraint-norm.png", "Norm of the constraint equations (thesis fig. 17)",
-         "norm [m]", "constraint_norm")
-    with figure(folder / "dynamics-crank-midpoint.png",
-                "Crank midpoint trajectory (thesis fig. 18)", "x [m]", "y [m]",
-                size=(5, 5)) as ax:
-        for name, data in ok.items():
-            ax.plot(*data["crank/midpoint_position"].T, label=name)
+         "crank angular acceleration [rad/s\u00b2]", "crank/angular_acceleration")
+    each("dynamics-constraint-norm.png",
+         "Norm of the position constraint equations (thesis fig. 17)",
+         "constraint norm [m]", "constraint_norm")
+    path = folder / "dynamics-crank-midpoint.png"
+    with panels(path, "Crank midpoint trajectory during the deployment (thesis fig. 18)",
+                size=(6.4, 4.5)) as (fig, (ax,)):
+        radius = max(np.hypot(*np.asarray(d["crank/midpoint_position"][0]) * 1e3)
+                     for d in ok.values()) if ok else 20.0
+        angle = np.linspace(0, np.pi, 181)
+        ax.plot(radius * np.cos(angle), radius * np.sin(angle), color="0.75", lw=0.8,
+                ls="--", label=f"circle of radius {radius:.3g} mm (crank pivot A at 0, 0)")
+        for index, (name, data) in enumerate(ok.items()):
+            midpoint = np.asarray(data["crank/midpoint_position"]) * 1e3
+            # the cases sweep the same arc: the later ones thinner and dashed on top
+            ax.plot(*midpoint.T, color=colour[name], lw=4.0 if index == 0 else 1.6,
+                    ls="-" if index == 0 else "--", alpha=0.6 if index == 0 else 1.0,
+                    label=f"{_case_label(name)} (x: t = {data['time'][-1]:g} s)")
+            ax.plot(*midpoint[-1], "x", color=colour[name], ms=9, mew=2)
+        if ok:
+            ax.plot(*np.asarray(next(iter(ok.values()))["crank/midpoint_position"][0]) * 1e3,
+                    "ko", ms=5, label="release (t = 0, both cases)")
+        ax.plot(0, 0, "k+", ms=10)
         ax.set_aspect("equal")
-    paths.append(folder / "dynamics-crank-midpoint.png")
+        ax.set_xlim(-radius * 1.1, radius * 1.1)
+        ax.set_ylim(-radius * 0.1, radius * 1.1)
+        sparse_ticks(ax)
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+        legend_below(fig)
+    paths.append(path)
     each("dynamics-slider-position.png", "Slider position (thesis fig. 19)",
-         "slider x [m]", "slider/position")
-    for joint, body, fig in (("A", "crank", 20), ("B", "crank", 21), ("B", "coupler", 22)):
+         "slider position x [m]", "slider/position")
+    for joint, body, fig_number in (("A", "crank", 20), ("B", "crank", 21),
+                                    ("B", "coupler", 22)):
         path = f"dynamics-force-{joint}-on-{body}.png"
-        with figure(folder / path, f"Reaction at {joint} on the {body} (thesis fig. {fig})",
-                    "time [s]", "force [N]") as ax:
+        with figure(folder / path, f"Reaction force at joint {joint} on the {body}, x and y "
+                    f"components (thesis fig. {fig_number})", "time [s]", "force [N]") as ax:
             for name, data in ok.items():
                 force = data[f"joints/{joint}/force_on_{body}"]
-                ax.plot(data["time"], force[:, 0], label=f"{name}: x")
-                ax.plot(data["time"], force[:, 1], "--", label=f"{name}: y")
+                ax.plot(data["time"], force[:, 0], "-", color=colour[name],
+                        label=_case_label(name))
+                ax.plot(data["time"], force[:, 1], "--", color=colour[name])
+            legend_below(ax.figure, [("x component (solid)", {"linestyle": "-"}),
+                                     ("y component (dashed)", {"linestyle": "--"})])
         paths.append(folder / path)
-    each("dynamics-force-B-modulus.png", "Modulus of the reaction at B (thesis fig. 23)",
-         "|force| [N]", "joints/B/force_modulus")
-    each("dynamics-energy.png", "Energy balance: kinetic + spring", "energy [J]",
-         "energy/total")
+    each("dynamics-force-B-modulus.png", "Modulus of the reaction force at joint B "
+         "(thesis fig. 23)", "|force at B| [N]", "joints/B/force_modulus")
+    path = folder / "dynamics-energy.png"
+    with panels(path, "Energy balance of the undamped deployment: kinetic + spring energy",
+                rows=2, size=(7.0, 6.5), sharex=True) as (fig, (energy, drift)):
+        for name, data in ok.items():
+            energy.plot(data["time"], data["energy/total"], "-", color=colour[name], lw=2,
+                        label=_case_label(name))
+            if "energy/kinetic" in data:
+                energy.plot(data["time"], data["energy/kinetic"], "--", color=colour[name])
+            if "energy/spring_potential" in data:
+                energy.plot(data["time"], data["energy/spring_potential"], ":",
+                            color=colour[name])
+            drift.plot(data["time"], relative_drift(data["energy/total"]), color=colour[name],
+                       label=_case_label(name))
+        energy.set_ylabel("energy [J]")
+        legend_below(fig, [("total energy, kinetic + spring (solid)",
+                            {"linestyle": "-", "lw": 2}),
+                           ("kinetic energy (dashed)", {"linestyle": "--"}),
+                           ("spring potential energy (dotted)", {"linestyle": ":"})])
+        drift.set_ylabel("relative drift of the total\n(E \u2212 E0) / E0 [-]")
+        drift.set_xlabel("time [s]")
+        drift.axhline(0.0, color="k", lw=0.6)
+    paths.append(path)
     return paths
-
 
 if __name__ == "__main__":
     from flex.cli import main

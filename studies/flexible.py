@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from flex.nonlinear import nonlinear_plate_for_scene
+from flex.physics import euler_buckling_load_N, n_values
 from flex.plotting import figure
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, validate
@@ -36,6 +37,7 @@ from flex.settings import pinned_overrides
 from flex.simulation import simulate_case
 from flex.solver import reduction_for_scene
 from flex.study import StudyRun, Summary
+from flex.thesis import THESIS_DELTA_T_S
 
 NAME = "flexible"
 DESCRIPTION = ("FFRF coupler plates t = 1, 3, 5, 10 mm against their rigid twins; nonlinear FE "
@@ -50,7 +52,7 @@ READS = ("coupler.length_m", "coupler.thickness_m", "coupler.width_m",
 # at most 2t; quadratic tetrahedra converge within 0.1 % there, see the modal study)
 MODELS = {"model0_t1mm": (0.001, 0.002), "model1_t3mm": (0.003, 0.003),
           "model2_t5mm": (0.005, 0.005), "model3_t10mm": (0.010, 0.005)}
-THESIS_DEPLOYMENT_TIME_S = 0.016128  # thesis sec. 6.2, Table 5 note
+THESIS_DEPLOYMENT_TIME_S = THESIS_DELTA_T_S  # thesis sec. 6.2, Table 5 note
 # the nonlinear FE reference: the thinnest plate (largest deflection, lowest Euler load)
 # over the whole deployment (None: the scene's end time; 0.002 covers the first peak). It
 # costs ~0.1 s per step against ~2 ms for the FFRF body: 4.6 min of CPU, 7.4 min wall on the
@@ -126,8 +128,8 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
         flex_data = {k: v.data for k, v in flex_case.datasets.items()}
         rigid_data = {k: v.data for k, v in rigid_case.datasets.items()}
         omega = 2 * np.pi * reduction.pinned_pinned_frequency_Hz
-        n_thesis = THESIS_DEPLOYMENT_TIME_S * omega
-        n_physical = n_thesis / (2 * np.pi)
+        n = n_values(THESIS_DEPLOYMENT_TIME_S, omega)
+        n_thesis, n_physical = n["thesis"], n["physical"]
         peak = np.abs(flex_data["coupler/midpoint_deflection"]).max()
         crank_dev = np.abs(flex_data["crank/angle"] - rigid_data["crank/angle"]).max()
         slider_dev = np.abs(flex_data["slider/position"] - rigid_data["slider/position"]).max()
@@ -160,10 +162,12 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
             datasets[f"{group}/{key}"] = Dataset(value, unit, text)
         lines.append(f"  {model:14s} {thickness_m * 1e3:6.0f} "
                      f"{reduction.pinned_pinned_frequency_Hz:10.1f} {n_thesis:9.1f} "
-                     f"{n_physical:8.2f} {peak * 1e6:15.3f} {peak / 0.08:9.2e} "
+                     f"{n_physical:8.2f} {peak * 1e6:15.3f} "
+                     f"{values['peak_deflection_over_length'][0]:9.2e} "
                      f"{crank_dev:13.2e} {stress / 1e6:11.2f} {wall:8.2f}")
     lines.append("  n thesis = delta_t * omega (thesis Table 5 takes T = 1/omega); "
-                 "n 2pi/w = delta_t / T with the physical period; delta_t = 0.016128 s")
+                 f"n 2pi/w = delta_t / T with the physical period; delta_t = "
+                 f"{THESIS_DEPLOYMENT_TIME_S:g} s")
     lines += nonlinear_reference(scene, results, datasets)
     return Summary(datasets, "\n".join(lines))
 
@@ -234,8 +238,8 @@ def nonlinear_reference(scene: Scene, results: dict[str, CaseResult],
     compression_N = np.einsum("ij,ij->i", flexible["joints/C/force_on_coupler"][:samples],
                               -chord)  # the slider pushes C toward B
     plate = cases(scene)[f"{model}_nonlinear_fe"]["coupler"]
-    euler_load_N = (np.pi**2 * plate["youngs_modulus_Pa"] * plate["width_m"]
-                    * plate["thickness_m"]**3 / 12 / plate["length_m"]**2)
+    euler_load_N = euler_buckling_load_N(plate["length_m"], plate["thickness_m"],
+                                         plate["width_m"], plate["youngs_modulus_Pa"])
     walls = {name: case.counters["wall_time_s"]
              for name, case in (("ffrf", flex_case), ("nonlinear_fe", nonlinear_case))}
     steps = {name: max(int(case.counters["steps"]), 1)
@@ -296,58 +300,91 @@ def nonlinear_reference(scene: Scene, results: dict[str, CaseResult],
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
+    from flex.plotting import MICRO, legend_below, panels
+
     ok = {n: {k: v.data for k, v in c.datasets.items()} for n, c in results.items()
           if c.status == "ok"}
     paths = []
-    path = folder / "flexible-midpoint-deflection.png"
-    with figure(path, "Elastic midpoint deflection of the coupler (cf. thesis figs. 47-50)",
-                "time [s]", "deflection [um]") as ax:
-        for model in MODELS:
-            data = ok.get(f"{model}_ffrf")
-            if data is not None:
-                ax.plot(data["time"], data["coupler/midpoint_deflection"] * 1e6, label=model)
-    paths.append(path)
+    um = f"{MICRO}m"
+    drawn = [model for model in MODELS if f"{model}_ffrf" in ok]
+    if drawn:
+        # per-model panels: the peaks differ by two orders of magnitude (180 um at 1 mm,
+        # under 1 um at 10 mm), one shared scale would flatten the stiffer plates
+        path = folder / "flexible-midpoint-deflection.png"
+        with panels(path, "Elastic midpoint deflection of the FFRF coupler, one panel per "
+                    "plate thickness (own scale each; cf. thesis figs. 47-50)",
+                    rows=len(drawn), size=(7.5, 1.4 + 1.9 * len(drawn)), sharex=True
+                    ) as (_, axes):
+            for index, (ax, model) in enumerate(zip(axes, drawn, strict=True)):
+                data = ok[f"{model}_ffrf"]
+                deflection = np.asarray(data["coupler/midpoint_deflection"]) * 1e6
+                ax.plot(data["time"], deflection, color=f"C{index}", lw=1.0)
+                ax.set_title(f"{_model_label(model)}: peak |deflection| "
+                             f"{np.abs(deflection).max():.3g} {um}", fontsize="small")
+                ax.set_ylabel(f"deflection [{um}]")
+                ax.axhline(0.0, color="k", lw=0.5)
+            axes[-1].set_xlabel("time [s]")
+        paths.append(path)
     for model in MODELS:
         flex_data, rigid_data = ok.get(f"{model}_ffrf"), ok.get(f"{model}_rigid")
         if flex_data is None or rigid_data is None:
             continue
         path = folder / f"flexible-midpoint-acceleration-{model}.png"
-        with figure(path, f"Coupler midpoint acceleration, {model} (cf. thesis figs. 35-42)",
-                    "time [s]", "acceleration [m/s^2]") as ax:
-            for column, axis in enumerate("xy"):
+        with panels(path, f"Coupler midpoint acceleration, {_model_label(model)}: FFRF "
+                    "coupler against its rigid twin (cf. thesis figs. 35-42)", rows=2,
+                    size=(7.5, 6.0), sharex=True) as (fig, axes):
+            for column, (ax, axis) in enumerate(zip(axes, "xy", strict=True)):
                 ax.plot(flex_data["time"], flex_data["coupler/midpoint_acceleration"][:, column],
-                        label=f"FFRF {axis}", lw=0.8)
+                        color="C0", lw=0.6, label="FFRF (flexible coupler)")
                 ax.plot(rigid_data["time"],
-                        rigid_data["coupler/midpoint_acceleration"][:, column], "--",
-                        label=f"rigid twin {axis}")
+                        rigid_data["coupler/midpoint_acceleration"][:, column], "k--", lw=1.4,
+                        label="rigid twin")
+                ax.set_ylabel(f"{axis} acceleration [m/s\u00b2]")
+            axes[-1].set_xlabel("time [s]")
+            legend_below(fig)
         paths.append(path)
     flex_data = ok.get(f"{NONLINEAR_MODEL}_ffrf")
     nonlinear_data = ok.get(f"{NONLINEAR_MODEL}_nonlinear_fe")
     if flex_data is not None and nonlinear_data is not None:
         path = folder / "flexible-nonlinear-reference.png"
         samples = len(nonlinear_data["time"])
-        with figure(path, f"Midpoint deflection, {NONLINEAR_MODEL}: FFRF against the "
-                    "nonlinear FE body", "time [s]", "deflection [um]") as ax:
+        with figure(path, f"Midpoint deflection, {_model_label(NONLINEAR_MODEL)}: FFRF "
+                    "(linear elastic body) against the nonlinear FE body",
+                    "time [s]", f"midpoint deflection [{um}]") as ax:
             ax.plot(flex_data["time"][:samples],
                     flex_data["coupler/midpoint_deflection"][:samples] * 1e6, label="FFRF")
             ax.plot(nonlinear_data["time"],
-                    nonlinear_data["coupler/midpoint_deflection"] * 1e6, "--",
+                    nonlinear_data["coupler/midpoint_deflection"] * 1e6, "k--",
                     label="nonlinear FE (reference)")
         paths.append(path)
     thickness, peak = [], []
     for model in MODELS:
         key = f"models/{model}/peak_midpoint_deflection"
         if key in summary.datasets:
-            thickness.append(summary.datasets[f"models/{model}/thickness_m"].data * 1e3)
-            peak.append(summary.datasets[key].data * 1e6)
+            thickness.append(float(summary.datasets[f"models/{model}/thickness_m"].data) * 1e3)
+            peak.append(float(summary.datasets[key].data) * 1e6)
     if thickness:
         path = folder / "flexible-peak-deflection.png"
-        with figure(path, "Peak elastic midpoint deflection against plate thickness",
-                    "thickness [mm]", "peak deflection [um]") as ax:
-            ax.loglog(thickness, peak, "o-")
+        with figure(path, "Peak elastic midpoint deflection of the coupler against plate "
+                    "thickness", "plate thickness t [mm] (log scale)",
+                    f"peak |midpoint deflection| [{um}]") as ax:
+            ax.loglog(thickness, peak, "o-", label="FFRF runs")
+            if len(thickness) >= 2 and min(peak) > 0:
+                slope, _ = np.polyfit(np.log(thickness), np.log(peak), 1)
+                ax.plot([], [], " ", label=f"fitted slope: peak \u221d $t^{{{slope:.2f}}}$")
+            ax.set_xticks(thickness, [f"{t:g}" for t in thickness])
+            ax.minorticks_off()
+            for t, p in zip(thickness, peak, strict=True):
+                ax.annotate(f"{p:.3g} {um}", (t, p), xytext=(6, 4), textcoords="offset points",
+                            fontsize="small")
         paths.append(path)
     return paths
 
+
+def _model_label(model: str) -> str:
+    """``model1_t3mm`` -> ``model 1, t = 3 mm`` (Table 5 model and plate thickness)."""
+    number, _, thickness = model.partition("_t")
+    return f"model {number.removeprefix('model')}, t = {thickness.removesuffix('mm')} mm"
 
 if __name__ == "__main__":
     from flex.cli import main

@@ -53,10 +53,14 @@ from flex.criteria import (
     ErrorLaw,
     fit_error_law,
 )
+from flex.physics import euler_buckling_load_N
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
 from flex.settings import pinned_overrides
 from flex.study import RESULTS_DIR, StudyRun, Summary
+from flex.thesis import THESIS_ANGLE_MAX_TIME_S, THESIS_DELTA_T_S
+from flex.thesis import THESIS_COMPRESSION_M as THESIS_PRELOAD_M  # sec. 6.1
+from flex.thesis import THESIS_SPRING_RATE_N_PER_M as THESIS_SPRING_N_PER_M  # Table 2
 
 SWEEP = True  # cases run on the sweep engine: --scheduler and --workers apply
 NAME = "kfit"
@@ -70,8 +74,6 @@ READS = ("coupler.length_m", "coupler.thickness_m", "coupler.width_m",
          "coupler.modes", "drive.spring_stiffness_N_per_m", "drive.spring_preload_m",
          "fidelity.tolerance")
 
-THESIS_SPRING_N_PER_M = 1500.0
-THESIS_PRELOAD_M = 0.022
 THICKNESSES_M = tuple(sorted({round(float(t), 6) for t in np.geomspace(0.5e-3, 12e-3, 20)}
                              | {1e-3, 3e-3, 5e-3, 10e-3}))
 THESIS_MODELS = {"model0": 1e-3, "model1": 3e-3, "model2": 5e-3, "model3": 10e-3}
@@ -138,7 +140,8 @@ def tuned(scene: Scene) -> Scene:
     omega = criteria.pinned_pinned_omega(coupler["length_m"], coupler["thickness_m"],
                                          coupler["youngs_modulus_Pa"],
                                          coupler["density_kg_per_m3"])
-    estimate = 0.0265 * math.sqrt(THESIS_SPRING_N_PER_M / drive["spring_stiffness_N_per_m"])
+    estimate = THESIS_ANGLE_MAX_TIME_S * math.sqrt(THESIS_SPRING_N_PER_M
+                                                   / drive["spring_stiffness_N_per_m"])
     estimate *= max(1.0, drive["spring_preload_m"] / THESIS_PRELOAD_M) ** 0.25
     step = min(1e-4, TWO_PI / omega / 40.0, estimate / 400.0)
     step = float(f"{step:.2g}")
@@ -166,8 +169,9 @@ def fit_cases(scene: Scene) -> dict[str, Scene]:
                  f"drive.spring_preload_m={THESIS_PRELOAD_M!r}"])
         for t in STIFFNESS_THICKNESSES_M:
             for k in STIFFNESSES_N_PER_M:
-                euler = math.pi**2 * scene["coupler"]["youngs_modulus_Pa"] * scene[
-                    "coupler"]["width_m"] * t**3 / 12 / scene["coupler"]["length_m"] ** 2
+                euler = euler_buckling_load_N(scene["coupler"]["length_m"], t,
+                                              scene["coupler"]["width_m"],
+                                              scene["coupler"]["youngs_modulus_Pa"])
                 if COMPRESSION_SHARE * k * THESIS_PRELOAD_M > SKIP_EULER_RATIO * euler:
                     continue
                 add(f"stf_t{_label(t, 1e3)}mm_k{k:.0f}_{z}",
@@ -175,8 +179,9 @@ def fit_cases(scene: Scene) -> dict[str, Scene]:
                      f"drive.spring_stiffness_N_per_m={k!r}",
                      f"drive.spring_preload_m={THESIS_PRELOAD_M!r}"])
         for t, k in FAST_CASES:
-            euler = math.pi**2 * scene["coupler"]["youngs_modulus_Pa"] * scene["coupler"][
-                "width_m"] * t**3 / 12 / scene["coupler"]["length_m"] ** 2
+            euler = euler_buckling_load_N(scene["coupler"]["length_m"], t,
+                                          scene["coupler"]["width_m"],
+                                          scene["coupler"]["youngs_modulus_Pa"])
             preload = min(THESIS_PRELOAD_M,
                           round(FAST_EULER_RATIO * euler / (COMPRESSION_SHARE * k), 4))
             add(f"stf_t{_label(t, 1e3)}mm_k{k:.0f}_{z}",
@@ -652,7 +657,9 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
         datasets[f"thesis/k_equivalent/{definition}/physical"] = Dataset(
             value, "1", "the thesis threshold (Table 5 model 1, t = 3 mm) as n = delta_t / T")
         datasets[f"thesis/k_equivalent/{definition}/thesis"] = Dataset(
-            value * TWO_PI, "1", "same in the thesis convention (108 with delta_t = 0.016128)")
+            value * TWO_PI, "1",
+            f"same in the thesis convention ({criteria.THESIS_K:g} with delta_t = "
+            f"{THESIS_DELTA_T_S:g})")
     datasets["thesis/k"] = Dataset(criteria.THESIS_K, "1", "thesis sec. 6.2, n = delta_t*omega")
 
     # report: the laws (primary delta_t)
@@ -742,8 +749,21 @@ def _validation_report(results: dict[str, CaseResult], datasets: dict[str, Datas
 # ------------------------------------------------------------------------------------------
 # figures
 # ------------------------------------------------------------------------------------------
+#: the case families' prefixes spelt out for figures (see the module doc)
+FAMILY_NAMES = {"thk": "thickness sweep", "stf": "spring stiffness sweep",
+                "pre": "preload sweep"}
+#: the error measures as axis labels (definitions: flex.criteria.MEASURES)
+MEASURE_LABELS = {GOVERNING: "governing error = largest of\ndeflection, angle, slider [-]",
+                  "deflection": "peak deflection\n/ coupler length L2 [-]",
+                  "crank_angle": "crank angle error\n/ crank swing [-]",
+                  "slider_position": "slider position error\n/ slider travel [-]",
+                  "stress_amplification": "|stress amplification\n\u2212 1| [-]"}
+
+
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
     import matplotlib.pyplot as plt
+
+    from flex.plotting import decade_ticks, legend_below, save, wrap
 
     analysis = summary.figure_data.get("analysis") or analyse(results)
     data, fits = analysis["table"], analysis["fits"]
@@ -753,8 +773,8 @@ def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> l
     paths = []
     path = folder / "kfit-error-vs-n.png"
     measures = [GOVERNING, "deflection", "crank_angle", "slider_position", "stress_amplification"]
-    fig, axes = plt.subplots(len(measures), 1, figsize=(8, 3.2 * len(measures)),
-                             layout="constrained")
+    fig, axes = plt.subplots(len(measures), 1, figsize=(8.5, 2.9 * len(measures) + 2.2),
+                             layout="constrained", sharex=True)
     n_all = data["n_physical/stop"]
     grid = np.geomspace(max(n_all.min() / 2, 1e-2), n_all.max() * 2, 200)
     styles = {"thk": "o", "stf": "s", "pre": "^"}
@@ -767,80 +787,114 @@ def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> l
                                                             zeta)
                 if rows.any():
                     ax.loglog(n_all[rows], np.abs(values[rows]), marker, color=color,
-                              mfc="none" if fam != "thk" else color, ms=5, alpha=0.8,
-                              label=f"{fam} zeta={zeta:g}")
+                              mfc="none" if fam != "thk" else color, ms=5, alpha=0.8)
         excluded = ~data["fitted"]
         if excluded.any():
-            ax.loglog(n_all[excluded], np.abs(values[excluded]), "x", color="red", ms=7,
-                      label="not fitted (deflection > 5 % L2 or P > 0.25 P_euler)")
+            ax.loglog(n_all[excluded], np.abs(values[excluded]), "x", color="red", ms=7)
         for zeta, color in colors.items():
             law = fits.get((zeta, "stop", measure))
             if law is None:
                 continue
             lower, upper = law.band(grid, kind="prediction")
             ax.loglog(grid, law.predict(grid), "-", color=color,
-                      label=f"fit zeta={zeta:g}: p={law.exponent:.2f}")
+                      label=f"fit \u03b6 = {zeta:g}: p = {law.exponent:.2f}")
             ax.fill_between(grid, lower, upper, color=color, alpha=0.12)
         for model, thickness in THESIS_MODELS.items():
             name = f"thk_t{_label(thickness, 1e3)}mm_z0"
             rows = data["name"] == name
             if rows.any():
                 ax.loglog(n_all[rows], np.abs(values[rows]), "*", color="k", ms=12)
-                ax.annotate(model, (n_all[rows][0], abs(values[rows][0])), fontsize=7,
+                ax.annotate(model.replace("model", "model "),
+                            (n_all[rows][0], abs(values[rows][0])), fontsize=7,
                             xytext=(4, 4), textcoords="offset points")
         if math.isfinite(thesis_k):
-            ax.axvline(thesis_k, color="k", ls="--", lw=1,
-                       label=f"thesis k=108 (model 1) = n {thesis_k:.3g}")
-        ax.set_ylabel(measure.replace("_", " ") + " [1]")
-        ax.grid(True, which="both", alpha=0.3)
-        secondary = ax.secondary_xaxis("top", functions=(lambda n: n * TWO_PI,
-                                                         lambda n: n / TWO_PI))
-        secondary.set_xlabel("n thesis = delta_t * omega" if measure == GOVERNING else "")
-    axes[0].set_title("Rigid-model error against n (delta_t: first crank-angle maximum; "
-                      "band: 95 % prediction)", fontsize="medium")
-    axes[0].legend(fontsize="x-small", ncol=3)
-    axes[-1].set_xlabel("n = delta_t / T, T = 2 pi / omega")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+            ax.axvline(thesis_k, color="k", ls="--", lw=1)
+        ax.set_ylabel(MEASURE_LABELS.get(measure, measure.replace("_", " ") + " [-]"))
+        ax.grid(True, which="major", alpha=0.3)
+        decade_ticks(ax, "y")
+        floor = any(law.with_floor for (_, d, m), law in fits.items()
+                    if d == "stop" and m == measure)
+        ax.legend(fontsize="x-small", loc="lower left", title_fontsize="x-small",
+                  title="error law $e = $" + ("floor + " if floor else "") + "$c\\,n^{-p}$")
+    secondary = axes[0].secondary_xaxis("top", functions=(lambda n: n * TWO_PI,
+                                                          lambda n: n / TWO_PI))
+    secondary.set_xlabel("n in the thesis convention = \u0394t \u00b7 \u03c9 [-]")
+    decade_ticks(axes[-1], "x")
+    fig.suptitle(wrap("Rigid-coupler error against n = \u0394t / T (\u0394t: time to the first "
+                      "crank-angle maximum; bands: 95 % prediction)", 8.5))
+    axes[-1].set_xlabel("n = \u0394t / T [-], T = 2\u03c0 / \u03c9 (period of the coupler's "
+                        "first bending mode)")
+    legend_below(fig, [(f"{FAMILY_NAMES[fam]} ({shape})",
+                        {"marker": marker, "mfc": "k" if fam == "thk" else "none", "ms": 6})
+                       for fam, marker, shape in (("thk", "o", "filled circles"),
+                                                  ("stf", "s", "open squares"),
+                                                  ("pre", "^", "open triangles"))]
+                 + [("colour: undamped (\u03b6 = 0)",
+                     {"marker": "s", "color": "tab:blue", "ms": 7}),
+                    ("colour: 2 % modal damping (\u03b6 = 0.02)",
+                     {"marker": "s", "color": "tab:orange", "ms": 7}),
+                    ("not fitted: deflection > 5 % of L2 or compression > 0.25 Euler "
+                     "buckling load", {"marker": "x", "color": "red", "ms": 7}),
+                    ("thesis Table 5 models 0-3 (t = 1, 3, 5, 10 mm, undamped)",
+                     {"marker": "*", "ms": 10}),
+                    (f"thesis threshold k = 108 (model 1) = n {thesis_k:.3g}",
+                     {"linestyle": "--"})], ncol=2, collect=False)
+    save(fig, path)
     paths.append(path)
 
     path = folder / "kfit-k-vs-tolerance.png"
     tolerances = np.geomspace(1e-5, 0.2, 60)
-    fig, ax = plt.subplots(figsize=(8, 5), layout="constrained")
-    for measure, style in ((GOVERNING, "-"), ("deflection", "--"), ("crank_angle", ":"),
-                           ("slider_position", "-."), ("stress_amplification", (0, (1, 4)))):
+    fig, ax = plt.subplots(figsize=(8.5, 6.8), layout="constrained")
+    measure_styles = ((GOVERNING, "-"), ("deflection", "--"), ("crank_angle", ":"),
+                      ("slider_position", "-."),
+                      ("stress_amplification", (0, (6, 2, 1, 2, 1, 2))))
+    entries, floors = [], []
+    for measure, style in measure_styles:
+        entries.append((MEASURE_LABELS[measure].replace("\n", " ").replace(" [-]", ""),
+                        {"linestyle": style, "lw": 2 if measure == GOVERNING else 1.2}))
         for zeta, color in colors.items():
             law = fits.get((zeta, "stop", measure))
             if law is None:
                 continue
             ks = np.array([law.k(t) for t in tolerances])
             finite = np.isfinite(ks)
-            label = f"{measure} zeta={zeta:g}"
-            if law.with_floor:
-                label += f" (none below the floor {law.floor:.2g})"
             ax.loglog(tolerances[finite], ks[finite], linestyle=style, color=color,
-                      lw=2 if measure == GOVERNING else 1, label=label)
+                      lw=2 if measure == GOVERNING else 1)
+            if law.with_floor:
+                floors.append((f"stress amplification, \u03b6 = {zeta:g}: no k below its "
+                               f"error floor {law.floor:.2g}", {"linestyle": "none"}))
             if measure == GOVERNING:
                 upper = [law.k(t, bound="upper") for t in tolerances]
-                ax.loglog(tolerances, upper, linestyle=style, color=color, alpha=0.4, lw=4,
-                          label=f"governing zeta={zeta:g}, conservative")
+                ax.loglog(tolerances, upper, linestyle=style, color=color, alpha=0.4, lw=5)
     if math.isfinite(thesis_k):
-        ax.axhline(thesis_k, color="k", ls="--", lw=1, label=f"thesis k=108 -> n {thesis_k:.3g}")
+        ax.axhline(thesis_k, color="k", ls="--", lw=1)
     for tolerance in TOLERANCES:
         ax.axvline(tolerance, color="grey", lw=0.5)
-    ax.set_xlabel("tolerance (dimensionless error)")
-    ax.set_ylabel("k = smallest n = delta_t / T for rigid")
+    ax.set_xlabel("tolerance on the error measure [-]")
+    ax.set_ylabel("threshold k: smallest n = \u0394t / T for a rigid coupler [-]")
     secondary = ax.secondary_yaxis("right", functions=(lambda n: n * TWO_PI,
                                                        lambda n: n / TWO_PI))
-    secondary.set_ylabel("k, thesis convention (delta_t * omega)")
-    ax.set_title("Threshold k against tolerance (delta_t = first crank-angle maximum)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize="x-small", ncol=2, loc="lower left")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    secondary.set_ylabel("k in the thesis convention, \u0394t \u00b7 \u03c9 [-]")
+    ax.set_title(wrap("Threshold k against tolerance, per error measure (\u0394t: time to the "
+                      "first crank-angle maximum)", 8.5))
+    ax.grid(True, which="major", alpha=0.3)
+    decade_ticks(ax)
+    legend_below(fig, [*entries,
+                       ("governing, conservative (95 % prediction band)",
+                        {"linestyle": "-", "lw": 5, "alpha": 0.4}),
+                       ("colour: undamped (\u03b6 = 0)",
+                        {"marker": "s", "color": "tab:blue", "ms": 7}),
+                       ("colour: 2 % modal damping (\u03b6 = 0.02)",
+                        {"marker": "s", "color": "tab:orange", "ms": 7}),
+                       (f"thesis threshold k = 108 (model 1) = n {thesis_k:.3g}",
+                        {"linestyle": "--"}),
+                       (f"tolerances tabulated in the report "
+                        f"({', '.join(f'{t:g}' for t in TOLERANCES)})",
+                        {"linestyle": "-", "color": "grey", "lw": 0.5}),
+                       *floors], ncol=2)
+    save(fig, path)
     paths.append(path)
     return paths
-
 
 if __name__ == "__main__":
     from flex.cli import main

@@ -13,11 +13,12 @@ from typing import Any
 
 import numpy as np
 
-from flex.kinematics import slider_crank
-from flex.plotting import figure
+from flex.kinematics import constant_speed_motion
+from flex.plotting import panels, scaled, sparse_ticks
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene
 from flex.study import Summary
+from flex.thesis import THESIS_SLIDER_KINEMATICS
 
 NAME = "kinematics"
 DESCRIPTION = "constant-speed crank, one turn per second, against the closed form"
@@ -26,8 +27,7 @@ OVERRIDES = ['drive.kind="constant_speed"', "drive.crank_speed_rad_per_s=6.28318
              "simulation.step_s=1e-4", "simulation.output_step_s=1e-3"]
 
 # thesis sec. 4.3-4.4 (MATLAB and SolidWorks agree)
-THESIS = {"stroke_m": 0.080, "velocity_max_m_per_s": 0.28, "velocity_min_m_per_s": -0.28,
-          "acceleration_max_m_per_s2": 1.2, "acceleration_min_m_per_s2": -2.3}
+THESIS = THESIS_SLIDER_KINEMATICS
 
 
 def cases(scene: Scene) -> dict[str, Scene]:
@@ -36,10 +36,10 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def closed_form(scene: Scene, time_s: np.ndarray):
     """Closed-form slider motion at the scene's constant crank speed."""
-    omega = scene["drive"]["crank_speed_rad_per_s"]
-    theta = np.radians(scene["crank"]["initial_angle_deg"]) + omega * time_s
-    return slider_crank(scene["crank"]["length_m"], scene["coupler"]["length_m"], theta, omega,
-                        0.0, scene["slider"]["offset_m"])
+    return constant_speed_motion(scene["crank"]["length_m"], scene["coupler"]["length_m"],
+                                 np.radians(scene["crank"]["initial_angle_deg"]),
+                                 scene["drive"]["crank_speed_rad_per_s"], time_s,
+                                 scene["slider"]["offset_m"])[1]
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
@@ -90,31 +90,75 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    data = {k: v.data for k, v in results["constant_speed"].datasets.items()}
+    case = results["constant_speed"]
+    data = {k: v.data for k, v in case.datasets.items()}
     closed = {k: v.data for k, v in summary.datasets.items()}
     paths = []
     for key, label, unit, fig in (("position", "Slider position", "m", 4),
                                   ("velocity", "Slider velocity", "m/s", 5),
-                                  ("acceleration", "Slider acceleration", "m/s^2", 6)):
+                                  ("acceleration", "Slider acceleration", "m/s\u00b2", 6)):
         path = folder / f"kinematics-slider-{key}.png"
-        with figure(path, f"{label} (thesis fig. {fig})", "time [s]",
-                    f"slider {key} [{unit}]") as ax:
-            ax.plot(data["time"], data[f"slider/{key}"], label="flex (Exudyn)")
-            ax.plot(data["time"], closed[f"closed_form/slider_{key}"], "--",
-                    label="closed form")
+        with panels(path, f"{label}: Exudyn against the closed form (thesis fig. {fig})",
+                    rows=2, size=(7.0, 5.5), sharex=True,
+                    gridspec_kw={"height_ratios": [3, 1.3]}) as (_, (ax, difference)):
+            ax.plot(data["time"], data[f"slider/{key}"], lw=2.2, label="flex (Exudyn)")
+            ax.plot(data["time"], closed[f"closed_form/slider_{key}"], "k--", lw=1.0,
+                    label="closed form (in-line slider-crank)")
+            ax.set_ylabel(f"slider {key} [{unit}]")
+            error, error_unit = scaled(data[f"slider/{key}"]
+                                       - closed[f"closed_form/slider_{key}"], unit)
+            difference.plot(data["time"], error, color="C3", lw=0.8)
+            difference.set_ylabel(f"Exudyn \u2212 closed\nform [{error_unit}]")
+            difference.set_xlabel("time [s]")
         paths.append(path)
     path = folder / "kinematics-crank-midpoint.png"
-    with figure(path, "Crank midpoint trajectory (thesis fig. 7)", "x [m]", "y [m]",
-                size=(5, 5)) as ax:
-        ax.plot(*data["crank/midpoint_position"].T)
+    midpoint_mm = np.asarray(data["crank/midpoint_position"]) * 1e3
+    radius_mm = _crank_length_m(case) / 2 * 1e3
+    deviation_m = np.abs(np.hypot(*midpoint_mm.T) - radius_mm).max() * 1e-3
+    with panels(path, "Crank midpoint trajectory, one crank turn (thesis fig. 7)",
+                size=(5.2, 6.0)) as (fig, (ax,)):
+        angle = np.linspace(0, 2 * np.pi, 361)
+        ax.plot(radius_mm * np.cos(angle), radius_mm * np.sin(angle), color="0.6", lw=4,
+                alpha=0.5, label=f"circle of radius L1/2 = {radius_mm:g} mm")
+        ax.plot(*midpoint_mm.T, color="C0", lw=1.2,
+                label=f"flex (Exudyn): max |r \u2212 L1/2| = {deviation_m:.1g} m")
+        ax.plot(*midpoint_mm[0], "o", color="C0", label="start (t = 0)")
         ax.set_aspect("equal")
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+        sparse_ticks(ax)
+        limit = radius_mm * 1.12
+        ax.set_xlim(-limit, limit)
+        ax.set_ylim(-limit, limit)
+        fig.legend(fontsize="small", loc="outside lower center")
     paths.append(path)
     path = folder / "kinematics-constraint-norm.png"
-    with figure(path, "Norm of the constraint equations", "time [s]", "norm [m]") as ax:
-        ax.semilogy(data["time"], np.maximum(data["constraint_norm"], 1e-20))
+    norm = np.asarray(data["constraint_norm"], dtype=float)
+    floor = 1e-20
+    low = norm < floor
+    with panels(path, "Norm of the position constraint equations (round-off level)",
+                size=(7.0, 5.0)) as (fig, (ax,)):
+        ax.semilogy(data["time"][~low], norm[~low], ".", ms=2.5, label="flex (Exudyn)")
+        if low.any():
+            ax.semilogy(data["time"][low], np.full(np.count_nonzero(low), floor), "v",
+                        ms=3, color="C1", label=f"below {floor:g} m (incl. exactly 0): "
+                                                f"{np.count_nonzero(low)} of {norm.size} "
+                                                f"samples, drawn at {floor:g} m")
+        ax.axhline(np.finfo(float).eps * 0.1, color="k", ls=":", lw=0.8,
+                   label="machine epsilon \u00d7 0.1 m (round-off of the link lengths)")
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel("constraint norm [m]")
+        ax.set_ylim(floor / 3, None)
+        fig.legend(fontsize="small", loc="outside lower center")
     paths.append(path)
     return paths
 
+
+def _crank_length_m(case: CaseResult) -> float:
+    """The crank length L1 of a case's scene (the trajectory's expected radius is L1/2)."""
+    import tomllib
+
+    return float(tomllib.loads(case.scene_toml)["crank"]["length_m"])
 
 if __name__ == "__main__":
     from flex.cli import main

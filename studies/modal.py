@@ -147,46 +147,108 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
+    from flex.plotting import decade_ticks
+
     s = {k: v.data for k, v in summary.datasets.items()}
     paths = []
     thickness_mm = s["table5/coupler_thickness_m"] * 1e3
     path = folder / "modal-table5.png"
-    with figure(path, "First pinned-pinned in-plane bending frequency of the coupler",
-                "plate thickness [mm]", "frequency / Euler-Bernoulli [-]") as ax:
+    with figure(path, "First pinned-pinned in-plane bending frequency of the coupler, "
+                "relative to Euler-Bernoulli (thesis Table 5)",
+                "plate thickness t [mm]", "frequency / Euler-Bernoulli frequency [-]") as ax:
         eb = s["table5/euler_bernoulli_frequency_Hz"]
         ax.plot(thickness_mm, s["table5/timoshenko_frequency_Hz"] / eb, "s-",
-                label="Timoshenko")
+                label="Timoshenko beam")
         ax.plot(thickness_mm, s["table5/fe_frequency_Hz"] / eb, "o", label="3D FE (NGsolve)")
-        ax.axhline(1.0, color="k", lw=0.8, label="Euler-Bernoulli (= thesis Table 5)")
+        ax.axhline(1.0, color="k", lw=0.8, label="Euler-Bernoulli beam (= thesis Table 5)")
     paths.append(path)
-    group = "links/coupler_t1mm/pinned-pinned"
-    nodes = s[f"{group}/node_coordinates"]
-    shapes = s[f"{group}/mode_shapes"]
-    kinds = s[f"{group}/fe_mode_kinds"]
-    freqs = s[f"{group}/fe_frequencies"]
     path = folder / "modal-mode-shapes.png"
-    with figure(path, "Coupler t = 1 mm, pinned-pinned: first modes (x-y and x-z views)",
-                "x [mm]", "normalized displacement [-]") as ax:
-        for mode in range(min(4, len(shapes))):
-            order = np.argsort(nodes[:, 0])
-            component = int(np.argmax(np.abs(shapes[mode]).max(axis=0)))
-            kind = kinds[mode].decode() if isinstance(kinds[mode], bytes) else kinds[mode]
-            ax.plot(nodes[order, 0] * 1e3, shapes[mode][order, component], ".", ms=2,
-                    label=f"mode {mode + 1}: {freqs[mode]:.0f} Hz, {kind} "
-                          f"(u_{'xyz'[component]})")
+    _mode_shapes(path, s, "links/coupler_t1mm/pinned-pinned")
     paths.append(path)
     path = folder / "modal-convergence.png"
-    with figure(path, "Mesh convergence, first pinned-pinned in-plane bending",
-                "degrees of freedom", "frequency / reference - 1 [-]") as ax:
-        for t in thickness_mm:
+    with figure(path, "Mesh convergence of the first pinned-pinned in-plane bending "
+                "frequency", "degrees of freedom of the FE mesh [-]",
+                "|f / f_reference \u2212 1| [-]") as ax:
+        for index, t in enumerate(thickness_mm):
             group = f"convergence/coupler_t{t:g}mm"
-            ax.loglog(s[f"{group}/dof"], np.abs(s[f"{group}/frequency"]
-                                                / s[f"{group}/reference_frequency"] - 1)
-                      + 1e-9, "o-", label=f"t = {t:g} mm")
-        ax.axhline(CONVERGENCE_TOLERANCE, color="r", ls="--", label="tolerance")
+            dof = np.asarray(s[f"{group}/dof"], dtype=float)
+            frequency = np.asarray(s[f"{group}/frequency"], dtype=float)
+            reference = float(s[f"{group}/reference_frequency"])
+            method = str(summary.datasets[f"{group}/reference_frequency"].description)
+            error = np.abs(frequency / reference - 1)
+            drawn = error > 0  # the finest level is the reference itself when not extrapolated
+            how = ("Richardson extrapolation" if method == "richardson"
+                   else "finest level, not drawn" if method == "finest" else method)
+            ax.loglog(dof[drawn], error[drawn], "o-", color=f"C{index}",
+                      label=f"t = {t:g} mm (reference: {how})")
+            production = np.isclose(s[f"{group}/mesh_size"],
+                                    float(s[f"{group}/production_mesh_size"]))
+            ax.loglog(dof[production & drawn], error[production & drawn], "o", ms=11,
+                      mfc="none", color=f"C{index}")
+        ax.axhline(CONVERGENCE_TOLERANCE, color="r", ls="--",
+                   label=f"tolerance {CONVERGENCE_TOLERANCE:.1%}")
+        ax.plot([], [], "o", ms=11, mfc="none", color="k",
+                label="production mesh (coarsest within tolerance)")
+        decade_ticks(ax)
     paths.append(path)
     return paths
 
+
+def _mode_shapes(path: Path, s: dict, group: str, count: int = 4) -> None:
+    """The first ``count`` FE modes of a plate in two views: x-y (the mechanism plane; the
+    in-plane displacement u_y averaged over each cross-section, i.e. the centre line) and
+    x-z (the plate's face, coloured by u_y: bending is uniform across the width, torsion
+    changes sign across it)."""
+    import matplotlib.pyplot as plt
+
+    from flex.plotting import save
+
+    nodes = np.asarray(s[f"{group}/node_coordinates"]) * 1e3
+    shapes = np.asarray(s[f"{group}/mode_shapes"])
+    kinds = [k.decode() if isinstance(k, bytes) else str(k) for k in s[f"{group}/fe_mode_kinds"]]
+    freqs = np.asarray(s[f"{group}/fe_frequencies"])
+    count = min(count, len(shapes))
+    mosaic = [["line", f"face{mode}"] for mode in range(count)]
+    fig, axes = plt.subplot_mosaic(mosaic, figsize=(12.0, 1.2 + 1.45 * count),
+                                   layout="constrained", width_ratios=[1.0, 1.25])
+    fig.suptitle(f"Coupler plate t = {np.ptp(nodes[:, 1]):g} mm, pinned-pinned: first "
+                 f"{count} FE modes in two views (normalized, max |u| = 1)")
+    line = axes["line"]
+    edges = np.linspace(nodes[:, 0].min(), nodes[:, 0].max(), 41)
+    bins = np.clip(np.digitize(nodes[:, 0], edges) - 1, 0, len(edges) - 2)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    face = nodes[:, 1] >= nodes[:, 1].max() - 1e-9  # one face: the x-z view
+    for mode in range(count):
+        u_y = shapes[mode][:, 1]
+        filled = np.bincount(bins, minlength=len(centres)) > 0
+        mean = np.bincount(bins, u_y, len(centres))[filled] / np.bincount(
+            bins, minlength=len(centres))[filled]
+        line.plot(centres[filled], mean, "-", color=f"C{mode}",
+                  label=f"mode {mode + 1}: {freqs[mode]:.0f} Hz, {kinds[mode]}")
+        ax = axes[f"face{mode}"]
+        contour = ax.tricontourf(nodes[face, 0], nodes[face, 2], u_y[face],
+                                 levels=np.linspace(-1, 1, 21), cmap="RdBu_r")
+        ax.set_aspect("equal")
+        ax.set_title(f"mode {mode + 1}: {freqs[mode]:.0f} Hz, {kinds[mode]}",
+                     fontsize="small", color=f"C{mode}")
+        ax.set_ylabel("z [mm]")
+        if mode < count - 1:
+            ax.tick_params(labelbottom=False)
+        else:
+            ax.set_xlabel("x along the coupler [mm]")
+    line.set_title("x-y view (mechanism plane): centre line, u_y averaged over the "
+                   "cross-section", fontsize="small")
+    line.set_xlabel("x along the coupler [mm]")
+    line.set_ylabel("normalized in-plane displacement u_y [-]")
+    line.axhline(0.0, color="k", lw=0.6)
+    line.grid(True, alpha=0.3)
+    line.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
+    colourbar = fig.colorbar(contour, ax=[axes[f"face{m}"] for m in range(count)],
+                             shrink=0.8)
+    colourbar.set_label("normalized u_y [-]")
+    axes["face0"].annotate("x-z view (plate face): colour = u_y", (0.5, 1.45),
+                           xycoords="axes fraction", ha="center", fontsize="small")
+    save(fig, path)
 
 if __name__ == "__main__":
     from flex.cli import main

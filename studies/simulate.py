@@ -37,7 +37,8 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
     data = {k: v.data for k, v in results["case"].datasets.items()}
     path = folder / "simulate-crank-angle.png"
-    with figure(path, "Crank angle", "time [s]", "crank angle [rad]") as ax:
+    with figure(path, "Crank angle of the simulated scene", "time [s]",
+                "crank angle from the slide line [rad]") as ax:
         ax.plot(data["time"], data["crank/angle"])
     return [path]
 

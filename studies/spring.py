@@ -90,7 +90,8 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
         "surge/with_slider_frequency": Dataset(with_slider_Hz, "Hz",
                                                "one end fixed, slider as end mass"),
         "surge/n_physical": Dataset(surge.n_fixed_fixed_physical, "1",
-                                    "delta_t / T, T = 1/f, delta_t = 0.016128 s"),
+                                    "delta_t / T, T = 1/f, delta_t = "
+                                    f"{sp.THESIS_DEPLOYMENT_TIME_S:g} s"),
         "surge/n_thesis_convention": Dataset(surge.n_fixed_fixed_thesis, "1",
                                              "delta_t * omega (thesis T = 1/omega)"),
         "surge/n_physical_half_swing": Dataset(surge_half_swing.n_fixed_fixed_physical, "1",
@@ -132,15 +133,19 @@ def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> l
     deflection = np.linspace(1e-4, design.deflection_to_solid_m, 60)
     wahl = [sp.spring_stress_check(design, y).wahl_shear_stress_Pa / 1e6 for y in deflection]
     path = folder / "spring-stress.png"
-    with figure(path, "Spring shear stress against compression (consistent design)",
-                "compression [mm]", "shear stress [MPa]") as ax:
-        ax.plot(deflection * 1e3, wahl, label="Wahl-corrected")
+    with figure(path, "Spring shear stress against compression (consistent thesis spring "
+                "design)", "spring compression [mm]", "shear stress [MPa]") as ax:
+        ax.plot(deflection * 1e3, wahl, label="closed form, Wahl-corrected (curvature factor)")
         ax.axhline(s["stress_press/allowable_shear_stress"] / 1e6, color="r", ls="--",
-                   label="allowable, ASTM A228 (0.45 S_ut)")
+                   label="allowable: 0.45 \u00d7 ultimate tensile strength, music wire ASTM A228")
         ax.plot(s["stress_press/deflection"] * 1e3, s["fe/inner_fibre_max_shear_stress"] / 1e6,
-                "ks", label="NGsolve helix segment")
+                "ks", label=f"3D FE of a helix segment (NGsolve), inner-fibre maximum, at "
+                            f"{float(s['stress_press/deflection']) * 1e3:g} mm")
         ax.axvline(s["design/deflection_to_solid"] * 1e3, color="gray", ls=":",
-                   label="solid")
+                   label=f"solid length reached (coils touch): "
+                         f"{float(s['design/deflection_to_solid']) * 1e3:.1f} mm")
+        ax.set_ylim(0, None)
+        ax.legend(fontsize="small", loc="center left")
     return [path]
 
 

@@ -33,13 +33,20 @@ from typing import Any
 import numpy as np
 
 from flex.errors import FlexError
-from flex.kinematics import slider_crank
+from flex.kinematics import constant_speed_motion
+from flex.physics import euler_buckling_load_N, pinned_pinned_omega
 from flex.plotting import figure
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, to_toml, validate
 from flex.settings import pinned_overrides
 from flex.simulation import simulate_case
 from flex.study import StudyRun, Summary
+from flex.thesis import (
+    THESIS_COUPLER_LENGTH_M,
+    THESIS_DENSITY_KG_PER_M3,
+    THESIS_SPRING_RATE_N_PER_M,
+    THESIS_YOUNGS_MODULUS_PA,
+)
 from flex.tradeoff import (
     Observables,
     ReductionPool,
@@ -86,8 +93,8 @@ def _plate(thickness_mm: float) -> tuple[str, ...]:
 
 def _period_s(thickness_mm: float) -> float:
     """Euler-Bernoulli pinned-pinned first bending period of the thesis plate [s]."""
-    t = thickness_mm * 1e-3
-    omega = (math.pi / 0.08) ** 2 * math.sqrt(200e9 * t**2 / 12 / 7850)
+    omega = pinned_pinned_omega(THESIS_COUPLER_LENGTH_M, thickness_mm * 1e-3,
+                                THESIS_YOUNGS_MODULUS_PA, THESIS_DENSITY_KG_PER_M3)
     return 2 * math.pi / omega
 
 
@@ -149,9 +156,9 @@ def extremes() -> list[Extreme]:
         out.append(Extreme(f"dead_centre_{angle:g}deg", "dead_centre",
                            (f"crank.initial_angle_deg={angle!r}",), "scipy", angle))
     for factor in (1, 10, 100):
+        rate = THESIS_SPRING_RATE_N_PER_M * factor
         out.append(Extreme(f"spring_x{factor}", "stiff_drive",
-                           (f"drive.spring_stiffness_N_per_m={1500.0 * factor!r}",), "scipy",
-                           factor))
+                           (f"drive.spring_stiffness_N_per_m={rate!r}",), "scipy", factor))
         speed = 2 * math.pi * factor
         out.append(Extreme(f"crank_speed_x{factor}", "stiff_drive",
                            ('drive.kind="constant_speed"',
@@ -212,13 +219,11 @@ def _nonlinear_setting(step: float) -> Setting:
 
 
 def _closed_form(scene: Scene, time_s: np.ndarray) -> Reference:
-    crank, drive = scene["crank"], scene["drive"]
-    theta0 = math.radians(crank["initial_angle_deg"])
-    omega = drive["crank_speed_rad_per_s"]
-    state = slider_crank(crank["length_m"], scene["coupler"]["length_m"],
-                         theta0 + omega * time_s, omega, 0.0, scene["slider"]["offset_m"])
-    observables = Observables(time_s, theta0 + omega * time_s,
-                              np.asarray(state.slider_position_m, dtype=float))
+    theta, state = constant_speed_motion(
+        scene["crank"]["length_m"], scene["coupler"]["length_m"],
+        math.radians(scene["crank"]["initial_angle_deg"]),
+        scene["drive"]["crank_speed_rad_per_s"], time_s, scene["slider"]["offset_m"])
+    observables = Observables(time_s, theta, np.asarray(state.slider_position_m, dtype=float))
     exact = {"crank_angle_rad": 0.0, "slider_position_m": 0.0, "error": 0.0}
     return Reference("closed form", observables, Setting("closed-form slider-crank"),
                      {"closed form (exact)": exact}, TOLERANCE, 0.0,
@@ -299,8 +304,8 @@ def _axial_over_euler(scene: Scene, data: dict[str, np.ndarray]) -> float:
     pi^2 E I / L^2 (pinned-pinned, I = width t^3 / 12): where it nears 1, the axial force
     changes the bending stiffness, which a linear FFRF body leaves out."""
     c = scene["coupler"]
-    euler_N = (math.pi**2 * c["youngs_modulus_Pa"] * c["width_m"] * c["thickness_m"] ** 3 / 12
-               / c["length_m"] ** 2)
+    euler_N = euler_buckling_load_N(c["length_m"], c["thickness_m"], c["width_m"],
+                                    c["youngs_modulus_Pa"])
     angle = data["coupler/angle"]
     chord = np.column_stack([np.cos(angle), np.sin(angle)])
     # the slider pushes on the coupler at C; compression is a force pointing from C to B
@@ -516,33 +521,59 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
     return Summary(datasets, "\n".join(lines))
 
 
+def _long_label(name: str) -> str:
+    """``long_rigid_index2_rho1`` -> a legend entry saying model and settings."""
+    text = name.removeprefix("long_")
+    for old, new in (("rigid_", "rigid, "), ("ffrf1mm", "FFRF coupler t = 1 mm"),
+                     ("ffrf10mm", "FFRF coupler t = 10 mm, h = 1e-05 s"),
+                     ("_h1e-5", ", h = 1e-05 s"), ("index2_", "index-2 formulation, "),
+                     ("rho", "spectral radius "),
+                     ("explicit_k1e8", "explicit Runge-Kutta, joint springs 1e8")):
+        text = text.replace(old, new)
+    if text == "FFRF coupler t = 1 mm":
+        text += ", h = 1e-04 s"
+    return text
+
+
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
+    from flex.plotting import decade_ticks, legend_below, relative_drift
+
     table = {key[len("runs/"):]: value.data for key, value in summary.datasets.items()
              if key.startswith("runs/")}
     paths = []
     path = folder / "stability-step.png"
-    with figure(path, "Error against time step (0.03 s deployment)", "time step [s]",
-                "largest relative error [-]") as ax:
-        for prefix, label in (("step_rigid", "rigid"), ("step_ffrf1mm", "FFRF 1 mm")):
+    with figure(path, "Largest relative error against the time step (0.03 s deployment)",
+                "time step h [s]", "largest relative error against the reference [-]") as ax:
+        for (prefix, label), marker in zip((("step_rigid", "rigid links (reference: scipy "
+                                             "DAE)"),
+                                            ("step_ffrf1mm", "FFRF coupler t = 1 mm "
+                                             "(reference: h = 2e-6 s)")), "os", strict=True):
             mask = np.array([str(n).startswith(prefix) for n in table["name"]])
             mask &= table["status"] == "ok"
             order = np.argsort(table["parameter"][mask])
-            ax.loglog(table["parameter"][mask][order], table["error"][mask][order], "o-",
-                      label=label)
-        ax.axhline(TOLERANCE, color="grey", ls=":", label="tolerance")
+            ax.loglog(table["parameter"][mask][order], table["error"][mask][order],
+                      f"{marker}-", label=label)
+        ax.axhline(TOLERANCE, color="grey", ls=":", label=f"tolerance {TOLERANCE:g}")
+        decade_ticks(ax)
     paths.append(path)
     path = folder / "stability-energy.png"
-    with figure(path, "Energy over 1 s of free motion (rigid and FFRF couplers)", "time [s]",
-                "(E - E0) / E0 [-]") as ax:
+    floor = 1e-16
+    with figure(path, "Energy drift over 1 s of free motion, |E \u2212 E0| / E0 on a log "
+                "scale (the runs differ by orders of magnitude)", "time [s]",
+                "|E \u2212 E0| / E0 [-] (E: kinetic + strain + spring)",
+                size=(8.0, 5.5)) as ax:
         for name, case in results.items():
             if (name.startswith("long_") and case.status == "ok"
                     and "energy/total" in case.datasets):
-                energy = case.datasets["energy/total"].data
-                ax.plot(case.datasets["time"].data, (energy - energy[0]) / energy[0],
-                        label=name, lw=0.8)
+                drift = np.abs(relative_drift(case.datasets["energy/total"].data))
+                ax.semilogy(case.datasets["time"].data, np.maximum(drift, floor),
+                            label=_long_label(name), lw=0.8)
+        ax.set_ylim(floor / 2, None)
+        ax.text(0.99, 0.01, f"values below {floor:g} drawn at {floor:g}", fontsize="x-small",
+                ha="right", va="bottom", transform=ax.transAxes)
+        legend_below(ax.figure)
     paths.append(path)
     return paths
-
 
 if __name__ == "__main__":
     from flex.cli import main

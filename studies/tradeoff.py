@@ -655,9 +655,11 @@ def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> l
         scipy = np.array(["'scipy'" in str(k) for k in table["knobs"]])
         explicit = np.array(["explicit_penalty" in str(k) for k in table["knobs"]])
         path = folder / f"tradeoff-{scene_name}.png"
-        with figure(path, f"Work-precision, {scene_name} (0.03 s deployment)",
-                    "wall time of the integration [s] (median)",
-                    "largest relative error [-]", size=(9.0, 6.0)) as ax:
+        with figure(path, f"Work-precision diagram, scene {scene_name} (0.03 s deployment): "
+                    "error against integration time of every setting",
+                    "wall time of the integration [s] (median of repeats)",
+                    "largest relative error against the reference [-]",
+                    size=(9.0, 7.5)) as ax:
             groups = sorted({g for g, good in zip(table["group"], ok, strict=True) if good})
             for index, group_name in enumerate(groups):
                 mask = ok & (table["group"] == group_name)
@@ -679,13 +681,20 @@ def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> l
                             textcoords="offset points")
             for level in ACCURACY_LEVELS:
                 ax.axhline(level, color="grey", lw=0.6, ls=":")
+            ax.plot([], [], color="grey", lw=0.6, ls=":",
+                    label=f"accuracy levels {', '.join(f'{v:g}' for v in ACCURACY_LEVELS)}")
             accuracy = summary.datasets.get(f"{scene_name}/reference/accuracy")
             if accuracy is not None and np.isfinite(float(accuracy.data)):
                 # errors below the reference's own accuracy are not resolved by it
                 ax.axhspan(ax.get_ylim()[0], float(accuracy.data), color="grey", alpha=0.12,
                            lw=0, label=f"below the reference's accuracy "
                                        f"({float(accuracy.data):.1e})")
-            ax.legend(fontsize="x-small", ncol=2)
+            from flex.plotting import legend_below
+
+            legend_below(ax.figure, [
+                ("o: Exudyn, implicit generalized-alpha (colour: sweep)", {"marker": "o"}),
+                ("s: scipy DAE (reference solver)", {"marker": "s"}),
+                ("^: Exudyn, explicit Runge-Kutta + joint springs", {"marker": "^"})], ncol=3)
         paths.append(path)
     return paths
 

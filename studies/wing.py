@@ -24,12 +24,19 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from flex import modal
+from flex.criteria import first_maximum_index
+from flex.physics import n_values
 from flex.plotting import figure
 from flex.reference import solve_reference
 from flex.results import CaseResult, Dataset
 from flex.scene import Scene, apply_overrides, validate
 from flex.simulation import simulate_case
 from flex.study import StudyRun, Summary
+from flex.thesis import (  # noqa: F401 - the thesis's sec. 6.4 values, named here as before
+    THESIS_WING_DEPLOYMENT_TIME_S as THESIS_DEPLOYMENT_TIME_S,
+)
+from flex.thesis import THESIS_WING_PEAK_RATE_DEG_PER_S as THESIS_PEAK_RATE_DEG_PER_S
+from flex.thesis import THESIS_WING_PEAK_TIME_S as THESIS_PEAK_TIME_S
 
 NAME = "wing"
 DESCRIPTION = "wing deployment (sec. 6.4): fitted spring, loads, wing flexibility"
@@ -38,9 +45,6 @@ OVERRIDES = ["wing.enabled=true", "simulation.end_time_s=0.025"]
 READS = ("wing.span_m", "wing.chord_m", "wing.thickness_m", "wing.density_kg_per_m3",
          "wing.youngs_modulus_Pa", "drive.spring_preload_m",
          "drive.spring_stiffness_N_per_m")
-THESIS_PEAK_RATE_DEG_PER_S = 7219.0  # sec. 6.4, fig. 60
-THESIS_PEAK_TIME_S = 0.008  # sec. 6.4, fig. 60 ("approx.")
-THESIS_DEPLOYMENT_TIME_S = 0.017  # sec. 6.4 ("approx.")
 
 
 def peak_rate(scene: Scene) -> tuple[float, float]:
@@ -108,10 +112,11 @@ def wing_flexibility(scene: Scene, peak_angular_acceleration_rad_per_s2: float,
     q0 = wing["density_kg_per_m3"] * area_m2 * peak_angular_acceleration_rad_per_s2 \
         * wing["span_m"]
     tip_m = 11 * q0 * wing["span_m"] ** 4 / (120 * wing["youngs_modulus_Pa"] * second_moment_m4)
+    n = n_values(deployment_time_s, in_plane)
     return {"in_plane_frequency_Hz": in_plane / (2 * np.pi),
             "out_of_plane_frequency_Hz": out_of_plane / (2 * np.pi),
-            "n_in_plane_physical": deployment_time_s * in_plane / (2 * np.pi),
-            "n_in_plane_thesis": deployment_time_s * in_plane,
+            "n_in_plane_physical": n["physical"],
+            "n_in_plane_thesis": n["thesis"],
             "quasi_static_tip_deflection_m": tip_m,
             "tip_deflection_over_span": tip_m / wing["span_m"]}
 
@@ -127,8 +132,9 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
     time_s, angle = data["time"], data["wing/angle"]
     rate_deg = data["wing/angular_velocity_deg"]
     peak = int(np.argmax(rate_deg))
-    stop = int(np.argmax(angle))
-    deployment_s = float(time_s[stop]) if stop < len(angle) - 1 else float("nan")
+    stop = first_maximum_index(angle)
+    deployment_s = float(time_s[stop]) if stop is not None else float("nan")
+    stop = len(angle) - 1 if stop is None else stop  # still rising: the swing so far
     alpha_peak = float(np.abs(data["wing/angular_acceleration"]).max())
     flexibility = wing_flexibility(scene_case, alpha_peak, deployment_s)
     from flex.reference import crank_mass_properties
@@ -140,9 +146,11 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
     values = {
         "spring_stiffness": (drive["spring_stiffness_N_per_m"], "N/m", "fitted"),
         "spring_preload": (drive["spring_preload_m"], "m", "fitted"),
-        "peak_rate": (float(rate_deg[peak]), "deg/s", "thesis 7219 deg/s"),
-        "peak_rate_time": (float(time_s[peak]), "s", "thesis ~0.008 s"),
-        "deployment_time": (deployment_s, "s", "first wing-angle maximum; thesis ~0.017 s"),
+        "peak_rate": (float(rate_deg[peak]), "deg/s",
+                      f"thesis {THESIS_PEAK_RATE_DEG_PER_S:g} deg/s"),
+        "peak_rate_time": (float(time_s[peak]), "s", f"thesis ~{THESIS_PEAK_TIME_S:g} s"),
+        "deployment_time": (deployment_s, "s", "first wing-angle maximum; thesis "
+                            f"~{THESIS_DEPLOYMENT_TIME_S:g} s"),
         "swing": (float(angle[stop] - angle[0]), "rad", "wing rotation during deployment"),
         "wing_plus_crank_inertia_about_A": (inertia_kgm2 + mass_kg * centre_m**2, "kg m^2",
                                             "rotating inertia about the pivot"),
@@ -213,14 +221,18 @@ def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> l
     path = folder / "wing-angular-velocity.png"
     with figure(path, "Wing-tip angular velocity (cf. thesis fig. 60)", "time [s]",
                 "angular velocity [deg/s]") as ax:
-        ax.plot(data["time"], data["wing/angular_velocity_deg"], label="flex")
+        ax.plot(data["time"], data["wing/angular_velocity_deg"], label="flex (Exudyn)")
         ax.plot([THESIS_PEAK_TIME_S], [THESIS_PEAK_RATE_DEG_PER_S], "r*", ms=12,
                 label="thesis peak (7219 deg/s, ~0.008 s)")
     paths.append(path)
     path = folder / "wing-loads.png"
-    with figure(path, "Joint loads during the wing deployment", "time [s]", "force [N]") as ax:
-        for name in ("A", "B", "C"):
-            ax.plot(data["time"], data[f"joints/{name}/force_modulus"], label=f"|force| at {name}")
+    with figure(path, "Joint reaction forces during the wing deployment (moduli)", "time [s]",
+                "|reaction force| [N]") as ax:
+        for name, where in (("A", "crank pivot"), ("B", "crank-coupler"),
+                            ("C", "coupler-slider")):
+            ax.plot(data["time"], data[f"joints/{name}/force_modulus"],
+                    label=f"joint {name} ({where})")
+        ax.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=3)
     paths.append(path)
     return paths
 
