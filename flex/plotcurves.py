@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import os
 import re
+import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -236,9 +237,15 @@ def _draw(plt, path, specs, files, curves_by_file, curves, y_units, title, targe
         h, lab = ax.get_legend_handles_labels()
         handles += h
         labels += lab
-    if len(labels) > 1:
-        left.legend(handles, labels, fontsize="small")
-    left.set_title(_plain(title or " vs ".join(Path(f).name for f in files)))
+    if len(labels) > 1:  # under the axes: a legend inside would hide curves
+        columns = 1 if len(labels) > 4 else 2
+        fig.set_figheight(4.5 + 0.22 * -(-len(labels) // columns))
+        fig.legend(handles, labels, fontsize="small", loc="outside lower center",
+                   ncol=columns)
+    if title is None:  # say what is shown: the paths, against what, from which file(s)
+        title = (f"{', '.join(specs)} against {first.x_label}: "
+                 + " vs ".join(dict.fromkeys(file_labels[str(f)] for f in files)))
+    left.set_title(_plain(textwrap.fill(title, 80)), fontsize="medium")
     try:
         fig.canvas.draw()  # drawing errors (values out of range) before any file is made
         target.parent.mkdir(parents=True, exist_ok=True)
