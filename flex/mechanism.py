@@ -189,220 +189,275 @@ def build_mechanism(scene: Scene, reduction: Any = None,
     ``reduction`` is the Craig-Bampton reduction (:func:`flex.reduction.build_reduction`)
     for an ``ffrf`` coupler (or the plate of a ``nonlinear_fe`` one; ``None``: built from the
     scene), ``crank_reduction`` the one of an ``ffrf`` crank; ``None`` for rigid links.
+    Links with ``model = "auto"`` must be resolved first (:func:`flex.simulation.simulate`).
     Returns a :class:`Mechanism`.
     """
-    import exudyn as exu
-    import exudyn.itemInterface as eii
-    from exudyn.utilities import RigidBodyInertia
+    for link in ("crank", "coupler"):
+        if scene[link]["model"] == "auto":
+            raise SceneError('model = "auto" must be resolved before building '
+                             "(flex.simulation.simulate does it with "
+                             "flex.criteria.resolve_fidelity)")
+    builder = _Builder(scene)
+    builder.add_crank_and_slider(crank_reduction)
+    builder.add_coupler(reduction)
+    builder.add_joints()
+    builder.add_drive()
+    builder.add_sensors()
+    builder.mbs.Assemble()
+    return builder.mech
 
-    init = initial_configuration(scene)
-    system_container = exu.SystemContainer()
-    mbs = system_container.AddSystem()
-    mech = Mechanism(system_container, mbs, scene, init)
-    ground = mbs.CreateGround()
-    out = exu.OutputVariableType
 
-    def rigid_body(name: str, mass_kg: float, inertia_kgm2: float, position, angle_rad: float,
-                   velocity, angular_velocity_rad_per_s: float) -> dict:
+class _Builder:
+    """Adds the items of one slider-crank to a new Exudyn system, in a fixed order (the
+    order numbers the coordinates, so it is kept the same for every scene of a kind)."""
+
+    def __init__(self, scene: Scene) -> None:
+        import exudyn as exu
+        import exudyn.itemInterface as eii
+
+        self.exu, self.eii = exu, eii
+        self.scene = scene
+        self.init = initial_configuration(scene)
+        system_container = exu.SystemContainer()
+        self.mbs = system_container.AddSystem()
+        self.mech = Mechanism(system_container, self.mbs, scene, self.init)
+        self.ground = self.mbs.CreateGround()
+        self.markers: dict[str, int] = {}
+        self.crank_body: dict | None = None
+        self.slider_body: dict = {}
+        self.coupler: dict = {}
+        self.wing_joint: int | None = None
+        self.joints: dict[str, int] = {}
+
+    def rigid_body(self, name: str, mass_kg: float, inertia_kgm2: float, position,
+                   angle_rad: float, velocity, angular_velocity_rad_per_s: float) -> dict:
+        """A planar rigid body [kg, kg m^2, m, rad, m/s, rad/s]."""
+        from exudyn.utilities import RigidBodyInertia
+
         # out-of-plane inertias do not enter planar motion; any positive, physically
         # admissible values will do, so take the in-plane one
         inertia = RigidBodyInertia(mass=mass_kg, inertiaTensor=np.eye(3) * inertia_kgm2)
-        body = mbs.CreateRigidBody(
+        body = self.mbs.CreateRigidBody(
             name=name, inertia=inertia, referencePosition=list(position),
             referenceRotationMatrix=_rotation_z(angle_rad), initialVelocity=list(velocity),
             initialAngularVelocity=[0.0, 0.0, angular_velocity_rad_per_s],
-            nodeType=exu.NodeType.RotationRxyz, returnDict=True)
-        mech.rigid_bodies[name] = (mass_kg, np.eye(3) * inertia_kgm2)
+            nodeType=self.exu.NodeType.RotationRxyz, returnDict=True)
+        self.mech.rigid_bodies[name] = (mass_kg, np.eye(3) * inertia_kgm2)
         return body
 
-    model = scene["coupler"]["model"]
-    crank = scene["crank"]
-    if model == "auto" or crank["model"] == "auto":
-        raise SceneError('model = "auto" must be resolved before building (flex.solver.simulate '
-                         "does it with flex.criteria.resolve_fidelity)")
-    crank_body = None
-    if crank["model"] == "rigid":
-        crank_body = rigid_body("crank", *plate_mass_properties(scene, "crank"),
-                                init.joint_B_m / 2, init.crank_angle_rad,
-                                init.joint_B_velocity_m_per_s / 2, init.crank_speed_rad_per_s)
-    slider = scene["slider"]
-    slider_body = rigid_body("slider", slider["mass_kg"], slider["inertia_kgm2"], init.joint_C_m,
-                             0.0, init.joint_C_velocity_m_per_s, 0.0)
-
-    def body_marker(body: dict, global_point) -> int:
-        node = mbs.GetNode(body["nodeNumber"])
+    def body_marker(self, body: dict, global_point) -> int:
+        """A marker on ``body`` at ``global_point`` [m] (reference configuration)."""
+        node = self.mbs.GetNode(body["nodeNumber"])
         reference = np.asarray(node["referenceCoordinates"][:3])
         rotation = _rotation_z(node["referenceCoordinates"][5])
         local = rotation.T @ (np.asarray(global_point) - reference)
-        return mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=body["bodyNumber"],
-                                                 localPosition=list(local)))
+        return self.mbs.AddMarker(self.eii.MarkerBodyRigid(bodyNumber=body["bodyNumber"],
+                                                           localPosition=list(local)))
 
-    ground_a = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground, localPosition=[0, 0, 0]))
-    ground_c = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground,
-                                                 localPosition=list(init.joint_C_m)))
-    if crank_body is not None:
-        crank_a = body_marker(crank_body, [0.0, 0.0, 0.0])
-        crank_b = body_marker(crank_body, init.joint_B_m)
-    else:
+    def add_crank_and_slider(self, crank_reduction: Any) -> None:
+        """The crank (rigid body or FFRF plate), the slider, the ground markers at A and C,
+        and the wing welded at A when enabled."""
+        scene, init, mbs, eii = self.scene, self.init, self.mbs, self.eii
+        crank = scene["crank"]
+        if crank["model"] == "rigid":
+            self.crank_body = self.rigid_body(
+                "crank", *plate_mass_properties(scene, "crank"), init.joint_B_m / 2,
+                init.crank_angle_rad, init.joint_B_velocity_m_per_s / 2,
+                init.crank_speed_rad_per_s)
+        slider = scene["slider"]
+        self.slider_body = self.rigid_body(
+            "slider", slider["mass_kg"], slider["inertia_kgm2"], init.joint_C_m, 0.0,
+            init.joint_C_velocity_m_per_s, 0.0)
+        m = self.markers
+        m["ground_A"] = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=self.ground,
+                                                          localPosition=[0, 0, 0]))
+        m["ground_C"] = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=self.ground,
+                                                          localPosition=list(init.joint_C_m)))
+        if self.crank_body is not None:
+            m["crank_A"] = self.body_marker(self.crank_body, [0.0, 0.0, 0.0])
+            m["crank_B"] = self.body_marker(self.crank_body, init.joint_B_m)
+        else:
+            self._add_flexible_crank(crank_reduction)
+        m["slider_C"] = self.body_marker(self.slider_body, init.joint_C_m)
+        if scene["wing"]["enabled"]:
+            self.wing_joint = _add_wing(self.mech, self.rigid_body, self.body_marker,
+                                        m["crank_A"])
+
+    def _add_flexible_crank(self, crank_reduction: Any) -> None:
         from .reduction import add_ffrf_link
 
         if crank_reduction is None:
-            raise SceneError('crank.model = "ffrf" needs its reduction (flex.solver.simulate '
-                             "builds it from the scene)")
+            raise SceneError('crank.model = "ffrf" needs its reduction (flex.simulation.'
+                             "simulate builds it from the scene)")
         # the plate's end_a face is the pivot A (the floating frame), end_b the joint B
         flexible_crank = add_ffrf_link(
-            mbs, crank_reduction, [0.0, 0.0, 0.0], init.crank_angle_rad,
-            damping_ratio=crank["damping_ratio"],
-            initial_angular_velocity_rad_per_s=init.crank_speed_rad_per_s, name="crank")
-        crank_a, crank_b = flexible_crank["marker_B"], flexible_crank["marker_C"]
-        mech.crank = dict(flexible_crank, reduction=crank_reduction)
-    slider_c = body_marker(slider_body, init.joint_C_m)
-    wing_joint = _add_wing(mech, rigid_body, body_marker, crank_a) \
-        if scene["wing"]["enabled"] else None
+            self.mbs, crank_reduction, [0.0, 0.0, 0.0], self.init.crank_angle_rad,
+            damping_ratio=self.scene["crank"]["damping_ratio"],
+            initial_angular_velocity_rad_per_s=self.init.crank_speed_rad_per_s, name="crank")
+        self.markers["crank_A"] = flexible_crank["marker_B"]
+        self.markers["crank_B"] = flexible_crank["marker_C"]
+        self.mech.crank = dict(flexible_crank, reduction=crank_reduction)
 
-    if model == "ffrf":
-        from .reduction import add_ffrf_link
+    def add_coupler(self, reduction: Any) -> None:
+        """The coupler B-C: FFRF body, nonlinear FE body or rigid body."""
+        scene, init, mbs = self.scene, self.init, self.mbs
+        model = scene["coupler"]["model"]
+        if model == "ffrf":
+            from .reduction import add_ffrf_link
 
-        coupler = add_ffrf_link(
-            mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
-            damping_ratio=scene["coupler"]["damping_ratio"],
-            initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
-            initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
-        coupler_b, coupler_c = coupler["marker_B"], coupler["marker_C"]
-        mech.coupler = dict(coupler, reduction=reduction)
-    elif model == "nonlinear_fe":
-        from .nonlinear import add_nonlinear_fe_coupler, nonlinear_plate_for_scene
+            self.coupler = add_ffrf_link(
+                mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
+                damping_ratio=scene["coupler"]["damping_ratio"],
+                initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+                initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
+            self.mech.coupler = dict(self.coupler, reduction=reduction)
+        elif model == "nonlinear_fe":
+            from .nonlinear import add_nonlinear_fe_coupler, nonlinear_plate_for_scene
 
-        plate = reduction if reduction is not None else nonlinear_plate_for_scene(scene)
-        coupler = add_nonlinear_fe_coupler(
-            mbs, plate, list(init.joint_B_m), init.coupler_angle_rad,
-            initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
-            initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
-        coupler_b, coupler_c = coupler["marker_B"], coupler["marker_C"]
-        mech.coupler = dict(coupler, plate=plate)
-    else:
-        mass_kg, inertia_kgm2 = plate_mass_properties(scene)
-        coupler_body = rigid_body(
-            "coupler", mass_kg, inertia_kgm2, (init.joint_B_m + init.joint_C_m) / 2,
-            init.coupler_angle_rad,
-            (init.joint_B_velocity_m_per_s + init.joint_C_velocity_m_per_s) / 2,
-            init.coupler_speed_rad_per_s)
-        coupler_b = body_marker(coupler_body, init.joint_B_m)
-        coupler_c = body_marker(coupler_body, init.joint_C_m)
-        mech.coupler = {"body": coupler_body["bodyNumber"], "node": coupler_body["nodeNumber"]}
+            plate = reduction if reduction is not None else nonlinear_plate_for_scene(scene)
+            self.coupler = add_nonlinear_fe_coupler(
+                mbs, plate, list(init.joint_B_m), init.coupler_angle_rad,
+                initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+                initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
+            self.mech.coupler = dict(self.coupler, plate=plate)
+        else:
+            mass_kg, inertia_kgm2 = plate_mass_properties(scene)
+            body = self.rigid_body(
+                "coupler", mass_kg, inertia_kgm2, (init.joint_B_m + init.joint_C_m) / 2,
+                init.coupler_angle_rad,
+                (init.joint_B_velocity_m_per_s + init.joint_C_velocity_m_per_s) / 2,
+                init.coupler_speed_rad_per_s)
+            self.coupler = {"marker_B": self.body_marker(body, init.joint_B_m),
+                            "marker_C": self.body_marker(body, init.joint_C_m)}
+            self.mech.coupler = {"body": body["bodyNumber"], "node": body["nodeNumber"]}
+        self.markers["coupler_B"] = self.coupler["marker_B"]
+        self.markers["coupler_C"] = self.coupler["marker_C"]
 
-    crank_ref = _rotation_z(init.crank_angle_rad)
-    coupler_ref = _rotation_z(init.coupler_angle_rad)
-    penalty = scene["simulation"]["integrator"] == "explicit_penalty"
-    if penalty:  # explicit solvers take no joint constraints (validate: rigid coupler only)
-        joint_a, joint_b, joint_c, joint_p = _add_penalty_joints(
-            mbs, scene["simulation"]["penalty_stiffness_N_per_m"],
-            min(plate_mass_properties(scene, "crank")[0], slider["mass_kg"],
-                plate_mass_properties(scene)[0]),
-            [(ground_a, crank_a), (crank_b, coupler_b), (slider_c, coupler_c),
-             (ground_c, slider_c)],
-            [crank_body["nodeNumber"], mech.coupler["node"], slider_body["nodeNumber"]])
-        mech.joint_frames = {"A": None, "B": None, "C": None, "P": None}
-    else:
+    def add_joints(self) -> None:
+        """Revolute A and B, the in-plane pin C, the prismatic slide (or penalty springs for
+        the explicit integrator)."""
+        scene, mbs, eii, m = self.scene, self.mbs, self.eii, self.markers
+        if scene["simulation"]["integrator"] == "explicit_penalty":
+            # explicit solvers take no joint constraints (validate: rigid coupler only)
+            joints = _add_penalty_joints(
+                mbs, scene["simulation"]["penalty_stiffness_N_per_m"],
+                min(plate_mass_properties(scene, "crank")[0], scene["slider"]["mass_kg"],
+                    plate_mass_properties(scene)[0]),
+                [(m["ground_A"], m["crank_A"]), (m["crank_B"], m["coupler_B"]),
+                 (m["slider_C"], m["coupler_C"]), (m["ground_C"], m["slider_C"])],
+                [self.crank_body["nodeNumber"], self.mech.coupler["node"],
+                 self.slider_body["nodeNumber"]])
+            self.joints = dict(zip("ABCP", joints, strict=True))
+            self.mech.joint_frames = {"A": None, "B": None, "C": None, "P": None}
+            return
+        crank_ref = _rotation_z(self.init.crank_angle_rad)
+        coupler_ref = _rotation_z(self.init.coupler_angle_rad)
         # joint frames coincide with the global axes at t = 0; force outputs are in the frame
         # of marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where
         # it can
-        joint_a = mbs.AddObject(eii.ObjectJointRevoluteZ(markerNumbers=[ground_a, crank_a],
-                                                         rotationMarker1=crank_ref.T))
-        joint_b = mbs.AddObject(eii.ObjectJointRevoluteZ(markerNumbers=[crank_b, coupler_b],
-                                                         rotationMarker0=crank_ref.T,
-                                                         rotationMarker1=coupler_ref.T))
-        joint_c = mbs.AddObject(eii.ObjectJointSpherical(markerNumbers=[slider_c, coupler_c],
-                                                         constrainedAxes=[1, 1, 0]))
-        joint_p = mbs.AddObject(eii.ObjectJointPrismaticX(markerNumbers=[ground_c, slider_c]))
+        self.joints = {
+            "A": mbs.AddObject(eii.ObjectJointRevoluteZ(
+                markerNumbers=[m["ground_A"], m["crank_A"]], rotationMarker1=crank_ref.T)),
+            "B": mbs.AddObject(eii.ObjectJointRevoluteZ(
+                markerNumbers=[m["crank_B"], m["coupler_B"]], rotationMarker0=crank_ref.T,
+                rotationMarker1=coupler_ref.T)),
+            "C": mbs.AddObject(eii.ObjectJointSpherical(
+                markerNumbers=[m["slider_C"], m["coupler_C"]], constrainedAxes=[1, 1, 0])),
+            "P": mbs.AddObject(eii.ObjectJointPrismaticX(
+                markerNumbers=[m["ground_C"], m["slider_C"]]))}
         # B's force is reported in the frame of the crank's marker at B (its joint face when
         # the crank is flexible): collect turns it with that marker's rotation
-        mech.joint_frames = {"A": None, "B": "marker_crank_B", "C": None, "P": None}
+        self.mech.joint_frames = {"A": None, "B": "marker_crank_B", "C": None, "P": None}
 
-    drive = scene["drive"]
-    ground_node = mbs.AddNode(eii.NodePointGround())
-    ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node,
-                                                               coordinate=0))
-    if drive["kind"] == "spring":
-        slider_x = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=slider_body["nodeNumber"],
-                                                          coordinate=0))
-        # slider coordinate = displacement from t = 0; spring force k (q + preload) pushes -x
-        mbs.AddObject(eii.ObjectConnectorCoordinateSpringDamper(
-            markerNumbers=[ground_coordinate, slider_x],
-            stiffness=drive["spring_stiffness_N_per_m"],
-            damping=drive["spring_damping_Ns_per_m"], offset=-drive["spring_preload_m"]))
-    else:
+    def add_drive(self) -> None:
+        """The preloaded spring on the slider, or the crank held at constant speed."""
+        drive, mbs, eii = self.scene["drive"], self.mbs, self.eii
+        ground_node = mbs.AddNode(eii.NodePointGround())
+        ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node,
+                                                                   coordinate=0))
+        if drive["kind"] == "spring":
+            slider_x = mbs.AddMarker(eii.MarkerNodeCoordinate(
+                nodeNumber=self.slider_body["nodeNumber"], coordinate=0))
+            # slider coordinate = displacement from t = 0; spring force k (q + preload) pushes -x
+            mbs.AddObject(eii.ObjectConnectorCoordinateSpringDamper(
+                markerNumbers=[ground_coordinate, slider_x],
+                stiffness=drive["spring_stiffness_N_per_m"],
+                damping=drive["spring_damping_Ns_per_m"], offset=-drive["spring_preload_m"]))
+            return
         crank_rotation = mbs.AddMarker(eii.MarkerNodeCoordinate(  # rigid crank (validate)
-            nodeNumber=crank_body["nodeNumber"], coordinate=5))
+            nodeNumber=self.crank_body["nodeNumber"], coordinate=5))
         # velocity-level constraint: no Python callback per step, crank speed held exactly
         mbs.AddObject(eii.ObjectConnectorCoordinate(
             markerNumbers=[ground_coordinate, crank_rotation], velocityLevel=True,
             offset=drive["crank_speed_rad_per_s"]))
 
-    def add(name: str, sensor) -> None:
-        mech.sensors[name] = mbs.AddSensor(sensor)
+    def add(self, name: str, sensor) -> None:
+        self.mech.sensors[name] = self.mbs.AddSensor(sensor)
 
-    if wing_joint is not None:
-        for output in ("Velocity", "Rotation", "AngularVelocity", "AngularAcceleration"):
-            add(f"wing.{output}", eii.SensorNode(nodeNumber=mech.wing["node"],
-                                                 storeInternal=True,
-                                                 outputVariableType=getattr(out, output)))
-        for output in ("ForceLocal", "TorqueLocal"):
-            add(f"joint_W.{output}", eii.SensorObject(objectNumber=wing_joint,
-                                                      storeInternal=True,
-                                                      outputVariableType=getattr(out, output)))
-    for name, body in (("crank", crank_body), ("slider", slider_body)):
-        if body is None:  # a flexible crank: its markers below
-            continue
-        node = body["nodeNumber"]
-        for output in ("Position", "Velocity", "Acceleration", "Rotation", "AngularVelocity",
-                       "AngularAcceleration"):
-            add(f"{name}.{output}", eii.SensorNode(nodeNumber=node, storeInternal=True,
-                                                   outputVariableType=getattr(out, output)))
-    if model == "rigid":
-        # the centre of mass is the coupler's midpoint
-        for output in ("Position", "Velocity", "Acceleration", "Rotation", "AngularVelocity"):
-            add(f"coupler.{output}", eii.SensorNode(nodeNumber=mech.coupler["node"],
-                                                    storeInternal=True,
-                                                    outputVariableType=getattr(out, output)))
-    for name, joint in (("A", joint_a), ("B", joint_b), ("C", joint_c), ("P", joint_p)):
-        # the spherical joint reports its force in global axes ("Force"), the others in
-        # the frame of marker 0 ("ForceLocal")
-        output = out.Force if name == "C" or penalty else out.ForceLocal
-        add(f"joint_{name}.Force",
-            eii.SensorObject(objectNumber=joint, storeInternal=True, outputVariableType=output))
-    for name, marker in (("ground_A", ground_a), ("crank_A", crank_a), ("crank_B", crank_b),
-                         ("coupler_B", coupler_b), ("coupler_C", coupler_c),
-                         ("slider_C", slider_c)):
-        add(f"marker_{name}.Position",
-            eii.SensorMarker(markerNumber=marker, storeInternal=True,
-                             outputVariableType=out.Position))
-    mech.constraint_points = [("ground_A", "crank_A"), ("crank_B", "coupler_B"),
-                              ("coupler_C", "slider_C")]
-    if not penalty:
-        add("marker_crank_B.Rotation", eii.SensorMarker(markerNumber=crank_b, storeInternal=True,
-                                                        outputVariableType=out.Rotation))
-    flexible = {"coupler": coupler} if model in ("ffrf", "nonlinear_fe") else {}
-    if mech.crank:
-        flexible["crank"] = mech.crank
-        for name, marker in (("crank_A", crank_a), ("crank_B", crank_b)):
-            add(f"marker_{name}.Velocity",
-                eii.SensorMarker(markerNumber=marker, storeInternal=True,
-                                 outputVariableType=out.Velocity))
-    for name, link in flexible.items():
-        for output in ("Position", "Velocity"):
-            add(f"marker_{name}_mid.{output}",
-                eii.SensorMarker(markerNumber=link["marker_mid"], storeInternal=True,
-                                 outputVariableType=getattr(out, output)))
-        if "node_modal" not in link:  # nonlinear FE: nodal coordinates only
-            continue
-        add(f"{name}.modal_coordinates",
-            eii.SensorNode(nodeNumber=link["node_modal"], storeInternal=True,
-                           outputVariableType=out.Coordinates))
-        # Exudyn's FFRF body reports its kinetic (rigid + elastic motion) and strain energy
-        sensors = [mbs.AddSensor(eii.SensorBody(bodyNumber=link["object"], storeInternal=True,
-                                                outputVariableType=kind))
-                   for kind in (out.KineticEnergy, out.PotentialEnergy)]
-        mech.flexible_energy[name] = (sensors[0], sensors[1])
-    mbs.Assemble()
-    return mech
+    def sensor(self, kind: str, output: str, **item: int):
+        """An Exudyn sensor (``kind``: Node, Object, Marker, Body) stored internally."""
+        return getattr(self.eii, f"Sensor{kind}")(
+            storeInternal=True, outputVariableType=getattr(self.exu.OutputVariableType,
+                                                           output), **item)
+
+    def add_sensors(self) -> None:
+        """What :func:`flex.solver.collect` reads: bodies, joints, markers, energies."""
+        if self.wing_joint is not None:
+            for output in ("Velocity", "Rotation", "AngularVelocity", "AngularAcceleration"):
+                self.add(f"wing.{output}",
+                         self.sensor("Node", output, nodeNumber=self.mech.wing["node"]))
+            for output in ("ForceLocal", "TorqueLocal"):
+                self.add(f"joint_W.{output}",
+                         self.sensor("Object", output, objectNumber=self.wing_joint))
+        for name, body in (("crank", self.crank_body), ("slider", self.slider_body)):
+            if body is None:  # a flexible crank: its markers below
+                continue
+            for output in ("Position", "Velocity", "Acceleration", "Rotation",
+                           "AngularVelocity", "AngularAcceleration"):
+                self.add(f"{name}.{output}",
+                         self.sensor("Node", output, nodeNumber=body["nodeNumber"]))
+        if self.scene["coupler"]["model"] == "rigid":
+            # the centre of mass is the coupler's midpoint
+            for output in ("Position", "Velocity", "Acceleration", "Rotation",
+                           "AngularVelocity"):
+                self.add(f"coupler.{output}",
+                         self.sensor("Node", output, nodeNumber=self.mech.coupler["node"]))
+        self._add_joint_and_marker_sensors()
+        self._add_flexible_sensors()
+
+    def _add_joint_and_marker_sensors(self) -> None:
+        penalty = self.scene["simulation"]["integrator"] == "explicit_penalty"
+        for name, joint in self.joints.items():
+            # the spherical joint reports its force in global axes ("Force"), the others in
+            # the frame of marker 0 ("ForceLocal")
+            output = "Force" if name == "C" or penalty else "ForceLocal"
+            self.add(f"joint_{name}.Force", self.sensor("Object", output, objectNumber=joint))
+        for name in ("ground_A", "crank_A", "crank_B", "coupler_B", "coupler_C", "slider_C"):
+            self.add(f"marker_{name}.Position",
+                     self.sensor("Marker", "Position", markerNumber=self.markers[name]))
+        self.mech.constraint_points = [("ground_A", "crank_A"), ("crank_B", "coupler_B"),
+                                       ("coupler_C", "slider_C")]
+        if not penalty:
+            self.add("marker_crank_B.Rotation",
+                     self.sensor("Marker", "Rotation", markerNumber=self.markers["crank_B"]))
+
+    def _add_flexible_sensors(self) -> None:
+        model = self.scene["coupler"]["model"]
+        flexible = {"coupler": self.coupler} if model in ("ffrf", "nonlinear_fe") else {}
+        if self.mech.crank:
+            flexible["crank"] = self.mech.crank
+            for name in ("crank_A", "crank_B"):
+                self.add(f"marker_{name}.Velocity",
+                         self.sensor("Marker", "Velocity", markerNumber=self.markers[name]))
+        for name, link in flexible.items():
+            for output in ("Position", "Velocity"):
+                self.add(f"marker_{name}_mid.{output}",
+                         self.sensor("Marker", output, markerNumber=link["marker_mid"]))
+            if "node_modal" not in link:  # nonlinear FE: nodal coordinates only
+                continue
+            self.add(f"{name}.modal_coordinates",
+                     self.sensor("Node", "Coordinates", nodeNumber=link["node_modal"]))
+            # Exudyn's FFRF body reports its kinetic (rigid + elastic motion) and strain energy
+            sensors = [self.mbs.AddSensor(self.sensor("Body", kind, bodyNumber=link["object"]))
+                       for kind in ("KineticEnergy", "PotentialEnergy")]
+            self.mech.flexible_energy[name] = (sensors[0], sensors[1])
