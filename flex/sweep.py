@@ -488,6 +488,28 @@ def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
             raise FlexError(f"sweep case name {name!r}: use letters, digits and _ . + - only "
                             f"(it becomes a file name)")
     digests = {name: case_hash(scene, case_function) for name, scene in scenes.items()}
+    results = _resumable(scenes, folder, digests, retry_failed)
+    own_executor = executor is None
+    executor = executor or make_executor(scheduler, workers)
+    run = _SweepRun(scenes, folder, case_function, digests, results, executor, study,
+                    progress)
+    try:
+        run.submit_all(prepare, prepare_key)
+        run.drain()
+    finally:
+        run.bar.close()
+        if own_executor:
+            executor.close()
+    outcome = run.outcome
+    outcome.results = {name: results[name] for name in scenes if name in results}
+    outcome.wall_time_s = time.perf_counter() - start
+    return outcome
+
+
+def _resumable(scenes: Mapping[str, Scene], folder: Path, digests: dict[str, str],
+               retry_failed: bool) -> dict[str, CaseResult]:
+    """The cases whose files in ``folder`` hold this scene and case function (and, with
+    ``retry_failed``, succeeded): they are not run again."""
     results: dict[str, CaseResult] = {}
     for name in scenes:
         path = case_path(folder, name)
@@ -499,102 +521,118 @@ def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
             continue  # damaged or foreign: run again (the write replaces it atomically)
         if digest == digests[name] and (case.status == "ok" or not retry_failed):
             results[name] = case
-    resumed = len(results)
-    todo = [name for name in scenes if name not in results]
-    own_executor = executor is None
-    executor = executor or make_executor(scheduler, workers)
-    outcome = SweepOutcome({}, folder, executor.description, executor.workers,
-                           resumed=resumed)
-    bar = _Progress(len(todo), resumed, study, progress)
-    groups: dict[Hashable, list[str]] = {}
-    loose: list[str] = []
-    for name in todo:
-        key = prepare_key(scenes[name]) if (prepare and prepare_key) else None
-        if key is None:
-            loose.append(name)
-        else:
-            groups.setdefault(key, []).append(name)
-    pending: dict[Any, _Job] = {}
-    suspects: list[_Job] = []
+    return results
 
-    def submit(job: _Job, where: Executor) -> None:
+
+class _SweepRun:
+    """One sweep's jobs on one executor: preparations, their cases, loose cases, and the
+    cases suspected of killing a worker (rerun alone)."""
+
+    def __init__(self, scenes: Mapping[str, Scene], folder: Path,
+                 case_function: CaseFunction, digests: dict[str, str],
+                 results: dict[str, CaseResult], executor: Executor, study: str,
+                 progress: bool) -> None:
+        self.scenes, self.folder, self.case_function = scenes, folder, case_function
+        self.digests, self.results, self.executor, self.study = digests, results, executor, study
+        todo = [name for name in scenes if name not in results]
+        self.outcome = SweepOutcome({}, folder, executor.description, executor.workers,
+                                    resumed=len(results))
+        self.bar = _Progress(len(todo), len(results), study, progress)
+        self.todo = todo
+        self.groups: dict[Hashable, list[str]] = {}
+        self.pending: dict[Any, _Job] = {}
+        self.suspects: list[_Job] = []
+
+    def submit(self, job: _Job, where: Executor) -> None:
         job.started = time.perf_counter()
+        pending = self.pending
         pending[where.submit(*((_prepare_guarded, job.function) if job.kind == "prepare"
                                else (_guarded, job.function)), *job.args)] = job
 
-    def case_job(name: str) -> _Job:
-        return _Job("case", name, case_function, (name, scenes[name]))
+    def case_job(self, name: str) -> _Job:
+        return _Job("case", name, self.case_function, (name, self.scenes[name]))
 
-    def record(name: str, case: CaseResult, seconds: float) -> None:
-        write_case_file(folder, case, digests[name], study)
-        results[name] = case
-        outcome.case_wall_time_s[name] = seconds
-        outcome.ran += 1
-        outcome.failed += case.status != "ok"
-        bar.case(case.status == "ok")
+    def submit_all(self, prepare: Callable[[Scene], Any] | None,
+                   prepare_key: Callable[[Scene], Hashable | None] | None) -> None:
+        """One preparation per group of cases sharing a key (its cases follow it), then
+        the cases that need none."""
+        loose: list[str] = []
+        for name in self.todo:
+            key = prepare_key(self.scenes[name]) if (prepare and prepare_key) else None
+            if key is None:
+                loose.append(name)
+            else:
+                self.groups.setdefault(key, []).append(name)
+        for key, names in self.groups.items():
+            self.submit(_Job("prepare", key, prepare, (self.scenes[names[0]],)), self.executor)
+            self.bar.preparation()
+        for name in loose:
+            self.submit(self.case_job(name), self.executor)
 
-    def finish(job: _Job, value: Any) -> None:
+    def record(self, name: str, case: CaseResult, seconds: float) -> None:
+        write_case_file(self.folder, case, self.digests[name], self.study)
+        self.results[name] = case
+        self.outcome.case_wall_time_s[name] = seconds
+        self.outcome.ran += 1
+        self.outcome.failed += case.status != "ok"
+        self.bar.case(case.status == "ok")
+
+    def finish(self, job: _Job, value: Any) -> None:
         seconds = time.perf_counter() - job.started
         if job.kind == "case":
-            record(job.key, value, seconds)
+            self.record(job.key, value, seconds)
             return
         ok, detail = value
-        outcome.prepared += 1
-        bar.preparation(done=True)
-        for name in groups[job.key]:
+        self.outcome.prepared += 1
+        self.bar.preparation(done=True)
+        for name in self.groups[job.key]:
             if ok:
-                submit(case_job(name), executor)
+                self.submit(self.case_job(name), self.executor)
             else:
-                record(name, CaseResult(name, to_toml(scenes[name]), status="failed",
-                                        message=f"preparation failed: {detail}"), 0.0)
+                self.record(name, CaseResult(name, to_toml(self.scenes[name]), status="failed",
+                                             message=f"preparation failed: {detail}"), 0.0)
 
-    try:
-        for key, names in groups.items():
-            submit(_Job("prepare", key, prepare, (scenes[names[0]],)), executor)
-            bar.preparation()
-        for name in loose:
-            submit(case_job(name), executor)
-        while pending:
+    def drain(self) -> None:
+        """Wait for every job; a dead worker's jobs are resubmitted or, when suspected,
+        rerun alone."""
+        while self.pending:
             # who was running before this wait: if the pool breaks now, they are the suspects
-            running = {id(job) for future, job in pending.items() if _is_running(future)}
-            done = executor.wait_first(list(pending), timeout=0.5)
-            bar.tick()
+            running = {id(job) for future, job in self.pending.items()
+                       if _is_running(future)}
+            done = self.executor.wait_first(list(self.pending), timeout=0.5)
+            self.bar.tick()
             broken: list[_Job] = []
             for future in done:
-                job = pending.pop(future)
+                job = self.pending.pop(future)
                 try:
                     value = future.result()
                 except BrokenProcessPool:
                     broken.append(job)
                     continue
                 except Exception as exc:  # noqa: BLE001 - e.g. Dask KilledWorker
-                    value = _lost(job, scenes, f"{type(exc).__name__}: {exc}")
-                finish(job, value)
+                    value = _lost(job, self.scenes, f"{type(exc).__name__}: {exc}")
+                self.finish(job, value)
             if broken:
-                # a worker process died: every queued future of the pool failed with it
-                for future, job in list(pending.items()):
-                    broken.append(job)
-                    del pending[future]
-                executor.restart()
-                seen = [job for job in broken if id(job) in running]
-                for job in broken:
-                    job.affected += 1
-                    if id(job) in running or job.affected >= 2 or not seen:
-                        suspects.append(job)
-                    else:
-                        submit(job, executor)
-                bar.note(f"{study}: a worker process died; {len(suspects)} suspect case(s) "
-                         f"will be rerun alone")
-            if not pending and suspects:
-                _run_isolated(suspects, executor, scenes, finish)
-                suspects.clear()
-    finally:
-        bar.close()
-        if own_executor:
-            executor.close()
-    outcome.results = {name: results[name] for name in scenes if name in results}
-    outcome.wall_time_s = time.perf_counter() - start
-    return outcome
+                self._restart_after(broken, running)
+            if not self.pending and self.suspects:
+                _run_isolated(self.suspects, self.executor, self.scenes, self.finish)
+                self.suspects.clear()
+
+    def _restart_after(self, broken: list[_Job], running: set[int]) -> None:
+        # a worker process died: every queued future of the pool failed with it
+        for future, job in list(self.pending.items()):
+            broken.append(job)
+            del self.pending[future]
+        self.executor.restart()
+        seen = [job for job in broken if id(job) in running]
+        for job in broken:
+            job.affected += 1
+            if id(job) in running or job.affected >= 2 or not seen:
+                self.suspects.append(job)
+            else:
+                self.submit(job, self.executor)
+        self.bar.note(f"{self.study}: a worker process died; {len(self.suspects)} suspect "
+                      f"case(s) will be rerun alone")
 
 
 def _is_running(future: Any) -> bool:
