@@ -357,6 +357,11 @@ class ErrorLaw:
         """``c`` such that ``e = floor + c n^-p`` with n in ``convention``."""
         return self.coefficient * (TWO_PI ** self.exponent if convention == "thesis" else 1.0)
 
+    def exponent_half_width(self, level: float = 0.95) -> float:
+        """Half width of the two-sided ``level`` confidence interval of the exponent p
+        (Student t on the law's degrees of freedom)."""
+        return _t_quantile(self.dof, level) * math.sqrt(self.covariance[1, 1])
+
     def _params(self) -> np.ndarray:
         values = [self.log_coefficient, self.exponent]
         if self.with_floor:

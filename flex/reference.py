@@ -224,3 +224,22 @@ def solve_reference(scene: Scene, time_s: np.ndarray | None = None, rtol: float 
         norm[i] = np.linalg.norm(dae.constraints(t, q[i]))
     return ReferenceSolution(sol.t, q, q_dot, q_ddot, lam, norm, sol.message, sol.nfev, wall,
                              {"x_slider0_m": dae.q0[6]})
+
+
+def deviations_from_reference(scene: Scene, data: dict[str, np.ndarray]
+                              ) -> tuple[ReferenceSolution, dict[str, tuple[float, str]]]:
+    """The reference DAE of ``scene`` solved at a run's output times, and the run's largest
+    deviations from it, ``{name: (max |run - reference|, unit)}``: ``crank_angle`` [rad],
+    ``crank_angular_velocity`` [rad/s], ``slider_position`` [m] and ``joint_B_force`` (on
+    the coupler) [N]. ``data``: the run's stored curves by name (``time``, ``crank/angle``,
+    ``crank/angular_velocity``, ``slider/position``, ``joints/B/force_on_coupler``)."""
+    reference = solve_reference(scene, data["time"])
+    forces = reference.reaction_forces_N()
+    return reference, {
+        "crank_angle": (np.abs(data["crank/angle"] - reference.q[:, 2]).max(), "rad"),
+        "crank_angular_velocity": (np.abs(data["crank/angular_velocity"]
+                                          - reference.q_dot[:, 2]).max(), "rad/s"),
+        "slider_position": (np.abs(data["slider/position"] - reference.q[:, 6]).max(), "m"),
+        "joint_B_force": (np.abs(data["joints/B/force_on_coupler"]
+                                 - forces["B/force_on_coupler"]).max(), "N"),
+    }

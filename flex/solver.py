@@ -187,6 +187,29 @@ def run(mech: Mechanism) -> dict[str, Any]:
             "wall_time_s": wall}
 
 
+def run_profiled(mech: Mechanism) -> tuple[dict[str, float], str]:
+    """Integrate ``mech`` once (implicit integrator) with Exudyn's CPU-time statistics on,
+    for benchmarks (:mod:`flex.benchmark`; :func:`run` is the production path): counters
+    (``steps``, ``newton_iterations``, ``jacobian_updates``; ``wall_time_s`` [s], the solve
+    alone) and the statistics text Exudyn printed. Raises SimulationError if it fails."""
+    import exudyn as exu
+
+    settings = _exudyn_settings(solver_settings(mech.scene))
+    settings.show.computationTime = True
+    settings.timeIntegration.verboseMode = 1  # the statistics are printed only when verbose
+    solver = exu.MainSolverImplicitSecondOrder()
+    captured = io.StringIO()
+    start = time.perf_counter()
+    with redirect_stdout(captured):
+        ok = solver.SolveSystem(mech.mbs, settings)
+    wall = time.perf_counter() - start
+    if not ok:
+        raise SimulationError("profiled run failed")
+    return {"wall_time_s": wall, "steps": float(solver.it.currentStepIndex),
+            "newton_iterations": float(solver.it.newtonStepsCount),
+            "jacobian_updates": float(solver.it.newtonJacobiCount)}, captured.getvalue()
+
+
 def _sensor(mech: Mechanism, name: str) -> np.ndarray:
     return np.asarray(mech.mbs.GetSensorStoredData(mech.sensors[name]))
 

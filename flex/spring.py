@@ -625,9 +625,46 @@ def fe_helix_segment_stress(design: SpringDesign, force_N: float, *,
         raise SceneError(f"spring youngs_modulus_Pa = {youngs_modulus_Pa!r}: with G = "
                          f"{design.shear_modulus_Pa:g} Pa the Poisson ratio {poisson:.3f} "
                          "must lie in (-1, 0.5), i.e. 2G < E < 3G")
+    start = time.perf_counter()
+    mesh = _helix_segment_mesh(design, turns, maxh, element_order)
+    space, stress_cf, fe_rate = _solve_helix_segment(mesh, design, f_axial, turns, e_mod,
+                                                     poisson, element_order)
+    samples = _mid_section_samples(mesh, stress_cf, design, turns, sample_points)
+    peak = max(samples, key=lambda s: s[1])
+    nominal = nominal_torsional_shear_stress_Pa(f_axial, design.mean_coil_diameter_m, d)
+    c = design.spring_index
+    return HelixSegmentStress(
+        force_N=f_axial, segment_turns=turns, element_order=element_order, mesh_size_m=maxh,
+        elements=mesh.ne, degrees_of_freedom=space.ndof,
+        inner_fibre_max_shear_Pa=samples[0][1], inner_fibre_von_mises_Pa=samples[0][2],
+        peak_max_shear_Pa=peak[1], peak_angle_deg=peak[0],
+        wahl_shear_stress_Pa=wahl_factor(c) * nominal,
+        bergstrasser_shear_stress_Pa=bergstrasser_factor(c) * nominal,
+        nominal_shear_stress_Pa=nominal, fe_rate_N_per_m=fe_rate,
+        analytic_rate_N_per_m=design.rate_N_per_m,
+        wall_time_s=time.perf_counter() - start)
 
-    import ngsolve as ngs
+
+def _helix_frame(design: SpringDesign, angle_rad: float):
+    """Centre [m], unit tangent and outward radial unit vector of the coil's centre line
+    at the helix angle ``angle_rad`` (spring axis z, first end at angle 0, z = 0)."""
     import numpy as np
+
+    coil_radius = design.mean_coil_diameter_m / 2.0
+    pitch = design.pitch_m
+    centre = np.array([coil_radius * math.cos(angle_rad), coil_radius * math.sin(angle_rad),
+                       pitch * angle_rad / (2.0 * math.pi)])
+    tangent = np.array([-coil_radius * math.sin(angle_rad),
+                        coil_radius * math.cos(angle_rad), pitch / (2.0 * math.pi)])
+    tangent /= np.linalg.norm(tangent)
+    radial_out = np.array([math.cos(angle_rad), math.sin(angle_rad), 0.0])
+    return centre, tangent, radial_out
+
+
+def _helix_segment_mesh(design: SpringDesign, turns: float, maxh: float, element_order: int):
+    """NGsolve mesh (curved to ``element_order``, netgen maxh [m]) of ``turns`` turns of the
+    wire, its end faces named ``clamped`` (z = 0) and ``loaded``."""
+    import ngsolve as ngs
     from netgen.occ import (
         Circle,
         Cylinder,
@@ -642,14 +679,11 @@ def fe_helix_segment_stress(design: SpringDesign, force_N: float, *,
         gp_Pnt2d,
     )
 
-    start = time.perf_counter()
-    coil_radius = design.mean_coil_diameter_m / 2.0
-    pitch = design.pitch_m
-    angle_end = 2.0 * math.pi * turns
-    height_end = pitch * turns
+    radius_wire = design.wire_diameter_m / 2.0
+    height_end = design.pitch_m * turns
     # Helix = straight line in the (angle, height) parameter plane of a cylinder's face.
-    cylinder = Cylinder(Pnt(0.0, 0.0, 0.0), Z, r=coil_radius, h=1.0)
-    helix = Edge(Segment(gp_Pnt2d(0.0, 0.0), gp_Pnt2d(angle_end, height_end)),
+    cylinder = Cylinder(Pnt(0.0, 0.0, 0.0), Z, r=design.mean_coil_diameter_m / 2.0, h=1.0)
+    helix = Edge(Segment(gp_Pnt2d(0.0, 0.0), gp_Pnt2d(2.0 * math.pi * turns, height_end)),
                  cylinder.faces[0])
     section = Face(Wire([Circle(helix.start, helix.Tangent(0.0), radius_wire)]))
     wire_solid = Pipe(Wire([helix]), section)
@@ -661,22 +695,24 @@ def fe_helix_segment_stress(design: SpringDesign, force_N: float, *,
     mesh.Curve(element_order)
     if not {"clamped", "loaded"} <= set(mesh.GetBoundaries()):
         raise SceneError("spring FE: could not identify the helix segment's end faces")
+    return mesh
 
-    def centre_and_frame(angle_rad: float):
-        centre = np.array([coil_radius * math.cos(angle_rad), coil_radius * math.sin(angle_rad),
-                           pitch * angle_rad / (2.0 * math.pi)])
-        tangent = np.array([-coil_radius * math.sin(angle_rad),
-                            coil_radius * math.cos(angle_rad), pitch / (2.0 * math.pi)])
-        tangent /= np.linalg.norm(tangent)
-        radial_out = np.array([math.cos(angle_rad), math.sin(angle_rad), 0.0])
-        return centre, tangent, radial_out
 
-    area = math.pi * radius_wire**2
+def _solve_helix_segment(mesh, design: SpringDesign, f_axial: float, turns: float,
+                         e_mod: float, poisson: float, element_order: int):
+    """Linear elastic solution of the clamped segment under the axial force ``f_axial`` [N]
+    acting on the spring axis (as a traction on the loaded face): the FE space, the stress
+    field [Pa] and the rate [N/m] scaled from the segment to the design's active coils."""
+    import ngsolve as ngs
+    import numpy as np
+
+    d = design.wire_diameter_m
+    area = math.pi * (d / 2.0)**2
     second_moment = math.pi * d**4 / 64.0
     polar_moment = 2.0 * second_moment
-    centre_end, normal_end, _ = centre_and_frame(angle_end)
+    centre_end, normal_end, _ = _helix_frame(design, 2.0 * math.pi * turns)
     force = np.array([0.0, 0.0, f_axial])
-    axis_point = np.array([0.0, 0.0, height_end])
+    axis_point = np.array([0.0, 0.0, design.pitch_m * turns])
     moment = np.cross(axis_point - centre_end, force)
     moment_torsion = moment.dot(normal_end) * normal_end
     moment_bending = moment - moment_torsion
@@ -688,7 +724,6 @@ def fe_helix_segment_stress(design: SpringDesign, force_N: float, *,
     traction = (vec(force / area) + ngs.Cross(vec(moment_torsion), rho) / polar_moment
                 + vec(normal_end) * ngs.InnerProduct(vec(np.cross(normal_end, moment_bending)),
                                                      rho) / second_moment)
-
     shear_mod = design.shear_modulus_Pa
     lame_lambda = e_mod * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson))
 
@@ -719,9 +754,18 @@ def fe_helix_segment_stress(design: SpringDesign, force_N: float, *,
     rotation = (m_rot - 0.5 * normal_end * normal_end.dot(m_rot)) / second_moment
     axial_deflection = (mean_u + np.cross(rotation, axis_point - centre_end))[2]
     fe_rate = f_axial / axial_deflection * turns / design.active_coils
+    return space, stress(displacement), fe_rate
 
-    stress_cf = stress(displacement)
-    centre_mid, tangent_mid, radial_mid = centre_and_frame(angle_end / 2.0)
+
+def _mid_section_samples(mesh, stress_cf, design: SpringDesign, turns: float,
+                         sample_points: int) -> list[tuple[float, float, float]]:
+    """``(angle from the inner fibre [deg], max shear [Pa], von Mises [Pa])`` at
+    ``sample_points`` points of the mid-section's perimeter (0.999 of the wire radius);
+    points just outside the curved mesh are skipped, the inner fibre must be found."""
+    import numpy as np
+
+    radius_wire = design.wire_diameter_m / 2.0
+    centre_mid, tangent_mid, radial_mid = _helix_frame(design, 2.0 * math.pi * turns / 2.0)
     binormal = np.cross(tangent_mid, radial_mid)
     samples = []
     for angle in np.linspace(0.0, 2.0 * math.pi, sample_points, endpoint=False):
@@ -740,16 +784,4 @@ def fe_helix_segment_stress(design: SpringDesign, force_N: float, *,
     if not samples or samples[0][0] != 0.0:
         raise SceneError("spring FE: the inner-fibre sample point fell outside the mesh; "
                          "refine mesh_size_m")
-    peak = max(samples, key=lambda s: s[1])
-    nominal = nominal_torsional_shear_stress_Pa(f_axial, design.mean_coil_diameter_m, d)
-    c = design.spring_index
-    return HelixSegmentStress(
-        force_N=f_axial, segment_turns=turns, element_order=element_order, mesh_size_m=maxh,
-        elements=mesh.ne, degrees_of_freedom=space.ndof,
-        inner_fibre_max_shear_Pa=samples[0][1], inner_fibre_von_mises_Pa=samples[0][2],
-        peak_max_shear_Pa=peak[1], peak_angle_deg=peak[0],
-        wahl_shear_stress_Pa=wahl_factor(c) * nominal,
-        bergstrasser_shear_stress_Pa=bergstrasser_factor(c) * nominal,
-        nominal_shear_stress_Pa=nominal, fe_rate_N_per_m=fe_rate,
-        analytic_rate_N_per_m=design.rate_N_per_m,
-        wall_time_s=time.perf_counter() - start)
+    return samples

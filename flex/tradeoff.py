@@ -301,6 +301,15 @@ class Measurement:
         return self.errors.get("error", float("nan"))
 
 
+def describe(m: Measurement | None) -> str:
+    """One line: label, median wall time [ms], error, steps, Newton iterations ("-" for
+    None)."""
+    if m is None:
+        return "-"
+    return (f"{m.setting.label} ({m.wall_time_s * 1e3:.1f} ms, error {m.error:.1e}, "
+            f"{m.steps} steps, {m.newton_iterations} Newton iterations)")
+
+
 @contextlib.contextmanager
 def element_order(order: int) -> Iterator[None]:
     """Build reductions with tetrahedra of ``order`` (1 or 2) inside the block.
@@ -529,43 +538,51 @@ def converged_reference(base: Scene, label: str, finest: Setting,
         except FlexError as exc:
             reference.evidence[refinement.knob] = {"error": math.inf, "failed": str(exc)}
             continue
-        fine_ref = Reference("fine", levels[0][0], refinement.levels[0], {}, tolerance, 0.0)
-        changes_fine = fine_ref.errors(levels[1][0])
-        three = len(levels) == 3
-        if three:
-            medium_ref = Reference("medium", levels[1][0], refinement.levels[1], {},
-                                   tolerance, 0.0)
-            changes_coarse = medium_ref.errors(levels[2][0])
-        peaks = [_signed_peak(obs) for obs, _ in levels]
-        record: dict[str, Any] = {"error": 0.0}
-        for measure_name in MEASURES:
-            d1 = changes_fine[measure_name]
-            if not math.isfinite(d1) and measure_name == "peak_deflection_relative" \
-                    and not reference.flexible:
-                continue  # a measure the scene does not have (peak of a rigid coupler)
-            if not three:
-                estimate = {"estimate": d1, "change_fine": d1, "change_coarse": math.nan,
-                            "order": math.nan, "asymptotic": False}
-            else:
-                d2 = changes_coarse[measure_name]
-                monotone = True
-                if measure_name == "peak_deflection_relative":
-                    monotone = (peaks[1] - peaks[0]) * (peaks[2] - peaks[1]) > 0
-                estimate = richardson(d1, d2, refinement.ratio, refinement.max_order,
-                                      monotone)
-            record[measure_name] = estimate["estimate"]
-            if estimate["estimate"] >= record["error"]:
-                record.update(error=estimate["estimate"], governing=measure_name,
-                              **{k: v for k, v in estimate.items() if k != "estimate"})
-        record["values"] = (peaks if reference.flexible
-                            else [float(obs.crank_angle_rad[-1]) for obs, _ in levels])
-        record["settings"] = [setting.label for setting in refinement.levels]
-        record["wall_times_s"] = [wall for _, wall in levels]
-        record["ratio"] = refinement.ratio
-        reference.evidence[refinement.knob] = record
+        reference.evidence[refinement.knob] = _refinement_evidence(reference, refinement,
+                                                                   levels)
     if anchor is not None and refinements:
         reference.evidence["interaction"] = _interaction(reference, refinements, anchor, run)
     return reference
+
+
+def _refinement_evidence(reference: Reference, refinement: Refinement,
+                         levels: Sequence[tuple[Observables, float]]) -> dict[str, Any]:
+    """The evidence record of one knob sequence from its levels' runs (observables, wall
+    time [s]), finest first (see :func:`converged_reference`)."""
+    tolerance = reference.tolerance
+    fine_ref = Reference("fine", levels[0][0], refinement.levels[0], {}, tolerance, 0.0)
+    changes_fine = fine_ref.errors(levels[1][0])
+    three = len(levels) == 3
+    if three:
+        medium_ref = Reference("medium", levels[1][0], refinement.levels[1], {},
+                               tolerance, 0.0)
+        changes_coarse = medium_ref.errors(levels[2][0])
+    peaks = [_signed_peak(obs) for obs, _ in levels]
+    record: dict[str, Any] = {"error": 0.0}
+    for measure_name in MEASURES:
+        d1 = changes_fine[measure_name]
+        if not math.isfinite(d1) and measure_name == "peak_deflection_relative" \
+                and not reference.flexible:
+            continue  # a measure the scene does not have (peak of a rigid coupler)
+        if not three:
+            estimate = {"estimate": d1, "change_fine": d1, "change_coarse": math.nan,
+                        "order": math.nan, "asymptotic": False}
+        else:
+            d2 = changes_coarse[measure_name]
+            monotone = True
+            if measure_name == "peak_deflection_relative":
+                monotone = (peaks[1] - peaks[0]) * (peaks[2] - peaks[1]) > 0
+            estimate = richardson(d1, d2, refinement.ratio, refinement.max_order, monotone)
+        record[measure_name] = estimate["estimate"]
+        if estimate["estimate"] >= record["error"]:
+            record.update(error=estimate["estimate"], governing=measure_name,
+                          **{k: v for k, v in estimate.items() if k != "estimate"})
+    record["values"] = (peaks if reference.flexible
+                        else [float(obs.crank_angle_rad[-1]) for obs, _ in levels])
+    record["settings"] = [setting.label for setting in refinement.levels]
+    record["wall_times_s"] = [wall for _, wall in levels]
+    record["ratio"] = refinement.ratio
+    return record
 
 
 def _knob_key(knob: str) -> str:

@@ -8,7 +8,8 @@ compared with Euler-Bernoulli and Timoshenko beam theory. Table 5 is reproduced 
 period conventions (thesis T = 1/omega; physical T = 2 pi/omega) with n = delta_t / T;
 Tables 7 and 9 (ANSYS BEAM188, units and sections not stated) with flex's reading of them.
 Mesh convergence is part of the result: per model the element count, DOF and frequency of
-each refinement level, and the production mesh (coarsest level within tolerance).
+each refinement level, and the production mesh (coarsest level within tolerance). The survey
+is :func:`flex.modal.survey`; nothing is simulated.
 """
 
 from __future__ import annotations
@@ -16,13 +17,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from flex import modal
-from flex.plotting import figure
-from flex.results import CaseResult, Dataset
+from flex.results import CaseResult
 from flex.scene import Scene
-from flex.study import Summary
+from flex.study import StudyRun, Summary
 
 NAME = "modal"
 DESCRIPTION = "link eigenmodes: FE vs beam theory, Tables 5, 7, 9, mesh convergence"
@@ -30,225 +28,25 @@ OVERRIDES: list[str] = []
 # keys the study reads itself (its modal analyses), beside what its cases simulate
 READS = ("coupler.length_m", "coupler.width_m", "coupler.youngs_modulus_Pa",
          "coupler.density_kg_per_m3", "coupler.poisson_ratio", "crank.length_m")
-CONVERGENCE_TOLERANCE = 0.001  # relative, on the first pinned-pinned in-plane frequency
-CRANK_SECTION_M = (0.010, 0.010)  # flex's reading of the thesis's ANSYS section (Table 7)
 
 
 def cases(scene: Scene) -> dict[str, Scene]:
     return {}
 
 
-def _unit(key: str) -> str:
-    for suffix, unit in (("_rad_per_s", "rad/s"), ("_Hz", "Hz"), ("_s", "s"), ("_m", "m")):
-        if key.endswith(suffix):
-            return unit
-    return "1"
-
-
-def _store(datasets: dict[str, Dataset], prefix: str, table: dict) -> None:
-    for key, value in table.items():
-        array = np.asarray(value)
-        if array.dtype.kind in "US":
-            array = array.astype(object)
-        datasets[f"{prefix}/{key}"] = Dataset(array, _unit(key), key.replace("_", " "))
+def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
+    run.notes["progress"] = run.progress  # the survey (in summarize) reports its long steps
+    return {}
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               notes: dict[str, Any] | None = None) -> Summary:
-    datasets: dict[str, Dataset] = {}
-    coupler = scene["coupler"]
-    material = modal.Material(coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"],
-                              coupler["poisson_ratio"])
-    table5 = modal.thesis_table5_reproduction(material=material)
-    _store(datasets, "table5", table5)
-    lines = ["modal: thesis Table 5 (first pinned-pinned in-plane bending of the coupler)",
-             f"  {'t [mm]':>6s} {'thesis':>10s} {'EB [rad/s]':>11s} {'Timo':>10s} "
-             f"{'FE':>10s} {'FE/EB-1':>8s} {'FE/Timo-1':>9s} {'n thesis':>9s} "
-             f"{'n FE 1/w':>9s} {'n FE 2pi/w':>10s} {'verdict k=108 (1/w | 2pi/w)':>28s}"]
-    for i, thickness_m in enumerate(table5["coupler_thickness_m"]):
-        lines.append(
-            f"  {thickness_m * 1e3:6.0f} {table5['thesis_frequency_as_published'][i]:10.2f} "
-            f"{table5['euler_bernoulli_omega_rad_per_s'][i]:11.2f} "
-            f"{table5['timoshenko_omega_rad_per_s'][i]:10.2f} "
-            f"{table5['fe_omega_rad_per_s'][i]:10.2f} "
-            f"{table5['fe_vs_euler_bernoulli_relative'][i]:+8.2%} "
-            f"{table5['fe_vs_timoshenko_relative'][i]:+9.2%} "
-            f"{table5['thesis_n_as_published'][i]:9.0f} "
-            f"{table5['fe_n_thesis_convention'][i]:9.1f} {table5['fe_n_physical'][i]:10.2f} "
-            f"{table5['fe_verdict_thesis_convention'][i]:>14s} | "
-            f"{table5['fe_verdict_physical'][i]}")
-    lines.append("  The thesis's 'Frequency' is the Euler-Bernoulli circular frequency [rad/s] "
-                 "and its period T = 1/omega is 2 pi too small; with T = 2 pi/omega every "
-                 "model falls below k = 108.")
-    for link in modal.THESIS_LINKS:
-        table = modal.thesis_link_modal_reproduction(link, material=material)
-        _store(datasets, f"table_{link}", table)
-        lines.append(f"  {link} (thesis {'Table 7' if link == 'crank' else 'Table 9'}): "
-                     f"thesis {np.array2string(table['thesis_value_as_published'], precision=1)}"
-                     f"; BEAM188 emulation [Hz] "
-                     f"{np.array2string(table['beam188_emulation_frequency_Hz'], precision=1)}; "
-                     f"Timoshenko {np.array2string(table['timoshenko_frequency_Hz'], precision=1)}"
-                     f"; k thesis {float(table['thesis_k_as_published']):.0f}, "
-                     f"k Timoshenko {float(table['timoshenko_k']):.0f}")
-
-    links = {f"coupler_t{t * 1e3:g}mm": (coupler["length_m"], t, coupler["width_m"], h)
-             for t, h in zip(table5["coupler_thickness_m"], modal.TABLE5_FE_MESH_SIZES_M,
-                             strict=True)}
-    links["crank"] = (scene["crank"]["length_m"], *CRANK_SECTION_M, CRANK_SECTION_M[0] / 3)
-    lines.append("  first five modes [Hz] (FE | Timoshenko beam), kinds from the mode shapes:")
-    for name, (length_m, thickness_m, width_m, mesh_m) in links.items():
-        for condition in ("free-free", "pinned-pinned"):
-            fe = modal.plate_modes(length_m, thickness_m, width_m, mesh_m, condition,
-                                   material=material)
-            beam = modal.beam_link_modes(length_m, thickness_m, width_m, condition,
-                                         material=material)
-            group = f"links/{name}/{condition}"
-            datasets[f"{group}/fe_frequencies"] = Dataset(fe.frequencies_Hz, "Hz", "3D FE")
-            datasets[f"{group}/fe_mode_kinds"] = Dataset(
-                np.array(fe.mode_kinds, dtype=object), "1", "classified from the mode shape")
-            datasets[f"{group}/timoshenko_frequencies"] = Dataset(
-                beam.frequencies_Hz, "Hz", "Timoshenko beam (all mode kinds)")
-            datasets[f"{group}/timoshenko_mode_kinds"] = Dataset(
-                np.array(beam.mode_kinds, dtype=object), "1", "beam mode kinds")
-            datasets[f"{group}/mesh_dof"] = Dataset(fe.dof_count, "1", "FE degrees of freedom")
-            if condition == "pinned-pinned":
-                datasets[f"{group}/node_coordinates"] = Dataset(fe.node_coordinates_m, "m",
-                                                                "mesh vertices")
-                datasets[f"{group}/mode_shapes"] = Dataset(fe.mode_shapes, "1",
-                                                           "(mode, node, xyz), max |u| = 1")
-            pairs = ", ".join(f"{f:.0f} {k} | {b:.0f}" for f, k, b in
-                              zip(fe.frequencies_Hz, fe.mode_kinds, beam.frequencies_Hz,
-                                  strict=True))
-            lines.append(f"    {name:16s} {condition:13s} {pairs}")
-
-    lines.append(f"  mesh convergence (pinned-pinned in-plane bending, tolerance "
-                 f"{CONVERGENCE_TOLERANCE:.1%}):")
-    for thickness_m in table5["coupler_thickness_m"]:
-        conv = modal.mesh_convergence(coupler["length_m"], thickness_m, coupler["width_m"],
-                                      relative_tolerance=CONVERGENCE_TOLERANCE,
-                                      material=material)
-        group = f"convergence/coupler_t{thickness_m * 1e3:g}mm"
-        datasets[f"{group}/mesh_size"] = Dataset(np.asarray(conv.mesh_sizes_m), "m", "maxh")
-        datasets[f"{group}/elements"] = Dataset(np.asarray(conv.element_counts), "1", "tets")
-        datasets[f"{group}/dof"] = Dataset(np.asarray(conv.dof_counts), "1", "DOF")
-        datasets[f"{group}/frequency"] = Dataset(np.asarray(conv.frequencies_Hz), "Hz",
-                                                 "first in-plane bending")
-        datasets[f"{group}/reference_frequency"] = Dataset(
-            conv.selection.reference_frequency, "Hz", conv.selection.reference_method)
-        datasets[f"{group}/production_mesh_size"] = Dataset(conv.production_mesh_size_m, "m",
-                                                            "coarsest level within tolerance")
-        lines.append(f"    t = {thickness_m * 1e3:4g} mm: levels "
-                     f"{', '.join(f'{h * 1e3:.2g}' for h in conv.mesh_sizes_m)} mm -> "
-                     f"{', '.join(f'{f:.1f}' for f in conv.frequencies_Hz)} Hz; reference "
-                     f"{conv.selection.reference_frequency:.2f} Hz "
-                     f"({conv.selection.reference_method}); production mesh "
-                     f"{conv.production_mesh_size_m * 1e3:.3g} mm")
-    return Summary(datasets, "\n".join(lines))
+    return Summary(*modal.survey(scene, (notes or {}).get("progress")))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    from flex.plotting import decade_ticks
+    return modal.draw_figures(summary.datasets, folder)
 
-    s = {k: v.data for k, v in summary.datasets.items()}
-    paths = []
-    thickness_mm = s["table5/coupler_thickness_m"] * 1e3
-    path = folder / "modal-table5.png"
-    with figure(path, "First pinned-pinned in-plane bending frequency of the coupler, "
-                "relative to Euler-Bernoulli (thesis Table 5)",
-                "plate thickness t [mm]", "frequency / Euler-Bernoulli frequency [-]") as ax:
-        eb = s["table5/euler_bernoulli_frequency_Hz"]
-        ax.plot(thickness_mm, s["table5/timoshenko_frequency_Hz"] / eb, "s-",
-                label="Timoshenko beam")
-        ax.plot(thickness_mm, s["table5/fe_frequency_Hz"] / eb, "o", label="3D FE (NGsolve)")
-        ax.axhline(1.0, color="k", lw=0.8, label="Euler-Bernoulli beam (= thesis Table 5)")
-    paths.append(path)
-    path = folder / "modal-mode-shapes.png"
-    _mode_shapes(path, s, "links/coupler_t1mm/pinned-pinned")
-    paths.append(path)
-    path = folder / "modal-convergence.png"
-    with figure(path, "Mesh convergence of the first pinned-pinned in-plane bending "
-                "frequency", "degrees of freedom of the FE mesh [-]",
-                "|f / f_reference \u2212 1| [-]") as ax:
-        for index, t in enumerate(thickness_mm):
-            group = f"convergence/coupler_t{t:g}mm"
-            dof = np.asarray(s[f"{group}/dof"], dtype=float)
-            frequency = np.asarray(s[f"{group}/frequency"], dtype=float)
-            reference = float(s[f"{group}/reference_frequency"])
-            method = str(summary.datasets[f"{group}/reference_frequency"].description)
-            error = np.abs(frequency / reference - 1)
-            drawn = error > 0  # the finest level is the reference itself when not extrapolated
-            how = ("Richardson extrapolation" if method == "richardson"
-                   else "finest level, not drawn" if method == "finest" else method)
-            ax.loglog(dof[drawn], error[drawn], "o-", color=f"C{index}",
-                      label=f"t = {t:g} mm (reference: {how})")
-            production = np.isclose(s[f"{group}/mesh_size"],
-                                    float(s[f"{group}/production_mesh_size"]))
-            ax.loglog(dof[production & drawn], error[production & drawn], "o", ms=11,
-                      mfc="none", color=f"C{index}")
-        ax.axhline(CONVERGENCE_TOLERANCE, color="r", ls="--",
-                   label=f"tolerance {CONVERGENCE_TOLERANCE:.1%}")
-        ax.plot([], [], "o", ms=11, mfc="none", color="k",
-                label="production mesh (coarsest within tolerance)")
-        decade_ticks(ax)
-    paths.append(path)
-    return paths
-
-
-def _mode_shapes(path: Path, s: dict, group: str, count: int = 4) -> None:
-    """The first ``count`` FE modes of a plate in two views: x-y (the mechanism plane; the
-    in-plane displacement u_y averaged over each cross-section, i.e. the centre line) and
-    x-z (the plate's face, coloured by u_y: bending is uniform across the width, torsion
-    changes sign across it)."""
-    import matplotlib.pyplot as plt
-
-    from flex.plotting import save
-
-    nodes = np.asarray(s[f"{group}/node_coordinates"]) * 1e3
-    shapes = np.asarray(s[f"{group}/mode_shapes"])
-    kinds = [k.decode() if isinstance(k, bytes) else str(k) for k in s[f"{group}/fe_mode_kinds"]]
-    freqs = np.asarray(s[f"{group}/fe_frequencies"])
-    count = min(count, len(shapes))
-    mosaic = [["line", f"face{mode}"] for mode in range(count)]
-    fig, axes = plt.subplot_mosaic(mosaic, figsize=(12.0, 1.2 + 1.45 * count),
-                                   layout="constrained", width_ratios=[1.0, 1.25])
-    fig.suptitle(f"Coupler plate t = {np.ptp(nodes[:, 1]):g} mm, pinned-pinned: first "
-                 f"{count} FE modes in two views (normalized, max |u| = 1)")
-    line = axes["line"]
-    edges = np.linspace(nodes[:, 0].min(), nodes[:, 0].max(), 41)
-    bins = np.clip(np.digitize(nodes[:, 0], edges) - 1, 0, len(edges) - 2)
-    centres = 0.5 * (edges[1:] + edges[:-1])
-    face = nodes[:, 1] >= nodes[:, 1].max() - 1e-9  # one face: the x-z view
-    for mode in range(count):
-        u_y = shapes[mode][:, 1]
-        filled = np.bincount(bins, minlength=len(centres)) > 0
-        mean = np.bincount(bins, u_y, len(centres))[filled] / np.bincount(
-            bins, minlength=len(centres))[filled]
-        line.plot(centres[filled], mean, "-", color=f"C{mode}",
-                  label=f"mode {mode + 1}: {freqs[mode]:.0f} Hz, {kinds[mode]}")
-        ax = axes[f"face{mode}"]
-        contour = ax.tricontourf(nodes[face, 0], nodes[face, 2], u_y[face],
-                                 levels=np.linspace(-1, 1, 21), cmap="RdBu_r")
-        ax.set_aspect("equal")
-        ax.set_title(f"mode {mode + 1}: {freqs[mode]:.0f} Hz, {kinds[mode]}",
-                     fontsize="small", color=f"C{mode}")
-        ax.set_ylabel("z [mm]")
-        if mode < count - 1:
-            ax.tick_params(labelbottom=False)
-        else:
-            ax.set_xlabel("x along the coupler [mm]")
-    line.set_title("x-y view (mechanism plane): centre line, u_y averaged over the "
-                   "cross-section", fontsize="small")
-    line.set_xlabel("x along the coupler [mm]")
-    line.set_ylabel("normalized in-plane displacement u_y [-]")
-    line.axhline(0.0, color="k", lw=0.6)
-    line.grid(True, alpha=0.3)
-    line.legend(fontsize="small", loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
-    colourbar = fig.colorbar(contour, ax=[axes[f"face{m}"] for m in range(count)],
-                             shrink=0.8)
-    colourbar.set_label("normalized u_y [-]")
-    axes["face0"].annotate("x-z view (plate face): colour = u_y", (0.5, 1.45),
-                           xycoords="axes fraction", ha="center", fontsize="small")
-    save(fig, path)
 
 if __name__ == "__main__":
     from flex.cli import main

@@ -1,8 +1,12 @@
-"""Study ``simulate``: run exactly the scene it is given, as one case.
+"""Study ``simulate``: run exactly the scene it is given, as one case; nothing is compared.
 
     python -m flex run simulate --set crank.initial_angle_deg=50 --set drive.spring_preload_m=0.01
 
-Any drive and coupler model; nothing is compared. Stores ``/cases/case/...``.
+Every study follows this protocol (:mod:`flex.study`; copy this file to start one): ``NAME``,
+``DESCRIPTION``, ``OVERRIDES`` declare it; ``cases(scene)`` names the scenes flex simulates
+and stores (here ``/cases/case/...``); ``summarize`` returns the report and the datasets stored
+under ``/summary``; ``figures`` draws PNGs. Each hook declares, or makes one call into the
+library module of its concept (:mod:`flex.single_case`): no loops, fits or measurements here.
 """
 
 from __future__ import annotations
@@ -10,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from flex.plotting import figure
+from flex import single_case
 from flex.results import CaseResult
 from flex.scene import Scene
 from flex.study import Summary
@@ -25,22 +29,11 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               notes: dict[str, Any] | None = None) -> Summary:
-    case = results["case"]
-    if case.status != "ok":
-        return Summary(report=f"simulate: case failed: {case.message}")
-    angle = case.datasets["crank/angle"].data
-    return Summary(report=(f"simulate: crank angle {angle[0]:.4f} -> {angle[-1]:.4f} rad, "
-                           f"max {angle.max():.4f} rad; max constraint norm "
-                           f"{case.datasets['constraint_norm'].data.max():.2e} m"))
+    return Summary(*single_case.summary(results["case"]))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    data = {k: v.data for k, v in results["case"].datasets.items()}
-    path = folder / "simulate-crank-angle.png"
-    with figure(path, "Crank angle of the simulated scene", "time [s]",
-                "crank angle from the slide line [rad]") as ax:
-        ax.plot(data["time"], data["crank/angle"])
-    return [path]
+    return single_case.draw_crank_angle(results["case"], folder)
 
 
 if __name__ == "__main__":

@@ -201,6 +201,7 @@ def test_crank_figures_synthetic(tmp_path, reviewed):
 
 
 def test_kfit_figures_synthetic(tmp_path, reviewed):
+    from flex.couplerfit import label
     from studies import kfit
 
     rng = np.random.default_rng(1)
@@ -214,7 +215,7 @@ def test_kfit_figures_synthetic(tmp_path, reviewed):
             names += [f"{fam}_{i}_z{z:g}" for i in range(count)]
     for model, thickness in kfit.THESIS_MODELS.items():
         names[list(kfit.THESIS_MODELS).index(model) * 3] = (
-            f"thk_t{kfit._label(thickness, 1e3)}mm_z0")
+            f"thk_t{label(thickness, 1e3)}mm_z0")
     n = np.array(n)
     table = {"name": np.array(names, dtype=object), "family": np.array(family, dtype=object),
              "parameters/damping_ratio": np.array(zeta), "n_physical/stop": n,

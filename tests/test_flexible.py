@@ -291,3 +291,45 @@ def test_ffrf_coupler_with_a_constant_speed_crank_follows_the_closed_form():
     assert np.abs(data["crank/angle"] - omega * data["time"]).max() < 1e-9
     assert np.abs(data["slider/position"] - exact.slider_position_m).max() < 1e-6
     assert np.abs(data["coupler/midpoint_deflection"]).max() < 1e-6
+
+
+# ------------------------------------------------------------------------------------------
+# flex.twins and flex.softening
+# ------------------------------------------------------------------------------------------
+def test_twin_cases_pair_each_plate_and_add_the_nonlinear_reference_when_undamped():
+    from flex.twins import twin_cases
+
+    plates = {"a_t3mm": (0.003, 0.003), "b_t5mm": (0.005, 0.005)}
+    base = load_scene(None, [*pinned_overrides(), 'coupler.geometry="plate"'])
+    scenes = twin_cases(base, plates, "a_t3mm", 0.002)
+    assert list(scenes) == ["a_t3mm_ffrf", "a_t3mm_rigid", "b_t5mm_ffrf", "b_t5mm_rigid",
+                            "a_t3mm_nonlinear_fe"]
+    assert scenes["b_t5mm_rigid"]["coupler"]["thickness_m"] == 0.005
+    assert scenes["b_t5mm_rigid"]["coupler"]["model"] == "rigid"
+    assert scenes["a_t3mm_nonlinear_fe"]["simulation"]["end_time_s"] == 0.002
+    damped = load_scene(None, [*pinned_overrides(), 'coupler.geometry="plate"',
+                               "coupler.damping_ratio=0.01"])
+    assert "a_t3mm_nonlinear_fe" not in twin_cases(damped, plates, "a_t3mm")
+
+
+def test_first_peak_is_the_first_lobe_not_the_ripple_or_the_largest_swing():
+    from flex.softening import first_peak_index
+
+    time_s = np.linspace(0.0, 1.0, 2001)
+    # first lobe peaks at t = 0.25 (1.0), ripple on it, then a larger negative lobe
+    deflection = np.sin(2 * np.pi * time_s) * np.where(time_s < 0.5, 1.0, 2.0)
+    deflection += 0.02 * np.sin(2 * np.pi * 40 * time_s) * (time_s < 0.5)
+    index = first_peak_index(deflection)
+    assert 0.2 < time_s[index] < 0.3 and deflection[index] > 0.99
+
+
+def test_coupler_compression_is_the_joint_C_force_toward_B():
+    from flex.softening import coupler_compression_N, coupler_euler_load_N
+
+    data = {"coupler/angle": np.array([0.0, np.pi / 2, 0.0]),
+            "joints/C/force_on_coupler": np.array([[-5.0, 0.0], [0.0, -3.0], [2.0, 0.0]])}
+    assert np.allclose(coupler_compression_N(data), [5.0, 3.0, -2.0], rtol=0, atol=1e-12)
+    assert np.allclose(coupler_compression_N(data, 2), [5.0, 3.0], rtol=0, atol=1e-12)
+    coupler = dict(length_m=0.08, thickness_m=0.001, width_m=0.01, youngs_modulus_Pa=200e9)
+    assert coupler_euler_load_N(coupler) == pytest.approx(
+        np.pi ** 2 * 200e9 * 0.01 * 0.001 ** 3 / 12 / 0.08 ** 2, rel=1e-12)  # 257 N

@@ -1,4 +1,6 @@
-"""Tests of flex.modal: beam theory, mode classification, 3D FE modes, mesh selection, tables.
+"""Tests of the modal modules: beam theory (flex.beams), mode classification and 3D FE modes
+(flex.fe_modes), BEAM188 emulation (flex.beam_elements), mesh selection (flex.mesh_convergence)
+and the thesis's tables (flex.thesis_tables).
 
 The FE tests use meshes of at most ~10k DOF (about 1 s each on one core); the full Table 5
 and a mesh-convergence run are marked slow.
@@ -14,10 +16,17 @@ import pytest
 
 os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
 
-from flex import modal  # noqa: E402
+from flex import (  # noqa: E402
+    beam_elements,
+    beams,
+    fe_modes,
+    mesh_convergence,
+    thesis,
+    thesis_tables,
+)
 from flex.errors import SceneError  # noqa: E402
 
-STEEL = modal.THESIS_STEEL
+STEEL = beams.THESIS_STEEL
 COUPLER_LENGTH_M = 0.08
 WIDTH_M = 0.01
 
@@ -33,7 +42,7 @@ def test_pinned_pinned_euler_bernoulli_is_the_textbook_formula_and_thesis_table5
     inertia_m4 = WIDTH_M * thickness_m**3 / 12
     textbook_rad_per_s = (math.pi / COUPLER_LENGTH_M) ** 2 * math.sqrt(
         200e9 * inertia_m4 / (7850 * area_m2))
-    omega = modal.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, thickness_m, WIDTH_M,
+    omega = beams.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, thickness_m, WIDTH_M,
                                                     "pinned-pinned", 3)
     assert omega[0] == pytest.approx(textbook_rad_per_s, rel=1e-12)
     assert omega[1:] / omega[0] == pytest.approx([4.0, 9.0], rel=1e-12)
@@ -51,25 +60,25 @@ def test_pinned_pinned_euler_bernoulli_is_the_textbook_formula_and_thesis_table5
 ])
 def test_euler_bernoulli_wave_numbers_match_tables(end_condition, expected):
     # Blevins, Formulas for natural frequency and mode shape, Table 8-1.
-    assert modal.euler_bernoulli_beta_l(end_condition, 3) == pytest.approx(expected, abs=2e-5)
+    assert beams.euler_bernoulli_beta_l(end_condition, 3) == pytest.approx(expected, abs=2e-5)
 
 
 def test_rectangle_torsion_constant():
     side_m = 0.01
-    assert modal.rectangle_torsion_constant_m4(side_m, side_m) == pytest.approx(
+    assert beams.rectangle_torsion_constant_m4(side_m, side_m) == pytest.approx(
         0.1406 * side_m**4, rel=1e-3)
     # Thin strip: J -> a b^3 / 3 (1 - 0.630 b / a).
     long_m, short_m = 0.1, 0.001
-    assert modal.rectangle_torsion_constant_m4(short_m, long_m) == pytest.approx(
+    assert beams.rectangle_torsion_constant_m4(short_m, long_m) == pytest.approx(
         long_m * short_m**3 / 3 * (1 - 0.630 * short_m / long_m), rel=1e-3)
 
 
-@pytest.mark.parametrize("end_condition", modal.BEAM_END_CONDITIONS)
+@pytest.mark.parametrize("end_condition", beams.BEAM_END_CONDITIONS)
 def test_timoshenko_without_shear_and_rotary_inertia_is_euler_bernoulli(end_condition):
     args = (COUPLER_LENGTH_M, 0.01, WIDTH_M, end_condition, 5)
-    reduced = modal.timoshenko_bending_rad_per_s(*args, rotary_inertia=False,
+    reduced = beams.timoshenko_bending_rad_per_s(*args, rotary_inertia=False,
                                                  shear_deformation=False)
-    assert reduced == pytest.approx(modal.euler_bernoulli_bending_rad_per_s(*args), rel=1e-8)
+    assert reduced == pytest.approx(beams.euler_bernoulli_bending_rad_per_s(*args), rel=1e-8)
 
 
 @pytest.mark.parametrize("boundary_condition", ["free-free", "pinned-pinned"])
@@ -78,8 +87,8 @@ def test_timoshenko_agrees_with_converged_beam_elements(boundary_condition):
     # free-free, pinned-pinned (in-plane) and clamped-clamped (out-of-plane) bending.
     # L/h = 4 to 7: shear matters; not square, so no equal pairs to order arbitrarily.
     length_m, thickness_m, width_m = 0.04, 0.006, 0.01
-    exact = modal.beam_link_modes(length_m, thickness_m, width_m, boundary_condition, 5)
-    elements = modal.beam_element_modes(length_m, thickness_m, width_m, boundary_condition,
+    exact = beams.beam_link_modes(length_m, thickness_m, width_m, boundary_condition, 5)
+    elements = beam_elements.beam_element_modes(length_m, thickness_m, width_m, boundary_condition,
                                         400, 5)
     assert elements.mode_kinds == exact.mode_kinds
     assert elements.frequencies_Hz == pytest.approx(exact.frequencies_Hz, rel=2e-4)
@@ -88,21 +97,21 @@ def test_timoshenko_agrees_with_converged_beam_elements(boundary_condition):
 def test_timoshenko_is_below_euler_bernoulli_by_shear_and_rotary_inertia():
     # L/t = 8: Timoshenko pinned-pinned 2.5 % below Euler-Bernoulli; slender: no difference.
     stubby = [f("pinned-pinned") for f in (
-        lambda bc: modal.timoshenko_bending_rad_per_s(COUPLER_LENGTH_M, 0.01, WIDTH_M, bc, 1),
-        lambda bc: modal.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, 0.01, WIDTH_M,
+        lambda bc: beams.timoshenko_bending_rad_per_s(COUPLER_LENGTH_M, 0.01, WIDTH_M, bc, 1),
+        lambda bc: beams.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, 0.01, WIDTH_M,
                                                            bc, 1))]
     assert stubby[0][0] / stubby[1][0] == pytest.approx(0.9748, abs=5e-4)
-    slender_ratio = (modal.timoshenko_bending_rad_per_s(1.0, 0.001, WIDTH_M, "free-free", 1)
-                     / modal.euler_bernoulli_bending_rad_per_s(1.0, 0.001, WIDTH_M,
+    slender_ratio = (beams.timoshenko_bending_rad_per_s(1.0, 0.001, WIDTH_M, "free-free", 1)
+                     / beams.euler_bernoulli_bending_rad_per_s(1.0, 0.001, WIDTH_M,
                                                                "free-free", 1))
     assert slender_ratio[0] == pytest.approx(1.0, abs=1e-5)
 
 
 def test_rod_frequencies():
     wave_speed = math.sqrt(200e9 / 7850)
-    assert modal.axial_rad_per_s(0.08, "fixed-free", 2) == pytest.approx(
+    assert beams.axial_rad_per_s(0.08, "fixed-free", 2) == pytest.approx(
         [math.pi / 2 * wave_speed / 0.08, 3 * math.pi / 2 * wave_speed / 0.08])
-    torsion = modal.torsion_rad_per_s(0.08, 0.01, 0.01, "fixed-fixed", 1)[0]
+    torsion = beams.torsion_rad_per_s(0.08, 0.01, 0.01, "fixed-fixed", 1)[0]
     shear_speed = math.sqrt(STEEL.shear_modulus_Pa / 7850)
     assert torsion == pytest.approx(math.pi / 0.08 * shear_speed * math.sqrt(0.1406 * 6),
                                     rel=1e-3)
@@ -122,7 +131,7 @@ def _symmetric_points():
 def _shares(field):
     points = _symmetric_points()
     mirrors = [points * flip for flip in ([1, -1, 1], [1, 1, -1], [1, -1, -1])]
-    return modal.parity_kind_shares(field(points), *(field(p) for p in mirrors))
+    return fe_modes.parity_kind_shares(field(points), *(field(p) for p in mirrors))
 
 
 def _axial(p):
@@ -152,15 +161,15 @@ def _torsion(p):
 def test_parity_classification_of_pure_fields(field, kind):
     shares = _shares(field)
     assert shares.sum() == pytest.approx(1.0)
-    assert shares[modal.MODE_KINDS.index(kind)] == pytest.approx(1.0, abs=1e-12)
-    assert modal.classify_kind_shares(shares) == kind
+    assert shares[beams.MODE_KINDS.index(kind)] == pytest.approx(1.0, abs=1e-12)
+    assert fe_modes.classify_kind_shares(shares) == kind
 
 
 def test_mixed_field_is_reported_mixed():
     shares = _shares(lambda p: _in_plane(p) + _out_of_plane(p))
     assert shares[1] == pytest.approx(shares[2], rel=0.2)
-    assert modal.classify_kind_shares(shares) == "mixed"
-    assert modal.classify_kind_shares(shares, minimum_share=0.4) in (
+    assert fe_modes.classify_kind_shares(shares) == "mixed"
+    assert fe_modes.classify_kind_shares(shares, minimum_share=0.4) in (
         "in-plane bending", "out-of-plane bending")
 
 
@@ -171,21 +180,21 @@ def test_mixed_field_is_reported_mixed():
 
 @pytest.fixture(scope="module")
 def slender_free():
-    return modal.plate_modes(COUPLER_LENGTH_M, 0.001, WIDTH_M, 0.002, "free-free", 5)
+    return fe_modes.plate_modes(COUPLER_LENGTH_M, 0.001, WIDTH_M, 0.002, "free-free", 5)
 
 
 @pytest.fixture(scope="module")
 def slender_pinned():
-    return modal.plate_modes(COUPLER_LENGTH_M, 0.001, WIDTH_M, 0.002, "pinned-pinned", 5)
+    return fe_modes.plate_modes(COUPLER_LENGTH_M, 0.001, WIDTH_M, 0.002, "pinned-pinned", 5)
 
 
 @pytest.fixture(scope="module")
 def stubby_pinned():
-    return modal.plate_modes(COUPLER_LENGTH_M, 0.01, WIDTH_M, 0.005, "pinned-pinned", 5)
+    return fe_modes.plate_modes(COUPLER_LENGTH_M, 0.01, WIDTH_M, 0.005, "pinned-pinned", 5)
 
 
 def test_slender_free_free_matches_euler_bernoulli(slender_free):
-    eb_Hz = modal.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, 0.001, WIDTH_M,
+    eb_Hz = beams.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, 0.001, WIDTH_M,
                                                     "free-free", 2) / (2 * math.pi)
     assert slender_free.mode_kinds == ("in-plane bending", "in-plane bending", "torsion",
                                        "in-plane bending", "in-plane bending")
@@ -200,13 +209,13 @@ def test_slender_free_free_matches_euler_bernoulli(slender_free):
     assert slender_free.mode_shapes.shape == (5, slender_free.node_count, 3)
     assert np.max(np.linalg.norm(slender_free.mode_shapes, axis=2), axis=1) == pytest.approx(1)
     # Torsion of a thin strip: St-Venant within 2 % (measured +1.6 %).
-    torsion_Hz = modal.torsion_rad_per_s(COUPLER_LENGTH_M, 0.001, WIDTH_M, "free-free",
+    torsion_Hz = beams.torsion_rad_per_s(COUPLER_LENGTH_M, 0.001, WIDTH_M, "free-free",
                                          1)[0] / (2 * math.pi)
     assert slender_free.frequencies_Hz[2] == pytest.approx(torsion_Hz, rel=0.02)
 
 
 def test_slender_pinned_pinned_matches_euler_bernoulli(slender_pinned):
-    eb_Hz = modal.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, 0.001, WIDTH_M,
+    eb_Hz = beams.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, 0.001, WIDTH_M,
                                                     "pinned-pinned", 3) / (2 * math.pi)
     assert slender_pinned.mode_kinds == ("in-plane bending",) * 3 + ("torsion",
                                                                      "in-plane bending")
@@ -224,28 +233,28 @@ def test_stubby_pinned_pinned_needs_timoshenko(stubby_pinned):
     assert stubby_pinned.mode_kinds == ("in-plane bending", "out-of-plane bending",
                                         "in-plane bending", "torsion", "out-of-plane bending")
     fe_Hz = stubby_pinned.frequencies_Hz[0]
-    timoshenko_Hz = modal.timoshenko_bending_rad_per_s(
+    timoshenko_Hz = beams.timoshenko_bending_rad_per_s(
         COUPLER_LENGTH_M, 0.01, WIDTH_M, "pinned-pinned", 1)[0] / (2 * math.pi)
-    eb_Hz = modal.euler_bernoulli_bending_rad_per_s(
+    eb_Hz = beams.euler_bernoulli_bending_rad_per_s(
         COUPLER_LENGTH_M, 0.01, WIDTH_M, "pinned-pinned", 1)[0] / (2 * math.pi)
     assert fe_Hz == pytest.approx(timoshenko_Hz, rel=3e-3)
     assert 0.015 < 1 - fe_Hz / eb_Hz < 0.035
     # The whole spectrum follows the beam model of the revolute joints: in-plane pinned,
     # out-of-plane clamped, torsion fixed (3D effects: within 3 %).
-    beam = modal.beam_link_modes(COUPLER_LENGTH_M, 0.01, WIDTH_M, "pinned-pinned", 5)
+    beam = beams.beam_link_modes(COUPLER_LENGTH_M, 0.01, WIDTH_M, "pinned-pinned", 5)
     assert stubby_pinned.mode_kinds == beam.mode_kinds
     assert stubby_pinned.frequencies_Hz == pytest.approx(beam.frequencies_Hz, rel=0.03)
 
 
 def test_square_section_free_free_degenerate_pair_is_separated():
-    modes = modal.plate_modes(COUPLER_LENGTH_M, 0.01, WIDTH_M, 0.01, "free-free", 2)
+    modes = fe_modes.plate_modes(COUPLER_LENGTH_M, 0.01, WIDTH_M, 0.01, "free-free", 2)
     assert sorted(modes.mode_kinds) == ["in-plane bending", "out-of-plane bending"]
     assert np.all(modes.kind_shares.max(axis=1) > 0.95)
     assert modes.frequencies_Hz[1] == pytest.approx(modes.frequencies_Hz[0], rel=0.01)
 
 
 def test_pinned_roller_frees_the_axial_mode():
-    modes = modal.plate_modes(COUPLER_LENGTH_M, 0.01, WIDTH_M, 0.01, "pinned-roller", 5)
+    modes = fe_modes.plate_modes(COUPLER_LENGTH_M, 0.01, WIDTH_M, 0.01, "pinned-roller", 5)
     assert modes.constraint_count == 9
     axial_Hz = modes.frequencies_Hz[modes.first_of_kind("axial")]
     quarter_wave_Hz = math.sqrt(200e9 / 7850) / (4 * COUPLER_LENGTH_M)
@@ -254,9 +263,9 @@ def test_pinned_roller_frees_the_axial_mode():
 
 def test_linear_tetrahedra_lock():
     # First-order tets: shear locking makes the thin plate far too stiff.
-    locked = modal.plate_modes(COUPLER_LENGTH_M, 0.001, WIDTH_M, 0.002, "free-free", 1,
+    locked = fe_modes.plate_modes(COUPLER_LENGTH_M, 0.001, WIDTH_M, 0.002, "free-free", 1,
                                element_order=1)
-    eb_Hz = modal.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, 0.001, WIDTH_M,
+    eb_Hz = beams.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, 0.001, WIDTH_M,
                                                     "free-free", 1)[0] / (2 * math.pi)
     assert locked.frequencies_Hz[0] > 1.3 * eb_Hz
 
@@ -269,16 +278,16 @@ def test_bad_inputs_raise_scene_error(kwargs):
                  "mesh_size_m": 0.002, "boundary_condition": "free-free", "mode_count": 5}
     arguments.update(kwargs)
     with pytest.raises(SceneError, match=next(iter(kwargs))):
-        modal.plate_modes(**arguments)
+        fe_modes.plate_modes(**arguments)
 
 
 def test_bad_beam_inputs_raise_scene_error():
     with pytest.raises(SceneError, match="accepted"):
-        modal.euler_bernoulli_bending_rad_per_s(0.08, 0.01, 0.01, "simply-supported")
+        beams.euler_bernoulli_bending_rad_per_s(0.08, 0.01, 0.01, "simply-supported")
     with pytest.raises(SceneError, match="positive"):
-        modal.timoshenko_bending_rad_per_s(0.08, -0.01, 0.01, "pinned-pinned")
+        beams.timoshenko_bending_rad_per_s(0.08, -0.01, 0.01, "pinned-pinned")
     with pytest.raises(SceneError, match="link"):
-        modal.thesis_link_modal_reproduction("slider")
+        thesis_tables.thesis_link_modal_reproduction("slider")
 
 
 # --------------------------------------------------------------------------------------------
@@ -290,18 +299,18 @@ def test_selection_extrapolates_and_picks_the_coarsest_level_within_tolerance():
     sizes_m = 0.004 * 2.0 ** (-np.arange(5) / 2)
     converged = 1000.0
     frequencies = converged * (1 + 0.3 * (sizes_m / 0.004) ** 2 / 100)  # 0.3 % at the coarsest
-    selection = modal.select_production_mesh(sizes_m, frequencies, 0.001)
+    selection = mesh_convergence.select_production_mesh(sizes_m, frequencies, 0.001)
     assert selection.reference_method == "richardson"
     assert selection.observed_order == pytest.approx(2.0, rel=1e-6)
     assert selection.reference_frequency == pytest.approx(converged, rel=1e-9)
     # Errors 0.3, 0.15, 0.075, ... %: the first level within 0.1 % is index 2.
     assert selection.selected_index == 2
-    assert modal.select_production_mesh(sizes_m, frequencies, 0.005).selected_index == 0
+    assert mesh_convergence.select_production_mesh(sizes_m, frequencies, 0.005).selected_index == 0
 
 
 def test_selection_falls_back_to_finest_without_monotone_convergence():
     sizes_m = [0.004, 0.002, 0.001]
-    selection = modal.select_production_mesh(sizes_m, [1010.0, 1000.0, 1004.0], 0.005)
+    selection = mesh_convergence.select_production_mesh(sizes_m, [1010.0, 1000.0, 1004.0], 0.005)
     assert selection.reference_method == "finest"
     assert math.isnan(selection.observed_order)
     assert selection.reference_frequency == 1004.0
@@ -311,10 +320,10 @@ def test_selection_falls_back_to_finest_without_monotone_convergence():
 
 def test_selection_rejects_unordered_sizes_and_reports_no_level_within_tolerance():
     with pytest.raises(SceneError, match="decreasing"):
-        modal.select_production_mesh([0.001, 0.002], [1.0, 1.0])
+        mesh_convergence.select_production_mesh([0.001, 0.002], [1.0, 1.0])
     sizes_m = 0.004 * 2.0 ** -np.arange(3)
     slow = 1000.0 * (1 + 0.1 * sizes_m / 0.004)  # first order, 10 % off at the coarsest
-    selection = modal.select_production_mesh(sizes_m, slow, 0.01)
+    selection = mesh_convergence.select_production_mesh(sizes_m, slow, 0.01)
     assert selection.observed_order == pytest.approx(1.0)
     assert selection.selected_index is None  # even the finest level is 2.5 % off
 
@@ -325,15 +334,15 @@ def test_selection_rejects_unordered_sizes_and_reports_no_level_within_tolerance
 
 
 def test_table5_beam_columns_and_both_period_conventions():
-    table = modal.thesis_table5_reproduction(mesh_sizes_m=None)
+    table = thesis_tables.thesis_table5_reproduction(mesh_sizes_m=None)
     assert table["euler_bernoulli_omega_rad_per_s"] == pytest.approx(
-        modal.THESIS_TABLE5["frequency_as_published"], rel=1e-5)
+        thesis.THESIS_TABLE5["frequency_as_published"], rel=1e-5)
     # The thesis's T = 1/omega and n = delta_t / T.
     assert table["euler_bernoulli_period_thesis_convention_s"] == pytest.approx(
-        modal.THESIS_TABLE5["period_as_published_s"], rel=1e-4)
+        thesis.THESIS_TABLE5["period_as_published_s"], rel=1e-4)
     # The thesis truncates n (108.7 -> 108).
     assert np.floor(table["euler_bernoulli_n_thesis_convention"]) == pytest.approx(
-        modal.THESIS_TABLE5["n_as_published"])
+        thesis.THESIS_TABLE5["n_as_published"])
     assert table["euler_bernoulli_n_physical"] == pytest.approx([5.77, 17.30, 28.84, 57.68],
                                                                 abs=0.01)
     assert list(table["euler_bernoulli_verdict_thesis_convention"]) == [
@@ -343,11 +352,11 @@ def test_table5_beam_columns_and_both_period_conventions():
 
 
 def test_beam188_emulation_reproduces_tables_7_and_9():
-    for link in modal.THESIS_LINKS:
-        table = modal.thesis_link_modal_reproduction(link)
+    for link in thesis_tables.THESIS_LINKS:
+        table = thesis_tables.thesis_link_modal_reproduction(link)
         assert np.all(np.abs(table["beam188_emulation_vs_thesis_relative"]) < 0.008), link
         assert int(table["thesis_k_as_published"]) == (733 if link == "crank" else 299)
-    coupler = modal.thesis_link_modal_reproduction("coupler")
+    coupler = thesis_tables.thesis_link_modal_reproduction("coupler")
     assert list(coupler["beam188_emulation_kind"]) == [
         "in-plane bending", "out-of-plane bending", "in-plane bending", "axial", "torsion"]
     # The converged beam (no discretisation error) is lower, up to 6 % for the 2nd bending.
@@ -357,17 +366,17 @@ def test_beam188_emulation_reproduces_tables_7_and_9():
 
 @pytest.mark.slow
 def test_table5_fe_columns():
-    table = modal.thesis_table5_reproduction()
+    table = thesis_tables.thesis_table5_reproduction()
     assert np.all(np.abs(table["fe_vs_timoshenko_relative"]) < 2e-3)
     assert table["fe_vs_euler_bernoulli_relative"][-1] == pytest.approx(-0.024, abs=3e-3)
 
 
 @pytest.mark.slow
 def test_mesh_convergence_of_the_thin_plate():
-    study = modal.mesh_convergence(COUPLER_LENGTH_M, 0.001, WIDTH_M, "pinned-pinned")
+    study = mesh_convergence.mesh_convergence(COUPLER_LENGTH_M, 0.001, WIDTH_M, "pinned-pinned")
     assert study.selection.reference_method == "richardson"
     assert study.production_mesh_size_m is not None
     assert np.all(np.diff(study.dof_counts) > 0)
-    eb_Hz = modal.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, 0.001, WIDTH_M,
+    eb_Hz = beams.euler_bernoulli_bending_rad_per_s(COUPLER_LENGTH_M, 0.001, WIDTH_M,
                                                     "pinned-pinned", 1)[0] / (2 * math.pi)
     assert study.selection.reference_frequency == pytest.approx(eb_Hz, rel=1e-3)

@@ -17,9 +17,9 @@ import h5py
 import numpy as np
 import pytest
 
-from flex.errors import SimulationError
+from flex.errors import FlexError, SimulationError
 from flex.reference import SliderCrankDAE, solve_reference
-from flex.results import Dataset, write_results
+from flex.results import CaseResult, Dataset, write_results
 from flex.scene import load_scene
 from flex.simulation import simulate, simulate_case
 from flex.solver import _check_finite
@@ -163,7 +163,6 @@ def test_ffrf_coupler_keeps_its_energy_over_a_long_horizon():
 
 
 def test_a_run_succeeds_when_exactly_the_expected_cases_fail():
-    from flex.results import CaseResult
     from flex.study import StudyOutput, Summary
 
     results = {"ok": CaseResult("ok", ""),
@@ -182,3 +181,45 @@ def test_the_stability_study_declares_its_forced_divergences():
 
     assert stability.EXPECTED_FAILURES == {"diverge_explicit_above_limit",
                                            "diverge_thin_plate_h1e-4", "long_rigid_rho1"}
+
+
+# ------------------------------------------------------------------------------------------
+# flex.stability: references, verdicts, trust boundary
+# ------------------------------------------------------------------------------------------
+def test_a_constant_speed_run_is_judged_against_the_closed_form():
+    from flex.settings import pinned_overrides
+    from flex.stability import Extreme, References, extreme_cases, judge
+    from flex.tradeoff import ReductionPool
+
+    extreme = Extreme("crank_speed", "stiff_drive", (
+        'drive.kind="constant_speed"', "simulation.end_time_s=0.01"), "closed_form", 1.0)
+    (scene,) = extreme_cases(load_scene(None, pinned_overrides()), [extreme]).values()
+    references = References(ReductionPool(), 1e-3)
+    verdict = judge(extreme, scene, simulate_case(scene, extreme.name), references, 1e-3)
+    assert verdict["verdict"] == "within tolerance" and verdict["within_tolerance"]
+    assert verdict["error"] < 1e-6 and verdict["reference_accuracy"] == 0.0
+    assert "energy_drift" not in verdict  # a prescribed crank speed has no spring energy
+    failed = CaseResult(extreme.name, "", status="failed", message="Newton failed at step 3")
+    diverging = Extreme("d", "divergence", (), "scipy", expect="diverges")
+    assert judge(diverging, scene, failed, references, 1e-3)["verdict"] == (
+        "diverged as expected, detected")
+    with pytest.raises(FlexError, match="unknown reference kind"):
+        references.get("fine", scene)  # a fine reference needs its step
+
+
+def test_trust_boundary_interpolates_where_ffrf_comes_within_one_percent():
+    from flex.stability import trust_boundary
+
+    def verdicts(errors):
+        return {f"nonlinear_{t:g}mm": {"group": "nonlinear", "parameter": t,
+                                       "error_peak_deflection_relative": e,
+                                       "axial_force_over_euler_load": 0.1}
+                for t, e in errors}
+
+    # log-interpolation: the error 4 % -> 0.25 % over t = 0.5 -> 1 mm is 1 % half-way
+    boundary, text = trust_boundary(verdicts([(1.0, 2.5e-3), (0.5, 4e-2), (2.0, 1e-3)]))
+    assert boundary == pytest.approx(0.5 * math.sqrt(2), rel=1e-12)
+    assert "0.5 mm: 4 % (P/P_euler 0.1)" in text
+    assert trust_boundary(verdicts([(0.5, 5e-3)]))[0] == 0.5
+    assert trust_boundary(verdicts([(0.5, 5e-2), (1.0, 2e-2)]))[0] == math.inf
+    assert math.isnan(trust_boundary({})[0])

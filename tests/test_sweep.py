@@ -174,6 +174,7 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch):
     """A shrunken kfit (3 thicknesses, 1 stiffness family, 1 validation scene) through the
     study runner and the local process pool: cases, fit, criterion file, validation."""
     import studies.kfit as kfit
+    from flex.couplerfit import analyse
     from flex.study import run_study
 
     monkeypatch.setattr(kfit, "THICKNESSES_M", (1e-3, 3e-3, 10e-3))
@@ -188,7 +189,7 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch):
     sweep = SweepSettings(folder=tmp_path / "cases", progress=False)
     output = run_study("kfit", out=tmp_path / "kfit.h5", figures=True, quiet=True, sweep=sweep)
     assert all(c.status == "ok" for c in output.results.values())
-    law = kfit.analyse(output.results)["fits"][(0.0, "stop", "deflection")]
+    law = analyse(output.results)["fits"][(0.0, "stop", "deflection")]
     assert 1.5 < law.exponent < 3.0  # quasi-static expectation: 2
     assert (tmp_path / "kfit-criterion.toml").exists()
     validation = output.results["val_t7mm_tol1pct"]

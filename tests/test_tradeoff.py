@@ -83,17 +83,17 @@ def test_recommend_counts_the_reference_accuracy_in_the_error(rigid_reference):
 
 
 def test_the_1mm_reference_sequences_run_through_the_reference():
-    import studies.tradeoff as study
+    from flex.reference_plans import FFRF_REFERENCE, reference_plan, through_reference
 
-    finest, _, _, _, refinements, anchor = study.reference_plan("ffrf_1mm")
-    assert study.through_reference(study.FFRF_REFERENCE["ffrf_1mm"]) and anchor is None
+    finest, _, _, _, refinements, anchor = reference_plan("ffrf_1mm")
+    assert through_reference(FFRF_REFERENCE["ffrf_1mm"]) and anchor is None
     for refinement in refinements[:3]:  # step, mesh, modes: the fine level is the reference
         assert refinement.levels[0].knobs() == finest.knobs()
         others = [dict(level.overrides) for level in refinement.levels]
         varied = {key for key in others[0] if len({repr(o[key]) for o in others}) > 1}
         assert len(varied) == 1  # only the sequence's own knob changes
     # 10 mm keeps cheaper bases, so it keeps the additivity check
-    assert study.reference_plan("ffrf_10mm")[5] is not None
+    assert reference_plan("ffrf_10mm")[5] is not None
 
 
 def test_richardson_estimates_the_fine_error_of_a_second_order_sequence():
@@ -244,20 +244,21 @@ def test_knob_values_are_validated_with_the_accepted_range(overrides, words):
 
 @pytest.mark.slow
 def test_bundled_defaults_are_the_fastest_setting_within_the_default_tolerance():
-    # the tradeoff study's rule (studies/tradeoff.py: DEFAULT_TOLERANCE): crank angle 1e-6
+    # the tradeoff study's rule (flex/defaults_check.py: DEFAULT_TOLERANCE): crank angle 1e-6
     # rad, slider 1e-7 m, step <= 1e-5 s (the thesis table's output grid); over the Newton
     # knobs at the largest step allowed, the defaults must be within the study's timing tie of
     # its pick (full and modified Newton at 1e-8 both take one iteration per step and swap
     # places from run to run), and take one Newton iteration per step
-    from studies.tradeoff import (
+    from flex.defaults_check import (
         DEFAULT_TIE,
         DEFAULT_TOLERANCE,
-        _default_setting,
-        _within_default_tolerance,
         default_recommendation,
+        default_setting,
+        within_default_tolerance,
     )
 
     base = load_scene()
+    pinned = load_scene(None, pinned_overrides())  # the rigid scene as the study runs it
     reference = converged_reference(
         base, "rigid", Setting("scipy 1e-13", engine="scipy", rtol=1e-13, atol=1e-15),
         {"rtol x10": Setting("scipy 1e-12", engine="scipy", rtol=1e-12, atol=1e-14)}, 1e-8)
@@ -265,9 +266,9 @@ def test_bundled_defaults_are_the_fastest_setting_within_the_default_tolerance()
     runs = [measure(base, Setting.of(f"{newton} {tol:g}", step_s=step, newton=newton,
                                      newton_relative_tolerance=tol), reference, repeats=3)
             for newton in ("full", "modified") for tol in (1e-10, 1e-8)]
-    defaults = measure(base, _default_setting(), reference, repeats=3)
-    best = default_recommendation([*runs, defaults])
-    assert best is not None and _within_default_tolerance(defaults)
+    defaults = measure(base, default_setting(), reference, repeats=3)
+    best = default_recommendation([*runs, defaults], pinned)
+    assert best is not None and within_default_tolerance(defaults, pinned)
     assert resolved_simulation(base)["step_s"] == step
     assert defaults.newton_iterations <= defaults.steps * 1.01
     assert defaults.wall_time_s <= (1 + DEFAULT_TIE) * best.wall_time_s
@@ -279,14 +280,15 @@ def test_ffrf_default_reaches_the_scene_tolerance_much_faster_than_the_scene_set
     # the tradeoff study's certified 1 % pick) against a finer FFRF run (h = 5e-6 s, 1.5 mm,
     # 12 modes: within 1.2e-3 of the study's reference, which is itself estimated accurate to
     # ~2e-3); the margin keeps the check about the default, not the test's reference
-    from studies.tradeoff import FFRF_DEFAULT_SCENE, SCENES, _default_setting
+    from flex.defaults_check import default_setting
+    from studies.tradeoff import FFRF_DEFAULT_SCENE, SCENES
 
     base = load_scene(overrides=pinned_overrides() + SCENES[FFRF_DEFAULT_SCENE])
     tolerance = base["fidelity"]["tolerance"]
     reference = converged_reference(base, "ffrf", Setting.of(
         "fine", step_s=5e-6, coupler__mesh_size_m=0.0015, coupler__modes=12,
         newton="modified", newton_relative_tolerance=1e-10), {}, 1e-2)
-    default = measure(base, _default_setting(), reference, repeats=3)
+    default = measure(base, default_setting(), reference, repeats=3)
     assert default.ok and default.error + 3e-3 < tolerance
     scene_settings = measure(base, Setting("rigid-model settings"), reference, repeats=1)
     assert scene_settings.ok and scene_settings.error < tolerance
@@ -297,15 +299,16 @@ def test_the_study_summary_checks_the_bundled_defaults(rigid_reference):
     # the summary path make tradeoff ends with: the "auto" run is found, resolved and judged
     # against DEFAULT_TOLERANCE (1e-6 rad, 1e-7 m, h <= 1e-5 s, rho <= 0.95)
     import studies.tradeoff as study
+    from flex.defaults_check import DEFAULT_LABEL, default_setting, within_default_tolerance
 
     base = load_scene(overrides=study.OVERRIDES + SHORT)
-    default = measure(base, study._default_setting(), rigid_reference, repeats=1)
+    default = measure(base, default_setting(), rigid_reference, repeats=1)
     coarse = measure(base, Setting.of("h=1e-4", step_s=1e-4), rigid_reference, repeats=1)
-    assert study._within_default_tolerance(default)
-    assert not study._within_default_tolerance(coarse)  # its step is above 1e-5 s
+    assert within_default_tolerance(default, base)
+    assert not within_default_tolerance(coarse, base)  # its step is above 1e-5 s
     summary = study.summarize(base, {}, {"runs": {"rigid": (rigid_reference, [default, coarse],
                                                           0.0)}})
-    assert summary.datasets["rigid/default/setting"].data == study.DEFAULT_LABEL
+    assert summary.datasets["rigid/default/setting"].data == DEFAULT_LABEL
     assert bool(summary.datasets["rigid/default/matches_table"].data)
     assert "defaults flex defaults (auto)" in summary.report
 
@@ -325,3 +328,21 @@ def test_the_work_precision_figure_draws_the_front_and_the_reference_band(tmp_pa
     paths = study.figures({}, Summary(datasets, ""), tmp_path)
     assert [path.name for path in paths] == ["tradeoff-demo.png"]
     assert paths[0].stat().st_size > 10_000
+
+
+def test_profile_times_flex_phases_and_reads_exudyn_shares():
+    # the bench study's profile (flex.benchmark.profile through flex.solver.run_profiled)
+    from flex.benchmark import profile
+    from flex.tradeoff import ReductionPool
+
+    scene = load_scene(overrides=pinned_overrides() + SHORT)
+    prof = profile(scene, ReductionPool())
+    steps = resolved_simulation(scene)["end_time_s"] / resolved_simulation(scene)["step_s"]
+    # Exudyn's step index may end one past the step count
+    assert round(steps) <= prof["steps"] <= round(steps) + 1
+    assert prof["newton_iterations"] >= round(steps) and prof["jacobian_updates"] >= 1
+    for phase in ("reduction", "build", "integration", "output"):
+        assert prof[f"phase_{phase}_s"] >= 0.0
+    shares = {k: v for k, v in prof.items() if k.startswith("exudyn_")}
+    assert len(shares) >= 3 and all(k.endswith("_percent") and 0 <= v <= 100
+                                    for k, v in shares.items())

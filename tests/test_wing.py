@@ -3,10 +3,12 @@
 import numpy as np
 import pytest
 
+from flex import wing
 from flex.reference import crank_mass_properties, solve_reference
 from flex.scene import load_scene
 from flex.simulation import simulate
-from studies import wing
+from flex.thesis import THESIS_WING_PEAK_RATE_DEG_PER_S, THESIS_WING_PEAK_TIME_S
+from studies.wing import OVERRIDES
 
 
 def test_wing_scene_matches_the_reference_dae():
@@ -56,8 +58,8 @@ def test_cantilever_formulas():
 
 
 def test_spring_fit_reaches_the_thesis_outcome():
-    scene = load_scene(overrides=wing.OVERRIDES)
+    scene = load_scene(overrides=OVERRIDES)
     fitted, values = wing.fit_spring(scene)
     rate, time_s = wing.peak_rate(fitted)
-    assert rate == pytest.approx(wing.THESIS_PEAK_RATE_DEG_PER_S, rel=2e-3)
-    assert time_s == pytest.approx(wing.THESIS_PEAK_TIME_S, abs=2e-4)
+    assert rate == pytest.approx(THESIS_WING_PEAK_RATE_DEG_PER_S, rel=2e-3)
+    assert time_s == pytest.approx(THESIS_WING_PEAK_TIME_S, abs=2e-4)
