@@ -852,63 +852,84 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
     tolerance = float(resolved["fidelity"]["tolerance"])
     delta_t_s, how, probe = deployment_probe(resolved)
     if wants_coupler:
-        omega = pinned_pinned_omega(coupler["length_m"], coupler["thickness_m"],
-                                    coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"])
-        ratio = euler_load_ratio(probe["joints/B/force_on_coupler"],
-                                 probe["joints/C/force_on_coupler"], probe["coupler/angle"],
-                                 coupler["length_m"], coupler["thickness_m"],
-                                 coupler["width_m"], coupler["youngs_modulus_Pa"])
-        if ratio > EULER_LOAD_LIMIT:
-            raise SceneError(
-                f'coupler.model = "auto": the coupler carries {ratio:.3g} x its Euler '
-                f"buckling load (pi^2 E I / L^2) during the deployment; the criterion is "
-                f"fitted up to {EULER_LOAD_LIMIT:g} x, and near buckling the error depends on "
-                f'that ratio, not on n (the linear "ffrf" model does not represent buckling '
-                f'either): use a thicker coupler, or coupler.model = "nonlinear_fe"')
-        how += f"; compressive load {ratio:.3g} x Euler load"
-        decision, k_phys = _decide("coupler", omega, delta_t_s, how, tolerance, criterion,
-                                   float(coupler["damping_ratio"]))
-        coupler["model"] = decision.model
-        if decision.model == "ffrf":
-            omega_cut = k_phys * TWO_PI / delta_t_s
-            decision.modes = modes_for_cutoff(resolved, omega_cut)
-            coupler["modes"] = decision.modes
-            decision.reason += (f"; modes = {decision.modes}: every estimated fixed-interface "
-                                f"mode below omega_cut = k/delta_t = {omega_cut:.4g} rad/s")
+        decision, how = _decide_coupler(resolved, probe, delta_t_s, how, tolerance, criterion)
         decisions.append(decision)
     if wants_crank:
-        lumped = crank["geometry"] == "lumped"
-        plate_scene = equivalent_crank_plate(resolved)
-        plate = plate_scene["crank"]
-        omega = crank_elastic_omega(plate_scene)
-        if lumped:
-            how += (f"; lumped crank as a plate of its mass: {plate['width_m'] * 1e3:g} mm wide, "
-                    f"{plate['thickness_m'] * 1e3:.3g} mm high")
-        crank_criterion = crank_criterion or load_criterion(DEFAULT_CRANK_CRITERION)
-        decision, k_phys = _decide(
-            "crank", omega, delta_t_s, how, tolerance, crank_criterion,
-            float(crank["damping_ratio"]),
-            omega_how="first in-plane elastic mode of the crank in the assembled mechanism, "
-                      "Exudyn eigenvalues at t = 0")
-        if decision.model == "ffrf":
-            if lumped:
-                raise SceneError(f'crank.model = "auto": the criterion says the crank is '
-                                 f"flexible ({decision.reason}); a flexible crank is meshed "
-                                 f'from a plate: set crank.geometry = "plate" (and its '
-                                 f'thickness_m, width_m, material), or crank.model = "rigid" '
-                                 f"to accept the error")
-            if resolved["drive"]["kind"] != "spring":
-                raise SceneError(f'crank.model = "auto": the criterion says the crank is '
-                                 f"flexible ({decision.reason}), but a flexible crank needs "
-                                 f'drive.kind = "spring"; set crank.model = "rigid" to accept '
-                                 f"the error")
-            omega_cut = k_phys * TWO_PI / delta_t_s
-            decision.modes = modes_for_cutoff(resolved, omega_cut, "crank")
-            crank["modes"] = decision.modes
-            decision.reason += (f"; modes = {decision.modes}: every estimated fixed-interface "
-                                f"mode below omega_cut = k/delta_t = {omega_cut:.4g} rad/s")
-        decision.reason += ("; crank law from "
-                            + (Path(crank_criterion.source).name or "(in memory)"))
-        crank["model"] = decision.model
-        decisions.append(decision)
+        decisions.append(_decide_crank(resolved, delta_t_s, how, tolerance,
+                                       crank_criterion or load_criterion(
+                                           DEFAULT_CRANK_CRITERION)))
     return resolved, decisions
+
+
+def _mode_cut(decision: FidelityDecision, resolved: dict[str, dict[str, Any]], link: str,
+              k_phys: float, delta_t_s: float) -> None:
+    """An ``ffrf`` decision keeps every estimated mode below omega_cut = k / delta_t."""
+    omega_cut = k_phys * TWO_PI / delta_t_s
+    decision.modes = modes_for_cutoff(resolved, omega_cut, link)
+    resolved[link]["modes"] = decision.modes
+    decision.reason += (f"; modes = {decision.modes}: every estimated fixed-interface "
+                        f"mode below omega_cut = k/delta_t = {omega_cut:.4g} rad/s")
+
+
+def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.ndarray],
+                    delta_t_s: float, how: str, tolerance: float, criterion: Criterion
+                    ) -> tuple[FidelityDecision, str]:
+    """The coupler's decision (refused near buckling); returns it and ``how`` with the
+    compressive load added."""
+    coupler = resolved["coupler"]
+    omega = pinned_pinned_omega(coupler["length_m"], coupler["thickness_m"],
+                                coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"])
+    ratio = euler_load_ratio(probe["joints/B/force_on_coupler"],
+                             probe["joints/C/force_on_coupler"], probe["coupler/angle"],
+                             coupler["length_m"], coupler["thickness_m"],
+                             coupler["width_m"], coupler["youngs_modulus_Pa"])
+    if ratio > EULER_LOAD_LIMIT:
+        raise SceneError(
+            f'coupler.model = "auto": the coupler carries {ratio:.3g} x its Euler '
+            f"buckling load (pi^2 E I / L^2) during the deployment; the criterion is "
+            f"fitted up to {EULER_LOAD_LIMIT:g} x, and near buckling the error depends on "
+            f'that ratio, not on n (the linear "ffrf" model does not represent buckling '
+            f'either): use a thicker coupler, or coupler.model = "nonlinear_fe"')
+    how += f"; compressive load {ratio:.3g} x Euler load"
+    decision, k_phys = _decide("coupler", omega, delta_t_s, how, tolerance, criterion,
+                               float(coupler["damping_ratio"]))
+    coupler["model"] = decision.model
+    if decision.model == "ffrf":
+        _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s)
+    return decision, how
+
+
+def _decide_crank(resolved: dict[str, dict[str, Any]], delta_t_s: float, how: str,
+                  tolerance: float, crank_criterion: Criterion) -> FidelityDecision:
+    """The crank's decision from its own law and its in-mechanism frequency; a flexible
+    verdict for a lumped crank or with a constant-speed drive is refused."""
+    crank = resolved["crank"]
+    lumped = crank["geometry"] == "lumped"
+    plate_scene = equivalent_crank_plate(resolved)
+    plate = plate_scene["crank"]
+    omega = crank_elastic_omega(plate_scene)
+    if lumped:
+        how += (f"; lumped crank as a plate of its mass: {plate['width_m'] * 1e3:g} mm wide, "
+                f"{plate['thickness_m'] * 1e3:.3g} mm high")
+    decision, k_phys = _decide(
+        "crank", omega, delta_t_s, how, tolerance, crank_criterion,
+        float(crank["damping_ratio"]),
+        omega_how="first in-plane elastic mode of the crank in the assembled mechanism, "
+                  "Exudyn eigenvalues at t = 0")
+    if decision.model == "ffrf":
+        if lumped:
+            raise SceneError(f'crank.model = "auto": the criterion says the crank is '
+                             f"flexible ({decision.reason}); a flexible crank is meshed "
+                             f'from a plate: set crank.geometry = "plate" (and its '
+                             f'thickness_m, width_m, material), or crank.model = "rigid" '
+                             f"to accept the error")
+        if resolved["drive"]["kind"] != "spring":
+            raise SceneError(f'crank.model = "auto": the criterion says the crank is '
+                             f"flexible ({decision.reason}), but a flexible crank needs "
+                             f'drive.kind = "spring"; set crank.model = "rigid" to accept '
+                             f"the error")
+        _mode_cut(decision, resolved, "crank", k_phys, delta_t_s)
+    decision.reason += ("; crank law from "
+                        + (Path(crank_criterion.source).name or "(in memory)"))
+    crank["model"] = decision.model
+    return decision

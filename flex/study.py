@@ -29,6 +29,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+from .caseloop import run_each
 from .errors import FlexError, SceneError
 from .outputs import (
     check_output,
@@ -167,13 +168,8 @@ def execute(module: ModuleType, scene: Scene,
     if hasattr(module, "simulate_cases"):
         results = module.simulate_cases(scenes, run)
     else:
-        results = {}
-        for index, (name, case_scene) in enumerate(scenes.items()):
-            if progress:
-                progress(name, index, len(scenes))
-            results[name] = simulate_case(case_scene, name)
-        if progress:
-            progress("done", len(scenes), len(scenes))
+        results = run_each(scenes, lambda name, case_scene: simulate_case(case_scene, name),
+                           progress)
     summary = module.summarize(scene, results, run.notes)
     return StudyOutput(module.NAME, scene, results, summary, time.perf_counter() - start)
 
