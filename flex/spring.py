@@ -88,6 +88,22 @@ def _require_positive(name: str, value: float, unit: str) -> float:
 
 # --- 1. Spring rate and its inversions -------------------------------------------------------
 
+#: Shigley eq. 10-9, ``k = G d^4 / (8 D^3 N)``, as exponents: ``G d^4 D^-3 N^-1 k^-1 = 8``
+_RATE_LAW: dict[str, tuple[int, str]] = {
+    "shear_modulus_Pa": (1, "Pa"), "wire_diameter_m": (4, "m"),
+    "mean_coil_diameter_m": (-3, "m"), "active_coils": (-1, "coils"),
+    "rate_N_per_m": (-1, "N/m")}
+
+
+def _solve_rate_law(unknown: str, **known: float) -> float:
+    """The quantity ``unknown`` of :data:`_RATE_LAW` from the other four (each > 0)."""
+    product = 1.0
+    for name, value in known.items():
+        exponent, unit = _RATE_LAW[name]
+        product *= _require_positive(name, value, unit) ** exponent
+    return (8.0 / product) ** (1.0 / _RATE_LAW[unknown][0])
+
+
 def helical_spring_rate_N_per_m(shear_modulus_Pa: float, wire_diameter_m: float,
                                 mean_coil_diameter_m: float, active_coils: float) -> float:
     """Axial rate of a helical spring, ``k = G d^4 / (8 D^3 N)`` in N/m (Shigley eq. 10-9).
@@ -95,51 +111,41 @@ def helical_spring_rate_N_per_m(shear_modulus_Pa: float, wire_diameter_m: float,
     ``shear_modulus_Pa`` G [Pa], ``wire_diameter_m`` d [m], ``mean_coil_diameter_m`` D [m],
     ``active_coils`` N [-]; all must be > 0.
     """
-    g = _require_positive("shear_modulus_Pa", shear_modulus_Pa, "Pa")
-    d = _require_positive("wire_diameter_m", wire_diameter_m, "m")
-    D = _require_positive("mean_coil_diameter_m", mean_coil_diameter_m, "m")
-    n = _require_positive("active_coils", active_coils, "coils")
-    return g * d**4 / (8.0 * D**3 * n)
+    return _solve_rate_law("rate_N_per_m", shear_modulus_Pa=shear_modulus_Pa,
+                           wire_diameter_m=wire_diameter_m,
+                           mean_coil_diameter_m=mean_coil_diameter_m, active_coils=active_coils)
 
 
 def mean_coil_diameter_for_rate_m(rate_N_per_m: float, shear_modulus_Pa: float,
                                   wire_diameter_m: float, active_coils: float) -> float:
     """Mean coil diameter D [m] that gives ``rate_N_per_m``: ``D = (G d^4 / (8 k N))^(1/3)``."""
-    k = _require_positive("rate_N_per_m", rate_N_per_m, "N/m")
-    g = _require_positive("shear_modulus_Pa", shear_modulus_Pa, "Pa")
-    d = _require_positive("wire_diameter_m", wire_diameter_m, "m")
-    n = _require_positive("active_coils", active_coils, "coils")
-    return (g * d**4 / (8.0 * k * n)) ** (1.0 / 3.0)
+    return _solve_rate_law("mean_coil_diameter_m", rate_N_per_m=rate_N_per_m,
+                           shear_modulus_Pa=shear_modulus_Pa, wire_diameter_m=wire_diameter_m,
+                           active_coils=active_coils)
 
 
 def active_coils_for_rate(rate_N_per_m: float, shear_modulus_Pa: float, wire_diameter_m: float,
                           mean_coil_diameter_m: float) -> float:
     """Number of active coils N [-] that gives ``rate_N_per_m``: ``N = G d^4 / (8 D^3 k)``."""
-    k = _require_positive("rate_N_per_m", rate_N_per_m, "N/m")
-    g = _require_positive("shear_modulus_Pa", shear_modulus_Pa, "Pa")
-    d = _require_positive("wire_diameter_m", wire_diameter_m, "m")
-    D = _require_positive("mean_coil_diameter_m", mean_coil_diameter_m, "m")
-    return g * d**4 / (8.0 * D**3 * k)
+    return _solve_rate_law("active_coils", rate_N_per_m=rate_N_per_m,
+                           shear_modulus_Pa=shear_modulus_Pa, wire_diameter_m=wire_diameter_m,
+                           mean_coil_diameter_m=mean_coil_diameter_m)
 
 
 def wire_diameter_for_rate_m(rate_N_per_m: float, shear_modulus_Pa: float,
                              mean_coil_diameter_m: float, active_coils: float) -> float:
     """Wire diameter d [m] that gives ``rate_N_per_m``: ``d = (8 k D^3 N / G)^(1/4)``."""
-    k = _require_positive("rate_N_per_m", rate_N_per_m, "N/m")
-    g = _require_positive("shear_modulus_Pa", shear_modulus_Pa, "Pa")
-    D = _require_positive("mean_coil_diameter_m", mean_coil_diameter_m, "m")
-    n = _require_positive("active_coils", active_coils, "coils")
-    return (8.0 * k * D**3 * n / g) ** 0.25
+    return _solve_rate_law("wire_diameter_m", rate_N_per_m=rate_N_per_m,
+                           shear_modulus_Pa=shear_modulus_Pa,
+                           mean_coil_diameter_m=mean_coil_diameter_m, active_coils=active_coils)
 
 
 def shear_modulus_for_rate_Pa(rate_N_per_m: float, wire_diameter_m: float,
                               mean_coil_diameter_m: float, active_coils: float) -> float:
     """Shear modulus G [Pa] that gives ``rate_N_per_m``: ``G = 8 k D^3 N / d^4``."""
-    k = _require_positive("rate_N_per_m", rate_N_per_m, "N/m")
-    d = _require_positive("wire_diameter_m", wire_diameter_m, "m")
-    D = _require_positive("mean_coil_diameter_m", mean_coil_diameter_m, "m")
-    n = _require_positive("active_coils", active_coils, "coils")
-    return 8.0 * k * D**3 * n / d**4
+    return _solve_rate_law("shear_modulus_Pa", rate_N_per_m=rate_N_per_m,
+                           wire_diameter_m=wire_diameter_m,
+                           mean_coil_diameter_m=mean_coil_diameter_m, active_coils=active_coils)
 
 
 @dataclass(frozen=True)
