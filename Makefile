@@ -16,8 +16,8 @@ LONG := tradeoff stability bench
 
 # A study's result, results/<study>.h5 (and its figures, results/figures/<study>-*.png),
 # is remade only when one of its inputs is newer: its module studies/<study>.py, or one of
-# INPUTS -- the library (flex/**/*.py), its bundled scenes and data files (flex/scenes/*.toml;
-# flex/*.toml: the fitted criteria and the solver defaults), studies/__init__.py and
+# INPUTS -- the library (flex/**/*.py), its bundled scenes and data files (flex/data/scenes/*.toml;
+# flex/fidelity, flex/config: the fitted criteria and the solver defaults), studies/__init__.py and
 # pyproject.toml. `make <study>` is an alias of `make results/<study>.h5`. FORCE=1 reruns
 # the studies asked for anyway (`make all FORCE=1`, `make kfit FORCE=1`).
 INPUTS := $(shell find flex -type f \( -name '*.py' -o -name '*.toml' \) \
@@ -80,13 +80,13 @@ results/kfit-criterion.toml results/crank-criterion.toml: results/%-criterion.to
 # after make kfit: install its fit as the criterion that model = "auto" reads (commit it).
 # Every study reads it: they are all out of date after a new law is installed.
 kfit-criterion: results/kfit-criterion.toml
-	@cmp -s $< flex/criteria_fit.toml && echo "flex/criteria_fit.toml is already $<" \
-		|| { cp $< flex/criteria_fit.toml && echo "cp $< flex/criteria_fit.toml"; }
+	@cmp -s $< flex/fidelity/criteria_fit.toml && echo "flex/fidelity/criteria_fit.toml is already $<" \
+		|| { cp $< flex/fidelity/criteria_fit.toml && echo "cp $< flex/fidelity/criteria_fit.toml"; }
 
 # after make crank: install the crank's law that crank.model = "auto" reads (commit it)
 crank-criterion: results/crank-criterion.toml
-	@cmp -s $< flex/crank_criteria_fit.toml && echo "flex/crank_criteria_fit.toml is already $<" \
-		|| { cp $< flex/crank_criteria_fit.toml && echo "cp $< flex/crank_criteria_fit.toml"; }
+	@cmp -s $< flex/fidelity/crank_criteria_fit.toml && echo "flex/fidelity/crank_criteria_fit.toml is already $<" \
+		|| { cp $< flex/fidelity/crank_criteria_fit.toml && echo "cp $< flex/fidelity/crank_criteria_fit.toml"; }
 
 test: $(STAMP)
 	$(PY) -m pytest -q

@@ -28,7 +28,7 @@ _PUBLIC = {
     "simulate": "flex.api",
     "run_study": "flex.api",
     "open_result": "flex.api",
-    "FlexError": "flex.errors",
+    "FlexError": "flex.base.errors",
 }
 
 __all__ = ["__version__", *_PUBLIC]

@@ -37,14 +37,14 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from .errors import SceneError
+from flex.base.errors import SceneError
 
 if TYPE_CHECKING:  # type names only; nothing heavy is imported at run time
     import xarray
 
-    from .results import CaseResult
-    from .scene import Scene
-    from .study import StudyOutput
+    from flex.data.results import CaseResult
+    from flex.data.scene import Scene
+    from flex.study import StudyOutput
 
 Overrides = list[str] | tuple[str, ...] | Mapping[str, Any]
 
@@ -120,7 +120,7 @@ def load_scene(source: str | Path | None = None, overrides: Overrides | None = N
         a linkage that cannot assemble (crank not shorter than coupler, slide line too far);
         inconsistent step settings; a plate that cannot be meshed sensibly.
     """
-    from .scene import load_scene as _load
+    from flex.data.scene import load_scene as _load
 
     return _load(source, override_strings(overrides))
 
@@ -146,7 +146,7 @@ def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
         linkage, ...), or for an override that is not ``section.key=value``;
         :class:`TypeError` when ``overrides`` is neither a list of strings nor a mapping.
     """
-    from .scene import apply_overrides, validate
+    from flex.data.scene import apply_overrides, validate
 
     derived = apply_overrides(scene, override_strings(overrides))
     validate(derived)
@@ -157,9 +157,9 @@ def _implementation():
     """The simulate function of this version of flex: :func:`flex.simulation.simulate` when
     that module exists (``model = "auto"`` resolved, then integrated), else the older
     :func:`flex.solver.simulate`."""
-    if importlib.util.find_spec("flex.simulation") is not None:
-        return importlib.import_module("flex.simulation").simulate
-    solver = importlib.import_module("flex.solver")
+    if importlib.util.find_spec("flex.fidelity.simulation") is not None:
+        return importlib.import_module("flex.fidelity.simulation").simulate
+    solver = importlib.import_module("flex.dynamics.solver")
     if not hasattr(solver, "simulate"):
         raise ImportError("flex.simulate: neither flex.simulation.simulate nor "
                           "flex.solver.simulate exists in this copy of flex")
@@ -236,7 +236,7 @@ def run_study(name: str, source: str | Path | None = None, overrides: Overrides 
         (:class:`~flex.errors.OutputError`); :class:`flex.study.Interrupted` (a
         :class:`KeyboardInterrupt`) on Ctrl-C, naming the files already written.
     """
-    from .study import run_study as _run
+    from flex.study import run_study as _run
 
     return _run(name, source, override_strings(overrides), out, figures, quiet, **options)
 
@@ -261,7 +261,7 @@ def open_result(path: str | Path, case: str | None = None) -> xarray.Dataset:
         :class:`flex.results.ResultPathError` (a ResultFileError): no such case, or no
         ``case`` given for a file with several cases (the message lists them).
     """
-    from .results import to_xarray
+    from flex.data.results import to_xarray
 
     return to_xarray(path, case)
 

@@ -11,8 +11,8 @@ import argparse
 import os
 import sys
 
-from . import __version__
-from .errors import (
+from flex import __version__
+from flex.base.errors import (
     EXIT_BAD_INPUT,
     EXIT_FAILED,
     EXIT_INTERNAL,
@@ -41,7 +41,7 @@ EPILOG = "exit status:\n" + "\n".join(f"  {code:<4} {text}" for code, text in
 
 
 def _parser() -> argparse.ArgumentParser:
-    from .study import STUDIES
+    from flex.study import STUDIES
 
     parser = _Parser(prog="flex", epilog=EPILOG,
                      formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -87,7 +87,7 @@ PATH_HELP = ("path inside the file: cases/<case>/crank/angle, <case>/crank/angle
 
 def _result_tools(commands) -> None:
     """The ``inspect``, ``plot`` and ``compare`` subcommands (reading result files)."""
-    from .compare import DEFAULT_ATOL, DEFAULT_RTOL, INTERPOLATIONS
+    from flex.tools.compare import DEFAULT_ATOL, DEFAULT_RTOL, INTERPOLATIONS
 
     inspect = commands.add_parser(
         "inspect", help="list a result file: cases, datasets, units, provenance, scene",
@@ -152,24 +152,24 @@ def _result_tool(args: argparse.Namespace) -> int:
     import json
 
     if args.command == "report":
-        from .report import write_report
+        from flex.tools.report import write_report
 
         _print(f"wrote {write_report(args.file, args.out)}")
         return EXIT_OK
     if args.command == "inspect":
-        from .inspect import describe, format_description
+        from flex.tools.inspect import describe, format_description
 
         info = describe(args.file, args.path)
         _print(json.dumps(info, indent=2) if args.json else format_description(info))
         return 0
     if args.command == "plot":
-        from .plotcurves import plot_curves
+        from flex.tools.plotcurves import plot_curves
 
         figure = plot_curves(args.file, args.paths, args.vs, args.x_spec, args.out,
                              args.title)
         _print(f"wrote {figure}")
         return 0
-    from .compare import compare_files
+    from flex.tools.compare import compare_files
 
     report = compare_files(args.file_a, args.file_b, args.paths, args.rtol, args.atol,
                            args.interp)
@@ -188,7 +188,7 @@ def _print(text: str, end: str = "\n") -> None:
 
 def _auto_note(scene) -> str:
     """A TOML comment saying what the scene's "auto" solver keys resolve to (or when)."""
-    from .settings import has_auto, resolve_solver_settings
+    from flex.config.settings import has_auto, resolve_solver_settings
 
     if not has_auto(scene):
         return ""
@@ -292,9 +292,9 @@ def _dispatch(argv: list[str] | None) -> int:
     if args.command == "run":
         return _run(args)
     if args.command == "scene":
-        from .scene import to_toml
-        from .study import check_cases, load_study, study_scene
-        from .usage import explicit_keys
+        from flex.config.usage import explicit_keys
+        from flex.data.scene import to_toml
+        from flex.study import check_cases, load_study, study_scene
 
         module = load_study(args.study)
         scene = study_scene(module, args.scene, args.overrides)
@@ -307,7 +307,7 @@ def _dispatch(argv: list[str] | None) -> int:
 def _run(args: argparse.Namespace) -> int:
     import re
 
-    from .study import load_study, run_study
+    from flex.study import load_study, run_study
 
     if args.workers is not None and args.workers < 1:
         raise FlexError(f"--workers {args.workers}: must be at least 1")
@@ -324,7 +324,7 @@ def _run(args: argparse.Namespace) -> int:
     if getattr(load_study(args.study), "SWEEP", False):
         import dataclasses
 
-        from .sweep import settings_from_environment
+        from flex.sweep import settings_from_environment
 
         # the environment is read here, once, at the edge; the library gets arguments
         sweep = settings_from_environment()

@@ -29,21 +29,21 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-from .caseloop import run_each
-from .errors import FlexError, SceneError
-from .outputs import (
+from flex.base.errors import FlexError, SceneError
+from flex.config.settings import check_runnable
+from flex.config.usage import explicit_keys, unused_keys
+from flex.data.outputs import (
     check_output,
     check_writable_folder,
     failed_path,
     figures_folder,
     staged_figures,
 )
-from .report import default_report_path, write_report
-from .results import CaseResult, Dataset, write_results
-from .scene import Scene, load_scene, to_toml
-from .settings import check_runnable
-from .simulation import simulate_case
-from .usage import explicit_keys, unused_keys
+from flex.data.results import CaseResult, Dataset, write_results
+from flex.data.scene import Scene, load_scene, to_toml
+from flex.fidelity.caseloop import run_each
+from flex.fidelity.simulation import simulate_case
+from flex.tools.report import default_report_path, write_report
 
 STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring", "kfit",
            "tradeoff", "stability", "bench", "wing", "crank")

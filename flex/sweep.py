@@ -52,9 +52,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .errors import FlexError
-from .results import CaseResult, Dataset, open_results, write_results
-from .scene import Scene, to_toml
+from flex.base.errors import FlexError
+from flex.data.results import CaseResult, Dataset, open_results, write_results
+from flex.data.scene import Scene, to_toml
 
 CaseFunction = Callable[[str, Scene], CaseResult]
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
@@ -67,7 +67,7 @@ SWEEP_FORMAT = "flex-sweep-case/1"
 def simulate_scene_case(name: str, scene: Scene) -> CaseResult:
     """The default case: :func:`flex.solver.simulate_case` of the scene (never raises for a
     diverged run: that is a ``failed`` case)."""
-    from .simulation import simulate_case
+    from flex.fidelity.simulation import simulate_case
 
     return simulate_case(scene, name)
 
@@ -259,8 +259,8 @@ def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
     """Identity of a case: its resolved scene and the case function's qualified name (and
     what its ``"auto"`` values resolve from: the solver defaults table, the fitted criterion
     files)."""
-    from . import settings
-    from .criteria import criteria_in_force_text
+    from flex.config import settings
+    from flex.fidelity.criteria import criteria_in_force_text
 
     function, extra = case_function, ""
     if isinstance(function, functools.partial):  # bound arguments are part of the identity
@@ -714,7 +714,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-figures", action="store_true")
     parser.add_argument("--quiet", action="store_true")
     args = parser.parse_args(argv)
-    from .study import run_study
+    from flex.study import run_study
 
     try:
         base = settings_from_environment()  # the environment, read once at this edge

@@ -29,14 +29,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from flex.benchmark import BenchPlan, run_bench
-from flex.benchmark_report import bench_figures, bench_summary
-from flex.reference_plans import ReferencePlan
-from flex.results import CaseResult
-from flex.scene import Scene, apply_overrides, validate
-from flex.settings import AUTO_OVERRIDES, pinned_overrides
+from flex.config.settings import AUTO_OVERRIDES, pinned_overrides
+from flex.data.results import CaseResult
+from flex.data.scene import Scene, apply_overrides, validate
+from flex.experiments.benchmark import BenchPlan, run_bench
+from flex.experiments.benchmark_report import bench_figures, bench_summary
+from flex.experiments.reference_plans import ReferencePlan
+from flex.experiments.tradeoff import Setting
 from flex.study import StudyRun, Summary
-from flex.tradeoff import Setting
 
 NAME = "bench"
 DESCRIPTION = "speed at a stated accuracy: rigid 1e-7 rad, FFRF 1 mm 1 %, cache, make all"

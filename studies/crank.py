@@ -30,12 +30,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from flex import crankfit, lawfit
-from flex.results import CaseResult
-from flex.scene import Scene
-from flex.settings import pinned_overrides
+from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M
+from flex.config.settings import pinned_overrides
+from flex.data.results import CaseResult
+from flex.data.scene import Scene
+from flex.experiments import crankfit, lawfit
 from flex.study import RESULTS_DIR, StudyRun, Summary
-from flex.thesis import THESIS_SPRING_RATE_N_PER_M
 
 NAME = "crank"
 DESCRIPTION = "flexible FFRF crank against auto's choice, with and without the wing"
@@ -84,6 +84,6 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    from flex.lawplots import crank_figures
+    from flex.experiments.lawplots import crank_figures
 
     return crank_figures(results, summary, list(SCENES), folder)

@@ -19,12 +19,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from flex import deployment
 from flex.api import derive_scene
-from flex.results import CaseResult
-from flex.scene import Scene
+from flex.base.thesis import THESIS_COMPRESSION_M, THESIS_SLIDER_TRAVEL_M
+from flex.data.results import CaseResult
+from flex.data.scene import Scene
+from flex.experiments import deployment
 from flex.study import Summary
-from flex.thesis import THESIS_COMPRESSION_M, THESIS_SLIDER_TRAVEL_M
 
 NAME = "dynamics"
 DESCRIPTION = "spring-driven deployment, both preload readings, against the reference DAE"

@@ -28,12 +28,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from flex.results import CaseResult
-from flex.scene import Scene
-from flex.settings import pinned_overrides
+from flex.base.thesis import THESIS_DELTA_T_S
+from flex.config.settings import pinned_overrides
+from flex.data.results import CaseResult
+from flex.data.scene import Scene
+from flex.experiments.twins import simulate_twins, summarize_twins, twin_cases, twin_figures
 from flex.study import StudyRun, Summary
-from flex.thesis import THESIS_DELTA_T_S
-from flex.twins import simulate_twins, summarize_twins, twin_cases, twin_figures
 
 NAME = "flexible"
 DESCRIPTION = ("FFRF coupler plates t = 1, 3, 5, 10 mm against their rigid twins; nonlinear FE "

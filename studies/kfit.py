@@ -38,11 +38,11 @@ from typing import Any
 
 import numpy as np
 
-from flex import couplerfit, lawfit
-from flex.couplerfit import THESIS_MODELS
-from flex.results import CaseResult
-from flex.scene import Scene
-from flex.settings import pinned_overrides
+from flex.config.settings import pinned_overrides
+from flex.data.results import CaseResult
+from flex.data.scene import Scene
+from flex.experiments import couplerfit, lawfit
+from flex.experiments.couplerfit import THESIS_MODELS
 from flex.study import RESULTS_DIR, StudyRun, Summary
 
 SWEEP = True  # cases run on the sweep engine: --scheduler and --workers apply
@@ -116,7 +116,7 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    from flex.lawplots import coupler_figures
+    from flex.experiments.lawplots import coupler_figures
 
     return coupler_figures(summary.figure_data.get("analysis") or couplerfit.analyse(results),
                            folder)

@@ -12,9 +12,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from flex import constant_speed
-from flex.results import CaseResult
-from flex.scene import Scene
+from flex.data.results import CaseResult
+from flex.data.scene import Scene
+from flex.experiments import constant_speed
 from flex.study import Summary
 
 NAME = "kinematics"

@@ -17,9 +17,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from flex import modal
-from flex.results import CaseResult
-from flex.scene import Scene
+from flex.data.results import CaseResult
+from flex.data.scene import Scene
+from flex.experiments import modal
 from flex.study import StudyRun, Summary
 
 NAME = "modal"

@@ -30,10 +30,11 @@ import math
 from pathlib import Path
 from typing import Any
 
-from flex.results import CaseResult
-from flex.scene import Scene
-from flex.settings import pinned_overrides
-from flex.stability import (
+from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M
+from flex.config.settings import pinned_overrides
+from flex.data.results import CaseResult
+from flex.data.scene import Scene
+from flex.experiments.stability import (
     Extreme,
     extreme_cases,
     plate_overrides,
@@ -43,7 +44,6 @@ from flex.stability import (
     thesis_plate_period_s,
 )
 from flex.study import StudyRun, Summary
-from flex.thesis import THESIS_SPRING_RATE_N_PER_M
 
 NAME = "stability"
 DESCRIPTION = "extremes: thickness, step, spectral radius, 1 s horizon, dead centres, stiff drives"

@@ -23,15 +23,15 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from flex.defaults_check import default_setting
-from flex.reference_plans import scipy_setting
-from flex.results import CaseResult
-from flex.scene import Scene, apply_overrides, validate
-from flex.settings import pinned_overrides
+from flex.config.settings import pinned_overrides
+from flex.data.results import CaseResult
+from flex.data.scene import Scene, apply_overrides, validate
+from flex.experiments.defaults_check import default_setting
+from flex.experiments.reference_plans import scipy_setting
+from flex.experiments.tradeoff import Setting
+from flex.experiments.workprecision import nonlinear_available, run_work_precision
+from flex.experiments.workprecision_report import summarize_work_precision, work_precision_figures
 from flex.study import StudyRun, Summary
-from flex.tradeoff import Setting
-from flex.workprecision import nonlinear_available, run_work_precision
-from flex.workprecision_report import summarize_work_precision, work_precision_figures
 
 NAME = "tradeoff"
 DESCRIPTION = "work-precision: every knob against a converged reference, rigid and FFRF 1/10 mm"

@@ -18,8 +18,8 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from flex.base.errors import EXIT_BAD_INPUT
 from flex.cli import main
-from flex.errors import EXIT_BAD_INPUT
 
 
 @dataclass

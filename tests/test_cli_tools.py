@@ -14,13 +14,13 @@ import matplotlib
 import numpy as np
 import pytest
 
+from flex.base.errors import ResultFileError
 from flex.cli import main
-from flex.compare import common_time_base, compare_files, resample
-from flex.errors import ResultFileError
-from flex.inspect import describe
-from flex.plotcurves import plot_curves
-from flex.results import CaseResult, Dataset, select_datasets, to_xarray, write_results
+from flex.data.results import CaseResult, Dataset, select_datasets, to_xarray, write_results
 from flex.study import run_study
+from flex.tools.compare import common_time_base, compare_files, resample
+from flex.tools.inspect import describe
+from flex.tools.plotcurves import plot_curves
 
 REPO = Path(__file__).resolve().parent.parent
 

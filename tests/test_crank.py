@@ -3,10 +3,10 @@
 import numpy as np
 import pytest
 
-from flex.criteria import crank_elastic_omega, pinned_pinned_omega, resolve_fidelity
-from flex.errors import SceneError
-from flex.scene import load_scene
-from flex.simulation import simulate
+from flex.base.errors import SceneError
+from flex.data.scene import load_scene
+from flex.fidelity.criteria import crank_elastic_omega, pinned_pinned_omega, resolve_fidelity
+from flex.fidelity.simulation import simulate
 
 PLATE = ['crank.geometry="plate"', "simulation.step_s=2e-5", "simulation.end_time_s=0.01"]
 

@@ -6,8 +6,10 @@ import math
 import numpy as np
 import pytest
 
-from flex import criteria
-from flex.criteria import (
+from flex.base.errors import FlexError, SceneError
+from flex.data.scene import load_scene
+from flex.fidelity import criteria
+from flex.fidelity.criteria import (
     Criterion,
     ErrorLaw,
     fit_error_law,
@@ -16,8 +18,6 @@ from flex.criteria import (
     pinned_pinned_omega,
     resolve_fidelity,
 )
-from flex.errors import FlexError, SceneError
-from flex.scene import load_scene
 
 
 # ------------------------------------------------------------------------------------------
@@ -317,7 +317,7 @@ def test_auto_needs_a_plate_and_a_tolerance_in_range():
 
 
 def test_simulate_resolves_auto_prints_and_stores_the_choice(tmp_path, monkeypatch, capsys):
-    from flex.simulation import simulate
+    from flex.fidelity.simulation import simulate
 
     path = tmp_path / "criterion.toml"
     path.write_text(_synthetic_criterion().to_toml())

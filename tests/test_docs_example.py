@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import flex
-from flex.errors import SceneError
+from flex.base.errors import SceneError
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "docs" / "example.py"
 
@@ -26,7 +26,7 @@ def example(tmp_path_factory):
 
 
 def test_example_peaks_match_the_reference_dae(example):
-    from flex.reference import solve_reference
+    from flex.dynamics.reference import solve_reference
 
     for label, scene in (("22 mm", example["scene"]), ("11 mm", example["soft"])):
         reference = solve_reference(scene).q_dot[:, 2].max()  # independent 9-coordinate DAE
@@ -46,7 +46,7 @@ def test_example_result_file_opens_as_xarray(example):
 
 def test_import_flex_is_light():
     code = ("import sys, flex; heavy = [m for m in ('exudyn', 'ngsolve', 'h5py', 'scipy', "
-            "'flex.solver', 'flex.study') if m in sys.modules]; print(heavy)")
+            "'flex.dynamics.solver', 'flex.study') if m in sys.modules]; print(heavy)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout
     assert out.strip() == "[]"

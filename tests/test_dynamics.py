@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from flex.reference import solve_reference
-from flex.scene import load_scene
-from flex.simulation import simulate
+from flex.data.scene import load_scene
+from flex.dynamics.reference import solve_reference
+from flex.fidelity.simulation import simulate
 
 
 @pytest.fixture(scope="module")

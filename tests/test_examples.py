@@ -4,7 +4,7 @@ import re
 
 import pytest
 
-from flex import deployment
+from flex.experiments import deployment
 from flex.study import execute, load_study, study_scene
 
 

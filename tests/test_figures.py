@@ -24,9 +24,9 @@ import matplotlib.image
 import numpy as np
 import pytest
 
-from flex import criteria
-from flex.plotting import review
-from flex.results import CaseResult, Dataset
+from flex.base.plotting import review
+from flex.data.results import CaseResult, Dataset
+from flex.fidelity import criteria
 from flex.study import Summary, execute, load_study, study_scene
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -201,7 +201,7 @@ def test_crank_figures_synthetic(tmp_path, reviewed):
 
 
 def test_kfit_figures_synthetic(tmp_path, reviewed):
-    from flex.couplerfit import label
+    from flex.experiments.couplerfit import label
     from studies import kfit
 
     rng = np.random.default_rng(1)

@@ -38,11 +38,11 @@ import h5py
 import numpy as np
 import pytest
 
-from flex.compare import compare_files
-from flex.results import CaseResult, Dataset, write_results
-from flex.scene import load_scene, to_toml
-from flex.settings import pinned_overrides
-from flex.simulation import simulate
+from flex.config.settings import pinned_overrides
+from flex.data.results import CaseResult, Dataset, write_results
+from flex.data.scene import load_scene, to_toml
+from flex.fidelity.simulation import simulate
+from flex.tools.compare import compare_files
 
 FOLDER = Path(__file__).resolve().parent / "reference_curves"
 REFERENCE = FOLDER / "ffrf_t1mm_midpoint_deflection.h5"
@@ -157,8 +157,8 @@ def test_deflection_converges_under_mode_refinement(tmp_path):
 
 
 def test_nonlinear_plate_has_the_reductions_mesh_and_node_sets():
-    from flex.nonlinear import build_nonlinear_plate
-    from flex.solver import reduction_for_scene
+    from flex.bodies.nonlinear import build_nonlinear_plate
+    from flex.dynamics.solver import reduction_for_scene
 
     plate = build_nonlinear_plate(**COARSE_PLATE)
     # the stiff-limit test's steel plate: the reduction comes from the cache
@@ -173,8 +173,8 @@ def test_nonlinear_plate_has_the_reductions_mesh_and_node_sets():
 
 
 def test_nonlinear_plate_refuses_bad_sizes():
-    from flex.errors import SceneError
-    from flex.nonlinear import build_nonlinear_plate
+    from flex.base.errors import SceneError
+    from flex.bodies.nonlinear import build_nonlinear_plate
 
     with pytest.raises(SceneError, match="thickness_m"):
         build_nonlinear_plate(**{**COARSE_PLATE, "thickness_m": -1.0})
@@ -183,7 +183,7 @@ def test_nonlinear_plate_refuses_bad_sizes():
 
 
 def test_nonlinear_fe_scene_needs_a_plate_and_no_damping():
-    from flex.errors import SceneError
+    from flex.base.errors import SceneError
 
     with pytest.raises(SceneError, match='needs coupler.geometry = "plate"'):
         load_scene(overrides=['coupler.model="nonlinear_fe"'])
@@ -279,7 +279,7 @@ if __name__ == "__main__":
 def test_ffrf_coupler_with_a_constant_speed_crank_follows_the_closed_form():
     # prescribed crank rotation with a stiff-enough FFRF plate: the slider follows the rigid
     # closed form to within the coupler's elastic stretch (well under a micrometre here)
-    from flex.kinematics import slider_crank
+    from flex.base.kinematics import slider_crank
 
     scene = load_scene(overrides=[
         'coupler.model="ffrf"', 'coupler.geometry="plate"', "coupler.thickness_m=0.005",
@@ -297,7 +297,7 @@ def test_ffrf_coupler_with_a_constant_speed_crank_follows_the_closed_form():
 # flex.twins and flex.softening
 # ------------------------------------------------------------------------------------------
 def test_twin_cases_pair_each_plate_and_add_the_nonlinear_reference_when_undamped():
-    from flex.twins import twin_cases
+    from flex.experiments.twins import twin_cases
 
     plates = {"a_t3mm": (0.003, 0.003), "b_t5mm": (0.005, 0.005)}
     base = load_scene(None, [*pinned_overrides(), 'coupler.geometry="plate"'])
@@ -313,7 +313,7 @@ def test_twin_cases_pair_each_plate_and_add_the_nonlinear_reference_when_undampe
 
 
 def test_first_peak_is_the_first_lobe_not_the_ripple_or_the_largest_swing():
-    from flex.softening import first_peak_index
+    from flex.fidelity.softening import first_peak_index
 
     time_s = np.linspace(0.0, 1.0, 2001)
     # first lobe peaks at t = 0.25 (1.0), ripple on it, then a larger negative lobe
@@ -324,7 +324,7 @@ def test_first_peak_is_the_first_lobe_not_the_ripple_or_the_largest_swing():
 
 
 def test_coupler_compression_is_the_joint_C_force_toward_B():
-    from flex.softening import coupler_compression_N, coupler_euler_load_N
+    from flex.fidelity.softening import coupler_compression_N, coupler_euler_load_N
 
     data = {"coupler/angle": np.array([0.0, np.pi / 2, 0.0]),
             "joints/C/force_on_coupler": np.array([[-5.0, 0.0], [0.0, -3.0], [2.0, 0.0]])}

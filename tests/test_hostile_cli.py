@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 from hostile import check_refused, fingerprint, run_cli
 
-from flex.errors import EXIT_FAILED, EXIT_OK, EXIT_SIGINT, EXIT_SIGTERM, EXIT_STATUSES
-from flex.results import CaseResult, Dataset, open_results, write_results
+from flex.base.errors import EXIT_FAILED, EXIT_OK, EXIT_SIGINT, EXIT_SIGTERM, EXIT_STATUSES
+from flex.data.results import CaseResult, Dataset, open_results, write_results
 
 REPO = Path(__file__).resolve().parent.parent
 SHORT = ["--set", "simulation.end_time_s=0.005"]

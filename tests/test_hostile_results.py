@@ -20,9 +20,9 @@ import numpy as np
 import pytest
 from hostile import check_refused, run_cli
 
-from flex.compare import compare_files
-from flex.errors import ResultFileError
-from flex.results import CaseResult, Dataset, check_layout, open_results, write_results
+from flex.base.errors import ResultFileError
+from flex.data.results import CaseResult, Dataset, check_layout, open_results, write_results
+from flex.tools.compare import compare_files
 
 REPO = Path(__file__).resolve().parent.parent
 REFERENCE_FILES = sorted((REPO / "tests" / "reference_curves").glob("*.h5"))

@@ -22,13 +22,18 @@ import numpy as np
 import pytest
 from hostile import check_refused, run_cli
 
-from flex.errors import SceneError, SimulationError
-from flex.results import CaseResult, Dataset, write_results
-from flex.scene import SCHEMA, estimate_mesh, load_scene
-from flex.settings import check_runnable
-from flex.simulation import simulate_case
-from flex.solver import VALIDITY_WARNING, _check_finite, divergence_advice, validity_warning
-from flex.usage import explicit_keys, unused_keys
+from flex.base.errors import SceneError, SimulationError
+from flex.config.settings import check_runnable
+from flex.config.usage import explicit_keys, unused_keys
+from flex.data.results import CaseResult, Dataset, write_results
+from flex.data.scene import SCHEMA, estimate_mesh, load_scene
+from flex.dynamics.solver import (
+    VALIDITY_WARNING,
+    _check_finite,
+    divergence_advice,
+    validity_warning,
+)
+from flex.fidelity.simulation import simulate_case
 
 PLATE = ["--set", 'coupler.geometry="plate"', "--set", 'coupler.model="ffrf"']
 
@@ -260,7 +265,7 @@ def test_mesh_estimate_matches_its_calibration():
 
 @pytest.mark.slow
 def test_mesh_estimate_against_a_fresh_netgen_mesh():
-    from flex.plate import plate_mesh
+    from flex.bodies.plate import plate_mesh
 
     for thickness, width, mesh in ((0.002, 0.01, 0.0015), (0.0005, 0.03, 0.003)):
         elements = plate_mesh(0.08, thickness, width, mesh).ne

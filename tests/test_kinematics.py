@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from flex.kinematics import slider_crank
-from flex.scene import load_scene
-from flex.simulation import simulate
+from flex.base.kinematics import slider_crank
+from flex.data.scene import load_scene
+from flex.fidelity.simulation import simulate
 
 
 def test_closed_form_is_self_consistent():

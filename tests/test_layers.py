@@ -1,6 +1,8 @@
-"""The library's layers: each flex module imports only from its own layer or lower ones.
+"""The library's layers are its folders: a module imports only from its own folder or lower ones.
 
-The layers, lowest first (README "Layout" describes each module):
+Lowest first: ``flex/base``, ``data``, ``config``, ``bodies``, ``dynamics``, ``fidelity``,
+``experiments``, ``tools``, then the top modules ``flex/study.py``, ``api.py``,
+``sweep.py``, ``cli.py`` (README "Layout" describes each module).
 """
 
 from __future__ import annotations
@@ -9,76 +11,60 @@ import ast
 from pathlib import Path
 
 FLEX = Path(__file__).resolve().parent.parent / "flex"
-
-LAYERS: list[tuple[str, set[str]]] = [
-    ("foundations: errors, closed forms, the thesis's numbers, figure helpers",
-     {"errors", "physics", "thesis", "kinematics", "plotting"}),
-    ("scenes and result files", {"scene", "results", "outputs", "plate"}),
-    ("settings: what a scene resolves to, which keys it uses", {"settings", "usage"}),
-    ("bodies: beams, meshes, modes, reductions, the nonlinear FE coupler, the spring",
-     {"beams", "fe_modes", "beam_elements", "mesh_convergence", "thesis_tables", "reduction",
-      "nonlinear", "spring"}),
-    ("mechanism and solvers: Exudyn model, integration, the independent reference DAE",
-     {"mechanism", "solver", "reference"}),
-    ("fidelity: the rigid-or-flexible criterion, auto, simulate any scene",
-     {"criteria", "simulation", "softening", "caseloop"}),
-    ("experiments: fits, work-precision, benchmark, stability, per-study computations",
-     {"lawfit", "couplerfit", "crankfit", "lawplots", "tradeoff", "reference_plans",
-      "workprecision", "defaults_check", "workprecision_report", "benchmark",
-      "benchmark_report", "stability", "twins", "deployment", "wing", "constant_speed",
-      "spring_check", "single_case", "modal"}),
-    ("result tools: inspect, compare, plot, report",
-     {"inspect", "compare", "plotcurves", "report"}),
-    ("running studies, the public face", {"study", "api"}),
-    ("sweeps", {"sweep"}),
-    ("command line", {"cli", "__main__"}),
-]
-__doc__ += "\n".join(f"{i}. {text}: {', '.join(sorted(names))}"
-                     for i, (text, names) in enumerate(LAYERS))
+#: the folders (and the top modules) from the lowest layer up
+LAYERS = ["base", "data", "config", "bodies", "dynamics", "fidelity", "experiments", "tools",
+          "study", "api", "sweep", "cli", "__main__"]
 
 
-def layer_of(module: str) -> int:
-    for index, (_, names) in enumerate(LAYERS):
-        if module in names:
-            return index
-    raise AssertionError(f"flex/{module}.py is in no layer: add it to tests/test_layers.py "
-                         f"(and to the README layout)")
+def layer_of(dotted: str) -> int:
+    """Layer of a module ``flex.<folder>.<name>`` or a top module ``flex.<name>``."""
+    parts = dotted.split(".")
+    assert parts[0] == "flex", dotted
+    key = parts[1] if len(parts) > 1 else "__init__"
+    if key == "__init__":
+        return -1  # the package face (``__version__``): importable from anywhere
+    assert key in LAYERS, f"{dotted}: flex/{key} is in no layer: add it to tests/test_layers.py"
+    return LAYERS.index(key)
+
+
+def dotted_name(path: Path) -> str:
+    parts = path.relative_to(FLEX.parent).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
 def flex_imports(path: Path) -> set[str]:
-    """The flex modules ``path`` imports (relative or absolute), at any depth."""
+    """The flex modules ``path`` imports, at any depth (every import is absolute)."""
     found = set()
     for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.ImportFrom):
-            if node.level == 1 and node.module:
-                found.add(node.module.split(".")[0])
-            elif node.level == 1:
-                found.update(alias.name for alias in node.names)
-            elif node.module and node.module.startswith("flex."):
-                found.add(node.module.split(".")[1])
+            assert node.level == 0, f"{path}: relative import (use flex.<layer>.<module>)"
+            if node.module and (node.module == "flex" or node.module.startswith("flex.")):
+                found.add(node.module)
         elif isinstance(node, ast.Import):
-            found.update(alias.name.split(".")[1] for alias in node.names
-                         if alias.name.startswith("flex."))
-    return found - {"__version__"}
+            found.update(alias.name for alias in node.names if alias.name.startswith("flex."))
+    return found
 
 
 def modules() -> list[Path]:
-    return sorted(p for p in FLEX.glob("*.py") if p.name != "__init__.py")
+    return sorted(p for p in FLEX.rglob("*.py") if "__pycache__" not in p.parts)
 
 
-def test_every_module_has_a_layer():
+def test_every_module_sits_in_a_layer_folder():
     for path in modules():
-        layer_of(path.stem)
+        if path.parent == FLEX and path.stem not in ("__init__",):
+            assert path.stem in LAYERS, f"flex/{path.name} belongs in a layer folder"
+        else:
+            layer_of(dotted_name(path))
 
 
 def test_no_module_imports_from_a_higher_layer():
     upward = []
     for path in modules():
-        own = layer_of(path.stem)
+        name = dotted_name(path)
+        own = layer_of(name)
         for target in flex_imports(path):
-            if target != "__init__" and layer_of(target) > own:
-                upward.append(f"{path.stem} (layer {own}) imports {target} "
-                              f"(layer {layer_of(target)})")
+            if layer_of(target) > own:
+                upward.append(f"{name} imports {target}")
     assert not upward, upward
 
 

@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from flex.results import CaseResult, Dataset
-from flex.scene import load_scene, to_toml
+from flex.data.results import CaseResult, Dataset
+from flex.data.scene import load_scene, to_toml
 
 ROOT = Path(__file__).resolve().parent.parent
 MAKEFILE = ROOT / "Makefile"
@@ -119,8 +119,9 @@ def database(tree: Path) -> dict[str, tuple[list[str], list[str]]]:
 def test_each_result_file_depends_on_its_module_the_library_data_and_pyproject(tree):
     rules = database(tree)
     library = [name for name in _inputs() if name.startswith("flex/")]
-    assert any(name.startswith("flex/scenes/") and name.endswith(".toml") for name in library)
-    assert "flex/criteria_fit.toml" in library and "flex/solver_defaults.toml" in library
+    assert any(name.startswith("flex/data/scenes/") and name.endswith(".toml") for name in library)
+    assert "flex/fidelity/criteria_fit.toml" in library
+    assert "flex/config/solver_defaults.toml" in library
     for study in STUDIES + LONG:
         normal, order = rules[f"results/{study}.h5"]
         assert f"studies/{study}.py" in normal
@@ -158,8 +159,9 @@ def test_touching_a_study_module_makes_only_that_study_out_of_date(tree, study):
         assert status == (1 if other == study else 0), other
 
 
-@pytest.mark.parametrize("name", ["flex/solver.py", "flex/scenes/cavezza2012.toml",
-                                  "flex/criteria_fit.toml", "flex/solver_defaults.toml",
+@pytest.mark.parametrize("name", ["flex/dynamics/solver.py", "flex/data/scenes/cavezza2012.toml",
+                                  "flex/fidelity/criteria_fit.toml",
+                                  "flex/config/solver_defaults.toml",
                                   "pyproject.toml"])
 def test_touching_the_library_or_its_data_reruns_every_study(tree, name):
     assert (tree / name).exists()
@@ -221,24 +223,25 @@ def test_criterion_targets_install_the_fitted_laws_after_their_study(tree):
         _set_time(tree / "studies" / f"{study}.py", T0 + 30)
         done = make(tree, f"{study}-criterion")
         assert done.returncode == 0, done.stderr
-        assert (tree / "flex" / installed).read_text() == (tree / "results" /
+        assert (tree / "flex" / "fidelity" / installed).read_text() == (tree / "results" /
                                                            f"{study}-criterion.toml").read_text()
         assert (tree / "results" / f"{study}.h5").read_text() == f"run {study}\n"
-    stamp = (tree / "flex" / "criteria_fit.toml").stat().st_mtime
+    stamp = (tree / "flex" / "fidelity" / "criteria_fit.toml").stat().st_mtime
     again = make(tree, "kfit-criterion", "kfit")
     assert again.returncode == 0
-    assert (tree / "flex" / "criteria_fit.toml").stat().st_mtime == stamp  # same law: no copy
+    # same law: no copy
+    assert (tree / "flex" / "fidelity" / "criteria_fit.toml").stat().st_mtime == stamp
 
 
 def test_no_law_is_installed_from_a_run_that_failed(tree):
     assert make(tree, "kfit", "FORCE=1", mode="failed").returncode != 0  # earlier kfit.h5 kept
-    before = (tree / "flex" / "criteria_fit.toml").stat().st_mtime
+    before = (tree / "flex" / "fidelity" / "criteria_fit.toml").stat().st_mtime
     done = make(tree, "kfit-criterion")
     assert done.returncode != 0 and "the last kfit run failed" in done.stderr
-    assert (tree / "flex" / "criteria_fit.toml").stat().st_mtime == before
+    assert (tree / "flex" / "fidelity" / "criteria_fit.toml").stat().st_mtime == before
     assert make(tree, "kfit", "FORCE=1").returncode == 0  # a good run: installed again
     assert make(tree, "kfit-criterion").returncode == 0
-    assert (tree / "flex" / "criteria_fit.toml").read_text() == "fit\n"
+    assert (tree / "flex" / "fidelity" / "criteria_fit.toml").read_text() == "fit\n"
 
 
 def test_clean_removes_results_figures_and_reports(tree):
@@ -340,7 +343,7 @@ def test_no_progress_when_disabled(capsys):
 
 
 def test_nonlinear_fe_progress_reports_time_steps_and_remaining(monkeypatch, capsys):
-    import flex.nonlinear as nonlinear
+    import flex.bodies.nonlinear as nonlinear
 
     clock = [100.0]
     monkeypatch.setattr(nonlinear.time, "monotonic", lambda: clock[0])

@@ -16,15 +16,15 @@ import pytest
 
 os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
 
-from flex import (  # noqa: E402
+from flex.base import thesis  # noqa: E402
+from flex.base.errors import SceneError  # noqa: E402
+from flex.bodies import (  # noqa: E402
     beam_elements,
     beams,
     fe_modes,
     mesh_convergence,
-    thesis,
     thesis_tables,
 )
-from flex.errors import SceneError  # noqa: E402
 
 STEEL = beams.THESIS_STEEL
 COUPLER_LENGTH_M = 0.08

@@ -10,7 +10,7 @@ import pytest
 from scipy.linalg import eigvalsh_tridiagonal
 from scipy.optimize import brentq
 
-from flex import physics, thesis
+from flex.base import physics, thesis
 
 STEEL_E_PA, STEEL_RHO = 200e9, 7850.0
 

@@ -13,8 +13,8 @@ import h5py
 import numpy as np
 import pytest
 
-from flex.errors import SceneError
-from flex.reduction import (
+from flex.base.errors import SceneError
+from flex.bodies.reduction import (
     add_ffrf_link,
     bending_stress_history,
     build_reduction,
@@ -127,7 +127,7 @@ def test_second_build_is_a_fast_identical_cache_hit(reduction, cache_dir):
 
 
 def test_key_depends_on_every_argument(reduction, tmp_path):
-    from flex.reduction import _cache_key
+    from flex.bodies.reduction import _cache_key
 
     base = {"length_m": LENGTH, "modes": MODES}
     assert _cache_key(base) == _cache_key(dict(base))

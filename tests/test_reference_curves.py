@@ -21,10 +21,10 @@ import numpy as np
 import pytest
 
 from flex.cli import main
-from flex.compare import compare_files
-from flex.results import write_results
-from flex.scene import load_scene, to_toml
-from flex.simulation import simulate
+from flex.data.results import write_results
+from flex.data.scene import load_scene, to_toml
+from flex.fidelity.simulation import simulate
+from flex.tools.compare import compare_files
 
 FOLDER = Path(__file__).resolve().parent / "reference_curves"
 REFERENCE = FOLDER / "deployment_preload_22mm.h5"

@@ -24,9 +24,8 @@ import h5py
 import numpy as np
 import pytest
 
-from flex.errors import ResultFileError, SceneError
-from flex.inspect import describe
-from flex.results import (
+from flex.base.errors import ResultFileError, SceneError
+from flex.data.results import (
     CaseResult,
     Dataset,
     open_results,
@@ -34,8 +33,9 @@ from flex.results import (
     remove_stale_parts,
     write_results,
 )
-from flex.scene import SCHEMA, load_scene
+from flex.data.scene import SCHEMA, load_scene
 from flex.study import run_study
+from flex.tools.inspect import describe
 
 REPO = Path(__file__).resolve().parent.parent
 # 10001 samples (~3 MB): the write phase (create, fsync, rename) lasts a few tenths of a second
@@ -161,7 +161,7 @@ def test_stale_parts_of_dead_writers_are_removed_live_ones_kept(tmp_path):
 
 WRITER = """
 import sys, numpy as np
-from flex.results import CaseResult, Dataset, write_results
+from flex.data.results import CaseResult, Dataset, write_results
 writer, path, rounds = int(sys.argv[1]), sys.argv[2], int(sys.argv[3])
 for round_ in range(rounds):
     values = np.full(100_000, writer * 1000.0 + round_)
@@ -412,8 +412,8 @@ def test_truncated_result_files_give_one_clear_message(tmp_path):
 def test_ctrl_c_inside_the_solver_is_an_interrupt_not_a_failed_case():
     import threading
 
-    from flex.scene import load_scene
-    from flex.simulation import simulate_case
+    from flex.data.scene import load_scene
+    from flex.fidelity.simulation import simulate_case
 
     scene = load_scene(overrides=['drive.kind="constant_speed"', "simulation.end_time_s=20.0",
                                   "simulation.step_s=1e-4", "simulation.output_step_s=1e-2"])

@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 from hostile import check_refused, run_cli
 
-from flex.errors import EXIT_OK, OutputError, ResultFileError
-from flex.report import LARGE, default_report_path, format_value, render_report, write_report
-from flex.results import CaseResult, Dataset, attribute_value, write_results
+from flex.base.errors import EXIT_OK, OutputError, ResultFileError
+from flex.data.results import CaseResult, Dataset, attribute_value, write_results
+from flex.tools.report import LARGE, default_report_path, format_value, render_report, write_report
 
 REPO = Path(__file__).resolve().parent.parent
 REPORT_TEXT = "demo: flex against the thesis\n  quantity  thesis  flex\n  stroke    0.08    0.0800"

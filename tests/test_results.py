@@ -4,8 +4,8 @@ import h5py
 import numpy as np
 import pytest
 
-from flex.errors import ResultFileError
-from flex.results import CaseResult, Dataset, open_results, read_case, write_results
+from flex.base.errors import ResultFileError
+from flex.data.results import CaseResult, Dataset, open_results, read_case, write_results
 from flex.study import run_study
 
 

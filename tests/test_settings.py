@@ -4,17 +4,17 @@ from __future__ import annotations
 
 import pytest
 
-from flex.errors import SceneError
-from flex.scene import load_scene
-from flex.settings import (
+from flex.base.errors import SceneError
+from flex.config.settings import (
     AUTO_KEYS,
     pinned_overrides,
     resolve_solver_settings,
     resolved_simulation,
     solver_defaults,
 )
-from flex.simulation import simulate
-from flex.solver import solver_settings
+from flex.data.scene import load_scene
+from flex.dynamics.solver import solver_settings
+from flex.fidelity.simulation import simulate
 
 PLATE = ['coupler.geometry="plate"', 'coupler.model="ffrf"']
 
@@ -115,8 +115,8 @@ def test_a_default_ffrf_run_uses_and_records_the_chosen_settings():
 
 def test_inspect_shows_the_resolved_solver_keys_and_no_scene_change(tmp_path, capsys):
     from flex.cli import main
-    from flex.results import write_results
-    from flex.scene import to_toml
+    from flex.data.results import write_results
+    from flex.data.scene import to_toml
 
     scene = load_scene(None, PLATE + ["simulation.end_time_s=0.004"])
     path = write_results(tmp_path / "auto.h5", "simulate", [simulate(scene, "default")],

@@ -10,8 +10,8 @@ import math
 
 import pytest
 
-from flex import spring
-from flex.errors import SceneError
+from flex.base.errors import SceneError
+from flex.bodies import spring
 
 INCH_M = 0.0254
 LBF_N = 4.4482216152605

@@ -17,12 +17,12 @@ import h5py
 import numpy as np
 import pytest
 
-from flex.errors import FlexError, SimulationError
-from flex.reference import SliderCrankDAE, solve_reference
-from flex.results import CaseResult, Dataset, write_results
-from flex.scene import load_scene
-from flex.simulation import simulate, simulate_case
-from flex.solver import _check_finite
+from flex.base.errors import FlexError, SimulationError
+from flex.data.results import CaseResult, Dataset, write_results
+from flex.data.scene import load_scene
+from flex.dynamics.reference import SliderCrankDAE, solve_reference
+from flex.dynamics.solver import _check_finite
+from flex.fidelity.simulation import simulate, simulate_case
 
 SHORT = ["simulation.end_time_s=0.01"]
 #: largest energy range over E0 (the spring's energy at the start) of the long FFRF run, per
@@ -187,9 +187,9 @@ def test_the_stability_study_declares_its_forced_divergences():
 # flex.stability: references, verdicts, trust boundary
 # ------------------------------------------------------------------------------------------
 def test_a_constant_speed_run_is_judged_against_the_closed_form():
-    from flex.settings import pinned_overrides
-    from flex.stability import Extreme, References, extreme_cases, judge
-    from flex.tradeoff import ReductionPool
+    from flex.config.settings import pinned_overrides
+    from flex.experiments.stability import Extreme, References, extreme_cases, judge
+    from flex.experiments.tradeoff import ReductionPool
 
     extreme = Extreme("crank_speed", "stiff_drive", (
         'drive.kind="constant_speed"', "simulation.end_time_s=0.01"), "closed_form", 1.0)
@@ -208,7 +208,7 @@ def test_a_constant_speed_run_is_judged_against_the_closed_form():
 
 
 def test_trust_boundary_interpolates_where_ffrf_comes_within_one_percent():
-    from flex.stability import trust_boundary
+    from flex.experiments.stability import trust_boundary
 
     def verdicts(errors):
         return {f"nonlinear_{t:g}mm": {"group": "nonlinear", "parameter": t,

@@ -7,9 +7,9 @@ import time
 import h5py
 import pytest
 
-from flex.errors import FlexError
-from flex.results import CaseResult, Dataset
-from flex.scene import load_scene
+from flex.base.errors import FlexError
+from flex.data.results import CaseResult, Dataset
+from flex.data.scene import load_scene
 from flex.sweep import (
     SerialExecutor,
     case_path,
@@ -174,7 +174,7 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch):
     """A shrunken kfit (3 thicknesses, 1 stiffness family, 1 validation scene) through the
     study runner and the local process pool: cases, fit, criterion file, validation."""
     import studies.kfit as kfit
-    from flex.couplerfit import analyse
+    from flex.experiments.couplerfit import analyse
     from flex.study import run_study
 
     monkeypatch.setattr(kfit, "THICKNESSES_M", (1e-3, 3e-3, 10e-3))
@@ -203,9 +203,9 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch):
 
 
 def test_case_hash_follows_the_solver_defaults_of_auto_scenes(monkeypatch):
-    # a resumed sweep must not reuse cases run with another flex/solver_defaults.toml
-    import flex.settings as settings
-    from flex.simulation import simulate_case
+    # a resumed sweep must not reuse cases run with another flex/config/solver_defaults.toml
+    import flex.config.settings as settings
+    from flex.fidelity.simulation import simulate_case
     from flex.sweep import case_hash
 
     auto = load_scene()
@@ -220,8 +220,8 @@ def test_case_hash_follows_the_solver_defaults_of_auto_scenes(monkeypatch):
 def test_case_hash_follows_the_criterion_of_auto_links(tmp_path, monkeypatch):
     import functools
 
-    import flex.criteria as criteria
-    from flex.simulation import simulate_case
+    import flex.fidelity.criteria as criteria
+    from flex.fidelity.simulation import simulate_case
     from flex.sweep import case_hash
 
     auto = load_scene(None, ['coupler.geometry="plate"', 'coupler.model="auto"'])
@@ -234,7 +234,7 @@ def test_case_hash_follows_the_criterion_of_auto_links(tmp_path, monkeypatch):
     assert case_hash(auto, simulate_case) != before[0]
     assert case_hash(rigid, simulate_case) == before[1]
     # a law passed as an argument is part of the case function's identity
-    law = criteria.load_criterion(criteria.Path(__file__).parent.parent / "flex"
-                                  / "criteria_fit.toml")
+    installed = criteria.Path(criteria.__file__).with_name("criteria_fit.toml")
+    law = criteria.load_criterion(installed)
     with_law = functools.partial(simulate_case, criterion=law)
     assert case_hash(auto, with_law) != case_hash(auto, simulate_case)

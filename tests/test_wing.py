@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from flex import wing
-from flex.reference import crank_mass_properties, solve_reference
-from flex.scene import load_scene
-from flex.simulation import simulate
-from flex.thesis import THESIS_WING_PEAK_RATE_DEG_PER_S, THESIS_WING_PEAK_TIME_S
+from flex.base.thesis import THESIS_WING_PEAK_RATE_DEG_PER_S, THESIS_WING_PEAK_TIME_S
+from flex.data.scene import load_scene
+from flex.dynamics.reference import crank_mass_properties, solve_reference
+from flex.experiments import wing
+from flex.fidelity.simulation import simulate
 from studies.wing import OVERRIDES
 
 

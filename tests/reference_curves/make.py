@@ -19,9 +19,9 @@ from pathlib import Path
 
 import numpy as np
 
-from flex.reference import solve_reference
-from flex.results import CaseResult, Dataset, write_results
-from flex.scene import load_scene, to_toml
+from flex.data.results import CaseResult, Dataset, write_results
+from flex.data.scene import load_scene, to_toml
+from flex.dynamics.reference import solve_reference
 
 FOLDER = Path(__file__).resolve().parent
 DEPLOYMENT_FILE = FOLDER / "deployment_preload_22mm.h5"

@@ -1,0 +1,664 @@
+"""Flexible links: NGsolve plate mesh -> Hurty-Craig-Bampton reduction -> Exudyn FFRF body.
+
+The building block of the flexible slider-crank (coupler between B and C, crank between A
+and B: the same plate reduction, ``end_a`` at the link's first joint). :func:`build_reduction`
+meshes a steel plate (:func:`flex.plate.plate_mesh`, second-order tetrahedra), reduces it
+with Hurty-Craig-Bampton modes whose two interfaces are the joint faces ``end_a`` (joint B)
+and ``end_b`` (joint C), adds stress post-processing modes and caches the result in one HDF5
+file.
+:func:`add_ffrf_link` puts the reduced body into an Exudyn ``MainSystem`` with markers at
+B, C and the midpoint. :func:`midpoint_deflection` and :func:`bending_stress_history` turn
+simulation output into the elastic quantities the study reports.
+
+Body coordinates (metres) are the mesh's: x along the link from the centre of ``end_a``
+(x = 0, joint B) to the centre of ``end_b`` (x = length, joint C), y across the thickness
+(in the mechanism plane, the bending height), z across the width (out of plane).
+
+Mode basis: 6 static modes of ``end_b`` (its rigid-face translations and rotations) followed
+by ``modes`` fixed-interface eigenmodes (both end faces clamped). ``end_a`` gets no static
+modes: its nodes move rigidly with the floating frame, so the frame *is* the joint-B face.
+Both end faces stay rigid (RBE2-like), as a pin through a stiff eye would keep them.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import math
+import numbers
+import os
+import tempfile
+import time
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from flex.base.errors import SceneError
+from flex.bodies.plate import plate_mesh
+
+#: Bump when the content or layout of a cache file changes; old entries are then rebuilt.
+CACHE_FORMAT_VERSION = 1
+
+END_A = "end_a"  #: mesh boundary name of the joint-B face (x = 0)
+END_B = "end_b"  #: mesh boundary name of the joint-C face (x = length)
+MID = "mid"  #: node-set name of the mid-length cross-section
+
+_MESH_ORDER = 2  # linear tets lock in bending (notes: first frequency 69-90 % too high)
+_STATIC_MODES = 6  # of end_b: 3 translations + 3 rotations of the rigid face
+
+
+# ------------------------------------------------------------------------------------------
+# result type
+# ------------------------------------------------------------------------------------------
+@dataclass
+class Reduction:
+    """A reduced flexible plate link, ready for :func:`add_ffrf_link`.
+
+    Node index arrays refer to ``fem``'s mesh nodes; weights sum to 1. ``centre_*`` are the
+    weighted reference positions of the node sets in body coordinates [m]: the points the
+    markers of :func:`add_ffrf_link` report.
+    """
+
+    fem: Any  #: exudyn.FEM.FEMinterface holding mesh, M, K, mode basis, stress modes
+    length_m: float
+    thickness_m: float
+    width_m: float
+    youngs_modulus_Pa: float
+    density_kg_per_m3: float
+    poisson_ratio: float
+    mesh_size_m: float
+    modes: int  #: number of fixed-interface eigenmodes (the reduced body has 6 more)
+    nodes_end_a: np.ndarray
+    weights_end_a: np.ndarray
+    nodes_end_b: np.ndarray
+    weights_end_b: np.ndarray
+    nodes_mid: np.ndarray
+    weights_mid: np.ndarray
+    centre_end_a: np.ndarray  #: [m], (0, 0, 0) by construction
+    centre_end_b: np.ndarray  #: [m], (length, 0, 0) by construction
+    centre_mid: np.ndarray  #: [m], (length/2, 0, 0) unless the mesh forbade it (see _mid_set)
+    fixed_interface_frequencies_Hz: np.ndarray  #: both end faces clamped
+    pinned_pinned_frequency_Hz: float  #: first in-plane bending mode, ends pinned about z
+    mass_kg: float  #: [kg]
+    n_nodes: int
+    n_elements: int  #: second-order tetrahedra
+    n_dof: int  #: 3 * n_nodes, unreduced
+    cold_build_time_s: float  #: time of the original (uncached) build
+    build_time_s: float  #: time spent by this call: the build, or the cache load
+    from_cache: bool
+    cache_file: Path | None
+    key: str  #: hash of everything the reduction depends on
+    _ffrf_interface: Any = field(default=None, repr=False, compare=False)
+
+    @property
+    def n_modal_coordinates(self) -> int:
+        """Number of elastic coordinates of the reduced body: 6 static + ``modes``."""
+        return _STATIC_MODES + self.modes
+
+    @property
+    def has_stress_modes(self) -> bool:
+        """True if the FEMinterface carries stress post-processing modes."""
+        return "matrix" in (self.fem.postProcessingModes or {})
+
+    def ffrf_interface(self):
+        """The ``ObjectFFRFreducedOrderInterface`` of this reduction, made once and reused.
+
+        Its constructor projects the full mass matrix on the basis (the costly part of adding
+        a body), so several systems built from one reduction share it.
+        """
+        if self._ffrf_interface is None:
+            from exudyn.FEM import ObjectFFRFreducedOrderInterface
+
+            self._ffrf_interface = ObjectFFRFreducedOrderInterface(self.fem)
+        return self._ffrf_interface
+
+
+class MidpointDeflection(NamedTuple):
+    """Elastic midpoint response relative to the chord B-C, both zero at the first sample [m]."""
+
+    transverse_m: np.ndarray  #: along the in-plane chord normal e_z x (C - B)/|C - B|
+    chord_change_m: np.ndarray  #: |C - B| minus its first value (axial stretch of the link)
+
+
+# ------------------------------------------------------------------------------------------
+# input checks
+# ------------------------------------------------------------------------------------------
+def _is_number(value: Any) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def _check_inputs(sizes: dict[str, float], poisson_ratio: float, modes: int) -> None:
+    for name, value in sizes.items():
+        if not (_is_number(value) and math.isfinite(value) and value > 0):
+            raise SceneError(f"reduction {name} = {value!r}: must be a finite number > 0")
+    if not (_is_number(poisson_ratio) and 0.0 < poisson_ratio < 0.5):
+        raise SceneError(
+            f"reduction poisson_ratio = {poisson_ratio!r}: must lie in the open range (0, 0.5)")
+    if isinstance(modes, bool) or not isinstance(modes, int | np.integer) or modes < 1:
+        raise SceneError(f"reduction modes = {modes!r}: must be an integer >= 1")
+    if sizes["mesh_size_m"] > sizes["length_m"]:
+        raise SceneError(
+            f"reduction mesh_size_m = {sizes['mesh_size_m']!r}: must be <= length_m "
+            f"({sizes['length_m']!r}); the notes recommend about 1-2 x thickness")
+
+
+# ------------------------------------------------------------------------------------------
+# cache
+# ------------------------------------------------------------------------------------------
+def _engine_versions() -> dict[str, str]:
+    # installed distribution versions: no need to import ngsolve (0.5 s) for a cache hit
+    from importlib.metadata import version
+
+    return {"exudyn": version("exudyn"), "ngsolve": version("ngsolve")}
+
+
+def _cache_key(parameters: dict[str, Any]) -> str:
+    # repr(float) is exact and canonical, so 0.003 and 3e-3 hash alike, 0.0030000001 not
+    canonical = {k: (repr(float(v)) if isinstance(v, float) else v)
+                 for k, v in parameters.items()}
+    canonical["format_version"] = CACHE_FORMAT_VERSION
+    canonical.update(_engine_versions())
+    text = json.dumps(canonical, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+def _content_digest(fem) -> str:
+    """SHA-256 over the arrays a simulation uses: detects a damaged file that still opens."""
+    digest = hashlib.sha256()
+    parts = [fem.GetNodePositionsAsArray(), fem.modeBasis["matrix"], np.asarray(fem.eigenValues)]
+    for matrix in (fem.massMatrix, fem.stiffnessMatrix):
+        parts += [matrix.data, matrix.indices, matrix.indptr]
+    if "matrix" in (fem.postProcessingModes or {}):
+        parts.append(fem.postProcessingModes["matrix"])
+    for node_set in fem.nodeSets:
+        parts += [node_set["NodeNumbers"], node_set["NodeWeights"]]
+    for part in parts:
+        array = np.ascontiguousarray(part)
+        digest.update(str(array.dtype).encode() + str(array.shape).encode())
+        digest.update(array.tobytes())
+    return digest.hexdigest()
+
+
+def _save_atomically(fem, path: Path) -> None:
+    """Write to a temporary file in the same directory, then rename: readers never see a
+    half-written entry, and concurrent builders of one key just replace each other."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=path.stem + ".", suffix=".tmp.hdf5",
+                                         dir=path.parent)
+    os.close(handle)
+    try:
+        fem.SaveToFile(temporary, mode="HDF5")
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def _load_cached(path: Path, key: str):
+    """Return the FEMinterface stored under ``path`` if it is whole and made for ``key``.
+
+    Returns None for a missing, truncated, foreign or damaged file (the caller rebuilds).
+    """
+    if not path.is_file():
+        return None
+    import h5py
+
+    # check with h5py first: FEMinterface.LoadFromFile prints a banner before re-raising
+    try:
+        with h5py.File(path, "r") as h5:
+            stored_key = h5["metaData"]["flex"]["key"][()]
+    except Exception:
+        return None
+    if isinstance(stored_key, bytes):
+        stored_key = stored_key.decode()
+    if stored_key != key:
+        return None
+    from exudyn.FEM import FEMinterface
+
+    fem = FEMinterface()
+    try:
+        fem.LoadFromFile(str(path), mode="HDF5")
+        meta = fem.metaData["flex"]
+        if meta["digest"] != _content_digest(fem):
+            return None
+        n_nodes = fem.NumberOfNodes()
+        if fem.modeBasis["matrix"].shape[0] != 3 * n_nodes:
+            return None
+    except Exception:
+        return None
+    return fem
+
+
+# ------------------------------------------------------------------------------------------
+# building
+# ------------------------------------------------------------------------------------------
+def _node_set(fem, name: str) -> dict:
+    for node_set in fem.nodeSets:
+        if node_set["Name"] == name:
+            return node_set
+    raise KeyError(name)
+
+
+def _mid_set(positions: np.ndarray, length_m: float, mesh_size_m: float,
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes of a thin slab around x = length/2 and weights placing their centre there.
+
+    A tetrahedral mesh has no node plane at mid-length, so the marker averages a slab of
+    half-width mesh_size/4 (widened until it holds >= 8 nodes). Equal weights are corrected by
+    the smallest change that puts the weighted reference centre exactly at (L/2, 0, 0); if that
+    would make a weight non-positive the equal weights are kept (centre then off by << h).
+    The slab average differs from the mid-section value by O((h/L)^2) in the deflection.
+    """
+    distance = np.abs(positions[:, 0] - length_m / 2)
+    half_width = 0.25 * mesh_size_m
+    nodes = np.flatnonzero(distance <= half_width)
+    while len(nodes) < 8:
+        half_width *= 1.5
+        nodes = np.flatnonzero(distance <= half_width)
+    weights = np.full(len(nodes), 1.0 / len(nodes))
+    constraint = np.vstack([np.ones(len(nodes)), positions[nodes].T])  # sum, x, y, z
+    target = np.array([1.0, length_m / 2, 0.0, 0.0])
+    try:
+        correction = constraint.T @ np.linalg.solve(constraint @ constraint.T,
+                                                    target - constraint @ weights)
+        if np.all(weights + correction > 0):
+            weights = weights + correction
+    except np.linalg.LinAlgError:
+        pass
+    return nodes, weights
+
+
+def _pinned_pinned_frequency_Hz(ffrf_interface, reduction_length_m: float,
+                                thickness_m: float, width_m: float,
+                                nodes_end_a, weights_end_a, nodes_end_b, weights_end_b,
+                                ) -> float:
+    """First bending frequency of the reduced body with both end faces pinned about z.
+
+    Exudyn's constrained eigenvalue solver on the body alone: each end face is held in all
+    translations and in rotation about x and y, rotation about z free (a revolute pin). With
+    the out-of-plane rotations held at both ends, the lowest mode is the in-plane one while
+    thickness < ~2.2 x width (pinned-pinned 9.87 t vs clamped-clamped 22.4 w); beyond that
+    NaN is returned instead of a wrong mode.
+    """
+    if thickness_m > 2.0 * width_m:
+        return float("nan")
+    import exudyn as exu
+    import exudyn.itemInterface as eii
+
+    system_container = exu.SystemContainer()
+    mbs = system_container.AddSystem()
+    body = ffrf_interface.AddObjectFFRFreducedOrder(mbs, positionRef=[0.0, 0.0, 0.0])
+    ground = mbs.AddObject(eii.ObjectGround())
+    for nodes, weights, x in ((nodes_end_a, weights_end_a, 0.0),
+                              (nodes_end_b, weights_end_b, reduction_length_m)):
+        face = mbs.AddMarker(eii.MarkerSuperElementRigid(
+            bodyNumber=body["oFFRFreducedOrder"], meshNodeNumbers=nodes,
+            weightingFactors=weights))
+        support = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground,
+                                                    localPosition=[x, 0.0, 0.0]))
+        mbs.AddObject(eii.GenericJoint(markerNumbers=[support, face],
+                                       constrainedAxes=[1, 1, 1, 1, 1, 0]))
+    mbs.Assemble()
+    eigenvalues, _ = mbs.ComputeODE2Eigenvalues(useAbsoluteValues=True)
+    eigenvalues = np.sort(np.abs(np.asarray(eigenvalues)))
+    # the constraint projection leaves no rigid-body modes; skip round-off zeros anyway
+    eigenvalues = eigenvalues[eigenvalues > 1e-6 * eigenvalues[-1]]
+    return float(np.sqrt(eigenvalues[0]) / (2 * np.pi))
+
+
+@contextlib.contextmanager
+def _ngsolve_thread_count(threads: int | None) -> Iterator[None]:
+    """Run NGsolve's task manager with ``threads`` threads inside the block, then restore."""
+    if threads is None:
+        yield
+        return
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+        raise SceneError(f"ngsolve_threads = {threads!r}: must be an integer >= 1 or None")
+    import ngsolve
+
+    with ngsolve.TaskManager():  # the count in force is only visible inside a task manager
+        previous = ngsolve.GetNumThreads()
+    ngsolve.SetNumThreads(threads)
+    try:
+        yield
+    finally:
+        ngsolve.SetNumThreads(previous)
+
+
+def _fix_eigenmode_signs(basis: np.ndarray) -> None:
+    """Turn each fixed-interface eigenmode so its largest entry is positive (in place).
+
+    PINVIT returns modes of arbitrary sign (and threads change round-off), so two builds of
+    one key could give modal coordinates of opposite sign; this makes them comparable. The
+    first entry within 1e-6 of the largest is used, so round-off cannot change the pick.
+    """
+    for column in range(_STATIC_MODES, basis.shape[1]):
+        magnitude = np.abs(basis[:, column])
+        pick = int(np.argmax(magnitude >= (1 - 1e-6) * magnitude.max()))
+        if basis[pick, column] < 0:
+            basis[:, column] *= -1
+
+
+def build_reduction(length_m: float, thickness_m: float, width_m: float,
+                    youngs_modulus_Pa: float, density_kg_per_m3: float, poisson_ratio: float,
+                    mesh_size_m: float, modes: int,
+                    cache_dir: str | os.PathLike | None, *,
+                    ngsolve_threads: int | None = 1) -> Reduction:
+    """Mesh, reduce and cache a plate link; return the :class:`Reduction`.
+
+    Contract:
+      - sizes in metres, E in Pa, density in kg/m^3; ``mesh_size_m`` is netgen's maxh
+        (recommendation: about the thickness, at most 2 x thickness); ``modes`` >= 1 is the
+        number of fixed-interface (both faces clamped) eigenmodes added to the 6 static modes
+        of ``end_b``. Bad values raise :class:`flex.errors.SceneError`.
+      - the mesh uses second-order tetrahedra; stress post-processing modes (local stress,
+        Pa per unit modal coordinate) are always computed.
+      - ``cache_dir``: directory of the cache (created if missing) or None for no caching. The
+        entry is ``<key>.hdf5``, ``key`` hashing every argument except ``cache_dir``, the
+        cache format version and the exudyn and ngsolve versions. A whole entry for the same
+        key is loaded (``from_cache`` True); a missing, truncated, damaged or foreign entry is
+        rebuilt and replaced by an atomic rename.
+      - ``ngsolve_threads``: threads of NGsolve's task manager during a build (restored
+        afterwards; None leaves NGsolve's setting). 1 by default: the task manager spins,
+        and on a shared 2-core machine 2 threads made a 0.6 s build take 12-20 s.
+      - a rebuild reproduces the same reduction up to round-off (threaded assembly and
+        eigensolver); eigenmode signs are normalised so modal coordinates keep their sign.
+    """
+    start = time.perf_counter()
+    sizes = {"length_m": length_m, "thickness_m": thickness_m, "width_m": width_m,
+             "youngs_modulus_Pa": youngs_modulus_Pa, "density_kg_per_m3": density_kg_per_m3,
+             "mesh_size_m": mesh_size_m}
+    _check_inputs(sizes, poisson_ratio, modes)
+    parameters = {name: float(value) for name, value in sizes.items()}
+    parameters.update(poisson_ratio=float(poisson_ratio), modes=int(modes),
+                      mesh_order=_MESH_ORDER, stress_modes=True)
+    key = _cache_key(parameters)
+    cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"
+
+    fem = _load_cached(cache_file, key) if cache_file is not None else None
+    from_cache = fem is not None
+    ffrf_interface = None
+    if fem is None:
+        with _ngsolve_thread_count(ngsolve_threads):
+            fem, ffrf_interface = _build_fem(parameters, key)
+        if cache_file is not None:
+            _save_atomically(fem, cache_file)
+
+    meta = fem.metaData["flex"]
+    end_a, end_b, mid = (_node_set(fem, name) for name in (END_A, END_B, MID))
+    positions = fem.GetNodePositionsAsArray()
+
+    def centre(node_set: dict) -> np.ndarray:
+        return np.asarray(node_set["NodeWeights"]) @ positions[node_set["NodeNumbers"]]
+
+    return Reduction(
+        fem=fem, **sizes, poisson_ratio=float(poisson_ratio), modes=int(modes),
+        nodes_end_a=np.asarray(end_a["NodeNumbers"]), weights_end_a=end_a["NodeWeights"],
+        nodes_end_b=np.asarray(end_b["NodeNumbers"]), weights_end_b=end_b["NodeWeights"],
+        nodes_mid=np.asarray(mid["NodeNumbers"]), weights_mid=mid["NodeWeights"],
+        centre_end_a=centre(end_a), centre_end_b=centre(end_b), centre_mid=centre(mid),
+        fixed_interface_frequencies_Hz=np.sqrt(np.abs(np.asarray(fem.eigenValues))) / (2 * np.pi),
+        pinned_pinned_frequency_Hz=float(meta["pinned_pinned_frequency_Hz"]),
+        mass_kg=float(meta["mass_kg"]), n_nodes=int(fem.NumberOfNodes()),
+        n_elements=int(meta["n_elements"]), n_dof=3 * int(fem.NumberOfNodes()),
+        cold_build_time_s=float(meta["cold_build_time_s"]),
+        build_time_s=time.perf_counter() - start, from_cache=from_cache,
+        cache_file=cache_file, key=key,
+        _ffrf_interface=ffrf_interface,
+    )
+
+
+def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
+    """Mesh + Craig-Bampton + stress modes.
+
+    Returns the FEMinterface (flex's own data in ``metaData['flex']``, the mid-length node set
+    in ``nodeSets``) and its ObjectFFRFreducedOrderInterface.
+    """
+    import exudyn as exu
+    from exudyn.FEM import FEMinterface, KirchhoffMaterial
+
+    start = time.perf_counter()
+    length_m = parameters["length_m"]
+    mesh = plate_mesh(length_m, parameters["thickness_m"], parameters["width_m"],
+                      parameters["mesh_size_m"])
+    fem = FEMinterface()
+    mass_form, stiffness_form, space = fem.ImportMeshFromNGsolve(
+        mesh, density=parameters["density_kg_per_m3"],
+        youngsModulus=parameters["youngs_modulus_Pa"],
+        poissonsRatio=parameters["poisson_ratio"], meshOrder=_MESH_ORDER,
+        boundaryNamesList=[END_A, END_B])
+    # sorted node numbers and area weights: reproducible files, weighted centre = face centre
+    interfaces = []
+    for name in (END_A, END_B):
+        node_set = _node_set(fem, name)
+        nodes = np.sort(np.asarray(node_set["NodeNumbers"], dtype=np.int64))
+        node_set["NodeNumbers"] = nodes
+        node_set["NodeWeights"] = fem.GetNodeWeightsFromSurfaceAreas(nodes)
+        interfaces.append(nodes)
+    # end_a first: it gets no static modes and becomes the floating frame
+    fem.ComputeHurtyCraigBamptonModesNGsolve(mass_form, stiffness_form, interfaces,
+                                             parameters["modes"])
+    _fix_eigenmode_signs(fem.modeBasis["matrix"])
+    material = KirchhoffMaterial(parameters["youngs_modulus_Pa"], parameters["poisson_ratio"],
+                                 parameters["density_kg_per_m3"])
+    fem.ComputePostProcessingModesNGsolve(space, material=material,
+                                          outputVariableType=exu.OutputVariableType.StressLocal)
+    positions = fem.GetNodePositionsAsArray()
+    mid_nodes, mid_weights = _mid_set(positions, length_m, parameters["mesh_size_m"])
+    fem.nodeSets.append({"Name": MID, "NodeNumbers": mid_nodes, "NodeWeights": mid_weights})
+
+    from exudyn.FEM import ObjectFFRFreducedOrderInterface
+
+    ffrf_interface = ObjectFFRFreducedOrderInterface(fem)
+    end_a, end_b = _node_set(fem, END_A), _node_set(fem, END_B)
+    pinned_pinned = _pinned_pinned_frequency_Hz(
+        ffrf_interface, length_m, parameters["thickness_m"], parameters["width_m"],
+        end_a["NodeNumbers"], end_a["NodeWeights"], end_b["NodeNumbers"], end_b["NodeWeights"])
+    fem.metaData["flex"] = {
+        "key": key,
+        "format_version": CACHE_FORMAT_VERSION,
+        "parameters": json.dumps(parameters, sort_keys=True),
+        "pinned_pinned_frequency_Hz": pinned_pinned,
+        "mass_kg": float(ffrf_interface.totalMass),
+        "n_elements": int(mesh.ne),
+        "cold_build_time_s": time.perf_counter() - start,
+        "digest": _content_digest(fem),
+    }
+    # handed to the Reduction (not stored): saves re-projecting on the first add
+    return fem, ffrf_interface
+
+
+# ------------------------------------------------------------------------------------------
+# Exudyn body
+# ------------------------------------------------------------------------------------------
+def as_vector3(value: Sequence[float], name: str) -> np.ndarray:
+    vector = np.asarray(value, dtype=float)
+    if vector.shape != (3,) or not np.all(np.isfinite(vector)):
+        raise SceneError(f"{name} = {value!r}: must be 3 finite numbers (metres, global frame)")
+    return vector
+
+
+def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_rad: float,
+                  damping_ratio: float = 0.0,
+                  initial_velocity_B_m_per_s: Sequence[float] = (0.0, 0.0, 0.0),
+                  initial_angular_velocity_rad_per_s: float = 0.0,
+                  name: str = "coupler") -> dict[str, Any]:
+    """Add the reduced plate to ``mbs`` as an ``ObjectFFRFreducedOrder`` between B and C.
+
+    Written for the coupler (``end_a`` at B, ``end_b`` at C); the crank uses it with
+    ``position_B`` = A and its markers ``marker_B`` at A and ``marker_C`` at B.
+
+    Contract:
+      - placement: the floating frame's origin is the centre of ``end_a`` and is put at
+        ``position_B`` [m, global]; its x axis (the link axis) is turned by ``angle_rad`` about
+        global z. C's reference position is ``position_B + length * (cos, sin, 0)``.
+      - markers: ``marker_B`` / ``marker_C`` are ``MarkerSuperElementRigid`` on the end faces
+        (area weights; reference point = face centre, orientation = the frame's) for joints
+        B and C; ``marker_mid`` is a ``MarkerSuperElementPosition`` on the mid-length slab
+        (reference point (L/2, 0, 0) in body coordinates).
+      - damping (0 allowed, must be in [0, 1)): stiffness-proportional Rayleigh damping
+        ``beta = 2 * damping_ratio / omega_pp`` on the elastic coordinates, with omega_pp the
+        reduced body's first pinned-pinned bending frequency [rad/s]. That mode then has
+        exactly ``damping_ratio`` of critical damping, higher modes proportionally more;
+        rigid-body motion is never damped.
+      - initial state: frame origin (point B) velocity [m/s] and angular velocity about z
+        [rad/s], elastic coordinates at rest. Give the coupler's rigid-body velocities of
+        the starting configuration (e.g. a crank turning at constant speed); default rest.
+      - the body is added at the reference configuration; call ``mbs.Assemble()`` afterwards.
+
+    Returns a dict:
+      ``object`` (ObjectIndex of the ObjectFFRFreducedOrder), ``node_frame`` (NodeIndex of the
+      floating frame, Euler parameters), ``node_modal`` (NodeIndex of the 6 + modes elastic
+      coordinates: sensor ``OutputVariableType.Coordinates`` feeds
+      :func:`bending_stress_history`), ``marker_B``, ``marker_C``, ``marker_mid``
+      (MarkerIndex), ``position_B``, ``position_C``, ``position_mid`` (reference positions
+      [m], global), ``rotation_matrix`` (3x3, body to global), ``mass_kg``,
+      ``stiffness_proportional_damping_s`` (beta [s]).
+    """
+    from exudyn.rigidBodyUtilities import RotationMatrixZ
+
+    position_B = as_vector3(position_B, "position_B")
+    velocity_B = as_vector3(initial_velocity_B_m_per_s, "initial_velocity_B_m_per_s")
+    for label, value in (("angle_rad", angle_rad),
+                         ("initial_angular_velocity_rad_per_s",
+                          initial_angular_velocity_rad_per_s)):
+        if not (_is_number(value) and math.isfinite(value)):
+            raise SceneError(f"{label} = {value!r}: must be a finite number")
+    if not (_is_number(damping_ratio) and 0.0 <= damping_ratio < 1.0):
+        raise SceneError(f"damping_ratio = {damping_ratio!r}: must lie in [0, 1)")
+    beta = 0.0
+    if damping_ratio > 0:
+        omega = 2 * np.pi * reduction.pinned_pinned_frequency_Hz
+        if not math.isfinite(omega):
+            raise SceneError("damping_ratio > 0 needs the pinned-pinned frequency, which is "
+                             "undefined for thickness > 2 x width: use damping_ratio = 0")
+        beta = 2.0 * damping_ratio / omega
+
+    rotation = np.asarray(RotationMatrixZ(float(angle_rad)))
+    added = reduction.ffrf_interface().AddObjectFFRFreducedOrder(
+        mbs, positionRef=list(position_B), rotationMatrixRef=rotation,
+        initialVelocity=list(velocity_B),
+        initialAngularVelocity=[0.0, 0.0, float(initial_angular_velocity_rad_per_s)],
+        stiffnessProportionalDamping=beta, name=name)
+    body = added["oFFRFreducedOrder"]
+    return {
+        "object": body,
+        "node_frame": added["nRigidBody"],
+        "node_modal": added["nGenericODE2"],
+        **add_plate_markers(mbs, body, reduction, position_B, rotation, name),
+        "stiffness_proportional_damping_s": beta,
+    }
+
+
+def add_plate_markers(mbs, body, plate, position_B: np.ndarray, rotation: np.ndarray,
+                      name: str = "coupler") -> dict[str, Any]:
+    """Joint and midpoint markers on a meshed plate body (FFRF or nonlinear FE).
+
+    ``plate`` carries the node sets ``nodes_end_a/_b/_mid``, their weights and the reference
+    centres ``centre_end_a/_b/_mid`` [m, body frame] (a :class:`Reduction` or a
+    ``flex.nonlinear.NonlinearPlate``). Returns ``marker_B`` and ``marker_C``
+    (``MarkerSuperElementRigid`` on the end faces), ``marker_mid``
+    (``MarkerSuperElementPosition``), their global reference positions ``position_B/_C/_mid``
+    [m], ``rotation_matrix`` (body to global) and ``mass_kg``.
+    """
+    import exudyn.itemInterface as eii
+
+    def marker(kind, label: str, nodes, weights):
+        return mbs.AddMarker(kind(name=f"{name}:{label}", bodyNumber=body,
+                                  meshNodeNumbers=nodes, weightingFactors=weights))
+
+    return {
+        "marker_B": marker(eii.MarkerSuperElementRigid, "B", plate.nodes_end_a,
+                           plate.weights_end_a),
+        "marker_C": marker(eii.MarkerSuperElementRigid, "C", plate.nodes_end_b,
+                           plate.weights_end_b),
+        "marker_mid": marker(eii.MarkerSuperElementPosition, "mid", plate.nodes_mid,
+                             plate.weights_mid),
+        "position_B": position_B + rotation @ plate.centre_end_a,
+        "position_C": position_B + rotation @ plate.centre_end_b,
+        "position_mid": position_B + rotation @ plate.centre_mid,
+        "rotation_matrix": rotation,
+        "mass_kg": plate.mass_kg,
+    }
+
+
+# ------------------------------------------------------------------------------------------
+# post-processing
+# ------------------------------------------------------------------------------------------
+def _as_track(positions: np.ndarray, name: str) -> np.ndarray:
+    track = np.asarray(positions, dtype=float)
+    if track.ndim != 2 or track.shape[1] != 3 or len(track) == 0:
+        raise ValueError(f"{name}: expected an array of shape (n, 3), got {track.shape}")
+    return track
+
+
+def midpoint_deflection(position_B: np.ndarray, position_C: np.ndarray,
+                        position_mid: np.ndarray) -> MidpointDeflection:
+    """Elastic midpoint deflection and chord stretch from global point tracks.
+
+    Contract: the three arguments are time series of global positions [m], shape (n, 3),
+    of the joint-B centre, the joint-C centre and the midpoint marker, motion in the x-y
+    plane. Returns :class:`MidpointDeflection` with, per sample,
+
+    - ``transverse_m``: (mid - B) . n with n = e_z x (C - B)/|C - B| (the chord turned by
+      +90 deg in the x-y plane, i.e. the body's +y for an undeformed link), minus its first
+      value;
+    - ``chord_change_m``: |C - B| minus its first value.
+
+    Rigid motion of the link gives zeros; the first sample is the reference (zero by
+    definition), so start the series in the undeformed state. Pure numpy; raises ValueError
+    for mismatched shapes or a zero-length chord.
+    """
+    b = _as_track(position_B, "position_B")
+    c = _as_track(position_C, "position_C")
+    m = _as_track(position_mid, "position_mid")
+    if not (b.shape == c.shape == m.shape):
+        raise ValueError(f"shapes differ: B {b.shape}, C {c.shape}, mid {m.shape}")
+    chord = c - b
+    chord_length = np.linalg.norm(chord, axis=1)
+    if np.any(chord_length == 0):
+        raise ValueError("B and C coincide in some sample: the chord has no direction")
+    in_plane = chord[:, :2] / np.linalg.norm(chord[:, :2], axis=1)[:, None]
+    normal = np.column_stack([-in_plane[:, 1], in_plane[:, 0]])  # e_z x chord
+    transverse = np.einsum("ij,ij->i", (m - b)[:, :2], normal)
+    return MidpointDeflection(transverse_m=transverse - transverse[0],
+                              chord_change_m=chord_length - chord_length[0])
+
+
+def bending_stress_history(reduction: Reduction, modal_coordinates: np.ndarray,
+                           x_range_m: tuple[float, float] | None = None) -> np.ndarray:
+    """Peak |sigma_xx| (axial stress along the link, body frame) per sample [Pa].
+
+    Contract: ``modal_coordinates`` has shape (n, 6 + modes) or (6 + modes,): the elastic
+    coordinates of the body (the ``node_modal`` of :func:`add_ffrf_link`, output
+    ``Coordinates``). Stress is linear in them (small strains, as the FFRF model assumes),
+    taken from the stress post-processing modes at the mesh nodes whose reference x lies in
+    ``x_range_m``; the default (thickness, length - thickness) leaves out one thickness at
+    each end, where the rigid end faces cause a local stress concentration that the pin of
+    a real eye would not (Saint-Venant). Bending dominates sigma_xx in a slender link; the
+    membrane part from the axial force is included. Returns an array of shape (n,).
+    """
+    if not reduction.has_stress_modes:
+        raise ValueError("this reduction has no stress post-processing modes")
+    coordinates = np.atleast_2d(np.asarray(modal_coordinates, dtype=float))
+    if coordinates.shape[1] != reduction.n_modal_coordinates:
+        raise ValueError(f"modal_coordinates: expected {reduction.n_modal_coordinates} columns, "
+                         f"got shape {coordinates.shape}")
+    if x_range_m is None:
+        x_range_m = (reduction.thickness_m, reduction.length_m - reduction.thickness_m)
+    x = reduction.fem.GetNodePositionsAsArray()[:, 0]
+    nodes = np.flatnonzero((x >= x_range_m[0]) & (x <= x_range_m[1]))
+    if len(nodes) == 0:
+        raise ValueError(f"x_range_m = {x_range_m!r} holds no mesh node")
+    # columns 6k + 0 hold sigma_xx of mode k (Exudyn order xx, yy, zz, yz, xz, xy)
+    stress_xx_modes = reduction.fem.postProcessingModes["matrix"][nodes, 0::6]
+    peaks = np.empty(len(coordinates))
+    chunk = max(1, 2_000_000 // len(nodes))  # bound the (samples x nodes) temporary
+    for start in range(0, len(coordinates), chunk):
+        stress = coordinates[start:start + chunk] @ stress_xx_modes.T
+        peaks[start:start + chunk] = np.abs(stress).max(axis=1)
+    return peaks

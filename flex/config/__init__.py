@@ -1,0 +1,1 @@
+"""What a scene resolves to: the "auto" solver settings and which keys a run uses."""

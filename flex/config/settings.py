@@ -1,0 +1,263 @@
+"""Solver settings by model: what the ``"auto"`` values of ``[simulation]`` resolve to.
+
+The bundled scene leaves ``simulation.step_s``, ``spectral_radius``, ``newton`` and
+``newton_relative_tolerance`` to flex (``"auto"``); a number (or choice) written in a scene
+or given with ``--set`` always wins. :func:`resolve_solver_settings` fills the ``"auto"`` keys
+from ``flex/config/solver_defaults.toml``, the settings ``make tradeoff`` measured as fastest within
+a certified accuracy:
+
+- ``ffrf_coupler`` (h = 4e-4 s, modified Newton): an FFRF coupler on a rigid crank, when the
+  scene's ``fidelity.tolerance`` is at least the entry's certified ``accuracy`` (1 %) and the
+  plate is the one it was certified on (the bundled 1 mm steel coupler: same length,
+  thickness, width and material; mesh and modes are the scene's);
+- ``rigid`` (h = 1e-5 s, full Newton): everything else -- rigid links, and flexible links for
+  which no setting is certified (other plates, finer tolerances, FFRF cranks, the nonlinear
+  FE coupler): a 40x smaller step than the certified FFRF one, but not certified for them
+  (:data:`FALLBACK`). Neither direction transfers: thinner plates fail Newton at 4e-4 s
+  (0.3 mm at the second step, 0.5 mm at 21 ms: they deflect more), and at 10 mm the same
+  fraction of the first bending period (4e-5 s) erred by 2.4 % in make tradeoff.
+
+Contract: input a validated scene whose links are concrete (``model = "auto"`` already
+resolved, :func:`flex.criteria.resolve_fidelity`); output the scene with numbers in place of
+``"auto"`` and a :class:`SolverChoice` (which entry, why; stored with every result). A scene
+without ``"auto"`` values is returned unchanged with ``None``.
+
+:func:`check_runnable` resolves what can be resolved cheaply and refuses, before anything is
+built, a scene that cannot run or would mean nothing (step count, irregular samples, an
+aliased crank, meshed plates that mean nothing or do not fit this machine).
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+import tomllib
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+from typing import Any
+
+from flex.base.errors import SceneError
+from flex.data.scene import MAX_STEPS, Scene, check_drive_steps, check_meshed_plate, check_steps
+
+#: the ``[simulation]`` keys that may be ``"auto"``
+AUTO_KEYS = ("step_s", "spectral_radius", "newton", "newton_relative_tolerance")
+AUTO = "auto"
+#: the ``--set`` pairs that leave every solver key to flex (what the bundled scene does)
+AUTO_OVERRIDES = tuple((f"simulation.{key}", AUTO) for key in AUTO_KEYS)
+#: what an uncertified flexible scene runs with, and what is known of it
+FALLBACK = ("the rigid model's 40x smaller step, not certified for it (README \"Defaults\")")
+
+
+@dataclass(frozen=True)
+class SolverChoice:
+    """Which entry of ``flex/config/solver_defaults.toml`` filled the ``"auto"`` keys, and why.
+
+    ``entry``: ``"rigid"`` or ``"ffrf_coupler"``; ``accuracy``: the relative error the entry
+    is certified to on the model it was measured on (dimensionless); ``keys``: the keys it
+    filled with their values; ``reason``: one sentence.
+    """
+
+    entry: str
+    accuracy: float
+    keys: dict[str, Any]
+    reason: str
+
+    def attrs(self) -> dict[str, Any]:
+        """Result-file attributes (``solver_defaults_*``)."""
+        return {"solver_defaults_entry": self.entry,
+                "solver_defaults_accuracy": self.accuracy,
+                "solver_defaults_keys": ", ".join(f"{k} = {v!r}" for k, v in self.keys.items()),
+                "solver_defaults_reason": self.reason}
+
+
+@cache
+def solver_defaults() -> dict[str, dict[str, Any]]:
+    """The entries of ``flex/config/solver_defaults.toml`` (read once)."""
+    text = resources.files("flex.config").joinpath("solver_defaults.toml").read_text("utf-8")
+    return tomllib.loads(text)
+
+
+def has_auto(scene: Scene) -> bool:
+    """Whether any ``[simulation]`` solver key of ``scene`` is ``"auto"``."""
+    return any(scene["simulation"].get(key) == AUTO for key in AUTO_KEYS)
+
+
+def _bending_omega(plate: dict[str, Any]) -> float:
+    from flex.base.physics import pinned_pinned_omega
+
+    return pinned_pinned_omega(plate["length_m"], plate["thickness_m"],
+                               plate["youngs_modulus_Pa"], plate["density_kg_per_m3"])
+
+
+def choose_entry(scene: Scene) -> tuple[str, str]:
+    """The entry (``"rigid"`` or ``"ffrf_coupler"``) for ``scene`` and the reason."""
+    defaults = solver_defaults()
+    crank, coupler = scene["crank"]["model"], scene["coupler"]["model"]
+    if AUTO in (crank, coupler):
+        raise ValueError('resolve model = "auto" links before the solver settings')
+    if crank == "rigid" and coupler == "rigid":
+        return "rigid", "rigid links"
+    entry = defaults["ffrf_coupler"]
+    level = entry["accuracy"]
+    if coupler != "ffrf" or crank != "rigid":
+        what = ("an FFRF crank" if crank == "ffrf" else f'coupler.model = "{coupler}"')
+        return "rigid", f"no certified setting for {what}: {FALLBACK}"
+    tolerance = scene["fidelity"]["tolerance"]
+    if tolerance < level:
+        return "rigid", (f"fidelity.tolerance = {tolerance:g} is finer than the FFRF coupler's "
+                         f"certified {level:g}: {FALLBACK}")
+    plate = entry["certified_plate"]
+    differs = [f"{key} = {scene['coupler'][key]:g} (certified: {value:g})"
+               for key, value in plate.items()
+               if not math.isclose(scene["coupler"][key], value, rel_tol=1e-9)]
+    if differs:
+        return "rigid", (f"the coupler plate is not the certified one ({', '.join(differs)}): "
+                         f"{FALLBACK}")
+    omega = _bending_omega(scene["coupler"])
+    return "ffrf_coupler", (f"FFRF coupler on a rigid crank, fidelity.tolerance = {tolerance:g} "
+                            f">= {level:g}, the certified plate (first bending frequency "
+                            f"{omega / (2 * math.pi):.4g} Hz)")
+
+
+def resolve_solver_settings(scene: Scene) -> tuple[Scene, SolverChoice | None]:
+    """``scene`` with its ``"auto"`` solver keys filled in (see module doc)."""
+    if not has_auto(scene):
+        return scene, None
+    name, reason = choose_entry(scene)
+    entry = solver_defaults()[name]
+    resolved = copy.deepcopy(scene)
+    filled = {}
+    for key in AUTO_KEYS:
+        if resolved["simulation"][key] == AUTO:
+            resolved["simulation"][key] = filled[key] = entry[key]
+    step, end = resolved["simulation"]["step_s"], resolved["simulation"]["end_time_s"]
+    if step > end:  # a short run: one step over the whole span
+        resolved["simulation"]["step_s"] = filled["step_s"] = end
+    try:
+        check_steps(resolved["simulation"])
+    except SceneError as exc:
+        raise SceneError(f"{exc} (step_s = \"auto\" chose {filled.get('step_s', step):g} s "
+                         f"for {name}: set simulation.step_s explicitly)") from None
+    return resolved, SolverChoice(name, entry["accuracy"], filled, reason)
+
+
+def resolved_simulation(scene: Scene) -> dict[str, Any]:
+    """The ``[simulation]`` section of ``scene`` with ``"auto"`` keys filled in.
+
+    For code that needs the step before a run (its links must be concrete; an ``"auto"``
+    link is taken as rigid here, which is what the fidelity probe runs).
+    """
+    if not has_auto(scene):
+        return scene["simulation"]
+    probe = copy.deepcopy(scene)
+    for link in ("crank", "coupler"):
+        if probe[link]["model"] == AUTO:
+            probe[link]["model"] = "rigid"
+    return resolve_solver_settings(probe)[0]["simulation"]
+
+
+def pinned_overrides(entry: str = "rigid") -> list[str]:
+    """``--set`` overrides that fix the solver keys to an entry's values.
+
+    For studies whose numbers must not move with the defaults (a knob study varies one
+    setting around a fixed base; a thesis figure needs the 1e-5 s grid).
+    """
+    values = solver_defaults()[entry]
+    return [f"simulation.{key}={values[key]!r}" if not isinstance(values[key], str)
+            else f'simulation.{key}="{values[key]}"' for key in AUTO_KEYS]
+
+
+def check_runnable(scene: Scene) -> None:
+    """Refuse, before anything is built, meshed or simulated, a scene that cannot run or
+    whose result would mean nothing; return None when it can run.
+
+    Contract: ``scene`` is validated (:func:`flex.scene.load_scene` or
+    :func:`flex.scene.validate`); links and solver keys may be ``"auto"``. Takes
+    milliseconds: nothing is meshed or simulated. Raises :class:`SceneError` with one line
+    naming the key and the accepted range. Checks, with the ``"auto"`` solver keys resolved
+    as :func:`flex.solver.simulate` resolves them (:func:`resolve_solver_settings`):
+
+    - steps (:func:`flex.scene.check_steps`): step <= end time, at most 5e7 steps, output
+      interval 0 or an integer multiple of the step;
+    - a constant-speed crank turns at most 0.1 rad per step and pi/4 per stored sample
+      (:func:`flex.scene.check_drive_steps`);
+    - every plate that will be meshed makes sense as a meshed link and fits this machine
+      (:func:`flex.scene.check_meshed_plate`, with the mesh estimate in the message);
+    - ``model = "auto"`` links: the rigid probe ``auto`` runs first
+      (:func:`flex.criteria.deployment_probe`) must fit the step limit, and the step checks
+      must pass for at least one model ``auto`` may choose (a check that fails for only
+      some choices is left to the run, which then stores a failed case naming it).
+    """
+    for link in ("crank", "coupler"):
+        check_meshed_plate(link, scene[link])
+    candidates = _model_candidates(scene)
+    errors: list[SceneError] = []
+    for candidate in candidates:
+        try:
+            resolved, choice = resolve_solver_settings(candidate)
+            check_steps(resolved["simulation"])
+            try:
+                check_drive_steps(resolved)
+            except SceneError as exc:
+                if choice is None or "step_s" not in choice.keys:
+                    raise
+                raise SceneError(f"{exc} (step_s = \"auto\" chose {choice.keys['step_s']:g} s "
+                                 f"for {choice.entry}: set simulation.step_s explicitly)"
+                                 ) from None
+        except SceneError as exc:
+            errors.append(exc)
+    if len(errors) == len(candidates):
+        if len(candidates) == 1:
+            raise errors[0]
+        raise SceneError(f'{errors[0]} (for every model "auto" may choose)')
+    if len(candidates) > 1 or AUTO in (scene["crank"]["model"], scene["coupler"]["model"]):
+        _check_probe(scene)
+
+
+def _model_candidates(scene: Scene) -> list[Scene]:
+    """The concrete scenes ``model = "auto"`` may turn ``scene`` into (itself if none)."""
+    choices = []
+    for link in ("crank", "coupler"):
+        values = scene[link]
+        if values["model"] != AUTO:
+            choices.append([values["model"]])
+        elif link == "crank" and (values["geometry"] != "plate"
+                                  or scene["drive"]["kind"] != "spring"):
+            choices.append(["rigid"])  # auto refuses a flexible choice of these
+        else:
+            choices.append(["rigid", "ffrf"])
+    if all(len(options) == 1 and options[0] == scene[link]["model"]
+           for options, link in zip(choices, ("crank", "coupler"), strict=True)):
+        return [scene]
+    out = []
+    for crank, coupler in itertools.product(*choices):
+        candidate = copy.deepcopy(scene)
+        candidate["crank"]["model"], candidate["coupler"]["model"] = crank, coupler
+        out.append(candidate)
+    return out
+
+
+def _check_probe(scene: Scene) -> None:
+    """The rigid run ``model = "auto"`` makes first (:func:`flex.criteria.deployment_probe`:
+    step min(step_s, 1e-4, end/200) s over the end time, or half a crank turn)."""
+    end = scene["simulation"]["end_time_s"]
+    drive = scene["drive"]
+    if drive["kind"] == "constant_speed":
+        speed = abs(drive["crank_speed_rad_per_s"])
+        if speed == 0:
+            raise SceneError('model = "auto" with a constant-speed drive needs '
+                             "drive.crank_speed_rad_per_s != 0 (the criterion uses half a "
+                             "crank turn as the deployment time)")
+        end = min(end, math.pi / speed)
+    step = scene["simulation"]["step_s"]
+    if step == AUTO:
+        step = solver_defaults()["rigid"]["step_s"]  # the probe's links are rigid
+    step = min(step, 1e-4, end / 200)
+    if end / step > MAX_STEPS:
+        raise SceneError(f"simulation.end_time_s = {scene['simulation']['end_time_s']:g}: "
+                         f'model = "auto" first runs the rigid model over it at a step of '
+                         f"{step:g} s to find the deployment time: {end / step:.3g} steps; "
+                         f"accepted: at most {MAX_STEPS:g} (end_time_s <= "
+                         f"{MAX_STEPS * step:.3g})")

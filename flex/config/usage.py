@@ -1,0 +1,156 @@
+"""Which scene keys a scene's models use, and which keys the user gave.
+
+A scene holds every key of :data:`flex.scene.SCHEMA`, but a scene's models read only some:
+``--set coupler.thickness_m=0.003`` on a lumped coupler changes nothing. Two functions let a
+study refuse such input instead of silently ignoring it:
+
+- :func:`unused_keys`: for one (case) scene, the ``"section.key"`` names its models do not
+  read, each with a short reason naming what would read it;
+- :func:`explicit_keys`: the ``"section.key"`` values the user gave (every ``--set`` key, and
+  every key of a user scene file whose value differs from the bundled default scene).
+
+A key the user gave that no case of a study uses (and that the study does not read itself,
+``read_by_study``) changed nothing.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any
+
+from flex.data.scene import Scene, default_scene, parse_override, read_source
+
+AUTO = "auto"
+#: plate keys of a link beyond the mass-giving ones
+_PLATE_MASS = ("thickness_m", "width_m", "density_kg_per_m3")
+_PLATE_ELASTIC = ("youngs_modulus_Pa", "poisson_ratio", "modes", "mesh_size_m",
+                  "damping_ratio")
+_SOLVER_ALPHA = ("spectral_radius", "formulation", "newton", "newton_relative_tolerance")
+_SOLVER_EXPLICIT = ("explicit_method", "penalty_stiffness_N_per_m")
+_SPRING = ("spring_stiffness_N_per_m", "spring_preload_m", "spring_damping_Ns_per_m")
+_WING = ("span_m", "chord_m", "thickness_m", "density_kg_per_m3", "youngs_modulus_Pa")
+
+
+def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset()) -> dict[str, str]:
+    """The keys of ``scene`` that its models do not read: ``{"section.key": reason}``.
+
+    Contract: ``scene`` is a validated scene (link models and solver keys may be
+    ``"auto"``: a key that ``auto`` may read counts as used; ``modes`` of an ``auto`` link
+    does not, ``auto`` chooses them). ``read_by_study``: ``"section.key"`` names a study
+    reads itself (e.g. the modal study's plate keys of rigid links); they are never
+    reported. The reason names what would read the key. Pure: reads nothing but ``scene``.
+    """
+    unused: dict[str, str] = {}
+    for link in ("crank", "coupler"):
+        unused.update(_link_unused(link, scene))
+    wing = scene["wing"]
+    if not wing["enabled"]:
+        for key in _WING:
+            unused[f"wing.{key}"] = "wing.enabled = false: used with a wing (enabled = true)"
+    else:
+        unused["wing.youngs_modulus_Pa"] = ("the wing is a rigid body in the mechanism: its "
+                                            "Young's modulus is read by no model (only by "
+                                            "the wing study's frequency estimate)")
+    unused["slider.inertia_kgm2"] = ("the slider does not turn (prismatic joint): its inertia "
+                                     "changes no result")
+    drive = scene["drive"]
+    if drive["kind"] == "spring":
+        unused["drive.crank_speed_rad_per_s"] = ('drive.kind = "spring": the spring moves the '
+                                                 'crank; used with kind = "constant_speed"')
+    else:
+        for key in _SPRING:
+            unused[f"drive.{key}"] = ('drive.kind = "constant_speed": no spring; used with '
+                                      'kind = "spring"')
+    sim = scene["simulation"]
+    if sim["integrator"] == "explicit_penalty":
+        for key in _SOLVER_ALPHA:
+            unused[f"simulation.{key}"] = ('simulation.integrator = "explicit_penalty": used '
+                                           'with integrator = "generalized_alpha"')
+    else:
+        for key in _SOLVER_EXPLICIT:
+            unused[f"simulation.{key}"] = ('simulation.integrator = "generalized_alpha": used '
+                                           'with integrator = "explicit_penalty"')
+    if not _reads_tolerance(scene):
+        unused["fidelity.tolerance"] = ('no "auto" choice reads it: used by model = "auto" '
+                                        'links, and by "auto" solver keys of an FFRF coupler '
+                                        "on a rigid crank")
+    for name in read_by_study:
+        unused.pop(name, None)
+    return unused
+
+
+def _link_unused(link: str, scene: Scene) -> dict[str, str]:
+    values = scene[link]
+    model, geometry = values["model"], values["geometry"]
+    unused: dict[str, str] = {}
+    elastic = ('"ffrf", "nonlinear_fe" or "auto"' if link == "coupler"
+               else '"ffrf" or "auto"')
+
+    def mark(keys: Iterable[str], reason: str) -> None:
+        for key in keys:
+            unused.setdefault(f"{link}.{key}", reason)
+
+    if geometry == "plate":
+        mark(("mass_kg", "inertia_kgm2"),
+             f'{link}.geometry = "plate": mass and inertia come from the plate (thickness_m, '
+             f'width_m, density_kg_per_m3); used with geometry = "lumped"')
+    if model == "rigid":
+        if geometry == "lumped":
+            mark(_PLATE_MASS + _PLATE_ELASTIC,
+                 f'{link}.geometry = "lumped": the {link} is its mass_kg and inertia_kgm2; '
+                 f'used with geometry = "plate"')
+        mark(_PLATE_ELASTIC, f'{link}.model = "rigid": a rigid link has no elasticity; used '
+                             f"with model = {elastic}")
+    elif model == "nonlinear_fe":
+        mark(("modes",), f'{link}.model = "nonlinear_fe" moves every mesh node (no modes); '
+                         f'used with model = "ffrf"')
+        mark(("damping_ratio",), f'{link}.model = "nonlinear_fe" has no damping model; used '
+                                 f'with model = "ffrf" or "auto"')
+    elif model == AUTO:
+        mark(("modes",), f'{link}.model = "auto" chooses the modes itself; used with '
+                         f'model = "ffrf"')
+        if geometry == "lumped":  # an auto crank: analysed as the plate of its mass
+            mark(("thickness_m",), f'{link}.model = "auto" with geometry = "lumped" analyses '
+                                   f"the plate of the {link}'s mass_kg (its thickness follows "
+                                   f'from it); used with geometry = "plate"')
+    return unused
+
+
+def _reads_tolerance(scene: Scene) -> bool:
+    """Whether ``fidelity.tolerance`` is read: by an ``auto`` link, or by ``"auto"`` solver
+    keys choosing the FFRF coupler's entry (:func:`flex.settings.choose_entry`)."""
+    from flex.config.settings import has_auto
+
+    crank, coupler = scene["crank"]["model"], scene["coupler"]["model"]
+    if AUTO in (crank, coupler):
+        return True
+    return has_auto(scene) and coupler == "ffrf" and crank == "rigid"
+
+
+def explicit_keys(source: str | Path | None = None,
+                  overrides: Sequence[str] | None = None) -> dict[str, Any]:
+    """The values the user gave: ``{"section.key": value}``.
+
+    Every key of ``overrides`` (``--set section.key=value`` strings; the last of a repeated
+    key wins), and every key of the scene file or bundled parameter set ``source`` whose
+    value differs from the bundled default scene's (a key absent from the default counts as
+    given). ``source`` None or the default parameter set gives no file keys. Inputs as
+    :func:`flex.scene.load_scene` takes them; a malformed one raises SceneError as there.
+    """
+    given: dict[str, Any] = {}
+    user = read_source(source)
+    if user is not None:
+        bundled = default_scene()
+        missing = object()
+        for section, table in user.items():
+            if not isinstance(table, dict):
+                continue  # load_scene refuses it
+            for key, value in table.items():
+                default = bundled.get(section, {}).get(key, missing)
+                if default is missing or default != value:
+                    given[f"{section}.{key}"] = value
+    for item in overrides or ():
+        section, key, value = parse_override(item)
+        given[f"{section}.{key}"] = value
+    return given

@@ -1,0 +1,3 @@
+"""Scenes and result files: TOML scenes and their schema, HDF5 files with units and provenance,
+where outputs go.
+"""

@@ -1,0 +1,1 @@
+"""The mechanism in Exudyn, integration of concrete scenes, the independent reference DAE."""

@@ -1,0 +1,463 @@
+"""Slider-crank assembly in Exudyn: a ready multibody system from a scene.
+
+Sketch (mechanism plane x-y; rotation axes along z)::
+
+                 B (revolute, crank-coupler)
+                / \\
+     crank L1  /   \\  coupler L2 (rigid body, FFRF plate or nonlinear FE plate)
+    (rigid or /     \\
+  FFRF plate)/       \\
+    frame == A       C (x,y pinned: non-redundant loop) -- slider ==[spring]== frame
+    (revolute)         prismatic joint along x, slide line y = offset
+
+All three links are 3D bodies moving in the x-y plane (nodes with Tait-Bryan rotation
+coordinates, so the z-rotation coordinate is the planar angle). A planar loop of 3D joints
+is redundant, so joint C constrains only x and y (17 constraints on 18 coordinates: one
+degree of freedom, as Gruebler's count in the thesis, Eq. 1). The same builder makes the
+rigid model and the flexible ones: only the crank and coupler bodies change
+(``crank.model``, ``coupler.model``).
+
+Drives: ``spring`` -- a linear spring (and optional damper) on the slider's x coordinate,
+compressed by ``spring_preload_m`` at t = 0 and attached throughout, released from rest;
+``constant_speed`` -- a velocity-level constraint on the crank angle.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from flex.base.errors import SceneError
+from flex.base.kinematics import crank_pin, slider_crank
+from flex.base.physics import cuboid_inertia_kgm2, cuboid_mass_kg
+from flex.data.scene import Scene, plate_mass_properties
+
+os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
+
+
+@dataclass
+class InitialConfiguration:
+    """Assembled configuration at t = 0 (metres, radians, per second)."""
+
+    crank_angle_rad: float
+    coupler_angle_rad: float
+    joint_B_m: np.ndarray
+    joint_C_m: np.ndarray
+    crank_speed_rad_per_s: float
+    coupler_speed_rad_per_s: float
+    joint_B_velocity_m_per_s: np.ndarray
+    joint_C_velocity_m_per_s: np.ndarray
+
+
+def initial_configuration(scene: Scene) -> InitialConfiguration:
+    """Positions and consistent velocities of the joints at t = 0 (closed form)."""
+    l1, l2 = scene["crank"]["length_m"], scene["coupler"]["length_m"]
+    offset_m = scene["slider"]["offset_m"]
+    theta = np.radians(scene["crank"]["initial_angle_deg"])
+    drive = scene["drive"]
+    omega = drive["crank_speed_rad_per_s"] if drive["kind"] == "constant_speed" else 0.0
+    state = slider_crank(l1, l2, theta, omega, 0.0, offset_m)
+    pin, pin_velocity = crank_pin(l1, theta, omega)
+    joint_b = np.array([*pin, 0.0])
+    joint_c = np.array([float(state.slider_position_m), offset_m, 0.0])
+    vel_b = np.array([*pin_velocity, 0.0])
+    vel_c = np.array([float(state.slider_velocity_m_per_s), 0.0, 0.0])
+    return InitialConfiguration(float(theta), float(state.coupler_angle_rad), joint_b, joint_c,
+                                float(omega), float(state.coupler_angular_velocity_rad_per_s),
+                                vel_b, vel_c)
+
+
+@dataclass
+class Mechanism:
+    """A built, assembled Exudyn system and the handles the solver reads.
+
+    ``sensors`` maps a name to ``(sensor index, columns)``: the columns of the stored sensor
+    data (after the time column) that hold the quantity. ``joint_frames`` tells how each
+    joint's local force output maps to global axes.
+    """
+
+    system_container: Any
+    mbs: Any
+    scene: Scene
+    initial: InitialConfiguration
+    sensors: dict[str, int] = field(default_factory=dict)
+    joint_frames: dict[str, str | None] = field(default_factory=dict)
+    constraint_points: list[tuple[str, str]] = field(default_factory=list)
+    rigid_bodies: dict[str, tuple[float, np.ndarray]] = field(default_factory=dict)
+    coupler: dict[str, Any] = field(default_factory=dict)
+    crank: dict[str, Any] = field(default_factory=dict)
+    #: FFRF links whose energy Exudyn reports: name -> (kinetic sensor, strain sensor)
+    flexible_energy: dict[str, tuple[int, int]] = field(default_factory=dict)
+    wing: dict[str, Any] = field(default_factory=dict)
+
+
+def _rotation_z(angle_rad: float) -> np.ndarray:
+    c, s = np.cos(angle_rad), np.sin(angle_rad)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+#: damping of the penalty joints, as a fraction of critical for the lightest link's mass
+PENALTY_DAMPING_RATIO = 0.2
+
+
+def _add_penalty_joints(mbs: Any, stiffness_N_per_m: float, lightest_mass_kg: float,
+                        joint_markers: list[tuple[int, int]], nodes: list[int]) -> list[int]:
+    """Joints A, B, C and the slide line as stiff springs, for Exudyn's explicit solvers.
+
+    ``joint_markers``: (marker 0, marker 1) of A, B, C and of the slide line (ground, slider);
+    ``nodes``: the rigid-body nodes (Tait-Bryan, coordinates x y z rx ry rz) of crank,
+    coupler and slider. A, B, C become ``CartesianSpringDamper``s of stiffness
+    ``stiffness_N_per_m`` in x and y, the slide line one in y only, damped with
+    :data:`PENALTY_DAMPING_RATIO` of critical for ``lightest_mass_kg`` (undamped, the
+    joint forces ring at the penalty frequency about their true values: measured +-20 N on
+    ~25 N at 1e8 N/m; damped, 1e-2 N, with the same crank angle). The out-of-plane
+    coordinates (z, rx, ry of every body) and the slider's angle are held by
+    ``CoordinateConstraint``s to ground, which the explicit solvers eliminate
+    (``timeIntegration.explicit.eliminateConstraints``). The joints then open by about
+    force / stiffness: the crank-angle error falls as 1 / stiffness, while the explicit
+    stability limit of the step falls as 1 / sqrt(stiffness). Returns the four connector
+    indices (their ``Force`` output is in global axes, acting on marker 0's body).
+    """
+    import exudyn.itemInterface as eii
+
+    ground_node = mbs.AddNode(eii.NodePointGround())
+    ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node,
+                                                               coordinate=0))
+    held = {node: [2, 3, 4] for node in nodes}
+    held[nodes[-1]].append(5)  # the slider does not turn
+    for node, coordinates in held.items():
+        for coordinate in coordinates:
+            marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=node,
+                                                            coordinate=coordinate))
+            mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate,
+                                                                       marker]))
+    k = stiffness_N_per_m
+    d = 2.0 * PENALTY_DAMPING_RATIO * np.sqrt(k * lightest_mass_kg)
+    springs = []
+    for index, markers in enumerate(joint_markers):
+        axes = np.array([1.0, 1.0, 0.0] if index < 3 else [0.0, 1.0, 0.0])
+        springs.append(mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
+            markerNumbers=list(markers), stiffness=list(k * axes), damping=list(d * axes))))
+    return springs
+
+
+def wing_mass_properties(scene: Scene) -> tuple[float, float, float]:
+    """Wing plate mass [kg], inertia about its centre [kg m^2] and centre distance from A [m].
+
+    The wing is a flat plate in the mechanism plane (switchblade wing): root at the crank
+    pivot A, span along the crank direction, chord across it, thickness out of plane.
+    """
+    wing = scene["wing"]
+    mass_kg = cuboid_mass_kg(wing["span_m"], wing["chord_m"], wing["thickness_m"],
+                             wing["density_kg_per_m3"])
+    return mass_kg, cuboid_inertia_kgm2(mass_kg, wing["span_m"], wing["chord_m"]), \
+        wing["span_m"] / 2.0
+
+
+def _add_wing(mech: Mechanism, rigid_body, body_marker, crank_root: int) -> int:
+    """Add the wing as a rigid body welded to the crank at A; return the weld joint.
+
+    ``crank_root``: the crank's marker at A (a rigid-body marker, or the joint face of a
+    flexible crank). The weld's reaction torque is the wing root bending moment in the
+    mechanism plane.
+    """
+    import exudyn.itemInterface as eii
+
+    init = mech.initial
+    mass_kg, inertia_kgm2, centre_m = wing_mass_properties(mech.scene)
+    direction = np.array([np.cos(init.crank_angle_rad), np.sin(init.crank_angle_rad), 0.0])
+    normal = np.array([-direction[1], direction[0], 0.0])
+    wing_body = rigid_body("wing", mass_kg, inertia_kgm2, direction * centre_m,
+                           init.crank_angle_rad,
+                           normal * centre_m * init.crank_speed_rad_per_s,
+                           init.crank_speed_rad_per_s)
+    mech.wing = {"body": wing_body["bodyNumber"], "node": wing_body["nodeNumber"]}
+    wing_root = body_marker(wing_body, [0.0, 0.0, 0.0])
+    crank_rotation = _rotation_z(init.crank_angle_rad)
+    return mech.mbs.AddObject(eii.ObjectJointGeneric(
+        markerNumbers=[crank_root, wing_root], constrainedAxes=[1, 1, 1, 1, 1, 1],
+        rotationMarker0=crank_rotation.T, rotationMarker1=crank_rotation.T))
+
+
+def build_mechanism(scene: Scene, reduction: Any = None,
+                    crank_reduction: Any = None) -> Mechanism:
+    """Build and assemble the slider-crank of ``scene`` in a new Exudyn system.
+
+    ``reduction`` is the Craig-Bampton reduction (:func:`flex.reduction.build_reduction`)
+    for an ``ffrf`` coupler (or the plate of a ``nonlinear_fe`` one; ``None``: built from the
+    scene), ``crank_reduction`` the one of an ``ffrf`` crank; ``None`` for rigid links.
+    Links with ``model = "auto"`` must be resolved first (:func:`flex.simulation.simulate`).
+    Returns a :class:`Mechanism`.
+    """
+    for link in ("crank", "coupler"):
+        if scene[link]["model"] == "auto":
+            raise SceneError('model = "auto" must be resolved before building '
+                             "(flex.simulation.simulate does it with "
+                             "flex.criteria.resolve_fidelity)")
+    builder = _Builder(scene)
+    builder.add_crank_and_slider(crank_reduction)
+    builder.add_coupler(reduction)
+    builder.add_joints()
+    builder.add_drive()
+    builder.add_sensors()
+    builder.mbs.Assemble()
+    return builder.mech
+
+
+class _Builder:
+    """Adds the items of one slider-crank to a new Exudyn system, in a fixed order (the
+    order numbers the coordinates, so it is kept the same for every scene of a kind)."""
+
+    def __init__(self, scene: Scene) -> None:
+        import exudyn as exu
+        import exudyn.itemInterface as eii
+
+        self.exu, self.eii = exu, eii
+        self.scene = scene
+        self.init = initial_configuration(scene)
+        system_container = exu.SystemContainer()
+        self.mbs = system_container.AddSystem()
+        self.mech = Mechanism(system_container, self.mbs, scene, self.init)
+        self.ground = self.mbs.CreateGround()
+        self.markers: dict[str, int] = {}
+        self.crank_body: dict | None = None
+        self.slider_body: dict = {}
+        self.coupler: dict = {}
+        self.wing_joint: int | None = None
+        self.joints: dict[str, int] = {}
+
+    def rigid_body(self, name: str, mass_kg: float, inertia_kgm2: float, position,
+                   angle_rad: float, velocity, angular_velocity_rad_per_s: float) -> dict:
+        """A planar rigid body [kg, kg m^2, m, rad, m/s, rad/s]."""
+        from exudyn.utilities import RigidBodyInertia
+
+        # out-of-plane inertias do not enter planar motion; any positive, physically
+        # admissible values will do, so take the in-plane one
+        inertia = RigidBodyInertia(mass=mass_kg, inertiaTensor=np.eye(3) * inertia_kgm2)
+        body = self.mbs.CreateRigidBody(
+            name=name, inertia=inertia, referencePosition=list(position),
+            referenceRotationMatrix=_rotation_z(angle_rad), initialVelocity=list(velocity),
+            initialAngularVelocity=[0.0, 0.0, angular_velocity_rad_per_s],
+            nodeType=self.exu.NodeType.RotationRxyz, returnDict=True)
+        self.mech.rigid_bodies[name] = (mass_kg, np.eye(3) * inertia_kgm2)
+        return body
+
+    def body_marker(self, body: dict, global_point) -> int:
+        """A marker on ``body`` at ``global_point`` [m] (reference configuration)."""
+        node = self.mbs.GetNode(body["nodeNumber"])
+        reference = np.asarray(node["referenceCoordinates"][:3])
+        rotation = _rotation_z(node["referenceCoordinates"][5])
+        local = rotation.T @ (np.asarray(global_point) - reference)
+        return self.mbs.AddMarker(self.eii.MarkerBodyRigid(bodyNumber=body["bodyNumber"],
+                                                           localPosition=list(local)))
+
+    def add_crank_and_slider(self, crank_reduction: Any) -> None:
+        """The crank (rigid body or FFRF plate), the slider, the ground markers at A and C,
+        and the wing welded at A when enabled."""
+        scene, init, mbs, eii = self.scene, self.init, self.mbs, self.eii
+        crank = scene["crank"]
+        if crank["model"] == "rigid":
+            self.crank_body = self.rigid_body(
+                "crank", *plate_mass_properties(scene, "crank"), init.joint_B_m / 2,
+                init.crank_angle_rad, init.joint_B_velocity_m_per_s / 2,
+                init.crank_speed_rad_per_s)
+        slider = scene["slider"]
+        self.slider_body = self.rigid_body(
+            "slider", slider["mass_kg"], slider["inertia_kgm2"], init.joint_C_m, 0.0,
+            init.joint_C_velocity_m_per_s, 0.0)
+        m = self.markers
+        m["ground_A"] = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=self.ground,
+                                                          localPosition=[0, 0, 0]))
+        m["ground_C"] = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=self.ground,
+                                                          localPosition=list(init.joint_C_m)))
+        if self.crank_body is not None:
+            m["crank_A"] = self.body_marker(self.crank_body, [0.0, 0.0, 0.0])
+            m["crank_B"] = self.body_marker(self.crank_body, init.joint_B_m)
+        else:
+            self._add_flexible_crank(crank_reduction)
+        m["slider_C"] = self.body_marker(self.slider_body, init.joint_C_m)
+        if scene["wing"]["enabled"]:
+            self.wing_joint = _add_wing(self.mech, self.rigid_body, self.body_marker,
+                                        m["crank_A"])
+
+    def _add_flexible_crank(self, crank_reduction: Any) -> None:
+        from flex.bodies.reduction import add_ffrf_link
+
+        if crank_reduction is None:
+            raise SceneError('crank.model = "ffrf" needs its reduction (flex.simulation.'
+                             "simulate builds it from the scene)")
+        # the plate's end_a face is the pivot A (the floating frame), end_b the joint B
+        flexible_crank = add_ffrf_link(
+            self.mbs, crank_reduction, [0.0, 0.0, 0.0], self.init.crank_angle_rad,
+            damping_ratio=self.scene["crank"]["damping_ratio"],
+            initial_angular_velocity_rad_per_s=self.init.crank_speed_rad_per_s, name="crank")
+        self.markers["crank_A"] = flexible_crank["marker_B"]
+        self.markers["crank_B"] = flexible_crank["marker_C"]
+        self.mech.crank = dict(flexible_crank, reduction=crank_reduction)
+
+    def add_coupler(self, reduction: Any) -> None:
+        """The coupler B-C: FFRF body, nonlinear FE body or rigid body."""
+        scene, init, mbs = self.scene, self.init, self.mbs
+        model = scene["coupler"]["model"]
+        if model == "ffrf":
+            from flex.bodies.reduction import add_ffrf_link
+
+            self.coupler = add_ffrf_link(
+                mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
+                damping_ratio=scene["coupler"]["damping_ratio"],
+                initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+                initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
+            self.mech.coupler = dict(self.coupler, reduction=reduction)
+        elif model == "nonlinear_fe":
+            from flex.bodies.nonlinear import add_nonlinear_fe_coupler, nonlinear_plate_for_scene
+
+            plate = reduction if reduction is not None else nonlinear_plate_for_scene(scene)
+            self.coupler = add_nonlinear_fe_coupler(
+                mbs, plate, list(init.joint_B_m), init.coupler_angle_rad,
+                initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+                initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
+            self.mech.coupler = dict(self.coupler, plate=plate)
+        else:
+            mass_kg, inertia_kgm2 = plate_mass_properties(scene)
+            body = self.rigid_body(
+                "coupler", mass_kg, inertia_kgm2, (init.joint_B_m + init.joint_C_m) / 2,
+                init.coupler_angle_rad,
+                (init.joint_B_velocity_m_per_s + init.joint_C_velocity_m_per_s) / 2,
+                init.coupler_speed_rad_per_s)
+            self.coupler = {"marker_B": self.body_marker(body, init.joint_B_m),
+                            "marker_C": self.body_marker(body, init.joint_C_m)}
+            self.mech.coupler = {"body": body["bodyNumber"], "node": body["nodeNumber"]}
+        self.markers["coupler_B"] = self.coupler["marker_B"]
+        self.markers["coupler_C"] = self.coupler["marker_C"]
+
+    def add_joints(self) -> None:
+        """Revolute A and B, the in-plane pin C, the prismatic slide (or penalty springs for
+        the explicit integrator)."""
+        scene, mbs, eii, m = self.scene, self.mbs, self.eii, self.markers
+        if scene["simulation"]["integrator"] == "explicit_penalty":
+            # explicit solvers take no joint constraints (validate: rigid coupler only)
+            joints = _add_penalty_joints(
+                mbs, scene["simulation"]["penalty_stiffness_N_per_m"],
+                min(plate_mass_properties(scene, "crank")[0], scene["slider"]["mass_kg"],
+                    plate_mass_properties(scene)[0]),
+                [(m["ground_A"], m["crank_A"]), (m["crank_B"], m["coupler_B"]),
+                 (m["slider_C"], m["coupler_C"]), (m["ground_C"], m["slider_C"])],
+                [self.crank_body["nodeNumber"], self.mech.coupler["node"],
+                 self.slider_body["nodeNumber"]])
+            self.joints = dict(zip("ABCP", joints, strict=True))
+            self.mech.joint_frames = {"A": None, "B": None, "C": None, "P": None}
+            return
+        crank_ref = _rotation_z(self.init.crank_angle_rad)
+        coupler_ref = _rotation_z(self.init.coupler_angle_rad)
+        # joint frames coincide with the global axes at t = 0; force outputs are in the frame
+        # of marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where
+        # it can
+        self.joints = {
+            "A": mbs.AddObject(eii.ObjectJointRevoluteZ(
+                markerNumbers=[m["ground_A"], m["crank_A"]], rotationMarker1=crank_ref.T)),
+            "B": mbs.AddObject(eii.ObjectJointRevoluteZ(
+                markerNumbers=[m["crank_B"], m["coupler_B"]], rotationMarker0=crank_ref.T,
+                rotationMarker1=coupler_ref.T)),
+            "C": mbs.AddObject(eii.ObjectJointSpherical(
+                markerNumbers=[m["slider_C"], m["coupler_C"]], constrainedAxes=[1, 1, 0])),
+            "P": mbs.AddObject(eii.ObjectJointPrismaticX(
+                markerNumbers=[m["ground_C"], m["slider_C"]]))}
+        # B's force is reported in the frame of the crank's marker at B (its joint face when
+        # the crank is flexible): collect turns it with that marker's rotation
+        self.mech.joint_frames = {"A": None, "B": "marker_crank_B", "C": None, "P": None}
+
+    def add_drive(self) -> None:
+        """The preloaded spring on the slider, or the crank held at constant speed."""
+        drive, mbs, eii = self.scene["drive"], self.mbs, self.eii
+        ground_node = mbs.AddNode(eii.NodePointGround())
+        ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node,
+                                                                   coordinate=0))
+        if drive["kind"] == "spring":
+            slider_x = mbs.AddMarker(eii.MarkerNodeCoordinate(
+                nodeNumber=self.slider_body["nodeNumber"], coordinate=0))
+            # slider coordinate = displacement from t = 0; spring force k (q + preload) pushes -x
+            mbs.AddObject(eii.ObjectConnectorCoordinateSpringDamper(
+                markerNumbers=[ground_coordinate, slider_x],
+                stiffness=drive["spring_stiffness_N_per_m"],
+                damping=drive["spring_damping_Ns_per_m"], offset=-drive["spring_preload_m"]))
+            return
+        crank_rotation = mbs.AddMarker(eii.MarkerNodeCoordinate(  # rigid crank (validate)
+            nodeNumber=self.crank_body["nodeNumber"], coordinate=5))
+        # velocity-level constraint: no Python callback per step, crank speed held exactly
+        mbs.AddObject(eii.ObjectConnectorCoordinate(
+            markerNumbers=[ground_coordinate, crank_rotation], velocityLevel=True,
+            offset=drive["crank_speed_rad_per_s"]))
+
+    def add(self, name: str, sensor) -> None:
+        self.mech.sensors[name] = self.mbs.AddSensor(sensor)
+
+    def sensor(self, kind: str, output: str, **item: int):
+        """An Exudyn sensor (``kind``: Node, Object, Marker, Body) stored internally."""
+        return getattr(self.eii, f"Sensor{kind}")(
+            storeInternal=True, outputVariableType=getattr(self.exu.OutputVariableType,
+                                                           output), **item)
+
+    def add_sensors(self) -> None:
+        """What :func:`flex.solver.collect` reads: bodies, joints, markers, energies."""
+        if self.wing_joint is not None:
+            for output in ("Velocity", "Rotation", "AngularVelocity", "AngularAcceleration"):
+                self.add(f"wing.{output}",
+                         self.sensor("Node", output, nodeNumber=self.mech.wing["node"]))
+            for output in ("ForceLocal", "TorqueLocal"):
+                self.add(f"joint_W.{output}",
+                         self.sensor("Object", output, objectNumber=self.wing_joint))
+        for name, body in (("crank", self.crank_body), ("slider", self.slider_body)):
+            if body is None:  # a flexible crank: its markers below
+                continue
+            for output in ("Position", "Velocity", "Acceleration", "Rotation",
+                           "AngularVelocity", "AngularAcceleration"):
+                self.add(f"{name}.{output}",
+                         self.sensor("Node", output, nodeNumber=body["nodeNumber"]))
+        if self.scene["coupler"]["model"] == "rigid":
+            # the centre of mass is the coupler's midpoint
+            for output in ("Position", "Velocity", "Acceleration", "Rotation",
+                           "AngularVelocity"):
+                self.add(f"coupler.{output}",
+                         self.sensor("Node", output, nodeNumber=self.mech.coupler["node"]))
+        self._add_joint_and_marker_sensors()
+        self._add_flexible_sensors()
+
+    def _add_joint_and_marker_sensors(self) -> None:
+        penalty = self.scene["simulation"]["integrator"] == "explicit_penalty"
+        for name, joint in self.joints.items():
+            # the spherical joint reports its force in global axes ("Force"), the others in
+            # the frame of marker 0 ("ForceLocal")
+            output = "Force" if name == "C" or penalty else "ForceLocal"
+            self.add(f"joint_{name}.Force", self.sensor("Object", output, objectNumber=joint))
+        for name in ("ground_A", "crank_A", "crank_B", "coupler_B", "coupler_C", "slider_C"):
+            self.add(f"marker_{name}.Position",
+                     self.sensor("Marker", "Position", markerNumber=self.markers[name]))
+        self.mech.constraint_points = [("ground_A", "crank_A"), ("crank_B", "coupler_B"),
+                                       ("coupler_C", "slider_C")]
+        if not penalty:
+            self.add("marker_crank_B.Rotation",
+                     self.sensor("Marker", "Rotation", markerNumber=self.markers["crank_B"]))
+
+    def _add_flexible_sensors(self) -> None:
+        model = self.scene["coupler"]["model"]
+        flexible = {"coupler": self.coupler} if model in ("ffrf", "nonlinear_fe") else {}
+        if self.mech.crank:
+            flexible["crank"] = self.mech.crank
+            for name in ("crank_A", "crank_B"):
+                self.add(f"marker_{name}.Velocity",
+                         self.sensor("Marker", "Velocity", markerNumber=self.markers[name]))
+        for name, link in flexible.items():
+            for output in ("Position", "Velocity"):
+                self.add(f"marker_{name}_mid.{output}",
+                         self.sensor("Marker", output, markerNumber=link["marker_mid"]))
+            if "node_modal" not in link:  # nonlinear FE: nodal coordinates only
+                continue
+            self.add(f"{name}.modal_coordinates",
+                     self.sensor("Node", "Coordinates", nodeNumber=link["node_modal"]))
+            # Exudyn's FFRF body reports its kinetic (rigid + elastic motion) and strain energy
+            sensors = [self.mbs.AddSensor(self.sensor("Body", kind, bodyNumber=link["object"]))
+                       for kind in ("KineticEnergy", "PotentialEnergy")]
+            self.mech.flexible_energy[name] = (sensors[0], sensors[1])

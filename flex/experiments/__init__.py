@@ -1,0 +1,3 @@
+"""What the studies compute: fits, work-precision, benchmark, stability, per-study tables and
+figures.
+"""

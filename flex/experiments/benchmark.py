@@ -1,0 +1,335 @@
+"""Benchmark: how fast flex reaches a stated accuracy (measured, not a timed test).
+
+Every number is measured by the run, on whatever else the machine is doing: wall times [s]
+are medians of ``repeats`` runs, and each comparison is a ratio of two times measured in the
+same run. :func:`run_bench` runs the four parts of a :class:`BenchPlan` in order, each into
+``notes[<part>]`` (a part that raises :class:`~flex.errors.FlexError` is stored as
+``notes["<part>_failed"]`` and a failed case ``<part>_failed``; the others still run):
+
+- ``rigid`` (:func:`bench_rigid`): the largest step of the tuned setting that reaches the
+  crank-angle accuracy, tuned and untuned at that step, and the loosest scipy tolerance that
+  reaches it, against a converged reference; with :func:`profile` of the untuned and tuned run;
+- ``ffrf_1mm`` (:func:`bench_ffrf`): the fastest candidate within the peak-deflection
+  accuracy, the untuned first set-up, the flex defaults, and the nonlinear FE coupler (if
+  installed and ``FLEX_BENCH_NONLINEAR`` is not ``0``) against its own run at half the step;
+- ``reduction`` (:func:`bench_reduction`): the plate reduction cold (empty cache), from cache,
+  and its first FFRF projection;
+- ``make_all`` (:func:`bench_make_all`): ``make all FORCE=1`` with an empty reduction cache and
+  again with it filled (``FLEX_BENCH_MAKE=0`` skips it).
+
+:mod:`flex.benchmark_report` turns the notes into the table and the figures.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import statistics
+import subprocess
+import tempfile
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.base.errors import FlexError
+from flex.data.results import CaseResult
+from flex.data.scene import Scene
+from flex.experiments.reference_plans import ReferencePlan, build_reference
+from flex.experiments.tradeoff import (
+    Measurement,
+    ReductionPool,
+    Reference,
+    Setting,
+    fastest,
+    measure,
+    run_once,
+    scene_for,
+)
+from flex.experiments.workprecision import (
+    Progress,
+    measurement_attrs,
+    measurement_case,
+    nonlinear_available,
+)
+
+Say = Callable[[str], None]
+
+
+@dataclass(frozen=True)
+class BenchPlan:
+    """What the benchmark measures.
+
+    Rigid: ``rigid_reference``; the crank-angle accuracy [rad]; the tuned Newton knobs
+    (``simulation`` keys) and the untuned ones; the steps [s] probed for the tuned setting,
+    largest first; the scipy DOP853 relative tolerances probed, loosest first. FFRF: its
+    reference; the relative peak-deflection accuracy; the target integration time [s]; the
+    candidate settings, cheapest first; the untuned first set-up; the flex defaults; the
+    nonlinear FE coupler at a fine and a coarse step.
+    """
+
+    rigid_reference: ReferencePlan
+    rigid_accuracy_rad: float
+    rigid_tuned: Mapping[str, Any]
+    rigid_untuned: Mapping[str, Any]
+    rigid_steps: Sequence[float]
+    scipy_rtols: Sequence[float]
+    ffrf_reference: ReferencePlan
+    ffrf_accuracy: float
+    ffrf_target_s: float
+    ffrf_candidates: Sequence[Setting]
+    ffrf_untuned: Setting
+    ffrf_defaults: Setting
+    nonlinear_fine: Setting
+    nonlinear_coarse: Setting
+
+
+def _g(value: float) -> str:
+    """Scientific, shortest: 1e-4 -> ``1e-4`` (how the plan's numbers read in labels and
+    messages)."""
+    return str(np.format_float_scientific(value, trim="-", exp_digits=1))
+
+
+# ------------------------------------------------------------------------------------------
+# profiling
+# ------------------------------------------------------------------------------------------
+_TIMER = re.compile(r"^\s*(_{0,2}[A-Za-z/ 0-9]+?)\s*=\s*([0-9.eE+-]+)%")
+
+
+def profile(scene: Scene, pool: ReductionPool) -> dict[str, float]:
+    """One run of ``scene`` with flex's phases timed [s] (``phase_reduction_s``,
+    ``phase_build_s``, ``phase_integration_s``, ``phase_output_s``), its counters and
+    Exudyn's CPU-time shares [%] (``exudyn_<phase>_percent``)."""
+    from flex.dynamics.mechanism import build_mechanism
+    from flex.dynamics.solver import collect, run_profiled
+
+    out: dict[str, float] = {}
+    start = time.perf_counter()
+    reduction = pool.for_scene(scene)
+    out["phase_reduction_s"] = time.perf_counter() - start
+    start = time.perf_counter()
+    mech = build_mechanism(scene, reduction)
+    out["phase_build_s"] = time.perf_counter() - start
+    counters, statistics_text = run_profiled(mech)
+    out["phase_integration_s"] = counters.pop("wall_time_s")
+    start = time.perf_counter()
+    collect(mech)
+    out["phase_output_s"] = time.perf_counter() - start
+    out.update(counters)
+    for line in statistics_text.splitlines():
+        match = _TIMER.match(line)
+        if match and "time" not in match[1]:
+            name = re.sub(r"[^A-Za-z0-9_]+", "_", match[1].strip())
+            out[f"exudyn_{name}_percent"] = float(match[2])
+    return out
+
+
+# ------------------------------------------------------------------------------------------
+# parts
+# ------------------------------------------------------------------------------------------
+def bench_case(name: str, scene: Scene, m: Measurement, extra: dict[str, Any] | None = None
+               ) -> CaseResult:
+    """A timed configuration's case (:func:`flex.workprecision.measurement_case`; attrs
+    knobs, label, errors and ``extra``)."""
+    return measurement_case(name, scene, m, measurement_attrs(m, group=False) | (extra or {}))
+
+
+def first_within(scene: Scene, settings: Sequence[Setting], reference: Reference,
+                 accepts: Callable[[Measurement], bool]) -> Setting | None:
+    """The first of ``settings`` whose single run is ok and ``accepts``, or None."""
+    for setting in settings:
+        probe = measure(scene, setting, reference, 1)
+        if probe.ok and accepts(probe):
+            return setting
+    return None
+
+
+def bench_rigid(scene: Scene, plan: BenchPlan, repeats: int, pool: ReductionPool, say: Say,
+                notes: dict[str, Any]) -> dict[str, CaseResult]:
+    """Rigid part: flex tuned and untuned, and scipy, at the plan's crank-angle accuracy."""
+    reference = build_reference(scene, "rigid", plan.rigid_reference, pool)
+    say(f"rigid reference: accuracy {reference.accuracy:.1e}")
+    accuracy = f"{_g(plan.rigid_accuracy_rad)} rad"
+
+    def reaches(m: Measurement) -> bool:
+        return m.errors["crank_angle_rad"] <= plan.rigid_accuracy_rad
+
+    tuned_tol = _g(plan.rigid_tuned["newton_relative_tolerance"])
+    probe = first_within(scene, [Setting.of(f"tuned h={step:g}", step_s=step, **plan.rigid_tuned)
+                                 for step in plan.rigid_steps], reference, reaches)
+    if probe is None:
+        raise FlexError(f"no flex step reached {accuracy}")
+    chosen = dict(probe.overrides)["simulation.step_s"]
+    say(f"rigid: flex reaches {accuracy} at h = {chosen:g} s")
+    tuned = measure(scene, Setting.of(f"flex tuned h={chosen:g} tol={tuned_tol}", step_s=chosen,
+                                      **plan.rigid_tuned), reference, repeats, pool)
+    untuned_tol = _g(plan.rigid_untuned["newton_relative_tolerance"])
+    untuned = measure(scene, Setting.of(f"flex untuned h={chosen:g} tol={untuned_tol}",
+                                        step_s=chosen, **plan.rigid_untuned),
+                      reference, repeats, pool)
+    scipy_pick = first_within(scene, [
+        Setting(f"scipy DOP853 rtol={rtol:g}", engine="scipy", rtol=rtol, atol=rtol * 1e-2)
+        for rtol in plan.scipy_rtols], reference, reaches)
+    if scipy_pick is None:
+        raise FlexError(f"no scipy tolerance reached {accuracy}")
+    scipy_run = measure(scene, scipy_pick, reference, repeats)
+    say(f"rigid: scipy reaches {accuracy} at {scipy_pick.label}")
+    notes["rigid"] = {"reference": reference, "tuned": tuned, "untuned": untuned,
+                      "scipy": scipy_run,
+                      "profile_untuned": profile(scene_for(scene, untuned.setting), pool),
+                      "profile_tuned": profile(scene_for(scene, tuned.setting), pool)}
+    return {"rigid_tuned": bench_case("rigid_tuned", scene, tuned),
+            "rigid_untuned": bench_case("rigid_untuned", scene, untuned),
+            "rigid_scipy": bench_case("rigid_scipy", scene, scipy_run)}
+
+
+def bench_ffrf(scene: Scene, plan: BenchPlan, repeats: int, pool: ReductionPool, say: Say,
+               notes: dict[str, Any]) -> dict[str, CaseResult]:
+    """FFRF part: the fastest candidate within the peak accuracy, untuned, defaults,
+    nonlinear FE."""
+    reference = build_reference(scene, "ffrf_1mm", plan.ffrf_reference, pool)
+    say(f"ffrf_1mm reference: accuracy {reference.accuracy:.1e}, peak "
+        f"{reference.peak_deflection_m * 1e6:.2f} um")
+    out: dict[str, CaseResult] = {}
+    probes = [measure(scene, setting, reference, 1, pool) for setting in plan.ffrf_candidates]
+    for index, probe in enumerate(probes, 1):
+        out[f"ffrf_probe_{index}"] = bench_case(f"ffrf_probe_{index}", scene, probe)
+    within = [p for p in probes if p.ok
+              and p.errors["peak_deflection_relative"] <= plan.ffrf_accuracy]
+    if not within:
+        raise FlexError(f"no FFRF candidate reached {plan.ffrf_accuracy * 100:g} % peak "
+                        f"deflection")
+    best = fastest(within)  # by integration time (the first total includes a projection)
+    tuned = measure(scene, best.setting, reference, repeats, pool)
+    say(f"ffrf_1mm: tuned {tuned.setting.label}: {tuned.wall_time_s:.3f} s")
+    untuned = measure(scene, plan.ffrf_untuned, reference, 1, pool)
+    say(f"ffrf_1mm: untuned {untuned.wall_time_s:.2f} s")
+    default = measure(scene, plan.ffrf_defaults, reference, repeats, pool)
+    say(f"ffrf_1mm: flex defaults {default.wall_time_s:.3f} s")
+    out["ffrf_tuned"] = bench_case("ffrf_tuned", scene, tuned)
+    out["ffrf_untuned"] = bench_case("ffrf_untuned", scene, untuned)
+    out["ffrf_default"] = bench_case("ffrf_default", scene, default)
+    results: dict[str, Any] = {
+        "reference": reference, "tuned": tuned, "untuned": untuned, "default": default,
+        "probes": probes,
+        "profile_untuned": profile(scene_for(scene, plan.ffrf_untuned), pool),
+        "profile_tuned": profile(scene_for(scene, tuned.setting), pool)}
+    if nonlinear_available() and os.environ.get("FLEX_BENCH_NONLINEAR", "1") != "0":
+        out.update(_bench_nonlinear(scene, plan, reference, pool, say, results))
+    notes["ffrf_1mm"] = results
+    return out
+
+
+def _bench_nonlinear(scene: Scene, plan: BenchPlan, reference: Reference,
+                     pool: ReductionPool, say: Say, results: dict[str, Any]
+                     ) -> dict[str, CaseResult]:
+    """The nonlinear FE coupler is another model (it keeps the axial force's effect on
+    bending): its accuracy is judged against its own run at the fine step, and its difference
+    to the converged FFRF reference is reported beside it."""
+    fine_setting, coarse_setting = plan.nonlinear_fine, plan.nonlinear_coarse
+    fine_step = _g(dict(fine_setting.overrides)["simulation.step_s"])
+    say(f"ffrf_1mm: nonlinear FE coupler at h = {fine_step} s (minutes)")
+    try:
+        fine, counters = run_once(scene_for(scene, fine_setting), fine_setting, pool)
+    except FlexError as exc:
+        results["nonlinear_failed"] = str(exc)
+        return {}
+    own = Reference(f"nonlinear FE h={fine_step}", fine, fine_setting, {}, plan.ffrf_accuracy,
+                    float(counters["wall_time_s"]), f"nonlinear FE, h = {fine_step} s")
+    say(f"ffrf_1mm: nonlinear FE coupler at h = "
+        f"{_g(dict(coarse_setting.overrides)['simulation.step_s'])} s")
+    coarse = measure(scene, coarse_setting, own, 1, pool)
+    results["nonlinear"] = {"fine_wall_time_s": own.wall_time_s, "coarse": coarse,
+                            "model_difference": own.errors(reference.observables)}
+    return {"nonlinear_fe": bench_case("nonlinear_fe", scene, coarse, {
+        "fine_wall_time_s": own.wall_time_s,
+        "note": f"errors against the nonlinear FE run at h = {fine_step} s"})}
+
+
+def bench_reduction(scene: Scene, say: Say, notes: dict[str, Any]) -> None:
+    """Build time [s] of the scene's coupler reduction: cold (empty cache, median of 2),
+    loaded from cache (median of 6), and its first FFRF projection (median of 2)."""
+    from flex.bodies.reduction import build_reduction
+
+    c = scene["coupler"]
+    args = (c["length_m"], c["thickness_m"], c["width_m"], c["youngs_modulus_Pa"],
+            c["density_kg_per_m3"], c["poisson_ratio"], c["mesh_size_m"], c["modes"])
+    cold, cached, interface = [], [], []
+    for _ in range(2):
+        with tempfile.TemporaryDirectory() as folder:
+            start = time.perf_counter()
+            build_reduction(*args, cache_dir=folder)
+            cold.append(time.perf_counter() - start)
+            for _ in range(3):
+                start = time.perf_counter()
+                reduction = build_reduction(*args, cache_dir=folder)
+                cached.append(time.perf_counter() - start)
+                assert reduction.from_cache
+            start = time.perf_counter()
+            reduction.ffrf_interface()  # what the first mechanism build of a loaded one costs
+            interface.append(time.perf_counter() - start)
+    notes["reduction"] = {"cold_s": statistics.median(cold),
+                          "cached_s": statistics.median(cached),
+                          "ffrf_interface_s": statistics.median(interface),
+                          "cold_runs": cold, "cached_runs": cached}
+    say(f"reduction: cold {statistics.median(cold):.2f} s, cached "
+        f"{statistics.median(cached):.3f} s")
+
+
+def bench_make_all(say: Say, notes: dict[str, Any]) -> None:
+    """``make all FORCE=1`` [s] in the repository holding flex, with an empty reduction cache
+    (cold) and again with it filled (warm); skipped when ``FLEX_BENCH_MAKE=0``."""
+    if os.environ.get("FLEX_BENCH_MAKE", "1") == "0":
+        notes["make_all"] = {"skipped": "FLEX_BENCH_MAKE=0"}
+        return
+    root = Path(__file__).resolve().parents[2]
+    subprocess.run(["make", "-s", "setup"], cwd=root, capture_output=True, check=False)
+    out: dict[str, Any] = {}
+    with tempfile.TemporaryDirectory() as folder:
+        env = dict(os.environ, FLEX_CACHE_DIR=str(folder))
+        for label in ("cold", "warm"):
+            say(f"make all ({label} reduction cache)")
+            start = time.perf_counter()
+            done = subprocess.run(["make", "all", "FORCE=1"], cwd=root, env=env,
+                                  capture_output=True, text=True, check=False)
+            out[f"{label}_s"] = time.perf_counter() - start
+            out[f"{label}_returncode"] = done.returncode
+            if done.returncode:
+                out[f"{label}_error"] = (done.stderr or done.stdout)[-400:]
+    notes["make_all"] = out
+
+
+def run_bench(scenes: Mapping[str, Scene], plan: BenchPlan, repeats: int,
+              progress: Progress | None = None, notes: dict[str, Any] | None = None
+              ) -> dict[str, CaseResult]:
+    """Run the four parts in order on ``scenes["rigid"]`` and ``scenes["ffrf_1mm"]`` (see the
+    module doc); each part's failure is stored, the others still run."""
+    pool = ReductionPool()
+    notes = {} if notes is None else notes
+    results: dict[str, CaseResult] = {}
+    parts: list[tuple[str, Callable[[Say], Any]]] = [
+        ("rigid", lambda say: bench_rigid(scenes["rigid"], plan, repeats, pool, say, notes)),
+        ("ffrf_1mm", lambda say: bench_ffrf(scenes["ffrf_1mm"], plan, repeats, pool, say,
+                                            notes)),
+        ("reduction", lambda say: bench_reduction(scenes["ffrf_1mm"], say, notes)),
+        ("make_all", lambda say: bench_make_all(say, notes))]
+    for index, (name, part) in enumerate(parts):
+        if progress:
+            progress(name, index, len(parts))
+
+        def say(text: str, _name: str = name, _index: int = index) -> None:
+            if progress:
+                progress(f"{_name}: {text}", _index, len(parts))
+
+        try:
+            results.update(part(say) or {})
+        except FlexError as exc:
+            notes[f"{name}_failed"] = str(exc)
+            results[f"{name}_failed"] = CaseResult(f"{name}_failed", "", status="failed",
+                                                   message=str(exc))
+    if progress:
+        progress("done", len(parts), len(parts))
+    return results

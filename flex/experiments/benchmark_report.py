@@ -1,0 +1,265 @@
+"""What the benchmark reports: its table and its bar charts.
+
+:func:`bench_summary` turns the notes of :func:`flex.benchmark.run_bench` into datasets --
+``rigid/...``, ``ffrf_1mm/...`` (times [s], errors, ratios, each run's profile),
+``reduction/...``, ``make_all/...`` -- and the printed table (``table/what``, ``table/value``,
+``table/detail``). :func:`bench_figures` draws the integration times at equal accuracy and the
+Exudyn CPU shares of the untuned and tuned runs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.base.plotting import figure
+from flex.data.results import Dataset
+from flex.experiments.benchmark import BenchPlan
+
+Row = tuple[str, str, str]
+
+
+def _put(datasets: dict[str, Dataset], key: str, value: Any, units: str, text: str) -> None:
+    datasets[key] = Dataset(value, units, text)
+
+
+def _times(datasets: dict[str, Dataset], prefix: str, m: Any) -> None:
+    """Median integration and total time [s] and the setting of measurement ``m``."""
+    _put(datasets, f"{prefix}/wall_time", m.wall_time_s, "s", "median integration time")
+    _put(datasets, f"{prefix}/total_time", m.total_time_s, "s",
+         "median build + integration + output")
+    _put(datasets, f"{prefix}/setting", m.setting.label, "1", "setting")
+
+
+def _rigid_rows(rigid: Mapping[str, Any], datasets: dict[str, Dataset]) -> list[Row]:
+    tuned, untuned, scipy = rigid["tuned"], rigid["untuned"], rigid["scipy"]
+    ratio = tuned.wall_time_s / scipy.wall_time_s
+    ratio_total = tuned.total_time_s / scipy.total_time_s
+    _put(datasets, "rigid/reference_accuracy", rigid["reference"].accuracy, "1",
+         "largest relative change of the reference under coarsening")
+    for name, m in (("flex_tuned", tuned), ("flex_untuned", untuned), ("scipy", scipy)):
+        _times(datasets, f"rigid/{name}", m)
+        _put(datasets, f"rigid/{name}/crank_angle_error",
+             m.errors.get("crank_angle_rad", np.nan), "rad", "max |crank angle - reference|")
+    _put(datasets, "rigid/ratio_flex_over_scipy", ratio, "1", "integration time ratio, same run")
+    _put(datasets, "rigid/ratio_flex_over_scipy_total", ratio_total, "1",
+         "end-to-end ratio (build + integration + output), same run")
+    _put(datasets, "rigid/speedup_tuning", untuned.wall_time_s / tuned.wall_time_s, "1",
+         "untuned / tuned integration time at the same step")
+    return [
+        ("rigid 1e-7 rad: flex tuned", f"{tuned.wall_time_s * 1e3:.0f} ms",
+         f"{tuned.setting.label}, error {tuned.errors['crank_angle_rad']:.1e} rad, "
+         f"{tuned.steps} steps, {tuned.newton_iterations} Newton iterations"),
+        ("rigid 1e-7 rad: flex untuned", f"{untuned.wall_time_s * 1e3:.0f} ms",
+         f"{untuned.setting.label}, {untuned.newton_iterations} Newton iterations"),
+        ("rigid 1e-7 rad: scipy DAE", f"{scipy.wall_time_s * 1e3:.1f} ms",
+         f"{scipy.setting.label}, error {scipy.errors['crank_angle_rad']:.1e} rad "
+         f"(end to end {scipy.total_time_s * 1e3:.0f} ms)"),
+        ("rigid: flex / scipy", f"{ratio:.1f}", f"integration; end to end {ratio_total:.1f}"),
+    ]
+
+
+def _ffrf_rows(ffrf: Mapping[str, Any], plan: BenchPlan, datasets: dict[str, Dataset]
+               ) -> list[Row]:
+    tuned, untuned, default = ffrf["tuned"], ffrf["untuned"], ffrf["default"]
+    target = plan.ffrf_target_s
+    _put(datasets, "ffrf_1mm/reference_accuracy", ffrf["reference"].accuracy, "1",
+         "largest relative change of the reference under coarsening")
+    _put(datasets, "ffrf_1mm/reference_peak_deflection", ffrf["reference"].peak_deflection_m,
+         "m", "reference peak |midpoint deflection|")
+    for name, m in (("tuned", tuned), ("untuned", untuned), ("default", default)):
+        _times(datasets, f"ffrf_1mm/{name}", m)
+        _put(datasets, f"ffrf_1mm/{name}/peak_deflection_error",
+             m.errors.get("peak_deflection_relative", np.nan), "1",
+             "relative peak deflection error")
+    _put(datasets, "ffrf_1mm/target_met", bool(tuned.wall_time_s < target), "1",
+         f"tuned integration under {target} s")
+    _put(datasets, "ffrf_1mm/speedup_tuning", untuned.wall_time_s / tuned.wall_time_s, "1",
+         "untuned / tuned integration time")
+    return [
+        ("FFRF 1 mm 1 %: tuned", f"{tuned.wall_time_s:.3f} s",
+         f"{tuned.setting.label}, peak error "
+         f"{tuned.errors['peak_deflection_relative'] * 100:.2f} %, {tuned.steps} steps, "
+         f"end to end {tuned.total_time_s:.2f} s; target < {target} s: "
+         f"{'met' if tuned.wall_time_s < target else 'NOT met'}"),
+        ("FFRF 1 mm: untuned first set-up", f"{untuned.wall_time_s:.2f} s",
+         f"{untuned.setting.label}, peak error "
+         f"{untuned.errors.get('peak_deflection_relative', np.nan) * 100:.3f} %"),
+        ("FFRF 1 mm: untuned / tuned", f"{untuned.wall_time_s / tuned.wall_time_s:.1f}",
+         "integration time"),
+        ("FFRF 1 mm: flex defaults", f"{default.wall_time_s:.3f} s",
+         f"the scene's \"auto\" solver keys, 2 mm mesh, 6 modes: peak error "
+         f"{default.errors.get('peak_deflection_relative', np.nan) * 100:.2f} %, "
+         f"{default.steps} steps; target < {target} s: "
+         f"{'met' if default.wall_time_s < target else 'NOT met'}"),
+    ] + _nonlinear_rows(ffrf, plan, datasets)
+
+
+def _nonlinear_rows(ffrf: Mapping[str, Any], plan: BenchPlan, datasets: dict[str, Dataset]
+                    ) -> list[Row]:
+    nonlinear = ffrf.get("nonlinear")
+    if nonlinear is None:
+        why = ffrf.get("nonlinear_failed", "not run (not installed or FLEX_BENCH_NONLINEAR=0)")
+        return [("FFRF 1 mm: nonlinear FE", "-", why[:150])]
+    coarse = nonlinear["coarse"]
+    if not coarse.ok:
+        return [("FFRF 1 mm: nonlinear FE", "failed", coarse.message[:120])]
+    own_error = coarse.errors["peak_deflection_relative"]
+    coarse_pick = own_error <= plan.ffrf_accuracy
+    pick_wall = coarse.wall_time_s if coarse_pick else nonlinear["fine_wall_time_s"]
+    ratio = pick_wall / ffrf["tuned"].wall_time_s
+    model = nonlinear["model_difference"]["peak_deflection_relative"]
+    _put(datasets, "ffrf_1mm/nonlinear/wall_time_h2e-4", coarse.wall_time_s, "s", "integration")
+    _put(datasets, "ffrf_1mm/nonlinear/wall_time_h1e-4", nonlinear["fine_wall_time_s"], "s",
+         "integration")
+    _put(datasets, "ffrf_1mm/nonlinear/peak_change_h2e-4_to_h1e-4", own_error, "1",
+         "its own time-discretization error estimate at h = 2e-4 s")
+    _put(datasets, "ffrf_1mm/nonlinear/peak_difference_to_ffrf_reference", model, "1",
+         "converged FFRF peak against the nonlinear FE peak (h = 1e-4 s)")
+    _put(datasets, "ffrf_1mm/ratio_nonlinear_over_tuned", ratio, "1",
+         "integration time ratio at 1 % (each model against its own finer run)")
+    return [("FFRF 1 mm: nonlinear FE / tuned FFRF", f"{ratio:.0f}",
+             f"nonlinear FE {pick_wall:.0f} s at h = {'2e-4' if coarse_pick else '1e-4'} s "
+             f"(peak changes {own_error * 100:.2f} % when the step halves); the models differ "
+             f"by {model * 100:.1f} % in peak deflection")]
+
+
+def _profile_rows(part: str, data: Mapping[str, Any], datasets: dict[str, Dataset]
+                  ) -> list[Row]:
+    rows = []
+    for which in ("profile_untuned", "profile_tuned"):
+        for key, value in data[which].items():
+            units = "%" if key.endswith("_percent") else ("s" if key.endswith("_s") else "1")
+            _put(datasets, f"{part}/{which}/{key}", value, units, "profile of one run")
+    for which in ("untuned", "tuned"):
+        prof = data[f"profile_{which}"]
+        top = sorted(((v, k) for k, v in prof.items()
+                      if k.endswith("_percent") and not k.startswith("exudyn___")),
+                     reverse=True)[:4]
+        rows.append((f"{part}: {which} profile", f"{prof['phase_integration_s']:.2f} s",
+                     ", ".join(f"{k[7:-8]} {v:.0f} %" for v, k in top)
+                     + f"; {prof['newton_iterations'] / max(prof['steps'], 1):.1f} Newton "
+                     f"iterations and {prof['jacobian_updates'] / max(prof['steps'], 1):.2f}"
+                     f" Jacobians per step"))
+    return rows
+
+
+def _cache_rows(notes: Mapping[str, Any], datasets: dict[str, Dataset]) -> list[Row]:
+    rows: list[Row] = []
+    reduction = notes.get("reduction")
+    if reduction:
+        _put(datasets, "reduction/cold", reduction["cold_s"], "s",
+             "build, empty cache (median of 2)")
+        _put(datasets, "reduction/cached", reduction["cached_s"], "s",
+             "load from cache (median of 6)")
+        _put(datasets, "reduction/ffrf_interface", reduction["ffrf_interface_s"], "s",
+             "projection of the loaded reduction for its first mechanism")
+        rows += [("reduction 1 mm plate: cold", f"{reduction['cold_s']:.2f} s", "empty cache"),
+                 ("reduction 1 mm plate: from cache", f"{reduction['cached_s']:.3f} s",
+                  f"+ {reduction['ffrf_interface_s']:.2f} s projection at the first build")]
+    make_all = notes.get("make_all", {})
+    for label in ("cold", "warm"):
+        if f"{label}_s" in make_all:
+            _put(datasets, f"make_all/{label}", make_all[f"{label}_s"], "s",
+                 f"make all, {label} cache")
+            _put(datasets, f"make_all/{label}_returncode", make_all[f"{label}_returncode"], "1",
+                 "exit status")
+            status = ("ok" if make_all[f"{label}_returncode"] == 0
+                      else f"FAILED: {make_all.get(f'{label}_error', '')[-120:]}")
+            rows.append((f"make all, {label} reduction cache",
+                         f"{make_all[f'{label}_s']:.0f} s", status))
+    if "skipped" in make_all:
+        rows.append(("make all", "-", make_all["skipped"]))
+    return rows
+
+
+def bench_summary(notes: Mapping[str, Any], plan: BenchPlan) -> tuple[dict[str, Dataset], str]:
+    """Datasets and the printed table of a benchmark run (see the module doc)."""
+    datasets: dict[str, Dataset] = {}
+    rows: list[Row] = []
+    if notes.get("rigid"):
+        rows += _rigid_rows(notes["rigid"], datasets)
+    if notes.get("ffrf_1mm"):
+        rows += _ffrf_rows(notes["ffrf_1mm"], plan, datasets)
+    for part in ("rigid", "ffrf_1mm"):
+        if notes.get(part):
+            rows += _profile_rows(part, notes[part], datasets)
+    rows += _cache_rows(notes, datasets)
+    rows += [(key, "failed", value[:150]) for key, value in notes.items()
+             if key.endswith("_failed")]
+    _put(datasets, "table/what", np.array([r[0] for r in rows], dtype=object), "1",
+         "measurement")
+    _put(datasets, "table/value", np.array([r[1] for r in rows], dtype=object), "see value",
+         "result")
+    _put(datasets, "table/detail", np.array([r[2] for r in rows], dtype=object), "1", "how")
+    width = max((len(r[0]) for r in rows), default=10)
+    lines = ["bench (medians of repeats; ratios from this run)"]
+    lines += [f"  {what:{width}s}  {value:>10s}  {detail}" for what, value, detail in rows]
+    return datasets, "\n".join(lines)
+
+
+def _times_figure(data: Mapping[str, Dataset], folder: Path, target_s: float) -> list[Path]:
+    bars = [(label, data[key].data) for label, key in (
+        ("rigid 1e-7 rad: flex untuned", "rigid/flex_untuned/wall_time"),
+        ("rigid 1e-7 rad: flex tuned", "rigid/flex_tuned/wall_time"),
+        ("rigid 1e-7 rad: scipy DAE", "rigid/scipy/wall_time"),
+        ("FFRF 1 mm 1 %: untuned", "ffrf_1mm/untuned/wall_time"),
+        ("FFRF 1 mm 1 %: tuned", "ffrf_1mm/tuned/wall_time"),
+        ("FFRF 1 mm: flex defaults", "ffrf_1mm/default/wall_time"),
+        ("FFRF 1 mm 1 %: nonlinear FE (h = 2e-4 s)", "ffrf_1mm/nonlinear/wall_time_h2e-4"),
+    ) if key in data]
+    if not bars:
+        return []
+    path = folder / "bench-times.png"
+    with figure(path, "Integration wall time at equal accuracy (median of repeats, log "
+                "scale)", "integration wall time [s]", "run (model, accuracy: settings)",
+                size=(8.5, 4.2)) as ax:
+        ax.barh([b[0] for b in bars], [b[1] for b in bars], color="tab:blue")
+        ax.set_xscale("log")
+        ax.axvline(target_s, color="grey", ls=":", label=f"FFRF target {target_s:g} s")
+        for index, (_, seconds) in enumerate(bars):
+            ax.annotate(f"{float(seconds):.3g} s", (float(seconds), index), xytext=(3, 0),
+                        textcoords="offset points", va="center", fontsize="x-small")
+        times = [float(b[1]) for b in bars] + [target_s]
+        ax.set_xlim(min(times) / 3, max(times) * 4)  # room for the value labels
+        ax.invert_yaxis()
+    return [path]
+
+
+def _profile_figure(data: Mapping[str, Dataset], folder: Path, part: str) -> list[Path]:
+    shares = {}
+    for which in ("profile_untuned", "profile_tuned"):
+        prefix = f"{part}/{which}/exudyn_"
+        shares[which] = {key[len(prefix):-len("_percent")]: value.data
+                         for key, value in data.items()
+                         if key.startswith(prefix) and key.endswith("_percent")
+                         and not key[len(prefix):].startswith("__")}
+    names = sorted(set(shares["profile_untuned"]) | set(shares["profile_tuned"]),
+                   key=lambda n: -shares["profile_untuned"].get(n, 0.0))
+    if not names:
+        return []
+    path = folder / f"bench-profile-{part}.png"
+    model = {"rigid": "rigid links", "ffrf_1mm": "FFRF coupler t = 1 mm"}.get(part, part)
+    with figure(path, f"Exudyn CPU share per solver phase, {model}: untuned against "
+                "tuned settings", "share of the Exudyn CPU time [%]", "solver phase",
+                size=(8.0, 4.5)) as ax:
+        y = np.arange(len(names))
+        for offset, which in ((-0.2, "profile_untuned"), (0.2, "profile_tuned")):
+            ax.barh(y + offset, [shares[which].get(n, 0.0) for n in names], height=0.4,
+                    label=which.replace("profile_", "") + " settings")
+        ax.set_yticks(y, names)
+        ax.invert_yaxis()
+    return [path]
+
+
+def bench_figures(datasets: Mapping[str, Dataset], folder: Path, target_s: float
+                  ) -> list[Path]:
+    """``bench-times.png`` (integration times at equal accuracy, log scale, the FFRF target
+    ``target_s`` [s] marked) and ``bench-profile-<part>.png`` (Exudyn CPU shares per solver
+    phase, untuned against tuned)."""
+    return (_times_figure(datasets, folder, target_s)
+            + _profile_figure(datasets, folder, "rigid")
+            + _profile_figure(datasets, folder, "ffrf_1mm"))

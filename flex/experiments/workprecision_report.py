@@ -1,0 +1,269 @@
+"""What a work-precision run reports: per scene the run table, the reference and its evidence,
+the recommendations, the defaults check, and the work-precision diagram.
+
+:func:`summarize_work_precision` turns ``notes["runs"]`` of :func:`flex.workprecision.
+run_work_precision` into datasets under ``<scene>/``: ``runs/...`` (the table of
+:func:`flex.tradeoff.measurements_table`, with ``on_pareto_front``), ``reference/...`` (what it
+is and its convergence evidence), ``recommended/...`` (per accuracy level 1 %, 0.1 %, 0.01 %)
+and ``default/...`` (:mod:`flex.defaults_check`), and into the report text.
+:func:`work_precision_figures` draws, from those datasets, one diagram per scene: error
+against wall time (log-log), the Pareto fronts, the accuracy levels and the band the reference
+cannot resolve.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.base.plotting import figure, legend_below
+from flex.data.results import Dataset
+from flex.data.scene import Scene
+from flex.experiments.defaults_check import ffrf_defaults_check, rigid_defaults_check
+from flex.experiments.tradeoff import (
+    ACCURACY_LEVELS,
+    Measurement,
+    Reference,
+    describe,
+    fastest,
+    measurements_table,
+    pareto_front,
+    recommend,
+)
+from flex.experiments.workprecision import SceneRuns
+
+HEADER = ("work-precision (error = largest relative error of crank angle / swing, slider / "
+          "travel, peak deflection / peak; wall = median integration time)")
+
+
+def _evidence_column(evidence: Mapping[str, Mapping[str, Any]], key: str, default: Any
+                     ) -> list[Any]:
+    return [evidence[n].get(key, default) for n in evidence]
+
+
+def evidence_datasets(prefix: str, evidence: Mapping[str, Mapping[str, Any]]
+                      ) -> dict[str, Dataset]:
+    """The reference's evidence (:attr:`flex.tradeoff.Reference.evidence`) as columns under
+    ``prefix``, one row per knob sequence or coarsening."""
+    names = list(evidence)
+    values = np.full((len(names), 3), np.nan)
+    for i, n in enumerate(names):
+        level_values = evidence[n].get("values", [])
+        values[i, :len(level_values)] = level_values
+    return {
+        f"{prefix}/coarsening": Dataset(
+            np.array(names, dtype=object), "1",
+            "knob sequence (three levels) or one-level coarsening of the reference"),
+        f"{prefix}/error": Dataset(
+            np.array([evidence[n]["error"] for n in names]), "1",
+            "estimated contribution to the reference's relative error (Richardson with "
+            "safety factor for an asymptotic sequence, else the conservative fallback; the "
+            "change itself for a one-level coarsening)"),
+        f"{prefix}/order": Dataset(
+            np.array(_evidence_column(evidence, "order", np.nan)), "1",
+            "observed order of the governing measure (nan: one or two levels)"),
+        f"{prefix}/change_fine": Dataset(
+            np.array([evidence[n].get("change_fine", evidence[n]["error"]) for n in names]),
+            "1", "relative change fine -> medium (or reference -> coarsening)"),
+        f"{prefix}/change_coarse": Dataset(
+            np.array(_evidence_column(evidence, "change_coarse", np.nan)), "1",
+            "relative change medium -> coarse"),
+        f"{prefix}/asymptotic": Dataset(
+            np.array([bool(v) for v in _evidence_column(evidence, "asymptotic", False)]), "1",
+            "monotone with observed order >= 1: Richardson estimate used"),
+        f"{prefix}/governing": Dataset(
+            np.array(_evidence_column(evidence, "governing", ""), dtype=object), "1",
+            "error measure with the largest estimate"),
+        f"{prefix}/values": Dataset(
+            values, "m or rad", "peak midpoint deflection [m] (rigid: final crank angle "
+            "[rad]) at the fine, medium, coarse level"),
+        f"{prefix}/settings": Dataset(
+            np.array(["; ".join(evidence[n].get("settings", [n])) for n in names],
+                     dtype=object), "1", "the levels' settings, finest first"),
+        f"{prefix}/wall_time": Dataset(
+            np.array([sum(evidence[n].get("wall_times_s", [np.nan])) for n in names]), "s",
+            "integration time of the levels (a run shared with the reference or another "
+            "sequence is counted in each)"),
+    }
+
+
+def reference_datasets(group: str, reference: Reference, reference_time_s: float
+                       ) -> dict[str, Dataset]:
+    """``<group>/reference/...``: what the reference is, its accuracy and its evidence."""
+    prefix = f"{group}/reference"
+    out = {
+        f"{prefix}/description": Dataset(reference.description, "1", "what the reference is"),
+        f"{prefix}/knobs": Dataset(repr(reference.setting.knobs()), "1", "reference setting"),
+        f"{prefix}/wall_time": Dataset(reference.wall_time_s, "s",
+                                       "reference integration time"),
+        f"{prefix}/accuracy": Dataset(reference.accuracy, "1",
+                                      "largest relative change under one-level coarsening"),
+        f"{prefix}/tolerance": Dataset(reference.tolerance, "1", "claimed relative accuracy"),
+        f"{prefix}/converged": Dataset(reference.converged, "1", "accuracy <= tolerance")}
+    if reference.flexible:
+        out[f"{prefix}/peak_deflection"] = Dataset(
+            reference.peak_deflection_m, "m", "reference peak |midpoint deflection|")
+    out.update(evidence_datasets(f"{prefix}/evidence", reference.evidence))
+    out[f"{prefix}/total_time"] = Dataset(
+        reference_time_s, "s", "wall time of the reference and all its evidence runs "
+        "(including reduction builds)")
+    return out
+
+
+def reference_lines(scene_name: str, reference: Reference, reference_time_s: float
+                    ) -> list[str]:
+    """Report lines: the reference, its accuracy and each knob's evidence."""
+    verdict = "converged" if reference.converged else "NOT converged"
+    lines = [f"  {scene_name}: reference {reference.description}; accuracy "
+             f"{reference.accuracy:.1e} ({verdict} to {reference.tolerance:g}; "
+             f"{reference_time_s:.0f} s in all); evidence:"]
+    for n, e in reference.evidence.items():
+        lines.append(f"      {n}: estimate {e['error']:.2e}"
+                     + (f", changes {e['change_fine']:.2e} / {e['change_coarse']:.2e}, "
+                        f"order {e['order']:.2f}, "
+                        f"{'asymptotic' if e['asymptotic'] else 'fallback'}"
+                        if "change_coarse" in e and math.isfinite(e["change_coarse"])
+                        else "")
+                     + (f"; values {', '.join(f'{v:.7e}' for v in e['values'])}"
+                        if "values" in e else "")
+                     + (f"; failed: {e['failed'][:120]}" if "failed" in e else ""))
+    return lines
+
+
+def recommendations(group: str, measurements: Sequence[Measurement], reference: Reference
+                    ) -> tuple[dict[str, Dataset], list[str]]:
+    """``<group>/recommended/...`` and report lines: per accuracy level the fastest certified
+    flex (Exudyn) setting, or why there is none."""
+    labels, walls, errors, reasons, lines = [], [], [], [], []
+    for rec in recommend(measurements, reference,
+                         eligible=lambda m: m.setting.engine == "exudyn"):
+        m = rec.measurement
+        labels.append(m.setting.label if m else "")
+        walls.append(m.wall_time_s if m else np.nan)
+        errors.append(m.error if m else np.nan)
+        reasons.append(rec.reason or repr(m.setting.knobs()))
+        lines.append(f"    {rec.level * 100:g} %: {describe(m) if m else rec.reason}")
+        if m is None and "certify" in rec.reason:
+            unchecked = [c for c in measurements if c.ok and c.setting.engine == "exudyn"
+                         and c.error <= rec.level]
+            if unchecked:
+                lines.append(f"      (fastest within it if the reference were exact: "
+                             f"{describe(fastest(unchecked))})")
+    prefix = f"{group}/recommended"
+    return {f"{prefix}/level": Dataset(np.array(ACCURACY_LEVELS), "1", "relative accuracy level"),
+            f"{prefix}/setting": Dataset(np.array(labels, dtype=object), "1",
+                                         "fastest flex setting within it"),
+            f"{prefix}/wall_time": Dataset(np.array(walls), "s", "its median wall time"),
+            f"{prefix}/error": Dataset(np.array(errors), "1", "its relative error"),
+            f"{prefix}/knobs": Dataset(np.array(reasons, dtype=object), "1",
+                                       "its knobs, or why there is none")}, lines
+
+
+def _front_lines(measurements: Sequence[Measurement], front: Sequence[int]) -> list[str]:
+    failed = [m for m in measurements if not m.ok]
+    return ["    Pareto front: " + "; ".join(
+        f"{measurements[i].setting.label} ({measurements[i].wall_time_s * 1e3:.1f} ms, "
+        f"{measurements[i].error:.1e})" for i in front),
+        f"    {len(measurements)} settings, {len(failed)} failed"
+        + "".join(f"\n      failed {m.setting.label}: {m.message[:160]}" for m in failed)]
+
+
+def summarize_work_precision(runs: Mapping[str, SceneRuns], scenes: Mapping[str, Scene],
+                             ffrf_default_scene: str | None = None,
+                             rigid_default_scene: str | None = "rigid", name: str = "tradeoff"
+                             ) -> tuple[dict[str, Dataset], str]:
+    """Datasets and report text of every scene's runs (see the module doc). ``scenes``: the
+    case scenes by name; the defaults are checked on ``ffrf_default_scene`` (the plate the
+    ``ffrf_coupler`` entry is for) and on ``rigid_default_scene``."""
+    datasets: dict[str, Dataset] = {}
+    lines = [f"{name}: {HEADER}"]
+    for scene_name, (reference, measurements, reference_time) in runs.items():
+        points = [(m.wall_time_s, m.error) if m.ok else (np.nan, np.nan) for m in measurements]
+        front = pareto_front(points)
+        datasets.update({f"{scene_name}/runs/{key}": value
+                         for key, value in measurements_table(measurements, front).items()})
+        datasets.update(reference_datasets(scene_name, reference, reference_time))
+        lines += reference_lines(scene_name, reference, reference_time)
+        recommended, text = recommendations(scene_name, measurements, reference)
+        datasets.update(recommended)
+        lines += text + _front_lines(measurements, front)
+        checks = []
+        if scene_name == ffrf_default_scene:
+            checks.append(ffrf_defaults_check(scene_name, measurements, reference,
+                                              scenes[scene_name]))
+        if scene_name == rigid_default_scene:
+            checks.append(rigid_defaults_check(scene_name, measurements, scenes[scene_name]))
+        for check_datasets, check_lines in checks:
+            datasets.update(check_datasets)
+            lines += check_lines
+        scipy = [m for m in measurements if m.ok and m.setting.engine == "scipy"]
+        if scipy:
+            lines.append("    scipy reference DAE: " + "; ".join(
+                f"{m.setting.label}: {m.wall_time_s * 1e3:.1f} ms, {m.error:.1e}"
+                for m in scipy))
+    return datasets, "\n".join(lines)
+
+
+def _diagram(ax: Any, table: dict[str, np.ndarray], accuracy: float | None) -> None:
+    """One work-precision diagram on ``ax`` from a scene's run table."""
+    import matplotlib
+
+    colours = matplotlib.colormaps["tab20"]
+    ok = table["status"] == "ok"
+    scipy = np.array(["'scipy'" in str(k) for k in table["knobs"]])
+    explicit = np.array(["explicit_penalty" in str(k) for k in table["knobs"]])
+    wall, error, label = table["wall_time"], table["error"], table["label"]
+    groups = sorted({g for g, good in zip(table["group"], ok, strict=True) if good})
+    for index, group_name in enumerate(groups):
+        mask = ok & (table["group"] == group_name)
+        marker = "s" if (mask & scipy).any() else "^" if (mask & explicit).any() else "o"
+        ax.loglog(wall[mask], error[mask], marker, ms=4.5, color=colours(index % 20),
+                  label=group_name, alpha=0.8)
+    front = table["on_pareto_front"].astype(bool)
+    order = np.argsort(wall[front])
+    ax.loglog(wall[front][order], error[front][order], "k-", lw=1.0,
+              label="Pareto front, all runs")
+    own = [i for i in range(len(ok)) if ok[i] and not scipy[i]]
+    own_front = [own[i] for i in pareto_front([(wall[i], error[i]) for i in own])]
+    ax.loglog(wall[own_front], error[own_front], "k--", lw=1.0,
+              label="Pareto front, flex settings")
+    for rank, i in enumerate(own_front):  # alternate sides: neighbours overlap
+        ax.annotate(str(label[i]), (wall[i], error[i]), fontsize=6,
+                    xytext=(4, -9 if rank % 2 == 0 else 4), textcoords="offset points")
+    for level in ACCURACY_LEVELS:
+        ax.axhline(level, color="grey", lw=0.6, ls=":")
+    ax.plot([], [], color="grey", lw=0.6, ls=":",
+            label=f"accuracy levels {', '.join(f'{v:g}' for v in ACCURACY_LEVELS)}")
+    if accuracy is not None and np.isfinite(accuracy):
+        # errors below the reference's own accuracy are not resolved by it
+        ax.axhspan(ax.get_ylim()[0], accuracy, color="grey", alpha=0.12, lw=0,
+                   label=f"below the reference's accuracy ({accuracy:.1e})")
+    legend_below(ax.figure, [
+        ("o: Exudyn, implicit generalized-alpha (colour: sweep)", {"marker": "o"}),
+        ("s: scipy DAE (reference solver)", {"marker": "s"}),
+        ("^: Exudyn, explicit Runge-Kutta + joint springs", {"marker": "^"})], ncol=3)
+
+
+def work_precision_figures(datasets: Mapping[str, Dataset], folder: Path) -> list[Path]:
+    """``tradeoff-<scene>.png`` per scene with a run table: every ok run (colour: sweep;
+    marker: engine), the Pareto front of all runs (solid) and of flex's own settings (dashed,
+    labelled)."""
+    paths = []
+    for scene_name in dict.fromkeys(key.split("/runs/")[0] for key in datasets
+                                    if "/runs/" in key):
+        table = {key.split("/runs/")[1]: value.data for key, value in datasets.items()
+                 if key.startswith(f"{scene_name}/runs/")}
+        accuracy = datasets.get(f"{scene_name}/reference/accuracy")
+        path = folder / f"tradeoff-{scene_name}.png"
+        with figure(path, f"Work-precision diagram, scene {scene_name} (0.03 s deployment): "
+                    "error against integration time of every setting",
+                    "wall time of the integration [s] (median of repeats)",
+                    "largest relative error against the reference [-]",
+                    size=(9.0, 7.5)) as ax:
+            _diagram(ax, table, None if accuracy is None else float(accuracy.data))
+        paths.append(path)
+    return paths

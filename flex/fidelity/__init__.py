@@ -1,0 +1,1 @@
+"""Rigid or flexible: the criterion, "auto", simulating any scene."""

@@ -1,0 +1,70 @@
+"""Simulate any scene: resolve ``model = "auto"`` links, then integrate.
+
+The layer above :mod:`flex.solver` (which integrates scenes whose links have concrete
+models) and :mod:`flex.criteria` (which decides ``auto`` from a rigid probe run, made with
+:func:`flex.solver.integrate`). The fitted laws ``auto`` reads are arguments: ``None``
+means the installed criterion files (:data:`flex.criteria.DEFAULT_CRITERION`,
+:data:`flex.criteria.DEFAULT_CRANK_CRITERION`); a study that has just fitted a law passes
+it as a :class:`flex.criteria.Criterion`.
+"""
+
+from __future__ import annotations
+
+import sys
+from typing import Any
+
+from flex.base.errors import FlexError
+from flex.config.settings import check_runnable
+from flex.data.results import CaseResult
+from flex.data.scene import Scene, to_toml
+from flex.dynamics.solver import integrate
+from flex.fidelity.criteria import Criterion, FidelityDecision, resolve_fidelity
+
+
+def resolve_auto(scene: Scene, criterion: Criterion | None = None,
+                 crank_criterion: Criterion | None = None
+                 ) -> tuple[Scene, list[FidelityDecision]]:
+    """Resolve ``model = "auto"`` links (:func:`flex.criteria.resolve_fidelity`) and print
+    each choice and its reason to stderr. A scene without ``auto`` links is returned as it
+    is, with no decisions."""
+    if scene["coupler"]["model"] != "auto" and scene["crank"]["model"] != "auto":
+        return scene, []
+    resolved, decisions = resolve_fidelity(scene, criterion, crank_criterion)
+    for decision in decisions:
+        modes = f" ({decision.modes} modes)" if decision.modes else ""
+        print(f"flex: fidelity: {decision.link}.model = auto -> {decision.model}{modes}: "
+              f"{decision.reason}", file=sys.stderr)
+    return resolved, decisions
+
+
+def simulate(scene: Scene, name: str = "case", reduction: Any = None,
+             crank_reduction: Any = None, criterion: Criterion | None = None,
+             crank_criterion: Criterion | None = None) -> CaseResult:
+    """One case of any scene; raises :class:`~flex.errors.FlexError` on bad input or
+    divergence.
+
+    ``model = "auto"`` links are first resolved to concrete models (given reductions are
+    then ignored: auto picks the modes), by ``criterion`` / ``crank_criterion`` (None: the
+    installed laws); the choice and its reason go to stderr and into the result's
+    attributes ``fidelity_<link>_*``. Then :func:`flex.solver.integrate` fills the
+    ``"auto"`` solver keys and integrates. ``reduction`` / ``crank_reduction``: reductions
+    of ``ffrf`` links (None: built or loaded from the cache).
+    """
+    check_runnable(scene)  # before anything is built or probed
+    scene, decisions = resolve_auto(scene, criterion, crank_criterion)
+    if decisions:
+        reduction = crank_reduction = None
+    result = integrate(scene, name, reduction, crank_reduction)
+    for decision in decisions:
+        result.attrs.update(decision.attrs())
+    return result
+
+
+def simulate_case(scene: Scene, name: str = "case", reduction: Any = None,
+                  crank_reduction: Any = None, criterion: Criterion | None = None,
+                  crank_criterion: Criterion | None = None) -> CaseResult:
+    """Like :func:`simulate`, but a failure becomes a ``failed`` case with its message."""
+    try:
+        return simulate(scene, name, reduction, crank_reduction, criterion, crank_criterion)
+    except FlexError as exc:
+        return CaseResult(name, to_toml(scene), status="failed", message=str(exc))

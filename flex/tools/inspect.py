@@ -1,0 +1,311 @@
+"""What is in a result file (``python -m flex inspect FILE.h5 [PATH]``).
+
+:func:`describe` reads a file into a plain dictionary (the ``--json`` output): provenance
+(flex and engine versions, git commit, creation time, command), the resolved scene, every
+case with its status, counters, time range, scene changes and datasets (shape, dtype, units,
+description), and the ``/summary`` datasets (scalars with their values). With a PATH (the
+forms of :func:`flex.results.select_datasets`) only the datasets it names are listed, the
+scene shown is that case's full scene, and a single dataset gets its statistics (minimum and
+maximum with the time they occur, first and last value). :func:`format_description` renders
+the dictionary as the text the command prints.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.data.results import attribute_value, case_names, reading, select_datasets, split_case_path
+
+PROVENANCE_KEYS = ("flex_format", "study", "flex_version", "git_commit", "git_dirty",
+                   "exudyn_version", "ngsolve_version", "h5py_version", "numpy_version",
+                   "scipy_version", "python_version", "platform", "created_utc", "command")
+ENGINES = ("exudyn", "ngsolve", "h5py", "numpy", "scipy")
+
+
+def describe(path: str | Path, spec: str | None = None) -> dict[str, Any]:
+    """Everything :mod:`flex.inspect` shows about ``path`` (restricted to ``spec``).
+
+    Returns a JSON-serialisable dict with keys ``file``, ``provenance``, ``attributes``
+    (other root attributes), ``scene_toml``, ``cases``, ``summary``, ``other`` and, with
+    ``spec``, ``selection`` and (one dataset) ``dataset``. Raises
+    :class:`~flex.errors.ResultFileError` for a bad file or a path it does not have.
+    """
+    with reading(path) as h5:
+        selected = set(select_datasets(h5, spec, path)) if spec else None
+        root = {key: attribute_value(value) for key, value in h5.attrs.items()}
+        provenance = {key: root.pop(key) for key in PROVENANCE_KEYS if key in root}
+        scene_toml = str(root.pop("scene_toml", ""))
+        out: dict[str, Any] = {"file": str(path), "provenance": provenance,
+                               "attributes": root, "scene_toml": scene_toml,
+                               "cases": {}, "summary": [], "other": []}
+        base_scene = _parse_toml(scene_toml)
+        for case in case_names(h5):
+            group = h5[f"cases/{case}"]
+            if not hasattr(group, "keys"):
+                continue
+            entries = _entries(group, f"cases/{case}/", selected)
+            if selected is not None and not entries:
+                continue
+            attrs = {key: attribute_value(value) for key, value in group.attrs.items()}
+            time_s = group["time"][()] if "time" in group and hasattr(group["time"],
+                                                                       "shape") else None
+            info: dict[str, Any] = {
+                "status": attrs.pop("status", "ok"), "message": attrs.pop("message", ""),
+                "samples": int(len(time_s)) if time_s is not None and time_s.ndim == 1 else None,
+                "time_range_s": ([float(time_s[0]), float(time_s[-1])]
+                                 if time_s is not None and time_s.ndim == 1 and len(time_s)
+                                 else None),
+                "counters": {key[len("counter_"):]: attrs.pop(key) for key in list(attrs)
+                             if key.startswith("counter_")},
+                "scene_toml": str(attrs.pop("scene_toml", "")),
+                "solver_settings_toml": str(attrs.pop("solver_settings_toml", "")),
+                "attributes": attrs, "datasets": entries}
+            info["scene_changes"] = _changes(base_scene, _parse_toml(info["scene_toml"]),
+                                             str(attrs.get("solver_defaults_keys", "")))
+            out["cases"][case] = info
+        for name in h5:
+            if name == "cases":
+                continue
+            obj = h5[name]
+            entries = (_entries(obj, f"{name}/", selected) if hasattr(obj, "keys")
+                       else _entries(h5, "", selected, only=[name]))
+            out["summary" if name == "summary" else "other"] += entries
+        if spec:
+            out["selection"] = spec
+            if len(selected or ()) == 1:
+                (only,) = selected
+                out["dataset"] = _statistics(h5, only)
+        return out
+
+
+def _entries(group, prefix: str, selected: set[str] | None,
+             only: list[str] | None = None) -> list[dict[str, Any]]:
+    """One entry per dataset below ``group`` (paths relative to the case for cases)."""
+    names: list[str] = []
+    if only is not None:
+        names = [n for n in only if hasattr(group[n], "shape")]
+    else:
+        group.visititems(lambda n, obj: names.append(n) if hasattr(obj, "shape") else None)
+    out = []
+    for name in names:
+        full = prefix + name
+        if selected is not None and full not in selected:
+            continue
+        dataset = group[name]
+        entry = {"path": full if not full.startswith("cases/") else split_case_path(full)[1],
+                 "full_path": full, "shape": list(dataset.shape), "dtype": _dtype(dataset),
+                 **_units_description(dataset)}
+        if dataset.shape == () or (dataset.size <= 3 and dataset.ndim == 1
+                                   and not full.startswith("cases/")):
+            entry["value"] = attribute_value(dataset[()])
+        out.append(entry)
+    return out
+
+
+def _units_description(dataset) -> dict[str, str]:
+    return {key: str(attribute_value(dataset.attrs.get(key, "")))
+            for key in ("units", "description")}
+
+
+def _dtype(dataset) -> str:
+    kind = dataset.dtype.kind
+    return "text" if kind in "OSU" else str(dataset.dtype)
+
+
+def _parse_toml(text: str) -> dict[str, Any] | None:
+    try:
+        return tomllib.loads(text) if text else None
+    except tomllib.TOMLDecodeError:
+        return None
+
+
+def _changes(base: dict[str, Any] | None, scene: dict[str, Any] | None,
+             filled_by_flex: str = "") -> dict[str, Any]:
+    """``{"section.key": value}`` where ``scene`` differs from ``base``; ``"auto"`` simulation
+    keys that flex filled (``filled_by_flex``: the case's ``solver_defaults_keys``) are not
+    changes."""
+    if base is None or scene is None:
+        return {}
+    filled = {item.split(" = ")[0] for item in filled_by_flex.split(", ") if item}
+    out = {}
+    for section, table in scene.items():
+        if not isinstance(table, dict):
+            continue
+        for key, value in table.items():
+            if section == "simulation" and key in filled:
+                continue
+            if not isinstance(base.get(section), dict) or base[section].get(key) != value:
+                out[f"{section}.{key}"] = value
+    return out
+
+
+def _statistics(h5, path: str) -> dict[str, Any]:
+    """Minimum, maximum (with their time), first and last value of a numeric dataset."""
+    dataset = h5[path]
+    info: dict[str, Any] = {"path": path, "shape": list(dataset.shape),
+                            "dtype": _dtype(dataset), **_units_description(dataset)}
+    values = dataset[()]
+    if not isinstance(values, np.ndarray) or values.dtype.kind not in "biuf" or values.size == 0:
+        info["value"] = attribute_value(values) if np.size(values) <= 20 else None
+        return info
+    case, _ = split_case_path(path)
+    time_s = None
+    if case is not None and f"cases/{case}/time" in h5:
+        candidate = h5[f"cases/{case}/time"][()]
+        if (values.ndim in (1, 2) and np.ndim(candidate) == 1
+                and len(candidate) == values.shape[0]):
+            time_s = candidate
+    columns = values.reshape(len(values), -1).T if values.ndim in (1, 2) else [values.ravel()]
+    stats = []
+    for column in columns:
+        finite = np.where(np.isfinite(column), column, np.nan)
+        if np.isnan(finite).all():
+            stats.append({"min": None, "max": None, "non_finite": int(column.size)})
+            continue
+        low, high = int(np.nanargmin(finite)), int(np.nanargmax(finite))
+        entry = {"min": float(column[low]), "max": float(column[high]),
+                 "first": float(column[0]), "last": float(column[-1]),
+                 "non_finite": int(np.isnan(finite).sum())}
+        if time_s is not None:
+            entry["time_of_min_s"] = float(time_s[low])
+            entry["time_of_max_s"] = float(time_s[high])
+        stats.append(entry)
+    info["columns"] = stats
+    return info
+
+
+def format_description(info: dict[str, Any]) -> str:
+    """The text ``python -m flex inspect`` prints for a :func:`describe` dictionary."""
+    prov = info["provenance"]
+    lines = [info["file"]]
+
+    def row(label: str, text: str) -> None:
+        if text:
+            lines.append(f"  {label:9s}{text}")
+
+    cases = info["cases"]
+    statuses = ", ".join(f"{name} {case['status']}" for name, case in cases.items())
+    row("study", f"{prov.get('study', '?')} ({prov.get('flex_format', '?')})"
+        + (f"; cases: {statuses}" if statuses else ""))
+    dirty = {"yes": " (with uncommitted changes)", "no": " (clean)"}.get(
+        str(prov.get("git_dirty")), "")
+    row("flex", f"{prov.get('flex_version', '?')}, git {prov.get('git_commit', '?')}{dirty}")
+    row("engines", ", ".join(f"{name} {prov[f'{name}_version']}" for name in ENGINES
+                             if f"{name}_version" in prov))
+    row("python", f"{prov.get('python_version', '?')} on {prov.get('platform', '?')}")
+    row("created", f"{prov.get('created_utc', '?')} (UTC)")
+    row("command", str(prov.get("command", "")))
+    row("also", ", ".join(f"{key} = {_short(value)}" for key, value in
+                          info["attributes"].items()))
+    for name, case in cases.items():
+        lines.append("")
+        lines.append(f"cases/{name}  {_case_line(case)}")
+        if case["message"]:
+            lines.append(f"  message: {case['message']}")
+        if case["attributes"].get("validity_warning"):
+            lines.append(f"  WARNING: {case['attributes']['validity_warning']}")
+        if case["scene_changes"]:
+            changes = ", ".join(f"{k} = {_short(v)}" for k, v in case["scene_changes"].items())
+            lines.append(f"  scene: the file's scene with {changes}")
+        attrs = case["attributes"]
+        if attrs.get("solver_defaults_keys"):
+            lines.append(f"  solver: \"auto\" -> {attrs['solver_defaults_keys']} "
+                         f"({attrs.get('solver_defaults_entry', '?')}: "
+                         f"{attrs.get('solver_defaults_reason', '')})")
+        lines += _table(case["datasets"])
+    for title, entries in (("summary", info["summary"]), ("other", info["other"])):
+        if entries:
+            lines += ["", title]
+            lines += _table(entries, strip=f"{title}/" if title == "summary" else "")
+    if "dataset" in info:
+        lines += ["", *_statistics_lines(info["dataset"])]
+    scene_toml, heading = info["scene_toml"], "scene (resolved; root attribute scene_toml)"
+    if '= "auto"' in scene_toml:
+        heading = 'scene (root attribute scene_toml; each case holds its "auto" keys resolved)'
+
+    if info.get("selection") and len(cases) == 1:
+        (name, case), = cases.items()
+        if case["scene_toml"]:
+            scene_toml, heading = case["scene_toml"], f"scene of case {name} (resolved)"
+    if scene_toml:
+        lines += ["", heading]
+        lines += [f"  {line}" if line else "" for line in scene_toml.rstrip().splitlines()]
+    return "\n".join(lines)
+
+
+def _case_line(case: dict[str, Any]) -> str:
+    parts = [case["status"]]
+    if case["samples"] is not None and case["time_range_s"]:
+        start, end = case["time_range_s"]
+        parts.append(f"{case['samples']} samples, t = {start:g} .. {end:g} s")
+    counters = case["counters"]
+    named = [("steps", "steps"), ("newton_iterations", "Newton iterations"),
+             ("jacobian_updates", "Jacobian updates")]
+    text = ", ".join(f"{_short(counters[key])} {label}" for key, label in named
+                     if key in counters)
+    if "wall_time_s" in counters:
+        wall = counters["wall_time_s"]
+        wall = f"{wall:.3g}" if isinstance(wall, int | float) else _short(wall)
+        text += f", {wall} s wall time"
+    if text:
+        parts.append(text.lstrip(", "))
+    return "; ".join(parts)
+
+
+def _table(entries: list[dict[str, Any]], strip: str = "") -> list[str]:
+    if not entries:
+        return []
+    names = [e["path"][len(strip):] if strip and e["path"].startswith(strip) else e["path"]
+             for e in entries]
+    width = max(len(n) for n in names)
+    lines = []
+    for name, entry in zip(names, entries, strict=True):
+        if "value" in entry:
+            shape = f"= {_short(entry['value'])}"
+        else:
+            shape = "(" + ", ".join(str(n) for n in entry["shape"]) + (
+                ",)" if len(entry["shape"]) == 1 else ")")
+            if entry["dtype"] == "text":
+                shape += " text"
+        lines.append(f"  {name:{width}s}  {shape:14s}  {entry['units']:9s}  "
+                     f"{entry['description']}")
+    return lines
+
+
+def _statistics_lines(stats: dict[str, Any]) -> list[str]:
+    lines = [stats["path"],
+             f"  shape {tuple(stats['shape'])} {stats['dtype']}, units {stats['units']}: "
+             f"{stats['description']}"]
+    columns = stats.get("columns")
+    if columns is None:
+        if stats.get("value") is not None:
+            lines.append(f"  value {_short(stats['value'], 200)}")
+        return lines
+    for index, column in enumerate(columns):
+        prefix = f"  [{index}] " if len(columns) > 1 else "  "
+        if column["min"] is None:
+            lines.append(f"{prefix}no finite values ({column['non_finite']} non-finite)")
+            continue
+        at_min = (f" at t = {column['time_of_min_s']:.6g} s" if "time_of_min_s" in column
+                  else "")
+        at_max = (f" at t = {column['time_of_max_s']:.6g} s" if "time_of_max_s" in column
+                  else "")
+        bad = f"; {column['non_finite']} non-finite" if column["non_finite"] else ""
+        lines.append(f"{prefix}min {column['min']:.6g}{at_min}, max {column['max']:.6g}"
+                     f"{at_max}; first {column['first']:.6g}, last {column['last']:.6g}{bad}")
+    return lines
+
+
+def _short(value: Any, limit: int = 60) -> str:
+    if isinstance(value, float):
+        text = f"{value:.4g}"
+    elif isinstance(value, list) and all(isinstance(v, float) for v in value):
+        text = "[" + ", ".join(f"{v:.4g}" for v in value) + "]"
+    else:
+        text = str(value)
+    text = text.replace("\n", " ")
+    return text if len(text) <= limit else text[:limit - 3] + "..."

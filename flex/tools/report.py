@@ -1,0 +1,490 @@
+"""Markdown reports generated from a result file (``flex report FILE.h5 [--out REPORT.md]``).
+
+Every number in a report is read from the HDF5 file it names; nothing is typed by hand. A
+report holds, in this order:
+
+1. the study (root attribute ``study``), the file, and the study's own printed report (root
+   attribute ``summary_report``) as a fenced block;
+2. provenance: flex version, git commit (and whether the tree was dirty), engine versions,
+   Python, platform, creation time, command, wall time, failed cases; other root attributes;
+3. the cases: status, samples, time range, solver counters, validity warnings, what
+   ``"auto"`` chose (fidelity, solver defaults), failure messages; other case attributes;
+4. every dataset under ``/summary`` (and any other top-level group), grouped by its parent
+   group, with units and descriptions: scalars as rows, 1-D arrays of one length as the
+   columns of one table, other short arrays as lists, small 2-D arrays as tables, arrays of
+   more than :data:`LARGE` elements as shape, minimum and maximum;
+5. every figure ``figures/<stem>-*.png`` beside the file, linked relative to the report;
+6. the resolved scene (root attribute ``scene_toml``), folded.
+
+Numbers are shown with 4 significant digits (:func:`format_value`); integers and booleans
+as they are. A study run writes ``reports/<stem>.md`` beside its result file
+(:func:`default_report_path`, :func:`write_report`).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+from urllib.parse import quote
+
+import numpy as np
+
+from flex.base.errors import OutputError
+from flex.data.outputs import RESULT_SUFFIXES, check_writable_folder, figures_folder
+from flex.data.results import atomic_path, attribute_value, case_names, reading
+
+REPORT_SUFFIX = ".md"
+#: arrays with more elements than this are summarised (shape, minimum, maximum)
+LARGE = 50
+ENGINES = ("exudyn", "ngsolve", "h5py", "numpy", "scipy")
+PROVENANCE_KEYS = ("flex_format", "study", "flex_version", "git_commit", "git_dirty",
+                   *(f"{engine}_version" for engine in ENGINES), "python_version",
+                   "platform", "created_utc", "command", "wall_time_s", "failed_cases")
+#: root attributes shown in their own sections (not in the table of other attributes)
+SHOWN_ELSEWHERE = ("scene_toml", "summary_report")
+CASE_KNOWN = ("status", "message", "scene_toml", "solver_settings_toml", "validity_warning")
+COUNTER_TITLES = {"steps": "steps", "newton_iterations": "Newton iterations",
+                  "jacobian_updates": "Jacobian updates", "wall_time_s": "wall time [s]"}
+
+
+@dataclass
+class _Item:
+    """One dataset outside ``/cases``: its path below the top-level group ``top``, units,
+    description and values (a numpy array; text as an object array of ``str``)."""
+
+    top: str
+    path: str
+    units: str
+    description: str
+    data: np.ndarray
+
+    @property
+    def name(self) -> str:
+        return self.path.rsplit("/", 1)[-1]
+
+    @property
+    def group(self) -> str:
+        """The full HDF5 path of the parent group (``/summary/energy``)."""
+        parent = self.path.rsplit("/", 1)[0] if "/" in self.path else ""
+        return "/" + "/".join(part for part in (self.top, parent) if part)
+
+    @property
+    def is_text(self) -> bool:
+        return self.data.dtype.kind == "O"
+
+
+def format_value(value: Any) -> str:
+    """A value as the report shows it: floats with 4 significant digits (``:.4g``, so never
+    more digits than the value has: ``0.08``, ``1500``, ``7.93e+10``), integers exactly,
+    booleans as ``true``/``false``, text as it is (bytes decoded as UTF-8)."""
+    if isinstance(value, np.ndarray) and value.shape == ():
+        value = value[()]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, bytes):
+        return value.decode("utf-8", "replace")
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    if value is None:
+        return ""
+    return str(value)
+
+
+def default_report_path(path: str | Path) -> Path:
+    """Where a result file's report goes: ``reports/<stem>.md`` beside it
+    (``results/dynamics.h5`` -> ``results/reports/dynamics.md``)."""
+    path = Path(path)
+    return path.parent / "reports" / f"{path.stem}{REPORT_SUFFIX}"
+
+
+def render_report(path: str | Path, report_folder: str | Path | None = None) -> str:
+    """The Markdown report of the result file ``path``.
+
+    ``report_folder`` is where the report will be saved (default: that of
+    :func:`default_report_path`); links to the result file and its figures are relative to
+    it. Raises :class:`~flex.errors.ResultFileError` for a missing or malformed file.
+    """
+    path = Path(path)
+    folder = Path(report_folder) if report_folder is not None else default_report_path(
+        path).parent
+    root, cases, items = _read(path)
+    lines = _title_section(path, folder, root)
+    lines += _provenance_section(root)
+    lines += _cases_section(cases)
+    lines += _data_section(items)
+    lines += _figures_section(path, folder)
+    lines += _scene_section(str(root.get("scene_toml") or ""))
+    return "\n".join(lines).rstrip("\n") + "\n"
+
+
+def write_report(path: str | Path, out: str | Path | None = None) -> Path:
+    """Write the report of the result file ``path`` to ``out`` (default
+    :func:`default_report_path`) atomically (a temporary file renamed into place, the folder
+    created) and return where it went.
+
+    Refuses with :class:`~flex.errors.OutputError`, writing nothing, an output that is the
+    result file itself, does not end in ``.md``, is a folder or cannot be written; a bad
+    result file raises :class:`~flex.errors.ResultFileError`, also before anything is
+    written.
+    """
+    path = Path(path)
+    target = default_report_path(path) if out is None else Path(out)
+    label = f"report '{target}'"
+    if _same_file(target, path):
+        raise OutputError(f"{label} is the result file it reports on; choose another name "
+                          f"ending in {REPORT_SUFFIX}")
+    if target.is_dir():
+        raise OutputError(f"{label} is a folder; give a file name ending in {REPORT_SUFFIX}")
+    if target.suffix != REPORT_SUFFIX:
+        raise OutputError(f"{label}: reports are Markdown files ending in {REPORT_SUFFIX}")
+    check_writable_folder(target.parent, label)
+    text = render_report(path, target.parent)
+    try:
+        with atomic_path(target) as tmp:
+            tmp.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise OutputError(f"cannot write {label}: {exc.strerror or exc}") from None
+    return target
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.resolve() == b.resolve() or (a.exists() and b.exists() and a.samefile(b))
+    except OSError:
+        return False
+
+
+# --- reading ----------------------------------------------------------------------------
+
+def _read(path: Path) -> tuple[dict[str, Any], list[dict[str, Any]], list[_Item]]:
+    """Root attributes, cases (name, attributes, samples, time range) and every dataset
+    outside ``/cases``, read through :func:`flex.results.reading` (which checks the file)."""
+    with reading(path) as h5:
+        root = {key: attribute_value(value) for key, value in h5.attrs.items()}
+        cases = []
+        for name in case_names(h5):
+            group = h5[f"cases/{name}"]
+            time_s = group["time"][()] if "time" in group else None
+            cases.append({"name": name,
+                          "attrs": {k: attribute_value(v) for k, v in group.attrs.items()},
+                          "time": time_s})
+        items: list[_Item] = []
+        for top in h5:
+            if top == "cases":
+                continue
+            obj = h5[top]
+            if hasattr(obj, "shape"):
+                items.append(_item("", top, obj))
+            else:
+                obj.visititems(lambda name, node, top=top: items.append(
+                    _item(top, name, node)) if hasattr(node, "shape") else None)
+        return root, cases, items
+
+
+def _item(top: str, path: str, dataset) -> _Item:
+    raw = dataset[()]
+    if dataset.dtype.kind in "OSU":  # text: an object array of str
+        data = np.empty(np.shape(raw), dtype=object)
+        for index in np.ndindex(data.shape):
+            data[index] = format_value(np.asarray(raw, dtype=object)[index])
+    else:
+        data = np.asarray(raw)
+    return _Item(top, path, str(attribute_value(dataset.attrs.get("units", "")) or ""),
+                 str(attribute_value(dataset.attrs.get("description", "")) or ""), data)
+
+
+# --- Markdown helpers -------------------------------------------------------------------
+
+def _cell(value: Any) -> str:
+    """A table cell: formatted, on one line, with ``|`` escaped."""
+    text = value if isinstance(value, str) else format_value(value)
+    return " ".join(text.split()).replace("|", "\\|")
+
+
+def _table(header: list[str], rows: list[list[Any]]) -> list[str]:
+    lines = ["| " + " | ".join(_cell(h) for h in header) + " |",
+             "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(_cell(value) for value in row) + " |" for row in rows]
+    return lines + [""]
+
+
+def _fenced(text: str, language: str = "text") -> list[str]:
+    """``text`` in a fenced block whose fence is longer than any backtick run inside."""
+    longest = max((len(run) for run in re.findall(r"`+", text)), default=0)
+    fence = "`" * max(3, longest + 1)
+    return [f"{fence}{language}", text.rstrip("\n"), fence, ""]
+
+
+def _code(text: str) -> str:
+    """Inline code that survives backticks in ``text``."""
+    longest = max((len(run) for run in re.findall(r"`+", text)), default=0)
+    fence = "`" * (longest + 1)
+    pad = " " if text.startswith("`") or text.endswith("`") else ""
+    return f"{fence}{pad}{text}{pad}{fence}"
+
+
+def _link(target: Path, folder: Path) -> str:
+    """``target`` relative to ``folder`` as a URL path (``../figures/a.png``)."""
+    relative = os.path.relpath(os.path.abspath(target), os.path.abspath(folder))
+    return quote(Path(relative).as_posix())
+
+
+def _with_unit(name: str, units: str) -> str:
+    return f"{name} [{units}]" if units else name
+
+
+# --- sections ---------------------------------------------------------------------------
+
+def _title_section(path: Path, folder: Path, root: dict[str, Any]) -> list[str]:
+    study = str(root.get("study") or "(no study attribute)")
+    lines = [f"# {study}", "",
+             f"Generated by `flex report` from [{_code(path.name)}]({_link(path, folder)}); "
+             f"every number below is read from that file.", "", "## Study report", ""]
+    report = root.get("summary_report")
+    if isinstance(report, str) and report.strip():
+        return lines + ["The study's printed report (root attribute `summary_report`):", "",
+                        *_fenced(report)]
+    return lines + ["This file has no study report (root attribute `summary_report`): it "
+                    "was written before flex stored one, or by a tool that does not.", ""]
+
+
+def _provenance_section(root: dict[str, Any]) -> list[str]:
+    dirty = {"yes": " (with uncommitted changes)", "no": " (clean)"}.get(
+        str(root.get("git_dirty")), f" (dirty: {root['git_dirty']})" if "git_dirty" in root
+        else "")
+    engines = ", ".join(f"{name} {format_value(root[f'{name}_version'])}" for name in ENGINES
+                        if f"{name}_version" in root)
+    rows: list[list[Any]] = [
+        ["flex_version", root.get("flex_version", "")],
+        ["flex_format", root.get("flex_format", "")],
+        ["git_commit", f"{format_value(root.get('git_commit', 'unknown'))}{dirty}"],
+        ["engines", engines],
+        ["python", root.get("python_version", "")],
+        ["platform", root.get("platform", "")],
+        ["created_utc", root.get("created_utc", "")],
+        ["command", _code(str(root["command"])) if root.get("command") else ""],
+        ["wall_time_s", root.get("wall_time_s", "not recorded")],
+        ["failed_cases", root.get("failed_cases", "not recorded")],
+    ]
+    lines = ["## Provenance", "", *_table(["item", "value"], rows)]
+    others = [[_code(key), value] for key, value in root.items()
+              if key not in PROVENANCE_KEYS and key not in SHOWN_ELSEWHERE]
+    if others:
+        lines += ["Other root attributes:", "", *_table(["attribute", "value"], others)]
+    return lines
+
+
+def _cases_section(cases: list[dict[str, Any]]) -> list[str]:
+    lines = ["## Cases", ""]
+    if not cases:
+        return lines + ["This file has no cases.", ""]
+    counters = _counter_keys(cases)
+    header = ["case", "status", "samples", "t [s]",
+              *(COUNTER_TITLES.get(key, key.replace("_", " ")) for key in counters), "notes"]
+    rows = []
+    for case in cases:
+        attrs, time_s = case["attrs"], case["time"]
+        has_time = time_s is not None and np.ndim(time_s) == 1 and len(time_s)
+        status = str(attrs.get("status", ""))
+        rows.append([_code(case["name"]), status if status == "ok" else f"**{status}**",
+                     len(time_s) if has_time else "-",
+                     f"{format_value(time_s[0])} .. {format_value(time_s[-1])}" if has_time
+                     else "-",
+                     *(attrs.get(f"counter_{key}", "-") for key in counters),
+                     "<br>".join(_case_notes(attrs))])
+    lines += _table(header, rows)
+    return lines + _case_attributes(cases)
+
+
+def _counter_keys(cases: list[dict[str, Any]]) -> list[str]:
+    found = dict.fromkeys(key[len("counter_"):] for case in cases for key in case["attrs"]
+                          if key.startswith("counter_"))
+    return [key for key in COUNTER_TITLES if key in found] + [
+        key for key in found if key not in COUNTER_TITLES]
+
+
+def _fidelity_links(attrs: dict[str, Any]) -> list[str]:
+    return [key[len("fidelity_"):-len("_model")] for key in attrs
+            if key.startswith("fidelity_") and key.endswith("_model")]
+
+
+def _case_notes(attrs: dict[str, Any]) -> list[str]:
+    """Failure message, validity warning and the ``"auto"`` choices, in short form."""
+    notes = []
+    if attrs.get("message"):
+        notes.append(f"message: {attrs['message']}")
+    if attrs.get("validity_warning"):
+        notes.append(f"**validity warning**: {attrs['validity_warning']}")
+    for link in _fidelity_links(attrs):
+        prefix = f"fidelity_{link}_"
+        modes = attrs.get(prefix + "modes")
+        shown = f", {format_value(modes)} modes" if isinstance(modes, int) and modes >= 0 else ""
+        reason = f" ({attrs[prefix + 'reason']})" if attrs.get(prefix + "reason") else ""
+        notes.append(f"fidelity {link}: {format_value(attrs[prefix + 'model'])}{shown}{reason}")
+    if attrs.get("solver_defaults_entry"):
+        reason = attrs.get("solver_defaults_reason")
+        notes.append(f"solver defaults: {attrs['solver_defaults_entry']}"
+                     + (f" ({reason})" if reason else "")
+                     + (f": {attrs['solver_defaults_keys']}"
+                        if attrs.get("solver_defaults_keys") else ""))
+    return notes
+
+
+def _shown_in_notes(key: str, attrs: dict[str, Any]) -> bool:
+    if key in CASE_KNOWN or key.startswith("counter_") or key.startswith("solver_defaults_"):
+        return True
+    return any(key.startswith(f"fidelity_{link}_") for link in _fidelity_links(attrs))
+
+
+def _case_attributes(cases: list[dict[str, Any]]) -> list[str]:
+    """The case attributes not in the cases table: one column each (up to 8), else one
+    list per case."""
+    extra = {case["name"]: {key: value for key, value in case["attrs"].items()
+                            if not _shown_in_notes(key, case["attrs"])} for case in cases}
+    keys = list(dict.fromkeys(key for attrs in extra.values() for key in attrs))
+    if not keys:
+        return []
+    lines = ["Other case attributes:", ""]
+    if len(keys) <= 8:
+        rows = [[_code(name), *(attrs.get(key, "-") for key in keys)]
+                for name, attrs in extra.items() if attrs]
+        return lines + _table(["case", *keys], rows)
+    for name, attrs in extra.items():
+        if attrs:
+            shown = "; ".join(f"{key} = {_cell(value)}" for key, value in attrs.items())
+            lines.append(f"- {_code(name)}: {shown}")
+    return lines + [""]
+
+
+def _data_section(items: list[_Item]) -> list[str]:
+    """Every dataset outside ``/cases``, one subsection per parent group."""
+    lines = ["## Summary", ""]
+    if not any(item.top == "summary" for item in items):
+        lines += ["This file has no `/summary` tables.", ""]
+    groups: dict[str, list[_Item]] = {}
+    for item in items:
+        groups.setdefault(item.group, []).append(item)
+    for group in sorted(groups):  # a group before the groups inside it
+        lines += [f"### {_code(group)}", ""]
+        lines += _group_lines(groups[group])
+    return lines
+
+
+def _group_lines(items: list[_Item]) -> list[str]:
+    """One group: scalars, tables of same-length 1-D arrays, lists, 2-D tables, then the
+    large arrays summarised."""
+    scalars = [item for item in items if item.data.ndim == 0]
+    large = [item for item in items if item.data.ndim > 0 and item.data.size > LARGE]
+    vectors = [item for item in items if item.data.ndim == 1 and item not in large]
+    matrices = [item for item in items if item.data.ndim >= 2 and item not in large]
+    lines: list[str] = []
+    if scalars:
+        lines += _table(["name", "value", "unit", "description"],
+                        [[_code(i.name), i.data[()], i.units, i.description] for i in scalars])
+    lengths = Counter(len(item.data) for item in vectors)
+    for length in dict.fromkeys(len(item.data) for item in vectors):
+        members = [item for item in vectors if len(item.data) == length]
+        if lengths[length] >= 2 and length > 0:
+            lines += _columns_table(members)
+        else:
+            lines += [_vector_line(item) for item in members] + [""]
+    for item in matrices:
+        lines += _matrix_table(item)
+    if large:
+        lines += [f"Large arrays (more than {LARGE} elements), summarised:", ""]
+        lines += _table(["name", "shape", "min", "max", "unit", "description"],
+                        [_large_row(item) for item in large])
+    return lines
+
+
+def _columns_table(items: list[_Item]) -> list[str]:
+    """1-D arrays of one length as the columns of one table (short text first, as row
+    labels; long text last), then what each column is."""
+    def order(item: _Item) -> int:
+        if not item.is_text:
+            return 1
+        return 0 if max(len(str(value)) for value in item.data) <= 40 else 2
+
+    items = sorted(items, key=order)
+    header = [_with_unit(item.name, "" if item.is_text else item.units) for item in items]
+    rows = [[item.data[row] for item in items] for row in range(len(items[0].data))]
+    lines = _table(header, rows)
+    legend = [f"{_code(item.name)}: {_cell(item.description)}" for item in items
+              if item.description and item.description != item.name]
+    return lines + ([f"Columns: {'; '.join(legend)}.", ""] if legend else [])
+
+
+def _vector_line(item: _Item) -> str:
+    values = ", ".join(_cell(value) for value in item.data) if len(item.data) else "(empty)"
+    about = f" ({item.description})" if item.description else ""
+    return f"- {_code(item.name)} [{item.units or '-'}]{about}: {values}"
+
+
+def _matrix_table(item: _Item) -> list[str]:
+    """A small array of 2 or more dimensions: one row per index of its first axis."""
+    data = item.data.reshape(item.data.shape[0], -1) if item.data.shape[0] else item.data
+    about = f": {item.description}" if item.description else ""
+    lines = [f"{_code(item.name)} [{item.units or '-'}], shape {item.data.shape}{about}", ""]
+    if data.size == 0:
+        return lines + ["(empty)", ""]
+    header = ["row", *(f"[{column}]" for column in range(data.shape[1]))]
+    return lines + _table(header, [[row, *data[row]] for row in range(data.shape[0])])
+
+
+def _large_row(item: _Item) -> list[Any]:
+    shape = str(item.data.shape)
+    if item.is_text:
+        return [_code(item.name), shape, "(text)", "(text)", item.units, item.description]
+    values = item.data.astype(float) if item.data.dtype.kind == "b" else item.data
+    finite = values[np.isfinite(values)]
+    bad = values.size - finite.size
+    if bad:
+        shape += f", {bad} non-finite"
+    low, high = (finite.min(), finite.max()) if finite.size else ("-", "-")
+    if item.data.dtype.kind == "b" and finite.size:
+        low, high = bool(low), bool(high)
+    return [_code(item.name), shape, low, high, item.units, item.description]
+
+
+def _figures_section(path: Path, folder: Path) -> list[str]:
+    """Every ``figures/<stem>-*.png`` beside the result file (not those of another result
+    file beside it whose name starts with ``<stem>-``)."""
+    lines = ["## Figures", ""]
+    figures = _figures_of(path)
+    if not figures:
+        return lines + [f"No figures `{figures_folder(Path(path.name)).as_posix()}/"
+                        f"{path.stem}-*.png` beside the file.", ""]
+    for figure in figures:
+        lines += [f"![{figure.stem[len(path.stem) + 1:]}]({_link(figure, folder)})", ""]
+    return lines
+
+
+def _figures_of(path: Path) -> list[Path]:
+    import glob
+
+    folder = figures_folder(path)
+    try:
+        found = sorted(Path(name) for name in glob.glob(
+            os.path.join(glob.escape(str(folder)), f"{glob.escape(path.stem)}-*.png")))
+        longer = [other.stem for other in path.parent.iterdir()
+                  if other.suffix in RESULT_SUFFIXES and other.stem.startswith(f"{path.stem}-")]
+    except OSError:
+        return []
+    return [figure for figure in found if figure.is_file()
+            and not any(figure.name.startswith(f"{stem}-") for stem in longer)]
+
+
+def _scene_section(scene_toml: str) -> list[str]:
+    if not scene_toml.strip():
+        return []
+    return ["## Scene", "", "<details><summary>The study's scene (root attribute "
+            "<code>scene_toml</code>)</summary>", "", *_fenced(scene_toml, "toml"),
+            "</details>", ""]
