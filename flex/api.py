@@ -31,8 +31,6 @@ Conventions shared by every function here:
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -153,26 +151,13 @@ def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
     return derived
 
 
-def _implementation():
-    """The simulate function of this version of flex: :func:`flex.simulation.simulate` when
-    that module exists (``model = "auto"`` resolved, then integrated), else the older
-    :func:`flex.solver.simulate`."""
-    if importlib.util.find_spec("flex.fidelity.simulation") is not None:
-        return importlib.import_module("flex.fidelity.simulation").simulate
-    solver = importlib.import_module("flex.dynamics.solver")
-    if not hasattr(solver, "simulate"):
-        raise ImportError("flex.simulate: neither flex.simulation.simulate nor "
-                          "flex.solver.simulate exists in this copy of flex")
-    return solver.simulate
-
-
 def simulate(scene: Scene, name: str = "case", **options: Any) -> CaseResult:
     """Simulate one scene in memory and return its curves (nothing is written to disk
     except the reduction cache).
 
     What runs is exactly the scene: ``model = "auto"`` links are decided first (a rigid probe
     run and the fitted criterion; the choice and its reason are printed to stderr), then
-    ``"auto"`` solver keys are filled by model (``flex/solver_defaults.toml``), then the
+    ``"auto"`` solver keys are filled by model (``flex/config/solver_defaults.toml``), then the
     mechanism is built in Exudyn and integrated at a fixed step from t = 0 to
     ``simulation.end_time_s``. A flexible (``ffrf``) link's Craig-Bampton reduction is built
     with NGsolve or read from the cache (``~/.cache/flex/reductions``, ``FLEX_CACHE_DIR``).
@@ -202,7 +187,9 @@ def simulate(scene: Scene, name: str = "case", **options: Any) -> CaseResult:
         exploding constraint norm; the message names the step and the time and what may
         help); :class:`ImportError` only in a broken installation.
     """
-    return _implementation()(scene, name, **options)
+    from flex.fidelity.simulation import simulate as simulate_scene
+
+    return simulate_scene(scene, name, **options)
 
 
 def run_study(name: str, source: str | Path | None = None, overrides: Overrides | None = None,
