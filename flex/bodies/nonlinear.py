@@ -60,7 +60,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.bodies.plate import plate_mesh
+from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction import (
     END_A,
     END_B,
@@ -76,7 +76,7 @@ PROGRESS_INTERVAL_S = 10.0
 
 
 @dataclass
-class NonlinearPlate:
+class NonlinearPlate(PlateLink):
     """A meshed plate ready for :func:`add_nonlinear_fe_coupler` (sizes in metres).
 
     Node index arrays refer to the mesh nodes (the order of ``FEMinterface`` and of the
@@ -87,23 +87,7 @@ class NonlinearPlate:
     """
 
     mesh: Any  #: ngsolve.Mesh, made second order by the import (do not import it again)
-    length_m: float
-    thickness_m: float
-    width_m: float
-    youngs_modulus_Pa: float
-    density_kg_per_m3: float
-    poisson_ratio: float
-    mesh_size_m: float
     node_positions_m: np.ndarray  #: (n_nodes, 3) reference positions, body coordinates
-    nodes_end_a: np.ndarray
-    weights_end_a: np.ndarray
-    nodes_end_b: np.ndarray
-    weights_end_b: np.ndarray
-    nodes_mid: np.ndarray
-    weights_mid: np.ndarray
-    centre_end_a: np.ndarray
-    centre_end_b: np.ndarray
-    centre_mid: np.ndarray
     mass_matrix: Any  #: scipy CSR, consistent mass [kg], Exudyn order (x, y, z per node)
     mass_kg: float  #: from the consistent mass matrix
     n_elements: int  #: second-order tetrahedra

@@ -7,6 +7,10 @@ z across the width (out of the mechanism plane). The origin is the centre of ``e
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+import numpy as np
+
 from flex.base.errors import SceneError
 
 
@@ -29,3 +33,28 @@ def plate_mesh(length_m: float, thickness_m: float, width_m: float, mesh_size_m:
     box.faces.Max(X).name = "end_b"
     mesh = ngs.Mesh(OCCGeometry(box).GenerateMesh(maxh=mesh_size_m))
     return mesh
+
+
+@dataclass
+class PlateLink:
+    """A meshed plate link: its sizes [m] and material, and the node sets of its two joint
+    faces (``end_a``, ``end_b``) and its mid-length slab (``mid``): mesh node indices and
+    weights summing to 1, ``centre_*`` their weighted reference positions in body
+    coordinates [m]. The FFRF reduction and the nonlinear FE plate extend it."""
+
+    length_m: float
+    thickness_m: float
+    width_m: float
+    youngs_modulus_Pa: float
+    density_kg_per_m3: float
+    poisson_ratio: float
+    mesh_size_m: float
+    nodes_end_a: np.ndarray
+    weights_end_a: np.ndarray
+    nodes_end_b: np.ndarray
+    weights_end_b: np.ndarray
+    nodes_mid: np.ndarray
+    weights_mid: np.ndarray
+    centre_end_a: np.ndarray
+    centre_end_b: np.ndarray
+    centre_mid: np.ndarray

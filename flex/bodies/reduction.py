@@ -38,7 +38,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.bodies.plate import plate_mesh
+from flex.bodies.plate import PlateLink, plate_mesh
 
 #: Bump when the content or layout of a cache file changes; old entries are then rebuilt.
 CACHE_FORMAT_VERSION = 1
@@ -55,7 +55,7 @@ _STATIC_MODES = 6  # of end_b: 3 translations + 3 rotations of the rigid face
 # result type
 # ------------------------------------------------------------------------------------------
 @dataclass
-class Reduction:
+class Reduction(PlateLink):
     """A reduced flexible plate link, ready for :func:`add_ffrf_link`.
 
     Node index arrays refer to ``fem``'s mesh nodes; weights sum to 1. ``centre_*`` are the
@@ -64,23 +64,7 @@ class Reduction:
     """
 
     fem: Any  #: exudyn.FEM.FEMinterface holding mesh, M, K, mode basis, stress modes
-    length_m: float
-    thickness_m: float
-    width_m: float
-    youngs_modulus_Pa: float
-    density_kg_per_m3: float
-    poisson_ratio: float
-    mesh_size_m: float
     modes: int  #: number of fixed-interface eigenmodes (the reduced body has 6 more)
-    nodes_end_a: np.ndarray
-    weights_end_a: np.ndarray
-    nodes_end_b: np.ndarray
-    weights_end_b: np.ndarray
-    nodes_mid: np.ndarray
-    weights_mid: np.ndarray
-    centre_end_a: np.ndarray  #: [m], (0, 0, 0) by construction
-    centre_end_b: np.ndarray  #: [m], (length, 0, 0) by construction
-    centre_mid: np.ndarray  #: [m], (length/2, 0, 0) unless the mesh forbade it (see _mid_set)
     fixed_interface_frequencies_Hz: np.ndarray  #: both end faces clamped
     pinned_pinned_frequency_Hz: float  #: first in-plane bending mode, ends pinned about z
     mass_kg: float  #: [kg]
