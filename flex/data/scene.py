@@ -608,19 +608,17 @@ def check_meshed_plate(link: str, values: dict[str, Any]) -> None:
         return (f"; i.e. {link}.mass_kg {relation} {mass:g} kg at its density_kg_per_m3, "
                 f"length_m and width_m")
 
-    thinnest, thickest = length / PLATE_SLENDERNESS_LIMIT, length / PLATE_STUBBINESS_LIMIT
-    if thickness < thinnest * (1 - 1e-9):
-        raise SceneError(f"{name} = {thickness:g}: a meshed plate link must be at "
-                         f"least {link}.length_m / {PLATE_SLENDERNESS_LIMIT:g} = "
-                         f"{thinnest:g} m thick ({why}){as_mass('>=', thinnest)}; "
-                         "thinner, it is a foil that buckles under any load the mechanism "
-                         "carries")
-    if thickness > thickest * (1 + 1e-9):
-        raise SceneError(f"{name} = {thickness:g}: a meshed plate link must be at "
-                         f"most {link}.length_m / {PLATE_STUBBINESS_LIMIT:g} = "
-                         f"{thickest:g} m thick ({why}){as_mass('<=', thickest)}; "
-                         "thicker, the rigid joint faces reach its midpoint (Saint-Venant) "
-                         "and its deflection and stress mean nothing")
+    for word, ratio, relation, outside, meaning in (
+            ("least", PLATE_SLENDERNESS_LIMIT, ">=", -1,
+             "thinner, it is a foil that buckles under any load the mechanism carries"),
+            ("most", PLATE_STUBBINESS_LIMIT, "<=", 1,
+             "thicker, the rigid joint faces reach its midpoint (Saint-Venant) and its "
+             "deflection and stress mean nothing")):
+        bound = length / ratio
+        if outside * (thickness - bound * (1 + outside * 1e-9)) > 0:
+            raise SceneError(f"{name} = {thickness:g}: a meshed plate link must be at "
+                             f"{word} {link}.length_m / {ratio:g} = {bound:g} m thick "
+                             f"({why}){as_mass(relation, bound)}; {meaning}")
     if mesh > length * (1 + 1e-9):
         raise SceneError(f"{link}.mesh_size_m = {mesh:g} must be <= {link}.length_m = "
                          f"{length:g} ({why}); about 1-2 x thickness_m is accurate")
