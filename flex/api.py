@@ -16,17 +16,17 @@ Conventions shared by every function here:
   (``length_m`` [m], ``mass_kg`` [kg], ``inertia_kgm2`` [kg m^2], ``initial_angle_deg``
   [deg], ``spring_stiffness_N_per_m`` [N/m], ``end_time_s`` [s], ``youngs_modulus_Pa``
   [Pa], ...; no suffix: dimensionless or a choice). The accepted keys, types and ranges are
-  :data:`flex.scene.SCHEMA`; ``python -m flex scene simulate`` prints a full scene.
+  :data:`flex.data.scene.SCHEMA`; ``python -m flex scene simulate`` prints a full scene.
 - **Overrides** are either a list of ``"section.key=value"`` strings (the value in TOML
   syntax, as ``--set`` takes them: ``"coupler.model=ffrf"``, ``"simulation.end_time_s=0.01"``)
   or a ``dict``, flat (``{"drive.spring_preload_m": 0.011}``) or by section
   (``{"drive": {"spring_preload_m": 0.011}}``), with Python values (str, int, float, bool;
   numpy scalars accepted).
-- Every problem a user can fix raises a :class:`flex.errors.FlexError` subclass whose message
-  is one line naming the key or file and the accepted range: :class:`~flex.errors.SceneError`
-  (a scene or override), :class:`~flex.errors.SimulationError` (a run diverged; the message
-  names the step and the time), :class:`~flex.errors.ResultFileError` (a result file),
-  :class:`~flex.errors.OutputError` (an output that cannot be written).
+- Every problem a user can fix raises a :class:`flex.base.errors.FlexError` subclass whose message
+  is one line naming the key or file and the accepted range: :class:`~flex.base.errors.SceneError`
+  (a scene or override), :class:`~flex.base.errors.SimulationError` (a run diverged; the message
+  names the step and the time), :class:`~flex.base.errors.ResultFileError` (a result file),
+  :class:`~flex.base.errors.OutputError` (an output that cannot be written).
 """
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ Overrides = list[str] | tuple[str, ...] | Mapping[str, Any]
 def override_strings(overrides: Overrides | None) -> list[str]:
     """``overrides`` (see the module doc) as ``"section.key=value"`` strings (TOML values).
 
-    Raises :class:`~flex.errors.SceneError` for a key that is not ``section.key`` or a value
+    Raises :class:`~flex.base.errors.SceneError` for a key that is not ``section.key`` or a value
     TOML cannot hold (``None``, an object), :class:`TypeError` when ``overrides`` is neither
     a list of strings nor a mapping.
     """
@@ -113,7 +113,7 @@ def load_scene(source: str | Path | None = None, overrides: Overrides | None = N
         ``"auto"`` values (``coupler.model``, ``simulation.step_s``, ...) are kept as
         written; :func:`simulate` resolves them.
     Errors:
-        :class:`~flex.errors.SceneError`: the file is missing, unreadable, not UTF-8 or not
+        :class:`~flex.base.errors.SceneError`: the file is missing, unreadable, not UTF-8 or not
         TOML; an unknown section or key; a wrong type; a non-finite or out-of-range number;
         a linkage that cannot assemble (crank not shorter than coupler, slide line too far);
         inconsistent step settings; a plate that cannot be meshed sensibly.
@@ -127,8 +127,8 @@ def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
     """A new scene: ``scene`` with ``overrides`` applied, validated as a whole.
 
     The one way to edit a scene in a script: the same parsing as ``--set``
-    (:func:`flex.scene.apply_overrides`) and the same checks as :func:`load_scene`
-    (:func:`flex.scene.validate`), so a derived scene is exactly what the command line would
+    (:func:`flex.data.scene.apply_overrides`) and the same checks as :func:`load_scene`
+    (:func:`flex.data.scene.validate`), so a derived scene is exactly what the command line would
     run with ``--set``.
 
     Inputs:
@@ -140,7 +140,7 @@ def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
     Output:
         the derived scene (a deep copy; ``"auto"`` values kept as written).
     Errors:
-        :class:`~flex.errors.SceneError` as :func:`load_scene` (unknown key, type, range,
+        :class:`~flex.base.errors.SceneError` as :func:`load_scene` (unknown key, type, range,
         linkage, ...), or for an override that is not ``section.key=value``;
         :class:`TypeError` when ``overrides`` is neither a list of strings nor a mapping.
     """
@@ -165,13 +165,13 @@ def simulate(scene: Scene, name: str = "case", **options: Any) -> CaseResult:
     Inputs:
         scene: a validated scene (:func:`load_scene`, :func:`derive_scene`).
         name: the case name stored with the result (default ``"case"``).
-        options: passed on to :func:`flex.simulation.simulate` (``reduction=``,
+        options: passed on to :func:`flex.fidelity.simulation.simulate` (``reduction=``,
             ``crank_reduction=``: prebuilt reductions; ``criterion=``, ``crank_criterion=``:
-            another fitted law for ``auto``, :func:`flex.criteria.load_criterion`); not
+            another fitted law for ``auto``, :func:`flex.fidelity.criteria.load_criterion`); not
             needed for ordinary use.
     Output:
-        a :class:`flex.results.CaseResult`: ``status == "ok"``; ``datasets`` maps paths of
-        the result layout to :class:`flex.results.Dataset` (``.data`` a numpy array,
+        a :class:`flex.data.results.CaseResult`: ``status == "ok"``; ``datasets`` maps paths of
+        the result layout to :class:`flex.data.results.Dataset` (``.data`` a numpy array,
         ``.units``, ``.description``): ``"time"`` [s], ``"crank/angle"`` [rad],
         ``"crank/angular_velocity"`` [rad/s], ``"slider/position"`` [m],
         ``"joints/B/force_on_coupler"`` [N] (n, 2), ``"energy/total"`` [J], ...
@@ -180,10 +180,10 @@ def simulate(scene: Scene, name: str = "case", **options: Any) -> CaseResult:
         linear FFRF link deflects too far to be trusted; ``scene_toml`` is the resolved
         scene; ``counters`` steps, Newton iterations and wall time [s].
     Errors:
-        :class:`~flex.errors.SceneError`: the scene cannot run as given (too many steps, an
+        :class:`~flex.base.errors.SceneError`: the scene cannot run as given (too many steps, an
         output interval that is not a multiple of the step, a plate too large to mesh,
         ``auto`` refused: a lumped link, compression near buckling, ...);
-        :class:`~flex.errors.SimulationError`: the run diverged (Newton failure, NaN,
+        :class:`~flex.base.errors.SimulationError`: the run diverged (Newton failure, NaN,
         exploding constraint norm; the message names the step and the time and what may
         help); :class:`ImportError` only in a broken installation.
     """
@@ -196,7 +196,7 @@ def run_study(name: str, source: str | Path | None = None, overrides: Overrides 
               out: str | Path | None = None, figures: bool = True, quiet: bool = False,
               **options: Any) -> StudyOutput:
     """Run a study as ``flex run`` does: its cases, its HDF5 file, its figures and report
-    (``reports/<stem>.md`` beside the file, :mod:`flex.report`).
+    (``reports/<stem>.md`` beside the file, :mod:`flex.tools.report`).
 
     Inputs:
         name: a study, one of :data:`flex.study.STUDIES` (``"simulate"`` runs exactly the
@@ -217,10 +217,10 @@ def run_study(name: str, source: str | Path | None = None, overrides: Overrides 
         and an existing file at ``out``, it goes beside it as ``<name>.failed.h5``. Failed
         cases do not raise: check ``as_expected`` or each case's ``status``.
     Errors:
-        :class:`~flex.errors.FlexError` before anything runs: an unknown study, a bad scene
-        or override (:class:`~flex.errors.SceneError`, also for a key the study would not
+        :class:`~flex.base.errors.FlexError` before anything runs: an unknown study, a bad scene
+        or override (:class:`~flex.base.errors.SceneError`, also for a key the study would not
         use), an output that cannot be written or would overwrite an input
-        (:class:`~flex.errors.OutputError`); :class:`flex.study.Interrupted` (a
+        (:class:`~flex.base.errors.OutputError`); :class:`flex.study.Interrupted` (a
         :class:`KeyboardInterrupt`) on Ctrl-C, naming the files already written.
     """
     from flex.study import run_study as _run
@@ -241,11 +241,11 @@ def open_result(path: str | Path, case: str | None = None) -> xarray.Dataset:
         the case (``ds["crank/angle"]``), each with ``units``, ``description`` and
         ``long_name`` attributes (so ``.plot()`` labels its axes); two-column curves have a
         dimension ``xy`` (``"x"``, ``"y"``). ``ds.attrs`` hold the case's attributes and
-        the file's provenance (prefixed ``file_``). See :func:`flex.results.to_xarray`.
+        the file's provenance (prefixed ``file_``). See :func:`flex.data.results.to_xarray`.
     Errors:
-        :class:`~flex.errors.ResultFileError`: the file is missing, truncated, not HDF5 or
+        :class:`~flex.base.errors.ResultFileError`: the file is missing, truncated, not HDF5 or
         not written by flex, or xarray is not installed (``pip install xarray``);
-        :class:`flex.results.ResultPathError` (a ResultFileError): no such case, or no
+        :class:`flex.data.results.ResultPathError` (a ResultFileError): no such case, or no
         ``case`` given for a file with several cases (the message lists them).
     """
     from flex.data.results import to_xarray

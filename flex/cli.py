@@ -2,7 +2,7 @@
 
 Every user error (bad scene key, impossible geometry, bad result file, an output that
 cannot be written) is printed as one line ``flex: error: ...`` and exits with status 2; no
-traceback. The exit statuses are those of :mod:`flex.errors`.
+traceback. The exit statuses are those of :mod:`flex.base.errors`.
 """
 
 from __future__ import annotations
@@ -201,7 +201,7 @@ def _auto_note(scene) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point; returns the process exit status (:mod:`flex.errors`). No exception
+    """Entry point; returns the process exit status (:mod:`flex.base.errors`). No exception
     leaves it: a bug prints one ``flex: internal error`` line and returns 3 (``FLEX_DEBUG=1``
     shows the traceback)."""
     received: list[int] = []
@@ -243,7 +243,7 @@ def _one_line(text: str, limit: int = 1000) -> str:
 
 
 def _catch_signals(received: list[int]):
-    """SIGINT raises KeyboardInterrupt and SIGTERM :class:`~flex.errors.Terminated` (a
+    """SIGINT raises KeyboardInterrupt and SIGTERM :class:`~flex.base.errors.Terminated` (a
     KeyboardInterrupt, so a terminated run cleans up like Ctrl-C); each is noted in
     ``received``. Returns the function restoring the previous handlers."""
     import signal

@@ -131,10 +131,10 @@ def progress_printer(stream=None) -> Callable[[str, int, int], None]:
 def check_cases(module: ModuleType, scenes: dict[str, Scene],
                 given: dict[str, object] | None = None) -> None:
     """Refuse (:class:`SceneError`), before any case runs, a case scene that cannot run or
-    would mean nothing (:func:`flex.settings.check_runnable`), and a value the user gave
-    (``given``: ``{"section.key": value}``, :func:`flex.usage.explicit_keys`) that no case
+    would mean nothing (:func:`flex.config.settings.check_runnable`), and a value the user gave
+    (``given``: ``{"section.key": value}``, :func:`flex.config.usage.explicit_keys`) that no case
     uses: one the study sets itself in each case, or one no case's models read
-    (:func:`flex.usage.unused_keys`, minus the keys the study declares it reads itself in
+    (:func:`flex.config.usage.unused_keys`, minus the keys the study declares it reads itself in
     ``READS``)."""
     for scene in scenes.values():
         check_runnable(scene)
@@ -179,14 +179,14 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
               sweep: Any = None) -> StudyOutput:
     """Run study ``name``, write its HDF5 file (default ``results/<name>.h5``) and figures
     (``figures/<file stem>-*.png`` beside it) and its report (``reports/<file stem>.md``
-    beside it, generated from the file: :func:`flex.report.write_report`), print the
+    beside it, generated from the file: :func:`flex.tools.report.write_report`), print the
     study's report, and return the output.
     ``sweep``: where and how a sweep study runs (:class:`flex.sweep.SweepSettings`).
 
-    Nothing is lost: the output is checked before any case runs (:func:`flex.outputs.
+    Nothing is lost: the output is checked before any case runs (:func:`flex.data.outputs.
     check_output`); a run that does not end as the study declares (an unexpected failed
     case) does not replace an existing result file but is written beside it
-    (:func:`flex.outputs.failed_path`); figures are drawn only for a run that ended as
+    (:func:`flex.data.outputs.failed_path`); figures are drawn only for a run that ended as
     declared. Failed cases are reported on
     stderr, also with ``quiet``. An interrupt raises :class:`Interrupted` saying which files
     were already written.

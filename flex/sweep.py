@@ -11,7 +11,7 @@ sweep and returns the results. Contract:
   process, one case after the other (debugging). The case function and its arguments
   must be importable/picklable (a module-level function; ``flex`` installed on the workers).
 - **pure cases, own files**: each case is a function of its scene alone; its result is
-  written (by this process, atomically, :func:`flex.results.write_results`) to
+  written (by this process, atomically, :func:`flex.data.results.write_results`) to
   ``<folder>/cases/<name>.h5`` as soon as it arrives, with the hash of its scene and case
   function. A rerun **resumes**: cases whose file holds the same hash are read back, not
   run; ``retry_failed`` reruns the recorded failures too.
@@ -65,7 +65,7 @@ SWEEP_FORMAT = "flex-sweep-case/1"
 # the default case function
 # ------------------------------------------------------------------------------------------
 def simulate_scene_case(name: str, scene: Scene) -> CaseResult:
-    """The default case: :func:`flex.solver.simulate_case` of the scene (never raises for a
+    """The default case: :func:`flex.dynamics.solver.simulate_case` of the scene (never raises for a
     diverged run: that is a ``failed`` case)."""
     from flex.fidelity.simulation import simulate_case
 
@@ -291,7 +291,7 @@ def _text(value: Any) -> Any:
 def read_case_file(path: str | Path) -> tuple[CaseResult, str]:
     """The :class:`CaseResult` stored in a case file and its case hash.
 
-    Raises :class:`flex.errors.ResultFileError` for a missing or damaged file.
+    Raises :class:`flex.base.errors.ResultFileError` for a missing or damaged file.
     """
     import h5py
 

@@ -2,7 +2,7 @@
 
 Every number is measured by this run, on whatever else the machine is doing: wall times are
 medians of :data:`REPEATS` runs, and each comparison is a ratio of two times measured here
-(:mod:`flex.benchmark`).
+(:mod:`flex.experiments.benchmark`).
 
 - ``rigid``: the thesis deployment (0.03 s) at 1e-7 rad crank-angle accuracy. The reference
   is the scipy DAE at rtol 1e-13 (shown converged by rtol 1e-12 and by flex at h = 1e-6 s).
@@ -21,7 +21,7 @@ medians of :data:`REPEATS` runs, and each comparison is a ratio of two times mea
 
 Stored: one case per timed configuration (attrs: knobs, errors, counters; dataset
 ``wall_times``) and ``/summary/table`` (the printed table) plus ``/summary/<part>/...``
-(:mod:`flex.benchmark_report`).
+(:mod:`flex.experiments.benchmark_report`).
 """
 
 from __future__ import annotations
@@ -117,7 +117,8 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               notes: dict[str, Any] | None = None) -> Summary:
-    """The table and the per-part datasets (:func:`flex.benchmark_report.bench_summary`)."""
+    """The table and the per-part datasets
+    (:func:`flex.experiments.benchmark_report.bench_summary`)."""
     return Summary(*bench_summary(notes or {}, PLAN))
 
 

@@ -3,14 +3,15 @@
 The thesis models only the coupler as flexible. flex also meshes the crank (a steel plate
 A-B, ``[crank] geometry = "plate"``, reduced like the coupler) and lets ``auto`` choose
 rigid or FFRF for it from a fitted criterion, with the crank's first in-plane elastic
-frequency in the assembled mechanism (:func:`flex.criteria.crank_elastic_omega`). Without a
+frequency in the assembled mechanism (:func:`flex.fidelity.criteria.crank_elastic_omega`). Without a
 wing that is the plate's pinned-pinned frequency; with the wing welded at A the crank is a
 cantilever from the wing carrying coupler and slider at B, an order of magnitude softer.
 
 The kfit law, fitted on couplers, under-predicts the error of a rigid crank that carries
 the wing (measured about 2x at equal n: at the same n the wing makes the crank a cantilever
 under a larger quasi-static load). So the crank gets its own law, through the same pipeline
-as the coupler's (:mod:`flex.lawfit`, the crank's half in :mod:`flex.crankfit`). Phase 1
+as the coupler's (:mod:`flex.experiments.lawfit`, the crank's half in
+:mod:`flex.experiments.crankfit`). Phase 1
 (fit): crank thicknesses 0.8-5 mm x two spring rates, all with the wing (the harder case;
 cranks without a wing err less at equal n, so the law is conservative for them), each run
 rigid and as the full model, an FFRF crank with 12 modes; the governing error against n is

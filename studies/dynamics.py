@@ -9,8 +9,10 @@ these two readings are run as named cases:
 - ``preload_11mm``: spring compressed 0.011 m, so the slider travels 0.022 m in the half
   swing (sec. 5.5.1 reading; the thesis never states this preload).
 
-Each case is also solved by the independent 9-coordinate DAE (:mod:`flex.reference`) and the
-deviation stored; the thesis comparison table (:mod:`flex.deployment`) is printed and stored
+Each case is also solved by the independent 9-coordinate DAE (:mod:`flex.dynamics.reference`) and
+the
+deviation stored; the thesis comparison table (:mod:`flex.experiments.deployment`) is printed and
+stored
 under ``/summary``.
 """
 

@@ -4,7 +4,7 @@ The coupler becomes a steel plate 0.08 x 0.01 x t (Table 5, models 0-3: t = 1, 3
 modelled twice in the same mechanism: as a floating-frame-of-reference body (NGsolve mesh,
 Hurty-Craig-Bampton reduction with the joint faces as interfaces) and as its rigid twin, a
 rigid body with the plate's own mass and inertia, so the pair differs only by elasticity
-(:mod:`flex.twins`). The spring deployment is the thesis scene (22 mm preload reading,
+(:mod:`flex.experiments.twins`). The spring deployment is the thesis scene (22 mm preload reading,
 undamped).
 
 Stored per case: the rigid-body quantities, ``coupler/midpoint_deflection`` (elastic,
@@ -15,12 +15,12 @@ deviations of the FFRF run from its rigid twin, and n = delta_t / T in both peri
 conventions (thesis: T = 1/omega; physical: T = 2 pi / omega).
 
 Accuracy reference: the thinnest model also runs with the fully nonlinear FE coupler
-(:mod:`flex.nonlinear`: the same mesh, Green-Lagrange strain, no reduction) over
+(:mod:`flex.bodies.nonlinear`: the same mesh, Green-Lagrange strain, no reduction) over
 ``NONLINEAR_END_TIME_S`` (default: the whole deployment); ``/summary/nonlinear_reference/
 <model>`` holds its first and largest deflection peaks against the FFRF run's over the same
 span, the largest difference of the two curves, the axial load of the link against its
 Euler load (the geometric softening the linear FFRF body leaves out) and both wall times
-(:mod:`flex.softening`).
+(:mod:`flex.fidelity.softening`).
 """
 
 from __future__ import annotations

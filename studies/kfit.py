@@ -2,7 +2,7 @@
 
 Each case is one steel-plate coupler scene run twice with the same integrator settings: as
 an FFRF body (6 static + 6 fixed-interface Craig-Bampton modes) and as its rigid twin (same
-mass and inertia). The error measures of :mod:`flex.criteria` compare the two over the
+mass and inertia). The error measures of :mod:`flex.fidelity.criteria` compare the two over the
 deployment (t <= delta_t_stop). Families of cases:
 
 - ``thk_*``: coupler thickness 0.5-12 mm (20 log-spaced values plus Table 5's 1, 3, 5,
@@ -20,9 +20,10 @@ deployment (t <= delta_t_stop). Families of cases:
   ``coupler.model = "auto"``, each against a full FFRF run (12 modes), using the law
   just fitted.
 
-Mesh, time step and end time per case: :func:`flex.couplerfit.tuned`. The pipeline (fit
-cases, laws, criterion, validation) is :mod:`flex.lawfit`'s, with the coupler's cases,
-fit and summary from :mod:`flex.couplerfit` and its figures from :mod:`flex.lawplots`.
+Mesh, time step and end time per case: :func:`flex.experiments.couplerfit.tuned`. The pipeline (fit
+cases, laws, criterion, validation) is :mod:`flex.experiments.lawfit`'s, with the coupler's cases,
+fit and summary from :mod:`flex.experiments.couplerfit` and its figures from
+:mod:`flex.experiments.lawplots`.
 
 Every case's file is ``<sweep folder>/cases/<case>.h5`` (default ``results/kfit-cases``);
 the sweep resumes from them. The fit (``results/kfit-criterion.toml``) is what
@@ -62,7 +63,7 @@ THICKNESSES_M = tuple(sorted({round(float(t), 6) for t in np.geomspace(0.5e-3, 1
 STIFFNESS_THICKNESSES_M = (0.5e-3, 1e-3, 3e-3)
 STIFFNESSES_N_PER_M = (150.0, 500.0, 5000.0, 15000.0, 50000.0)
 #: fast deployments of thicker plates: (thickness, spring rate); preload from
-#: flex.couplerfit.FAST_EULER_RATIO
+#: flex.experiments.couplerfit.FAST_EULER_RATIO
 FAST_CASES = ((3e-3, 1.5e5), (3e-3, 5e5), (5e-3, 5e5), (5e-3, 1.5e6), (10e-3, 5e6))
 PRELOAD_THICKNESSES_M = (0.826e-3, 1e-3, 1.91e-3, 3e-3, 5.2e-3)
 PRELOADS_M = (0.011, 0.016, 0.033)
@@ -95,7 +96,8 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
-    """The :mod:`flex.lawfit` pipeline on the sweep engine (``run.sweep``: where and how;
+    """The :mod:`flex.experiments.lawfit` pipeline on the sweep engine (``run.sweep``: where and
+    how;
     None: a process pool on all cores, ``results/kfit-cases``); the criterion goes beside
     the case folder (``kfit-criterion.toml``)."""
     from flex.sweep import SweepSettings, make_executor, run_sweep

@@ -4,7 +4,7 @@ One crank turn per second for 1 s (sec. 4.3; the data sheet's check shows the re
 stroke, velocity and acceleration extremes belong to omega = 2 pi rad/s). Exudyn's slider
 position, velocity and acceleration are compared with the closed-form in-line slider-crank;
 the crank midpoint must trace a circle of radius L1/2; the constraint norm stays at round-off
-(:mod:`flex.constant_speed`).
+(:mod:`flex.experiments.constant_speed`).
 """
 
 from __future__ import annotations

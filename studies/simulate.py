@@ -6,7 +6,8 @@ Every study follows this protocol (:mod:`flex.study`; copy this file to start on
 ``DESCRIPTION``, ``OVERRIDES`` declare it; ``cases(scene)`` names the scenes flex simulates
 and stores (here ``/cases/case/...``); ``summarize`` returns the report and the datasets stored
 under ``/summary``; ``figures`` draws PNGs. Each hook declares, or makes one call into the
-library module of its concept (:mod:`flex.single_case`): no loops, fits or measurements here.
+library module of its concept (:mod:`flex.experiments.single_case`): no loops, fits or measurements
+here.
 """
 
 from __future__ import annotations

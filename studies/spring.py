@@ -3,11 +3,12 @@
 The thesis's spring data are not self-consistent (1500 N/m from d = 4.4 mm, N = 3 needs a
 mean coil diameter near 94 mm, not the stated 150 mm). The study shows which single input
 reproduces 1500 N/m, carries on with the stated consistent design
-(:data:`flex.spring.CONSISTENT_THESIS_SPRING`), and checks it: Wahl- and
+(:data:`flex.bodies.spring.CONSISTENT_THESIS_SPRING`), and checks it: Wahl- and
 Bergstrasser-corrected shear stress at the 22 mm press and at solid against ASTM A228's
 allowable stress; solid length and clash allowance; surge frequency and the thesis's
 rigid-or-flexible ratio n for the spring itself; an NGsolve model of a helix segment for
-the peak stress, compared with Wahl (:mod:`flex.spring_check`). No mechanism is simulated.
+the peak stress, compared with Wahl (:mod:`flex.experiments.spring_check`). No mechanism is
+simulated.
 """
 
 from __future__ import annotations

@@ -21,7 +21,7 @@ the step and the time, with no data. Groups:
 References: rigid -- the scipy DAE (rtol 1e-12, shown converged by rtol 1e-11); FFRF --
 flex's model at a finer step (shown converged by twice that step); constant crank speed --
 the closed-form slider-crank (exact). The references, the judging, the verdict tables, the
-trust boundary and the figures are :mod:`flex.stability`'s.
+trust boundary and the figures are :mod:`flex.experiments.stability`'s.
 """
 
 from __future__ import annotations

@@ -2,19 +2,22 @@
 
 Three scenes of the thesis deployment (22 mm preload, 0.03 s): the rigid Table 1 model
 (``rigid``) and a steel-plate FFRF coupler 1 mm and 10 mm thick (``ffrf_1mm``, ``ffrf_10mm``).
-For each, a converged reference is run and shown converged (:mod:`flex.reference_plans`), then
+For each, a converged reference is run and shown converged
+(:mod:`flex.experiments.reference_plans`), then
 the knobs are varied one at a time around a base setting and in combination (:func:`settings`):
 time step, generalized-alpha spectral radius, index-3 versus index-2 (Newmark) constraints,
 full versus modified Newton and its tolerance, explicit Runge-Kutta with penalty joints
 (rigid), number of modes, mesh size and element order, the fully nonlinear FE coupler instead
 of the FFRF reduction, and the independent scipy reference DAE (rigid) at several tolerances.
 
-Stored (:mod:`flex.workprecision`): per run a case ``<scene>__<setting>`` (a diverged run is a
+Stored (:mod:`flex.experiments.workprecision`): per run a case ``<scene>__<setting>`` (a diverged
+run is a
 ``failed`` case with the step and time in its message and no data); per scene under
-``/summary/<scene>/`` (:mod:`flex.workprecision_report`): ``runs/...`` (with
+``/summary/<scene>/`` (:mod:`flex.experiments.workprecision_report`): ``runs/...`` (with
 ``on_pareto_front``), ``reference/...`` (with its convergence evidence), ``recommended/...``
 (per accuracy level 1 %, 0.1 %, 0.01 %) and ``default/...`` (whether the bundled "auto" solver
-keys are the measured pick, :mod:`flex.defaults_check`). Figures: one work-precision diagram
+keys are the measured pick, :mod:`flex.experiments.defaults_check`). Figures: one work-precision
+diagram
 (error against wall time, log-log, Pareto front marked) per scene.
 """
 
@@ -181,7 +184,7 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 def summarize(scene: Scene, results: dict[str, CaseResult],
               notes: dict[str, Any] | None = None) -> Summary:
     """Per scene the run table, the reference and its evidence, the recommendations and the
-    defaults check (:func:`flex.workprecision_report.summarize_work_precision`)."""
+    defaults check (:func:`flex.experiments.workprecision_report.summarize_work_precision`)."""
     datasets, report = summarize_work_precision((notes or {}).get("runs", {}), cases(scene),
                                                 FFRF_DEFAULT_SCENE)
     return Summary(datasets, report)

@@ -5,13 +5,14 @@ near 7219 deg/s at ~0.008 s; no wing geometry, inertia or spring. flex states a 
 aluminium switchblade plate in the mechanism plane, welded to the crank at the pivot A, the
 ``[wing]`` keys of the scene) and fits the two spring values the thesis leaves open --
 stiffness and preload -- so that the deployment reproduces the reported peak speed and its
-time (:func:`flex.wing.fit_spring`). The deployment time (first crank-angle maximum) is then
+time (:func:`flex.experiments.wing.fit_spring`). The deployment time (first crank-angle maximum) is
+then
 a prediction, compared with the thesis's ~0.017 s.
 
 Reported beside it: the joint loads and the wing-root bending moment; the wing's own
 flexibility (cantilever bending frequencies in and out of plane, the thesis's ratio n, and
 the quasi-static tip deflection under the peak inertial load); and, for the other bodies,
-the ``auto`` fidelity decision of :mod:`flex.criteria` where a fitted criterion exists.
+the ``auto`` fidelity decision of :mod:`flex.fidelity.criteria` where a fitted criterion exists.
 """
 
 from __future__ import annotations

@@ -3,7 +3,7 @@
 Each hostile case asserts (README "When something goes wrong"):
 
 - no traceback, on stdout or stderr;
-- the documented exit status (:mod:`flex.errors`);
+- the documented exit status (:mod:`flex.base.errors`);
 - for a refusal (status 2): exactly one ``flex: error: ...`` line on stderr that contains
   the words the case names (the key, file or argument at fault);
 - no watched file changed (result files, scene files, figures: compared byte for byte).

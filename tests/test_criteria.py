@@ -316,13 +316,12 @@ def test_auto_needs_a_plate_and_a_tolerance_in_range():
         load_scene(None, ["fidelity.tolerance=0.9"])
 
 
-def test_simulate_resolves_auto_prints_and_stores_the_choice(tmp_path, monkeypatch, capsys):
+def test_simulate_resolves_auto_prints_and_stores_the_choice(capsys):
     from flex.fidelity.simulation import simulate
 
-    path = tmp_path / "criterion.toml"
-    path.write_text(_synthetic_criterion().to_toml())
-    monkeypatch.setenv("FLEX_CRITERION", str(path))
-    result = simulate(_auto_scene(0.010, 0.01, "simulation.end_time_s=0.005"))
+    # the law is an argument (a fitted Criterion), not an environment variable
+    result = simulate(_auto_scene(0.010, 0.01, "simulation.end_time_s=0.005"),
+                      criterion=_synthetic_criterion())
     assert result.attrs["fidelity_coupler_model"] == "rigid"
     assert "model = \"rigid\"" in result.scene_toml
     assert "coupler.model = auto -> rigid" in capsys.readouterr().err

@@ -2,7 +2,7 @@
 
 Each study's ``figures(results, summary, folder)`` is called and every PNG it returns must
 exist, be non-empty, decode as a PNG (``matplotlib.image.imread``) of a sensible size, and
-pass :func:`flex.plotting.review` (a title; every numeric axis labelled with a unit; no
+pass :func:`flex.base.plotting.review` (a title; every numeric axis labelled with a unit; no
 colliding tick labels; no text cut at the figure's edge), checked on each figure as it is
 saved.
 
@@ -34,7 +34,7 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 @pytest.fixture
 def reviewed(monkeypatch):
-    """Run :func:`flex.plotting.review` on every figure saved during the test; the list of
+    """Run :func:`flex.base.plotting.review` on every figure saved during the test; the list of
     problems found (``"<file>: <problem>"``) is yielded and must end empty."""
     problems: list[str] = []
     save = matplotlib.figure.Figure.savefig

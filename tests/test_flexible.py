@@ -6,7 +6,7 @@
 - Convergence: the 1 mm plate's midpoint deflection under mode count and step refinement,
   against a stored converged curve (below). The default suite runs the cheapest check (the
   study's 6 modes and 1e-5 s step, first 10 ms); the sweeps are marked slow.
-- Nonlinear FE body (:mod:`flex.nonlinear`): built on the reduction's mesh and node sets; a
+- Nonlinear FE body (:mod:`flex.bodies.nonlinear`): built on the reduction's mesh and node sets; a
   short run of a coarse stiff plate agrees with its FFRF twin. The slow test checks the 1 mm
   plate's first deflection peak against the FFRF one and against the geometric softening
   the linear FFRF body leaves out.
@@ -211,7 +211,7 @@ def test_nonlinear_fe_coupler_follows_its_ffrf_twin():
     # measured 1.0e-6 rad against 4.7e-6 rad
     assert (np.abs(fe["crank/angle"] - ffrf["crank/angle"]).max()
             < 0.5 * np.abs(ffrf["crank/angle"] - rigid["crank/angle"]).max())
-    # the face-marker tilt artefact (flex.nonlinear): measured 1.2e-3 of the peak
+    # the face-marker tilt artefact (flex.bodies.nonlinear): measured 1.2e-3 of the peak
     assert np.abs(fe["coupler/midpoint_out_of_plane"]).max() < 1e-2 * peak
 
 
@@ -294,7 +294,7 @@ def test_ffrf_coupler_with_a_constant_speed_crank_follows_the_closed_form():
 
 
 # ------------------------------------------------------------------------------------------
-# flex.twins and flex.softening
+# flex.experiments.twins and flex.fidelity.softening
 # ------------------------------------------------------------------------------------------
 def test_twin_cases_pair_each_plate_and_add_the_nonlinear_reference_when_undamped():
     from flex.experiments.twins import twin_cases

@@ -1,10 +1,10 @@
 """Hostile result files and arguments for ``inspect``, ``plot`` and ``compare``.
 
 Issue "Nothing lost, nothing silent": every command that reads a result file checks its
-layout (:func:`flex.results.check_layout`) and names what is wrong and where (file, HDF5
+layout (:func:`flex.data.results.check_layout`) and names what is wrong and where (file, HDF5
 path, what was expected); no traceback, one ``flex: error:`` line, exit status 2, and no
 input file changed (tests/hostile.py). Each malformed file starts as a valid file written by
-:func:`flex.results.write_results` with one thing damaged.
+:func:`flex.data.results.write_results` with one thing damaged.
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ impossible geometry; settings that cannot mean anything once ``"auto"`` is resol
 count, irregular samples, an aliased crank); meshed plates that make no sense or that this
 machine cannot mesh (estimated before any meshing); malformed scene files. Then what a run
 that is not refused must not hide: honest divergence advice, the linear-FFRF validity
-warning, keys a scene's models do not use (:mod:`flex.usage`).
+warning, keys a scene's models do not use (:mod:`flex.config.usage`).
 """
 
 from __future__ import annotations

@@ -1,6 +1,7 @@
-"""Tests of the modal modules: beam theory (flex.beams), mode classification and 3D FE modes
-(flex.fe_modes), BEAM188 emulation (flex.beam_elements), mesh selection (flex.mesh_convergence)
-and the thesis's tables (flex.thesis_tables).
+"""Tests of the modal modules: beam theory (flex.bodies.beams), mode classification and 3D FE modes
+(flex.bodies.fe_modes), BEAM188 emulation (flex.bodies.beam_elements), mesh selection
+(flex.bodies.mesh_convergence)
+and the thesis's tables (flex.bodies.thesis_tables).
 
 The FE tests use meshes of at most ~10k DOF (about 1 s each on one core); the full Table 5
 and a mesh-convergence run are marked slow.

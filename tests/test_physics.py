@@ -1,5 +1,5 @@
-"""flex.physics: each closed form against an independent check (a hand computation, a
-textbook value, a limiting case or a numerical solution), and flex.thesis against itself."""
+"""flex.base.physics: each closed form against an independent check (a hand computation, a
+textbook value, a limiting case or a numerical solution), and flex.base.thesis against itself."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Tests of flex.reduction: cache, FFRF coupler against beam theory, post-processing.
+"""Tests of flex.bodies.reduction: cache, FFRF coupler against beam theory, post-processing.
 
 One coarse 3 mm plate (second-order tets, maxh 3 mm, 3.6k DOF, 6 fixed-interface modes) is
 built once per module; Euler-Bernoulli references: I = w t^3 / 12 (bending height t in plane).

@@ -1,4 +1,4 @@
-"""Exudyn against stored reference curves, through ``flex.compare`` (the code of the CLI).
+"""Exudyn against stored reference curves, through ``flex.tools.compare`` (the code of the CLI).
 
 The curves in ``tests/reference_curves/deployment_preload_22mm.h5`` are the thesis
 deployment (22 mm preload) solved by the independent reference DAE, not by Exudyn; they are

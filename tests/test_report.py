@@ -1,7 +1,7 @@
 """``flex report``: Markdown reports generated from a result file, checked against that file.
 
 Each check reads the HDF5 file independently (h5py) and asserts that what it holds appears
-in the report as :func:`flex.report.format_value` formats it.
+in the report as :func:`flex.tools.report.format_value` formats it.
 """
 
 from __future__ import annotations

@@ -184,7 +184,7 @@ def test_the_stability_study_declares_its_forced_divergences():
 
 
 # ------------------------------------------------------------------------------------------
-# flex.stability: references, verdicts, trust boundary
+# flex.experiments.stability: references, verdicts, trust boundary
 # ------------------------------------------------------------------------------------------
 def test_a_constant_speed_run_is_judged_against_the_closed_form():
     from flex.config.settings import pinned_overrides

@@ -1,4 +1,4 @@
-"""Work-precision machinery (flex.tradeoff) and the [simulation] knobs it varies."""
+"""Work-precision machinery (flex.experiments.tradeoff) and the [simulation] knobs it varies."""
 
 from __future__ import annotations
 
@@ -335,7 +335,8 @@ def test_the_work_precision_figure_draws_the_front_and_the_reference_band(tmp_pa
 
 
 def test_profile_times_flex_phases_and_reads_exudyn_shares():
-    # the bench study's profile (flex.benchmark.profile through flex.solver.run_profiled)
+    # the bench study's profile (flex.experiments.benchmark.profile through
+    # flex.dynamics.solver.run_profiled)
     from flex.experiments.benchmark import profile
     from flex.experiments.tradeoff import ReductionPool
 

@@ -1,9 +1,9 @@
 """Closed forms of beam and plate theory used across flex (numpy and math only).
 
-Each formula exists once, here; the library and the studies import it (:mod:`flex.modal`
+Each formula exists once, here; the library and the studies import it (:mod:`flex.experiments.modal`
 adds the input checks of its public functions, Timoshenko beams and finite elements). Units
 are in the names; frequencies are circular [rad/s]. The thesis's own numbers are in
-:mod:`flex.thesis`.
+:mod:`flex.base.thesis`.
 
 Theory: Euler-Bernoulli beams, elementary rods and St-Venant torsion as tabulated in
 Blevins, *Formulas for Natural Frequency and Mode Shape* (1979), ch. 8 (straight beams:
@@ -146,7 +146,7 @@ def pinned_pinned_omega(length_m: float, height_m: float, youngs_modulus_Pa: flo
     Euler-Bernoulli: ``omega = (pi / L)^2 sqrt(E I / (rho A))`` with ``I / A = h^2 / 12``
     (``h`` the bending height, the plate thickness in the mechanism plane; the width
     cancels). Thesis Table 5's "Frequency" column is this value (4.7e-6 higher: the thesis
-    took pi = 3.1416). The finite-element value of :class:`flex.reduction.Reduction` is
+    took pi = 3.1416). The finite-element value of :class:`flex.bodies.reduction.Reduction` is
     within 2.4 % of it up to t = 10 mm (L/t = 8).
     """
     _check_positive(length_m=length_m, height_m=height_m,
@@ -220,7 +220,7 @@ def clamped_plate_frequencies(length_m: float, thickness_m: float, width_m: floa
     Returns the ``count`` lowest ``(omega [rad/s], kind)`` with kind ``in_plane`` (bending
     height t), ``out_of_plane`` (height w), ``torsion`` (St-Venant,
     :func:`rectangle_torsion_constant_m4`) or ``axial``: the order in which the Craig-Bampton
-    fixed-interface modes of :func:`flex.reduction.build_reduction` appear (estimates;
+    fixed-interface modes of :func:`flex.bodies.reduction.build_reduction` appear (estimates;
     shear and warping shift them by some per cent).
     """
     e, rho, length = youngs_modulus_Pa, density_kg_per_m3, length_m

@@ -3,9 +3,10 @@
 Cavezza, F. (2012). *Flexibility and Transient Dynamic Analysis of a Slider-Crank Deployment
 Mechanism*. MS thesis, West Virginia University ("the thesis"). Values the thesis reads off
 its own figures are marked "approx." as it marks them. The library and the studies import
-them from here (:mod:`flex.criteria`, :mod:`flex.modal` and :mod:`flex.spring` re-export
+them from here (:mod:`flex.fidelity.criteria`, :mod:`flex.experiments.modal` and
+:mod:`flex.bodies.spring` re-export
 the ones they have always exposed); the closed forms that use them are in
-:mod:`flex.physics`. The bundled scene ``flex/scenes/cavezza2012.toml`` is the thesis's
+:mod:`flex.base.physics`. The bundled scene ``flex/scenes/cavezza2012.toml`` is the thesis's
 mechanism as an input file (data, with its own citations).
 
 SI units, in the names. No flex imports.

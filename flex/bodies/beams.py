@@ -1,7 +1,7 @@
 """Beam and rod theory of rectangular plate links: sections, Euler-Bernoulli and Timoshenko
 bending, axial and torsional modes, and a link's lowest modes merged over the four kinds.
 
-Geometry and axes are those of :mod:`flex.plate`: x along the link (0..L), y across the
+Geometry and axes are those of :mod:`flex.bodies.plate`: x along the link (0..L), y across the
 thickness t (in the mechanism plane: t is the height of in-plane bending), z across the width
 (out of the mechanism plane). All quantities are SI: metres, seconds, kilograms, pascals;
 circular frequencies in rad/s, cyclic ones in Hz. Names carry their unit.
@@ -17,15 +17,15 @@ Link boundary conditions (:data:`LINK_BOUNDARY_CONDITIONS`):
 
 - ``"free-free"``: unsupported; the six rigid-body modes are skipped.
 - ``"pinned-pinned"``: the coupler between its two revolute joints; each end rotates freely
-  about the z axis through its centre (:func:`flex.fe_modes.plate_modes` says how the 3D
+  about the z axis through its centre (:func:`flex.bodies.fe_modes.plate_modes` says how the 3D
   model imposes it and why it is the simply supported end of in-plane bending).
 - ``"pinned-roller"``: as pinned-pinned, but ``end_b`` may slide along x (the textbook simply
   supported beam: pin and roller). Bending and torsion are those of pinned-pinned; the axial
   modes become fixed-free. This is the support that reproduces the thesis's ANSYS Tables 7
-  and 9 (:func:`flex.thesis_tables.thesis_link_modal_reproduction`).
+  and 9 (:func:`flex.bodies.thesis_tables.thesis_link_modal_reproduction`).
 
-The 3D finite-element modes are in :mod:`flex.fe_modes`, the BEAM188 emulation in
-:mod:`flex.beam_elements`, the thesis's Tables 5, 7, 9 in :mod:`flex.thesis_tables`.
+The 3D finite-element modes are in :mod:`flex.bodies.fe_modes`, the BEAM188 emulation in
+:mod:`flex.bodies.beam_elements`, the thesis's Tables 5, 7, 9 in :mod:`flex.bodies.thesis_tables`.
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ from flex.base.thesis import THESIS_DENSITY_KG_PER_M3, THESIS_YOUNGS_MODULUS_PA
 
 MODE_KINDS: tuple[str, ...] = ("axial", "in-plane bending", "out-of-plane bending", "torsion")
 """Kinds of link modes; also the column order of
-:attr:`flex.fe_modes.PlateModes.kind_shares`."""
+:attr:`flex.bodies.fe_modes.PlateModes.kind_shares`."""
 
 LINK_BOUNDARY_CONDITIONS: tuple[str, ...] = ("free-free", "pinned-pinned", "pinned-roller")
 """Boundary conditions of a whole link (3D FE model and :func:`beam_link_modes`)."""
@@ -145,7 +145,7 @@ class RectangleSection:
 def rectangle_torsion_constant_m4(height_m: float, width_m: float, series_terms: int = 50
                                   ) -> float:
     """St-Venant torsion constant J of a solid rectangle, m^4: the series of
-    :func:`flex.physics.rectangle_torsion_constant_m4` (Timoshenko & Goodier), sizes checked.
+    :func:`flex.base.physics.rectangle_torsion_constant_m4` (Timoshenko & Goodier), sizes checked.
     """
     check_positive(height_m=height_m, width_m=width_m)
     return physics.rectangle_torsion_constant_m4(height_m, width_m, series_terms)
@@ -177,7 +177,7 @@ def euler_bernoulli_beta_l(end_condition: str, mode_count: int = 5) -> np.ndarra
     """Dimensionless wave numbers beta_n L of an Euler-Bernoulli beam, n = 1..mode_count.
 
     omega_n = (beta_n L)^2 / L^2 * sqrt(E I / (rho A)). The roots of
-    :func:`flex.physics.euler_bernoulli_beta_l` (free-free and clamped-clamped 4.7300,
+    :func:`flex.base.physics.euler_bernoulli_beta_l` (free-free and clamped-clamped 4.7300,
     7.8532, ...; pinned-pinned n pi; clamped-free 1.8751, 4.6941, ...; clamped-pinned
     3.9266, 7.0686, ...), inputs checked.
     """
@@ -396,7 +396,7 @@ def beam_link_modes(length_m: float, thickness_m: float, width_m: float,
                     shear_correction: float = SHEAR_CORRECTION_RECTANGLE) -> BeamLinkModes:
     """The first ``mode_count`` modes of a rectangular link from beam and rod theory.
 
-    The link's counterpart of :func:`flex.fe_modes.plate_modes`: thickness (m) along y
+    The link's counterpart of :func:`flex.bodies.fe_modes.plate_modes`: thickness (m) along y
     (in-plane bending height), width (m) along z. ``boundary_condition`` from
     :data:`LINK_BOUNDARY_CONDITIONS`: free-free uses free ends for every kind; pinned-pinned
     (revolute joints about z) uses pinned in-plane bending, clamped out-of-plane bending,

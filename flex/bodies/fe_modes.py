@@ -1,11 +1,12 @@
 """Elastic modes of a plate link from 3D finite elements (NGsolve), classified by symmetry.
 
-:func:`plate_modes` meshes a box link (:func:`flex.plate.plate_mesh`: x along the link,
+:func:`plate_modes` meshes a box link (:func:`flex.bodies.plate.plate_mesh`: x along the link,
 y across the thickness t, in the mechanism plane; z across the width) with tetrahedra of
 order 2, assembles stiffness K and consistent mass M of linear elasticity, and returns the
 lowest elastic modes as :class:`PlateModes`. All quantities are SI (m, kg, Pa, s); circular
 frequencies in rad/s, cyclic ones in Hz. Kinds and link boundary conditions are those of
-:mod:`flex.beams` (:data:`~flex.beams.MODE_KINDS`, :data:`~flex.beams.LINK_BOUNDARY_CONDITIONS`).
+:mod:`flex.bodies.beams` (:data:`~flex.bodies.beams.MODE_KINDS`,
+:data:`~flex.bodies.beams.LINK_BOUNDARY_CONDITIONS`).
 
 Method: the generalized eigenproblem K phi = omega^2 M phi is solved by Lanczos (ARPACK,
 ``scipy.sparse.linalg.eigsh``) in shift-invert mode about a negative shift
@@ -388,7 +389,7 @@ def plate_modes(length_m: float, thickness_m: float, width_m: float, mesh_size_m
     ``material``; ``element_order`` of the vector H1 space (2 = second-order tetrahedra; 1 is
     allowed to show shear locking); ``minimum_share`` for :func:`classify_kind_shares`;
     ``mesh`` an already built ``ngsolve.Mesh`` of the same plate (from
-    :func:`flex.plate.plate_mesh`) to skip meshing. Returns :class:`PlateModes`. Method,
+    :func:`flex.bodies.plate.plate_mesh`) to skip meshing. Returns :class:`PlateModes`. Method,
     joint constraints and classification: see the module doc.
 
     Raises :class:`SceneError` for non-positive sizes, an unknown boundary condition or a

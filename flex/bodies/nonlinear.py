@@ -1,6 +1,7 @@
 """Fully nonlinear FE coupler: the accuracy reference for the FFRF reduction.
 
-The same plate mesh as :mod:`flex.reduction` (:func:`flex.plate.plate_mesh`, second-order
+The same plate mesh as :mod:`flex.bodies.reduction` (:func:`flex.bodies.plate.plate_mesh`,
+second-order
 tetrahedra, end faces ``end_a`` at joint B and ``end_b`` at joint C, the same node numbering)
 becomes an Exudyn ``ObjectGenericODE2``: every mesh node is a ``NodePoint`` (3 displacement
 coordinates), the mass matrix is the mesh's consistent one, and the elastic forces and their
@@ -17,7 +18,7 @@ Why not Exudyn's function itself: with ``meshOrder=2`` (needed: linear tets lock
 and the second pass adds unconnected nodes (1 mm plate: 3209 -> 4092 nodes, 883 of them
 without mass or stiffness), which leaves the system singular. This module imports once.
 
-Body coordinates (metres) are the mesh's, as in :mod:`flex.reduction`: x along the link from
+Body coordinates (metres) are the mesh's, as in :mod:`flex.bodies.reduction`: x along the link from
 the centre of ``end_a`` (joint B) to the centre of ``end_b`` (joint C), y across the thickness
 (in the mechanism plane), z across the width.
 
@@ -112,9 +113,9 @@ def build_nonlinear_plate(length_m: float, thickness_m: float, width_m: float,
     """Mesh the plate and find its joint and midpoint node sets.
 
     Contract: sizes in metres, E in Pa, density in kg/m^3, ``mesh_size_m`` is netgen's maxh;
-    the same arguments as :func:`flex.reduction.build_reduction` (without ``modes``) give the
+    the same arguments as :func:`flex.bodies.reduction.build_reduction` (without ``modes``) give the
     same mesh, node numbering and node sets. Bad values raise
-    :class:`flex.errors.SceneError`. ``ngsolve_threads`` as in ``build_reduction`` (1: the
+    :class:`flex.base.errors.SceneError`. ``ngsolve_threads`` as in ``build_reduction`` (1: the
     import's assembly took 0.85 s with NGsolve's default threads on the shared 2-core
     machine, 0.05 s with one). Nothing is cached: meshing takes one to a few seconds; the
     bodies are made per system by :func:`add_nonlinear_fe_coupler`.
@@ -313,7 +314,7 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
     """Add the plate to ``mbs`` as a fully nonlinear FE body between joints B and C.
 
     Contract:
-      - placement as :func:`flex.reduction.add_ffrf_link`: the centre of ``end_a`` is put at
+      - placement as :func:`flex.bodies.reduction.add_ffrf_link`: the centre of ``end_a`` is put at
         ``position_B`` [m, global], the link axis (body x) turned by ``angle_rad`` about global
         z; C's reference position is ``position_B + length * (cos, sin, 0)``. The nodes'
         reference positions are the placed ones (see the module doc); the body starts
@@ -322,7 +323,7 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
         velocity about z [rad/s]; default rest.
       - markers: ``marker_B`` / ``marker_C`` are ``MarkerSuperElementRigid`` on the end faces
         (area weights); ``marker_mid`` a ``MarkerSuperElementPosition`` on the mid-length
-        slab. Position sensors of the three give :func:`flex.reduction.midpoint_deflection`.
+        slab. Position sensors of the three give :func:`flex.bodies.reduction.midpoint_deflection`.
       - no damping (the nonlinear body has no damping model); no stress output.
       - call ``mbs.Assemble()`` afterwards, and integrate with a sparse linear solver
         (``LinearSolverType.EigenSparse``): the body has ``plate.n_dof`` coordinates.

@@ -2,7 +2,7 @@
 
 The building block of the flexible slider-crank (coupler between B and C, crank between A
 and B: the same plate reduction, ``end_a`` at the link's first joint). :func:`build_reduction`
-meshes a steel plate (:func:`flex.plate.plate_mesh`, second-order tetrahedra), reduces it
+meshes a steel plate (:func:`flex.bodies.plate.plate_mesh`, second-order tetrahedra), reduces it
 with Hurty-Craig-Bampton modes whose two interfaces are the joint faces ``end_a`` (joint B)
 and ``end_b`` (joint C), adds stress post-processing modes and caches the result in one HDF5
 file.
@@ -338,7 +338,7 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
       - sizes in metres, E in Pa, density in kg/m^3; ``mesh_size_m`` is netgen's maxh
         (recommendation: about the thickness, at most 2 x thickness); ``modes`` >= 1 is the
         number of fixed-interface (both faces clamped) eigenmodes added to the 6 static modes
-        of ``end_b``. Bad values raise :class:`flex.errors.SceneError`.
+        of ``end_b``. Bad values raise :class:`flex.base.errors.SceneError`.
       - the mesh uses second-order tetrahedra; stress post-processing modes (local stress,
         Pa per unit modal coordinate) are always computed.
       - ``cache_dir``: directory of the cache (created if missing) or None for no caching. The
@@ -544,7 +544,7 @@ def add_plate_markers(mbs, body, plate, position_B: np.ndarray, rotation: np.nda
 
     ``plate`` carries the node sets ``nodes_end_a/_b/_mid``, their weights and the reference
     centres ``centre_end_a/_b/_mid`` [m, body frame] (a :class:`Reduction` or a
-    ``flex.nonlinear.NonlinearPlate``). Returns ``marker_B`` and ``marker_C``
+    ``flex.bodies.nonlinear.NonlinearPlate``). Returns ``marker_B`` and ``marker_C``
     (``MarkerSuperElementRigid`` on the end faces), ``marker_mid``
     (``MarkerSuperElementPosition``), their global reference positions ``position_B/_C/_mid``
     [m], ``rotation_matrix`` (body to global) and ``mass_kg``.

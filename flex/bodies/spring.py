@@ -59,7 +59,7 @@ MUSIC_WIRE_ALLOWABLE_TORSION_FRACTION_SET_REMOVED = 0.60
 
 # --- The thesis's spring (sec. 6.1, Table 2) and its use -------------------------------------
 # THESIS_SPRING_RATE_N_PER_M, THESIS_FREE_LENGTH_M, THESIS_WIRE_DIAMETER_M,
-# THESIS_SPRING_DIAMETER_M, THESIS_ACTIVE_COILS, THESIS_COMPRESSION_M: see flex.thesis.
+# THESIS_SPRING_DIAMETER_M, THESIS_ACTIVE_COILS, THESIS_COMPRESSION_M: see flex.base.thesis.
 #: Deployment time used in the rigid-or-flexible criterion (sec. 6.2); its origin is unstated.
 THESIS_DEPLOYMENT_TIME_S = THESIS_DELTA_T_S
 #: Half swing of the spring-driven mechanism: crank angle maximum at ~0.0265 s (sec. 5.5.1).

@@ -1,11 +1,11 @@
 """The thesis's modal tables recomputed: Table 5 (four plate couplers, the rigid-or-flexible
 number n = delta_t / T in both period conventions) and Tables 7 and 9 (ANSYS BEAM188 crank and
-coupler frequencies) beside beam theory (:mod:`flex.beams`), the BEAM188 emulation
-(:mod:`flex.beam_elements`) and 3D FE (:mod:`flex.fe_modes`).
+coupler frequencies) beside beam theory (:mod:`flex.bodies.beams`), the BEAM188 emulation
+(:mod:`flex.bodies.beam_elements`) and 3D FE (:mod:`flex.bodies.fe_modes`).
 
 Cavezza (2012), *Flexibility and Transient Dynamic Analysis of a Slider-Crank Deployment
 Mechanism* (West Virginia University, MS thesis), sections 6.2-6.3; its published values are in
-:mod:`flex.thesis`. SI units; the keys of the returned tables carry theirs.
+:mod:`flex.base.thesis`. SI units; the keys of the returned tables carry theirs.
 """
 
 from __future__ import annotations
@@ -42,7 +42,8 @@ from flex.bodies.beams import (
 from flex.bodies.fe_modes import plate_modes
 
 DEPLOYMENT_TIME_S = THESIS_DELTA_T_S
-"""Deployment time delta_t of the thesis's criterion, s (:data:`flex.thesis.THESIS_DELTA_T_S`)."""
+"""Deployment time delta_t of the thesis's criterion, s
+(:data:`flex.base.thesis.THESIS_DELTA_T_S`)."""
 
 THESIS_K_CRITERION = int(THESIS_K)
 """Cavezza 2012, sec. 6.2: the k chosen for the criterion (model 1 of Table 5), 108."""
@@ -50,7 +51,7 @@ THESIS_K_CRITERION = int(THESIS_K)
 
 TABLE5_FE_MESH_SIZES_M: tuple[float, ...] = (0.002, 0.003, 0.0025, 0.0035)
 """Production netgen maxh (m) of the four Table 5 plates, t = 1, 3, 5, 10 mm, from
-:func:`flex.mesh_convergence.mesh_convergence` (pinned-pinned, first in-plane bending): each
+:func:`flex.bodies.mesh_convergence.mesh_convergence` (pinned-pinned, first in-plane bending): each
 lies within 0.05 % of the Richardson-extrapolated (or finest) frequency and costs at most
 ~10k DOF."""
 

@@ -18,7 +18,8 @@ a certified accuracy:
   fraction of the first bending period (4e-5 s) erred by 2.4 % in make tradeoff.
 
 Contract: input a validated scene whose links are concrete (``model = "auto"`` already
-resolved, :func:`flex.criteria.resolve_fidelity`); output the scene with numbers in place of
+resolved, :func:`flex.fidelity.criteria.resolve_fidelity`); output the scene with numbers in place
+of
 ``"auto"`` and a :class:`SolverChoice` (which entry, why; stored with every result). A scene
 without ``"auto"`` values is returned unchanged with ``None``.
 
@@ -173,20 +174,20 @@ def check_runnable(scene: Scene) -> None:
     """Refuse, before anything is built, meshed or simulated, a scene that cannot run or
     whose result would mean nothing; return None when it can run.
 
-    Contract: ``scene`` is validated (:func:`flex.scene.load_scene` or
-    :func:`flex.scene.validate`); links and solver keys may be ``"auto"``. Takes
+    Contract: ``scene`` is validated (:func:`flex.data.scene.load_scene` or
+    :func:`flex.data.scene.validate`); links and solver keys may be ``"auto"``. Takes
     milliseconds: nothing is meshed or simulated. Raises :class:`SceneError` with one line
     naming the key and the accepted range. Checks, with the ``"auto"`` solver keys resolved
-    as :func:`flex.solver.simulate` resolves them (:func:`resolve_solver_settings`):
+    as :func:`flex.dynamics.solver.simulate` resolves them (:func:`resolve_solver_settings`):
 
-    - steps (:func:`flex.scene.check_steps`): step <= end time, at most 5e7 steps, output
+    - steps (:func:`flex.data.scene.check_steps`): step <= end time, at most 5e7 steps, output
       interval 0 or an integer multiple of the step;
     - a constant-speed crank turns at most 0.1 rad per step and pi/4 per stored sample
-      (:func:`flex.scene.check_drive_steps`);
+      (:func:`flex.data.scene.check_drive_steps`);
     - every plate that will be meshed makes sense as a meshed link and fits this machine
-      (:func:`flex.scene.check_meshed_plate`, with the mesh estimate in the message);
+      (:func:`flex.data.scene.check_meshed_plate`, with the mesh estimate in the message);
     - ``model = "auto"`` links: the rigid probe ``auto`` runs first
-      (:func:`flex.criteria.deployment_probe`) must fit the step limit, and the step checks
+      (:func:`flex.fidelity.criteria.deployment_probe`) must fit the step limit, and the step checks
       must pass for at least one model ``auto`` may choose (a check that fails for only
       some choices is left to the run, which then stores a failed case naming it).
     """
@@ -240,7 +241,8 @@ def _model_candidates(scene: Scene) -> list[Scene]:
 
 
 def _check_probe(scene: Scene) -> None:
-    """The rigid run ``model = "auto"`` makes first (:func:`flex.criteria.deployment_probe`:
+    """The rigid run ``model = "auto"`` makes first
+    (:func:`flex.fidelity.criteria.deployment_probe`:
     step min(step_s, 1e-4, end/200) s over the end time, or half a crank turn)."""
     end = scene["simulation"]["end_time_s"]
     drive = scene["drive"]

@@ -1,6 +1,6 @@
 """Which scene keys a scene's models use, and which keys the user gave.
 
-A scene holds every key of :data:`flex.scene.SCHEMA`, but a scene's models read only some:
+A scene holds every key of :data:`flex.data.scene.SCHEMA`, but a scene's models read only some:
 ``--set coupler.thickness_m=0.003`` on a lumped coupler changes nothing. Two functions let a
 study refuse such input instead of silently ignoring it:
 
@@ -119,7 +119,7 @@ def _link_unused(link: str, scene: Scene) -> dict[str, str]:
 
 def _reads_tolerance(scene: Scene) -> bool:
     """Whether ``fidelity.tolerance`` is read: by an ``auto`` link, or by ``"auto"`` solver
-    keys choosing the FFRF coupler's entry (:func:`flex.settings.choose_entry`)."""
+    keys choosing the FFRF coupler's entry (:func:`flex.config.settings.choose_entry`)."""
     from flex.config.settings import has_auto
 
     crank, coupler = scene["crank"]["model"], scene["coupler"]["model"]
@@ -136,7 +136,7 @@ def explicit_keys(source: str | Path | None = None,
     key wins), and every key of the scene file or bundled parameter set ``source`` whose
     value differs from the bundled default scene's (a key absent from the default counts as
     given). ``source`` None or the default parameter set gives no file keys. Inputs as
-    :func:`flex.scene.load_scene` takes them; a malformed one raises SceneError as there.
+    :func:`flex.data.scene.load_scene` takes them; a malformed one raises SceneError as there.
     """
     given: dict[str, Any] = {}
     user = read_source(source)

@@ -36,7 +36,7 @@ class Field:
     positive: bool = False  # strictly > 0
     maximum: float | None = None  # inclusive upper bound
     below: float | None = None  # strictly < below
-    auto: bool = False  # "auto" accepted too: flex chooses (flex.settings)
+    auto: bool = False  # "auto" accepted too: flex chooses (flex.config.settings)
 
     def accepted(self) -> str:
         """Human-readable accepted range, used in error messages."""
@@ -127,7 +127,8 @@ SCHEMA: dict[str, dict[str, Field]] = {
     },
     "simulation": {
         "end_time_s": Field(doc="simulated time span", **_POS),
-        "step_s": Field(doc="fixed time step of the integrator (auto: by model, flex.settings)",
+        "step_s": Field(doc="fixed time step of the integrator (auto: by model, "
+                            "flex.config.settings)",
                         auto=True, **_POS),
         "output_step_s": Field(float, "interval of the stored samples (>= step_s; 0: every "
                                "step)", minimum=0.0),
@@ -277,7 +278,7 @@ def validate(scene: Scene) -> None:
     Checks: known sections and keys, every key present, types, finiteness, ranges, and the
     geometry: the crank must be able to turn (``L1 + |offset| < L2``), the step settings
     consistent (an explicit step: :func:`check_steps`, :func:`check_drive_steps`; an
-    ``"auto"`` one is checked once resolved, :func:`flex.settings.check_runnable`), FFRF
+    ``"auto"`` one is checked once resolved, :func:`flex.config.settings.check_runnable`), FFRF
     couplers need plate geometry, and plates that will be meshed must make sense and fit
     this machine (:func:`check_meshed_plate`).
     """
@@ -502,7 +503,7 @@ class MeshEstimate:
     """Estimated size and cost of meshing and reducing one plate (before any meshing).
 
     Calibrated on netgen meshes of steel plates 80 mm long (second-order tetrahedra, as
-    :mod:`flex.reduction` builds them), one process, 2-core machine:
+    :mod:`flex.bodies.reduction` builds them), one process, 2-core machine:
 
     ==========================  ========  =======  ======  ===========  =========
     t x w, maxh [mm]            elements  DOF      est.    build [s]    peak RSS
@@ -569,7 +570,7 @@ def meshed_plate(link: str, values: dict[str, Any]) -> tuple[float, str, str] | 
 
     ``ffrf`` and ``nonlinear_fe`` links are meshed; an ``auto`` crank always is (its
     frequency is computed on the mesh; a lumped crank as the plate of its mass, of thickness
-    mass / (density x length x width), as :func:`flex.criteria.equivalent_crank_plate`); an
+    mass / (density x length x width), as :func:`flex.fidelity.criteria.equivalent_crank_plate`); an
     ``auto`` coupler is when the criterion chooses ``ffrf``.
     """
     model = values["model"]

@@ -186,17 +186,18 @@ def build_mechanism(scene: Scene, reduction: Any = None,
                     crank_reduction: Any = None) -> Mechanism:
     """Build and assemble the slider-crank of ``scene`` in a new Exudyn system.
 
-    ``reduction`` is the Craig-Bampton reduction (:func:`flex.reduction.build_reduction`)
+    ``reduction`` is the Craig-Bampton reduction (:func:`flex.bodies.reduction.build_reduction`)
     for an ``ffrf`` coupler (or the plate of a ``nonlinear_fe`` one; ``None``: built from the
     scene), ``crank_reduction`` the one of an ``ffrf`` crank; ``None`` for rigid links.
-    Links with ``model = "auto"`` must be resolved first (:func:`flex.simulation.simulate`).
+    Links with ``model = "auto"`` must be resolved first
+    (:func:`flex.fidelity.simulation.simulate`).
     Returns a :class:`Mechanism`.
     """
     for link in ("crank", "coupler"):
         if scene[link]["model"] == "auto":
             raise SceneError('model = "auto" must be resolved before building '
-                             "(flex.simulation.simulate does it with "
-                             "flex.criteria.resolve_fidelity)")
+                             "(flex.fidelity.simulation.simulate does it with "
+                             "flex.fidelity.criteria.resolve_fidelity)")
     builder = _Builder(scene)
     builder.add_crank_and_slider(crank_reduction)
     builder.add_coupler(reduction)
@@ -287,7 +288,7 @@ class _Builder:
         from flex.bodies.reduction import add_ffrf_link
 
         if crank_reduction is None:
-            raise SceneError('crank.model = "ffrf" needs its reduction (flex.simulation.'
+            raise SceneError('crank.model = "ffrf" needs its reduction (flex.fidelity.simulation.'
                              "simulate builds it from the scene)")
         # the plate's end_a face is the pivot A (the floating frame), end_b the joint B
         flexible_crank = add_ffrf_link(
@@ -401,7 +402,7 @@ class _Builder:
                                                            output), **item)
 
     def add_sensors(self) -> None:
-        """What :func:`flex.solver.collect` reads: bodies, joints, markers, energies."""
+        """What :func:`flex.dynamics.solver.collect` reads: bodies, joints, markers, energies."""
         if self.wing_joint is not None:
             for output in ("Velocity", "Rotation", "AngularVelocity", "AngularAcceleration"):
                 self.add(f"wing.{output}",

@@ -15,7 +15,7 @@ is ``-Psi_q^T lambda``.
 The constraint equations are derived here afresh rather than copied: the thesis's Eq. 25
 (row 5, d/dq6 printed as -L2/2 cos q6 instead of -L2/2 sin q6) and Eq. 9-10 (sign of the
 coupler angle) carry typos; see the README. This module shares no code with the Exudyn model
-(:mod:`flex.mechanism`) beyond the scene it reads, so the two check each other.
+(:mod:`flex.dynamics.mechanism`) beyond the scene it reads, so the two check each other.
 """
 
 from __future__ import annotations
@@ -200,7 +200,7 @@ def solve_reference(scene: Scene, time_s: np.ndarray | None = None, rtol: float 
 
     ``time_s``: output times [s] (default: every ``simulation.output_step_s`` up to
     ``end_time_s``). Returns a :class:`ReferenceSolution`; raises
-    :class:`~flex.errors.SimulationError` if the integrator fails.
+    :class:`~flex.base.errors.SimulationError` if the integrator fails.
     """
     dae = SliderCrankDAE(scene)
     sim = resolved_simulation(scene)

@@ -3,13 +3,13 @@
 :func:`simulate` is the one entry point the studies use. Contract:
 
 - input: a validated scene (and, for an FFRF coupler, its reduction);
-- output: a :class:`~flex.results.CaseResult` whose datasets are the quantities of the
+- output: a :class:`~flex.data.results.CaseResult` whose datasets are the quantities of the
   result layout (``time``, ``crank/...``, ``slider/...``, ``joints/<A|B|C>/...``,
   ``constraint_norm``, ``energy/...`` (rigid and FFRF links), ``coupler/...``), each with units;
-- refused before anything is built: what :func:`flex.settings.check_runnable` refuses
-  (:class:`~flex.errors.SceneError`, a ``failed`` case from :func:`simulate_case`);
+- refused before anything is built: what :func:`flex.config.settings.check_runnable` refuses
+  (:class:`~flex.base.errors.SceneError`, a ``failed`` case from :func:`simulate_case`);
 - status: ``ok``; a diverging run (solver failure, NaN, exploding constraint norm) raises
-  :class:`~flex.errors.SimulationError` naming the step and time and what may help
+  :class:`~flex.base.errors.SimulationError` naming the step and time and what may help
   (:func:`divergence_advice`: a smaller step only where the step does not resolve the
   scene's fastest time scale; the extreme inputs), and :func:`simulate_case` turns that
   into a ``failed`` case instead of data; an ``ok`` run whose validity is in doubt (a
@@ -64,7 +64,7 @@ NONLINEAR_FE_NEWTON_ABSOLUTE_TOLERANCE = 1e-6
 
 def solver_settings(scene: Scene) -> dict[str, Any]:
     """The integrator settings used for ``scene`` (stored in every result file); ``"auto"``
-    keys resolved as :func:`simulate` resolves them (:mod:`flex.settings`)."""
+    keys resolved as :func:`simulate` resolves them (:mod:`flex.config.settings`)."""
     sim = resolved_simulation(scene)
     settings = {
         "integrator": "generalized-alpha (Exudyn, index 3)",
@@ -189,7 +189,7 @@ def run(mech: Mechanism) -> dict[str, Any]:
 
 def run_profiled(mech: Mechanism) -> tuple[dict[str, float], str]:
     """Integrate ``mech`` once (implicit integrator) with Exudyn's CPU-time statistics on,
-    for benchmarks (:mod:`flex.benchmark`; :func:`run` is the production path): counters
+    for benchmarks (:mod:`flex.experiments.benchmark`; :func:`run` is the production path): counters
     (``steps``, ``newton_iterations``, ``jacobian_updates``; ``wall_time_s`` [s], the solve
     alone) and the statistics text Exudyn printed. Raises SimulationError if it fails."""
     import exudyn as exu
@@ -421,7 +421,7 @@ def _coupler_datasets(mech: Mechanism, time_s: np.ndarray) -> dict[str, Dataset]
                                  "B-C", time_s))
     if mech.scene["coupler"]["model"] == "nonlinear_fe":
         # the face markers' linearised rotation can tilt the faces out of plane (see
-        # flex.nonlinear): record how far the midpoint leaves the plane
+        # flex.bodies.nonlinear): record how far the midpoint leaves the plane
         position_mid = _sensor(mech, "marker_coupler_mid.Position")[:, 1:4]
         out["coupler/midpoint_out_of_plane"] = Dataset(
             position_mid[:, 2] - position_mid[0, 2], "m",
@@ -533,17 +533,18 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     """Build, integrate and collect one case of a scene whose links have concrete models
     (rigid, ffrf, nonlinear_fe); raises on divergence (see module doc).
 
-    ``model = "auto"`` links are resolved a layer above (:func:`flex.simulation.simulate`);
+    ``model = "auto"`` links are resolved a layer above (:func:`flex.fidelity.simulation.simulate`);
     here they are refused. ``reduction`` / ``crank_reduction``: the reductions of an
     ``ffrf`` coupler / crank (None: :func:`reduction_for_scene`, cached on disk).
-    ``"auto"`` solver keys are filled by model (:func:`flex.settings.
+    ``"auto"`` solver keys are filled by model (:func:`flex.config.settings.
     resolve_solver_settings`; attributes ``solver_defaults_*``). ``scene_toml`` holds the
     resolved scene.
     """
     for link in ("crank", "coupler"):
         if scene[link]["model"] == "auto":
-            raise FlexError(f'{link}.model = "auto" is resolved by flex.simulation.simulate, '
-                            f"not by flex.solver.integrate")
+            raise FlexError(f'{link}.model = "auto" is resolved by '
+                            f"flex.fidelity.simulation.simulate, not by "
+                            f"flex.dynamics.solver.integrate")
     scene, solver_choice = resolve_solver_settings(scene)
     check_runnable(scene)  # the concrete models and steps, before anything is built
     if scene["coupler"]["model"] == "ffrf" and reduction is None:

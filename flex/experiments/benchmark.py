@@ -3,7 +3,7 @@
 Every number is measured by the run, on whatever else the machine is doing: wall times [s]
 are medians of ``repeats`` runs, and each comparison is a ratio of two times measured in the
 same run. :func:`run_bench` runs the four parts of a :class:`BenchPlan` in order, each into
-``notes[<part>]`` (a part that raises :class:`~flex.errors.FlexError` is stored as
+``notes[<part>]`` (a part that raises :class:`~flex.base.errors.FlexError` is stored as
 ``notes["<part>_failed"]`` and a failed case ``<part>_failed``; the others still run):
 
 - ``rigid`` (:func:`bench_rigid`): the largest step of the tuned setting that reaches the
@@ -17,7 +17,7 @@ same run. :func:`run_bench` runs the four parts of a :class:`BenchPlan` in order
 - ``make_all`` (:func:`bench_make_all`): ``make all FORCE=1`` with an empty reduction cache and
   again with it filled (``FLEX_BENCH_MAKE=0`` skips it).
 
-:mod:`flex.benchmark_report` turns the notes into the table and the figures.
+:mod:`flex.experiments.benchmark_report` turns the notes into the table and the figures.
 """
 
 from __future__ import annotations
@@ -132,7 +132,7 @@ def profile(scene: Scene, pool: ReductionPool) -> dict[str, float]:
 # ------------------------------------------------------------------------------------------
 def bench_case(name: str, scene: Scene, m: Measurement, extra: dict[str, Any] | None = None
                ) -> CaseResult:
-    """A timed configuration's case (:func:`flex.workprecision.measurement_case`; attrs
+    """A timed configuration's case (:func:`flex.experiments.workprecision.measurement_case`; attrs
     knobs, label, errors and ``extra``)."""
     return measurement_case(name, scene, m, measurement_attrs(m, group=False) | (extra or {}))
 

@@ -1,6 +1,7 @@
 """What the benchmark reports: its table and its bar charts.
 
-:func:`bench_summary` turns the notes of :func:`flex.benchmark.run_bench` into datasets --
+:func:`bench_summary` turns the notes of :func:`flex.experiments.benchmark.run_bench` into datasets
+--
 ``rigid/...``, ``ffrf_1mm/...`` (times [s], errors, ratios, each run's profile),
 ``reduction/...``, ``make_all/...`` -- and the printed table (``table/what``, ``table/value``,
 ``table/detail``). :func:`bench_figures` draws the integration times at equal accuracy and the

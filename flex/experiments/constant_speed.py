@@ -1,6 +1,6 @@
 """A crank driven at constant speed (thesis ch. 4, figs. 4-7): a run checked against the
-closed-form in-line slider-crank (:mod:`flex.kinematics`) and the thesis's reported extremes
-(sec. 4.3-4.4, :data:`flex.thesis.THESIS_SLIDER_KINEMATICS`); the summary and figures of the
+closed-form in-line slider-crank (:mod:`flex.base.kinematics`) and the thesis's reported extremes
+(sec. 4.3-4.4, :data:`flex.base.thesis.THESIS_SLIDER_KINEMATICS`); the summary and figures of the
 ``kinematics`` study.
 
 Slider position in m, velocity in m/s, acceleration in m/s^2, times in s, angles in rad.

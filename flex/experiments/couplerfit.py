@@ -1,12 +1,13 @@
 """The coupler's rigid-or-flexible law (study ``kfit``): its scenes, cases, fit and summary.
 
-The link-specific half of the :mod:`flex.lawfit` pipeline for the coupler (thesis sec. 6.2,
+The link-specific half of the :mod:`flex.experiments.lawfit` pipeline for the coupler (thesis sec.
+6.2,
 Eq. 64-65). A fit case (:func:`fit_case`, run on a sweep worker) is one steel-plate coupler
 scene run twice with the same integrator settings, as an FFRF body and as its rigid twin
-(same mass and inertia); the error measures of :mod:`flex.criteria` compare the two over
+(same mass and inertia); the error measures of :mod:`flex.fidelity.criteria` compare the two over
 the deployment (t <= delta_t_stop). A validation case (:func:`validation_case`) runs
 ``coupler.model = "auto"`` with the law just fitted against the full FFRF model
-(:data:`flex.lawfit.FULL_MODES` modes).
+(:data:`flex.experiments.lawfit.FULL_MODES` modes).
 
 Scenes (:func:`fit_cases`): each is :func:`tuned` (mesh maxh = 3 t within [2 mm, 10 mm],
 the first frequency within 0.3 % of the converged one; time step h = min(1e-4 s, T/40,
@@ -17,7 +18,7 @@ load are left out (the linear FFRF model diverges there: measured at 3.3 and 11 
 
 Fit (:func:`analyse`): a law per damping ratio, delta_t definition and measure over the
 cases within the small-deformation model (:data:`VALIDITY_DEFLECTION`) and below
-:data:`flex.criteria.EULER_LOAD_LIMIT` of their Euler load; the thesis's k = 108 located
+:data:`flex.fidelity.criteria.EULER_LOAD_LIMIT` of their Euler load; the thesis's k = 108 located
 at Table 5's model 1.
 """
 
@@ -259,7 +260,7 @@ def _run_pair(scene: Scene, reduction: Any) -> tuple[dict, dict, dict[str, float
     return rigid_data, case_data(ffrf), times, walls
 
 
-#: units and descriptions of the measures beyond flex.criteria.MEASURES
+#: units and descriptions of the measures beyond flex.fidelity.criteria.MEASURES
 _MEASURE_UNITS = {"deflection_abs_m": "m", "crank_angle_abs_rad": "rad",
                   "slider_position_abs_m": "m", "peak_stress_ffrf_Pa": "Pa",
                   "peak_stress_quasi_static_Pa": "Pa", "crank_swing_rad": "rad",
@@ -356,7 +357,7 @@ def fit_case(name: str, scene: Scene) -> CaseResult:
 def validation_case(name: str, scene: Scene, criterion_toml: str | None = None) -> CaseResult:
     """``auto`` against the full FFRF model on a scene outside the fit.
 
-    The ``auto`` run goes through :func:`flex.simulation.simulate` with the law just fitted
+    The ``auto`` run goes through :func:`flex.fidelity.simulation.simulate` with the law just fitted
     (``criterion_toml``, passed as an argument; None: the installed one). Stores the
     decision, the errors of the auto run against the full FFRF run and both wall times.
     """
@@ -413,7 +414,7 @@ def criterion_path(folder: Path) -> Path:
 
 def fit_then_validate(scenes: dict[str, Scene], runner: lawfit.CaseRunner, folder: Path
                       ) -> tuple[dict[str, CaseResult], dict[str, Any]]:
-    """The :mod:`flex.lawfit` pipeline for the coupler: fit cases, :func:`analyse`, the
+    """The :mod:`flex.experiments.lawfit` pipeline for the coupler: fit cases, :func:`analyse`, the
     criterion beside ``folder`` (:func:`criterion_path`), the ``val_*`` cases."""
     return lawfit.fit_then_validate(scenes, lambda name: not name.startswith("val_"), runner,
                                     analyse, criterion_toml, criterion_path(folder))

@@ -1,17 +1,19 @@
 """The crank's rigid-or-flexible law (study ``crank``): its cases, fit and summary.
 
-The link-specific half of the :mod:`flex.lawfit` pipeline for a plate crank. The coupler's
+The link-specific half of the :mod:`flex.experiments.lawfit` pipeline for a plate crank. The
+coupler's
 law under-predicts the error of a rigid crank that carries the wing (measured about 2x at
 equal n: the wing makes the crank a cantilever under a larger quasi-static load), so the
 crank gets its own, with n = delta_t / T and T the period of the crank's first in-plane
-elastic mode in the assembled mechanism (:func:`flex.criteria.crank_elastic_omega`).
+elastic mode in the assembled mechanism (:func:`flex.fidelity.criteria.crank_elastic_omega`).
 
 Cases (:func:`cases`): each fit scene (with the wing: the harder case, so the law is
 conservative for cranks without one) as ``<name>__rigid`` and ``<name>__full`` (an FFRF
-crank with :data:`flex.lawfit.FULL_MODES` modes); each validation scene as ``<name>__auto``
+crank with :data:`flex.experiments.lawfit.FULL_MODES` modes); each validation scene as
+``<name>__auto``
 (``crank.model = "auto"`` with the law just fitted) and ``<name>__full``. Errors, of rigid
 or auto against the full model over its deployment, are
-:func:`flex.criteria.errors_against_full` with the crank's midpoint deflection / L1; the
+:func:`flex.fidelity.criteria.errors_against_full` with the crank's midpoint deflection / L1; the
 governing one is fitted and held against the tolerance.
 """
 
@@ -71,7 +73,8 @@ def cases(scene: Scene, fit: tuple[tuple[float, float], ...],
 def analyse(scenes: dict[str, Scene], results: dict[str, CaseResult]) -> dict[str, Any]:
     """Fit table (per fit scene with both runs ok: n = delta_t of the rigid run x the
     crank's in-mechanism frequency / 2 pi, the errors of the rigid crank against the full
-    one) and the governing law over it (``fits``, keyed as :func:`flex.lawfit.fit_laws`)."""
+    one) and the governing law over it (``fits``, keyed as
+    :func:`flex.experiments.lawfit.fit_laws`)."""
     rows = {}
     for name, scene in scenes.items():
         name = name.removesuffix("__rigid")
@@ -106,7 +109,7 @@ def criterion_toml(analysis: dict[str, Any], provenance: bool = False) -> str:
 
 def fit_then_validate(scenes: dict[str, Scene], runner: lawfit.CaseRunner, path: Path
                       ) -> tuple[dict[str, CaseResult], dict[str, Any]]:
-    """The :mod:`flex.lawfit` pipeline for the crank: fit cases, :func:`analyse`, the
+    """The :mod:`flex.experiments.lawfit` pipeline for the crank: fit cases, :func:`analyse`, the
     criterion at ``path``, the validation cases."""
     fit = {n: s for n, s in scenes.items() if n.startswith("fit_")}
     return lawfit.fit_then_validate(scenes, lambda name: name.startswith("fit_"), runner,

@@ -1,7 +1,8 @@
 """Whether flex's bundled solver defaults are what the work-precision runs measured as fastest.
 
 The setting labelled :data:`DEFAULT_LABEL` is what a user gets: the bundled scene's ``"auto"``
-solver keys (:data:`flex.settings.AUTO_OVERRIDES`), which :mod:`flex.settings` fills from
+solver keys (:data:`flex.config.settings.AUTO_OVERRIDES`), which :mod:`flex.config.settings` fills
+from
 ``flex/solver_defaults.toml`` (README "Defaults"). On the 1 mm FFRF plate (the bundled 2 mm
 mesh and 6 modes) they resolve to its ``ffrf_coupler`` entry, the certified 1 % pick
 h = 4e-4 s, modified Newton 1e-8; on the rigid scene to the ``rigid`` entry.

@@ -7,7 +7,7 @@ angle maximum [rad] and its time [s], crank speed maximum [rad/s] and its time, 
 [m] at the angle maximum, slider start position [m], constraint norm [m], half-swing time
 [s]); :func:`comparison_table` sets them beside the thesis's numbers (:data:`THESIS_ROWS`)
 with the reason for each difference (:data:`REASONS`); :func:`summary` adds per case the
-deviation from the reference DAE (:func:`flex.reference.deviations_from_reference`) and the
+deviation from the reference DAE (:func:`flex.dynamics.reference.deviations_from_reference`) and the
 energy drift; :func:`draw_figures` draws the thesis's figures 14-23 and the energy balance.
 """
 

@@ -3,16 +3,16 @@
 The ``kfit`` (coupler) and ``crank`` studies run the same steps (thesis sec. 6.2, Eq. 64-65):
 
 1. **fit cases**: scenes of the link over a range of n = delta_t / T, each run with the link
-   rigid and flexible (what is measured is the link's own: :mod:`flex.couplerfit`,
-   :mod:`flex.crankfit`);
+   rigid and flexible (what is measured is the link's own: :mod:`flex.experiments.couplerfit`,
+   :mod:`flex.experiments.crankfit`);
 2. **fit table -> laws**: one row per fit case (n, dimensionless errors); power laws
    ``e = floor + c n^-p`` per damping ratio, delta_t definition and measure
-   (:func:`fit_laws`, by :func:`flex.criteria.fit_error_law`);
+   (:func:`fit_laws`, by :func:`flex.fidelity.criteria.fit_error_law`);
 3. **criterion**: the laws of the primary delta_t as criterion TOML (:func:`criterion_toml`,
    the format of ``flex/criteria_fit.toml``), written to a file for ``make
    <study>-criterion`` to install;
 4. **in force**: the validation cases get the law just fitted as a
-   :class:`flex.criteria.Criterion` parsed from that text (:func:`simulate_with_law`),
+   :class:`flex.fidelity.criteria.Criterion` parsed from that text (:func:`simulate_with_law`),
    never the installed file;
 5. **validation**: ``auto`` against the full flexible model (:data:`FULL_MODES` modes) on
    scenes outside the fit (:class:`Validation`, :func:`validation_lines`).
@@ -41,7 +41,7 @@ from flex.fidelity.criteria import GOVERNING, PRIMARY_DELTA_T, Criterion, ErrorL
 FULL_MODES = 12
 #: tolerances the reports tabulate k(tolerance) for
 REPORT_TOLERANCES = (0.1, 0.01, 0.001)
-#: the keyword of :func:`flex.simulation.simulate` that carries a link's law
+#: the keyword of :func:`flex.fidelity.simulation.simulate` that carries a link's law
 CRITERION_ARGUMENT = {"coupler": "criterion", "crank": "crank_criterion"}
 
 
@@ -60,7 +60,7 @@ def simulate_with_law(scene: Scene, name: str, link: str, criterion_text: str | 
                       source: str, raising: bool = False) -> CaseResult:
     """Simulate ``scene`` with ``link``'s ``auto`` decided by the law in ``criterion_text``
     (criterion TOML; None: the installed file). ``raising``: a failure raises
-    (:func:`flex.simulation.simulate`) instead of becoming a failed case."""
+    (:func:`flex.fidelity.simulation.simulate`) instead of becoming a failed case."""
     from flex.fidelity.criteria import parse_criterion
     from flex.fidelity.simulation import simulate, simulate_case
 
@@ -247,7 +247,7 @@ def criterion_toml(fits: Mapping[tuple[float, str, str], ErrorLaw], header: str,
 @dataclass
 class Validation:
     """One validation scene: ``auto``'s choice for ``link`` and its error against the full
-    model. ``errors``: :func:`flex.criteria.errors_against_full` (dimensionless, and
+    model. ``errors``: :func:`flex.fidelity.criteria.errors_against_full` (dimensionless, and
     ``delta_t`` [s]); ``attrs``: the auto run's ``fidelity_<link>_*`` attributes;
     ``timings``: report column -> wall time [s]."""
 

@@ -1,4 +1,5 @@
-"""Figures of the rigid-or-flexible law fits (:mod:`flex.lawfit`): the coupler's (``kfit``)
+"""Figures of the rigid-or-flexible law fits (:mod:`flex.experiments.lawfit`): the coupler's
+(``kfit``)
 errors and k against n and tolerance, the crank's law, its validation and deflections."""
 
 from __future__ import annotations
@@ -16,10 +17,10 @@ from flex.experiments.couplerfit import THESIS_MODELS, label
 from flex.experiments.lawfit import FULL_MODES, REPORT_TOLERANCES
 from flex.fidelity.criteria import GOVERNING, TWO_PI
 
-#: the coupler fit's case families spelt out (see :func:`flex.couplerfit.fit_cases`)
+#: the coupler fit's case families spelt out (see :func:`flex.experiments.couplerfit.fit_cases`)
 FAMILY_NAMES = {"thk": "thickness sweep", "stf": "spring stiffness sweep",
                 "pre": "preload sweep"}
-#: the error measures as axis labels (definitions: flex.criteria.MEASURES)
+#: the error measures as axis labels (definitions: flex.fidelity.criteria.MEASURES)
 MEASURE_LABELS = {GOVERNING: "governing error = largest of\ndeflection, angle, slider [-]",
                   "deflection": "peak deflection\n/ coupler length L2 [-]",
                   "crank_angle": "crank angle error\n/ crank swing [-]",
@@ -42,7 +43,7 @@ def _thesis_entry(thesis_k: float) -> tuple[str, dict]:
 # ------------------------------------------------------------------------------------------
 def coupler_figures(analysis: dict[str, Any], folder: Path) -> list[Path]:
     """``kfit-error-vs-n.png`` and ``kfit-k-vs-tolerance.png`` from an analysis of
-    :func:`flex.couplerfit.analyse` (none without fits)."""
+    :func:`flex.experiments.couplerfit.analyse` (none without fits)."""
     if not analysis["fits"]:
         return []
     return [_error_vs_n(analysis, folder / "kfit-error-vs-n.png"),

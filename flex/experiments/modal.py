@@ -2,10 +2,11 @@
 and draws.
 
 :func:`survey` computes, for the scene's coupler material: Table 5 in both period conventions
-and Tables 7 and 9 with flex's reading of them (:mod:`flex.thesis_tables`); the first five
+and Tables 7 and 9 with flex's reading of them (:mod:`flex.bodies.thesis_tables`); the first five
 modes of each Table 5 coupler plate and of the crank, free-free and pinned-pinned, by 3D FE
-(:mod:`flex.fe_modes`) beside the Timoshenko beam (:mod:`flex.beams`), each classified; and
-the mesh convergence of each Table 5 plate (:mod:`flex.mesh_convergence`). It returns the
+(:mod:`flex.bodies.fe_modes`) beside the Timoshenko beam (:mod:`flex.bodies.beams`), each
+classified; and
+the mesh convergence of each Table 5 plate (:mod:`flex.bodies.mesh_convergence`). It returns the
 datasets stored under ``/summary`` (units from the keys: ``_m``, ``_s``, ``_Hz``,
 ``_rad_per_s``) and the report. :func:`draw_figures` draws them back from those datasets.
 """

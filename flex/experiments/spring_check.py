@@ -1,8 +1,8 @@
 """The thesis's deployment spring checked as a designer would (sec. 6.1): the summary and the
-figure of the ``spring`` study, from the formulas of :mod:`flex.spring`.
+figure of the ``spring`` study, from the formulas of :mod:`flex.bodies.spring`.
 
 :func:`summary` shows which single input reproduces the stated 1500 N/m, then checks the
-consistent design (:data:`flex.spring.CONSISTENT_THESIS_SPRING`): Wahl- and
+consistent design (:data:`flex.bodies.spring.CONSISTENT_THESIS_SPRING`): Wahl- and
 Bergstrasser-corrected shear stress [Pa] at the press and at solid against ASTM A228's
 allowable stress, solid length [m], surge frequencies [Hz] and the thesis's rigid-or-flexible
 ratio n for the spring itself, and the peak stress of an NGsolve helix segment against Wahl.

@@ -2,7 +2,7 @@
 
 An :class:`Extreme` is one run (scene overrides) with the reference it is checked against:
 
-- ``scipy``: the scipy DAE (:mod:`flex.reference`, DOP853 rtol 1e-12, shown converged by
+- ``scipy``: the scipy DAE (:mod:`flex.dynamics.reference`, DOP853 rtol 1e-12, shown converged by
   rtol 1e-11), rigid links;
 - ``fine:<step>``: flex's own model at ``<step>`` [s] with modified Newton to 1e-10 (shown
   converged by twice that step);
@@ -202,7 +202,7 @@ class References:
 # judging
 # ------------------------------------------------------------------------------------------
 def nonlinear_available() -> bool:
-    """Whether the nonlinear FE coupler (:mod:`flex.nonlinear`) can be built here."""
+    """Whether the nonlinear FE coupler (:mod:`flex.bodies.nonlinear`) can be built here."""
     try:
         from flex.bodies.nonlinear import add_nonlinear_fe_coupler  # noqa: F401
     except ImportError:

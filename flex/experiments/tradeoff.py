@@ -4,7 +4,7 @@ A :class:`Setting` is one combination of knobs: scene overrides (``simulation.st
 ``simulation.spectral_radius``, ``simulation.formulation``, ``simulation.newton``,
 ``simulation.integrator``, ``coupler.modes``, ``coupler.mesh_size_m``, ``coupler.model``,
 ...) run by flex's Exudyn model, or the independent scipy reference DAE
-(:mod:`flex.reference`, ``engine = "scipy"``) at a given method and tolerance.
+(:mod:`flex.dynamics.reference`, ``engine = "scipy"``) at a given method and tolerance.
 :func:`measure` runs a setting ``repeats`` times and returns a :class:`Measurement`: the
 median wall time of the integration, steps, Newton iterations, and the errors against a
 converged :class:`Reference`:
@@ -77,8 +77,8 @@ class Setting:
     """One knob combination.
 
     ``overrides``: scene keys ``"section.key"`` -> value, applied to the scene being studied;
-    ``engine``: ``"exudyn"`` (flex's model, :func:`flex.solver.simulate`) or ``"scipy"``
-    (the reference DAE of :mod:`flex.reference`, rigid coupler only) with ``method``,
+    ``engine``: ``"exudyn"`` (flex's model, :func:`flex.dynamics.solver.simulate`) or ``"scipy"``
+    (the reference DAE of :mod:`flex.dynamics.reference`, rigid coupler only) with ``method``,
     ``rtol`` and ``atol`` for ``solve_ivp``; ``group``: which sweep it belongs to (one knob
     at a time, or a combination), used to colour the diagrams.
     """
@@ -178,7 +178,7 @@ class Observables:
 
     @staticmethod
     def of_datasets(datasets: dict[str, Dataset], flexible: bool) -> Observables:
-        """From a :class:`~flex.results.CaseResult`'s datasets."""
+        """From a :class:`~flex.data.results.CaseResult`'s datasets."""
         return Observables(np.asarray(datasets["time"].data),
                            np.asarray(datasets["crank/angle"].data),
                            np.asarray(datasets["slider/position"].data),
@@ -314,7 +314,8 @@ def describe(m: Measurement | None) -> str:
 def element_order(order: int) -> Iterator[None]:
     """Build reductions with tetrahedra of ``order`` (1 or 2) inside the block.
 
-    :mod:`flex.reduction` fixes quadratic tetrahedra (module constant ``_MESH_ORDER``, part of
+    :mod:`flex.bodies.reduction` fixes quadratic tetrahedra (module constant ``_MESH_ORDER``, part
+    of
     the cache key); the work-precision study sets it for the duration of one build to show
     what linear tetrahedra cost in accuracy. Raises SceneError if the constant is gone.
     """
@@ -323,7 +324,7 @@ def element_order(order: int) -> Iterator[None]:
     if order not in (1, 2):
         raise SceneError(f"element_order = {order!r}: must be 1 or 2")
     if not hasattr(reduction, "_MESH_ORDER"):
-        raise SceneError("element_order: flex.reduction no longer exposes _MESH_ORDER")
+        raise SceneError("element_order: flex.bodies.reduction no longer exposes _MESH_ORDER")
     previous = reduction._MESH_ORDER
     reduction._MESH_ORDER = order
     try:
@@ -359,7 +360,7 @@ def run_once(scene: Scene, setting: Setting, pool: ReductionPool | None = None
              ) -> tuple[Observables, dict[str, float]]:
     """Run ``setting`` on ``scene`` (already overridden) once: observables and counters
     (``wall_time_s`` = integration only, ``total_time_s``, steps, Newton iterations).
-    Raises :class:`~flex.errors.FlexError` (SimulationError, SceneError) on failure."""
+    Raises :class:`~flex.base.errors.FlexError` (SimulationError, SceneError) on failure."""
     start = time.perf_counter()
     flexible = scene["coupler"]["model"] != "rigid"
     if setting.engine == "scipy":
@@ -504,7 +505,7 @@ def converged_reference(base: Scene, label: str, finest: Setting,
     its level at the anchor's value of the knob; the relative difference between the
     reference and that prediction is stored as the evidence ``interaction`` and counts in the
     accuracy like a knob (the knobs' joint effect that the sequences do not see). Raises
-    :class:`~flex.errors.FlexError` if the finest run fails.
+    :class:`~flex.base.errors.FlexError` if the finest run fails.
     """
     scene = scene_for(base, finest)
     if progress:

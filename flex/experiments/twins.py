@@ -5,12 +5,12 @@ floating-frame-of-reference body (NGsolve mesh, Hurty-Craig-Bampton reduction) a
 rigid twin, a rigid body with the plate's own mass and inertia, so the pair differs only by
 elasticity. :func:`twin_cases` builds the pairs of a table of plates (``{model:
 (thickness [m], mesh size [m])}``) and, for an undamped scene, the fully nonlinear FE coupler
-(:mod:`flex.nonlinear`) of one of them; :func:`simulate_twins` runs them, each reduction
+(:mod:`flex.bodies.nonlinear`) of one of them; :func:`simulate_twins` runs them, each reduction
 built (or loaded from the cache) once, its facts kept in the run's notes;
 :func:`summarize_twins` tabulates, per plate, the reduction's frequencies and mesh, the
 thesis's n = delta_t / T in both period conventions and the FFRF run's deviations from its
 twin, and compares the nonlinear FE run with its FFRF twin
-(:func:`flex.softening.compare_with_nonlinear_fe`); :func:`twin_figures` draws them.
+(:func:`flex.fidelity.softening.compare_with_nonlinear_fe`); :func:`twin_figures` draws them.
 """
 
 from __future__ import annotations

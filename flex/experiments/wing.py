@@ -2,9 +2,9 @@
 the wing's flexibility, and the summary and figures of the ``wing`` study.
 
 The thesis gives only the outcome (peak wing-tip angular velocity
-:data:`~flex.thesis.THESIS_WING_PEAK_RATE_DEG_PER_S` at
-:data:`~flex.thesis.THESIS_WING_PEAK_TIME_S`, deployment in
-:data:`~flex.thesis.THESIS_WING_DEPLOYMENT_TIME_S`). :func:`fit_spring` fits the two spring
+:data:`~flex.base.thesis.THESIS_WING_PEAK_RATE_DEG_PER_S` at
+:data:`~flex.base.thesis.THESIS_WING_PEAK_TIME_S`, deployment in
+:data:`~flex.base.thesis.THESIS_WING_DEPLOYMENT_TIME_S`). :func:`fit_spring` fits the two spring
 values it leaves open, stiffness [N/m] and preload [m], to the peak on the reference DAE;
 :func:`wing_flexibility` rates the wing plate as a cantilever (frequencies [Hz], n, quasi-static
 tip deflection [m]); :func:`summary` reports a run's loads, timing and flexibility, and the

@@ -1,14 +1,17 @@
 """Running a work-precision plan: per scene a converged reference, then every setting.
 
-:func:`run_work_precision` runs, per scene, its :class:`~flex.reference_plans.ReferencePlan`
-(:func:`flex.reference_plans.build_reference`) and then measures each of its settings against
-that reference (:func:`flex.tradeoff.measure`), sharing reductions within the scene
-(:class:`~flex.tradeoff.ReductionPool`). It returns one case per run -- ``<scene>__reference``
+:func:`run_work_precision` runs, per scene, its
+:class:`~flex.experiments.reference_plans.ReferencePlan`
+(:func:`flex.experiments.reference_plans.build_reference`) and then measures each of its settings
+against
+that reference (:func:`flex.experiments.tradeoff.measure`), sharing reductions within the scene
+(:class:`~flex.experiments.tradeoff.ReductionPool`). It returns one case per run --
+``<scene>__reference``
 (the reference's curves) and ``<scene>__<setting>`` (:func:`measurement_case`: attrs knobs,
 group, label and errors; counters with the median wall time [s]; dataset ``wall_times``, every
 repeat [s]; a failed run is a ``failed`` case with its message and no data) -- and leaves the
 measurements in ``notes["runs"]`` (:class:`SceneRuns`), from which
-:mod:`flex.workprecision_report` builds the tables.
+:mod:`flex.experiments.workprecision_report` builds the tables.
 """
 
 from __future__ import annotations
@@ -46,7 +49,7 @@ class SceneRuns(NamedTuple):
 
 
 def nonlinear_available() -> bool:
-    """Whether the nonlinear FE coupler (:mod:`flex.nonlinear`, NGsolve) is installed."""
+    """Whether the nonlinear FE coupler (:mod:`flex.bodies.nonlinear`, NGsolve) is installed."""
     try:
         from flex.bodies.nonlinear import add_nonlinear_fe_coupler  # noqa: F401
     except ImportError:

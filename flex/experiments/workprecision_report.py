@@ -1,11 +1,12 @@
 """What a work-precision run reports: per scene the run table, the reference and its evidence,
 the recommendations, the defaults check, and the work-precision diagram.
 
-:func:`summarize_work_precision` turns ``notes["runs"]`` of :func:`flex.workprecision.
+:func:`summarize_work_precision` turns ``notes["runs"]`` of :func:`flex.experiments.workprecision.
 run_work_precision` into datasets under ``<scene>/``: ``runs/...`` (the table of
-:func:`flex.tradeoff.measurements_table`, with ``on_pareto_front``), ``reference/...`` (what it
+:func:`flex.experiments.tradeoff.measurements_table`, with ``on_pareto_front``), ``reference/...``
+(what it
 is and its convergence evidence), ``recommended/...`` (per accuracy level 1 %, 0.1 %, 0.01 %)
-and ``default/...`` (:mod:`flex.defaults_check`), and into the report text.
+and ``default/...`` (:mod:`flex.experiments.defaults_check`), and into the report text.
 :func:`work_precision_figures` draws, from those datasets, one diagram per scene: error
 against wall time (log-log), the Pareto fronts, the accuracy levels and the band the reference
 cannot resolve.
@@ -47,7 +48,8 @@ def _evidence_column(evidence: Mapping[str, Mapping[str, Any]], key: str, defaul
 
 def evidence_datasets(prefix: str, evidence: Mapping[str, Mapping[str, Any]]
                       ) -> dict[str, Dataset]:
-    """The reference's evidence (:attr:`flex.tradeoff.Reference.evidence`) as columns under
+    """The reference's evidence (:attr:`flex.experiments.tradeoff.Reference.evidence`) as columns
+    under
     ``prefix``, one row per knob sequence or coarsening."""
     names = list(evidence)
     values = np.full((len(names), 3), np.nan)

@@ -170,7 +170,7 @@ def quasi_static_stress(force_B_N: np.ndarray, force_C_N: np.ndarray,
     transverse components. The axial force is interpolated linearly between the axial
     components (exact for uniform axial acceleration). Stress = |N| / A + 6 |M| / (w t^2),
     the outer-fibre value, maximised over ``x_range_m`` (default: one thickness away from
-    each end, as :func:`flex.reduction.bending_stress_history`).
+    each end, as :func:`flex.bodies.reduction.bending_stress_history`).
     """
     force_b = np.asarray(force_B_N, dtype=float)
     force_c = np.asarray(force_C_N, dtype=float)
@@ -663,7 +663,7 @@ class FidelityDecision:
     extrapolated: bool
 
     def attrs(self) -> dict[str, Any]:
-        """Flat attributes ``fidelity_<link>_*`` for :class:`flex.results.CaseResult`."""
+        """Flat attributes ``fidelity_<link>_*`` for :class:`flex.data.results.CaseResult`."""
         prefix = f"fidelity_{self.link}_"
         return {prefix + "model": self.model, prefix + "modes": -1 if self.modes is None
                 else self.modes, prefix + "reason": self.reason,

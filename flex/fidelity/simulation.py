@@ -1,11 +1,11 @@
 """Simulate any scene: resolve ``model = "auto"`` links, then integrate.
 
-The layer above :mod:`flex.solver` (which integrates scenes whose links have concrete
-models) and :mod:`flex.criteria` (which decides ``auto`` from a rigid probe run, made with
-:func:`flex.solver.integrate`). The fitted laws ``auto`` reads are arguments: ``None``
-means the installed criterion files (:data:`flex.criteria.DEFAULT_CRITERION`,
-:data:`flex.criteria.DEFAULT_CRANK_CRITERION`); a study that has just fitted a law passes
-it as a :class:`flex.criteria.Criterion`.
+The layer above :mod:`flex.dynamics.solver` (which integrates scenes whose links have concrete
+models) and :mod:`flex.fidelity.criteria` (which decides ``auto`` from a rigid probe run, made with
+:func:`flex.dynamics.solver.integrate`). The fitted laws ``auto`` reads are arguments: ``None``
+means the installed criterion files (:data:`flex.fidelity.criteria.DEFAULT_CRITERION`,
+:data:`flex.fidelity.criteria.DEFAULT_CRANK_CRITERION`); a study that has just fitted a law passes
+it as a :class:`flex.fidelity.criteria.Criterion`.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ from flex.fidelity.criteria import Criterion, FidelityDecision, resolve_fidelity
 def resolve_auto(scene: Scene, criterion: Criterion | None = None,
                  crank_criterion: Criterion | None = None
                  ) -> tuple[Scene, list[FidelityDecision]]:
-    """Resolve ``model = "auto"`` links (:func:`flex.criteria.resolve_fidelity`) and print
+    """Resolve ``model = "auto"`` links (:func:`flex.fidelity.criteria.resolve_fidelity`) and print
     each choice and its reason to stderr. A scene without ``auto`` links is returned as it
     is, with no decisions."""
     if scene["coupler"]["model"] != "auto" and scene["crank"]["model"] != "auto":
@@ -40,13 +40,13 @@ def resolve_auto(scene: Scene, criterion: Criterion | None = None,
 def simulate(scene: Scene, name: str = "case", reduction: Any = None,
              crank_reduction: Any = None, criterion: Criterion | None = None,
              crank_criterion: Criterion | None = None) -> CaseResult:
-    """One case of any scene; raises :class:`~flex.errors.FlexError` on bad input or
+    """One case of any scene; raises :class:`~flex.base.errors.FlexError` on bad input or
     divergence.
 
     ``model = "auto"`` links are first resolved to concrete models (given reductions are
     then ignored: auto picks the modes), by ``criterion`` / ``crank_criterion`` (None: the
     installed laws); the choice and its reason go to stderr and into the result's
-    attributes ``fidelity_<link>_*``. Then :func:`flex.solver.integrate` fills the
+    attributes ``fidelity_<link>_*``. Then :func:`flex.dynamics.solver.integrate` fills the
     ``"auto"`` solver keys and integrates. ``reduction`` / ``crank_reduction``: reductions
     of ``ffrf`` links (None: built or loaded from the cache).
     """

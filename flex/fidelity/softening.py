@@ -7,7 +7,7 @@ soften its bending (no geometric stiffness). Two measures say how much that matt
   along its chord B-C against the pinned-pinned Euler load pi^2 E I / L^2 (I = w t^3 / 12);
   near 1 the axial force changes the bending stiffness;
 - :func:`compare_with_nonlinear_fe`: an FFRF run against the fully nonlinear FE coupler
-  (:mod:`flex.nonlinear`, same mesh, Green-Lagrange strain) sample by sample: first and
+  (:mod:`flex.bodies.nonlinear`, same mesh, Green-Lagrange strain) sample by sample: first and
   largest deflection peaks, the largest difference of the curves, the compression over the
   Euler load and both wall times, as summary datasets and report lines.
 """

@@ -17,7 +17,7 @@ with the same rule; text must be equal. A case that failed (status ``"failed"``)
 file, among the cases compared, is a failure of its own: its row reads ``case X failed in A:
 <the case's message> (<file>)``, and a PATH into it selects nothing instead of being an error.
 
-Which datasets: the PATHs given (see :func:`flex.results.select_datasets` for the forms,
+Which datasets: the PATHs given (see :func:`flex.data.results.select_datasets` for the forms,
 including the case shorthand and wildcards). A PATH that names one dataset missing from
 either file is an error (exit 2). A PATH naming a group compares the datasets both files
 have below it and lists the rest as *only in A* / *only in B*. Without PATH, every curve of
@@ -328,7 +328,7 @@ def compare_files(file_a: str | Path, file_b: str | Path, specs: Sequence[str] =
                   interpolation: str = "cubic") -> Comparison:
     """Compare the datasets ``specs`` name (all common ones when empty) of two result files.
 
-    See the module documentation for the rule. Raises :class:`~flex.errors.FlexError`
+    See the module documentation for the rule. Raises :class:`~flex.base.errors.FlexError`
     (:class:`ResultFileError` for a bad file or a missing path) when nothing can be compared.
     """
     for name, value in (("rtol", rtol), ("atol", atol)):

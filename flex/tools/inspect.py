@@ -4,7 +4,7 @@
 (flex and engine versions, git commit, creation time, command), the resolved scene, every
 case with its status, counters, time range, scene changes and datasets (shape, dtype, units,
 description), and the ``/summary`` datasets (scalars with their values). With a PATH (the
-forms of :func:`flex.results.select_datasets`) only the datasets it names are listed, the
+forms of :func:`flex.data.results.select_datasets`) only the datasets it names are listed, the
 scene shown is that case's full scene, and a single dataset gets its statistics (minimum and
 maximum with the time they occur, first and last value). :func:`format_description` renders
 the dictionary as the text the command prints.
@@ -27,12 +27,12 @@ ENGINES = ("exudyn", "ngsolve", "h5py", "numpy", "scipy")
 
 
 def describe(path: str | Path, spec: str | None = None) -> dict[str, Any]:
-    """Everything :mod:`flex.inspect` shows about ``path`` (restricted to ``spec``).
+    """Everything :mod:`flex.tools.inspect` shows about ``path`` (restricted to ``spec``).
 
     Returns a JSON-serialisable dict with keys ``file``, ``provenance``, ``attributes``
     (other root attributes), ``scene_toml``, ``cases``, ``summary``, ``other`` and, with
     ``spec``, ``selection`` and (one dataset) ``dataset``. Raises
-    :class:`~flex.errors.ResultFileError` for a bad file or a path it does not have.
+    :class:`~flex.base.errors.ResultFileError` for a bad file or a path it does not have.
     """
     with reading(path) as h5:
         selected = set(select_datasets(h5, spec, path)) if spec else None

@@ -1,6 +1,6 @@
 """Plot stored curves (``python -m flex plot FILE.h5 PATH [PATH ...]``).
 
-Contract: each PATH (the forms of :func:`flex.results.select_datasets`, plus an optional
+Contract: each PATH (the forms of :func:`flex.data.results.select_datasets`, plus an optional
 ``[column]`` suffix) is drawn against its case's ``time`` -- or, with ``x_spec``, against
 another dataset of the same case (``--x crank/angle``: speed over angle; ``--x
 crank/midpoint_position[0]`` with ``crank/midpoint_position[1]``: the trajectory). Axis
@@ -12,7 +12,7 @@ another case (sampled on another time base) is refused, naming both cases. The f
 written atomically (PNG, PDF or SVG by the extension; a temporary file renamed when complete,
 so a failure leaves a previous figure intact) and its path returned; a figure path that is
 one of the files being read, a folder, or inside a file or an unwritable folder is refused
-(:class:`~flex.errors.OutputError`) before anything is read.
+(:class:`~flex.base.errors.OutputError`) before anything is read.
 """
 
 from __future__ import annotations
@@ -169,7 +169,7 @@ def plot_curves(path: str | Path, specs: Sequence[str], others: Sequence[str | P
     """Draw ``specs`` of result file ``path`` (and of each file in ``others``) and save.
 
     Returns the figure's path (default :func:`default_output`). Raises
-    :class:`~flex.errors.FlexError` for a bad file, a missing path, mismatched x units or
+    :class:`~flex.base.errors.FlexError` for a bad file, a missing path, mismatched x units or
     more than two y units.
     """
     if not specs:

@@ -110,7 +110,7 @@ def render_report(path: str | Path, report_folder: str | Path | None = None) -> 
 
     ``report_folder`` is where the report will be saved (default: that of
     :func:`default_report_path`); links to the result file and its figures are relative to
-    it. Raises :class:`~flex.errors.ResultFileError` for a missing or malformed file.
+    it. Raises :class:`~flex.base.errors.ResultFileError` for a missing or malformed file.
     """
     path = Path(path)
     folder = Path(report_folder) if report_folder is not None else default_report_path(
@@ -130,9 +130,9 @@ def write_report(path: str | Path, out: str | Path | None = None) -> Path:
     :func:`default_report_path`) atomically (a temporary file renamed into place, the folder
     created) and return where it went.
 
-    Refuses with :class:`~flex.errors.OutputError`, writing nothing, an output that is the
+    Refuses with :class:`~flex.base.errors.OutputError`, writing nothing, an output that is the
     result file itself, does not end in ``.md``, is a folder or cannot be written; a bad
-    result file raises :class:`~flex.errors.ResultFileError`, also before anything is
+    result file raises :class:`~flex.base.errors.ResultFileError`, also before anything is
     written.
     """
     path = Path(path)
@@ -166,7 +166,7 @@ def _same_file(a: Path, b: Path) -> bool:
 
 def _read(path: Path) -> tuple[dict[str, Any], list[dict[str, Any]], list[_Item]]:
     """Root attributes, cases (name, attributes, samples, time range) and every dataset
-    outside ``/cases``, read through :func:`flex.results.reading` (which checks the file)."""
+    outside ``/cases``, read through :func:`flex.data.results.reading` (which checks the file)."""
     with reading(path) as h5:
         root = {key: attribute_value(value) for key, value in h5.attrs.items()}
         cases = []
