@@ -27,10 +27,16 @@ Conventions shared by every function here:
   (a scene or override), :class:`~flex.base.errors.SimulationError` (a run diverged; the message
   names the step and the time), :class:`~flex.base.errors.ResultFileError` (a result file),
   :class:`~flex.base.errors.OutputError` (an output that cannot be written).
+- The **reduction cache** (Craig-Bampton reductions of ``ffrf`` plates) is a folder argument,
+  ``cache_dir``; left out, these functions read the user's from the environment when called
+  (``FLEX_CACHE_DIR``/reductions, else ``$XDG_CACHE_HOME/flex/reductions``, else
+  ``~/.cache/flex/reductions``: :func:`flex.bodies.reduction.reduction_cache_dir`), as the
+  command line does. The library below takes it as an argument only.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -151,7 +157,8 @@ def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
     return derived
 
 
-def simulate(scene: Scene, name: str = "case", **options: Any) -> CaseResult:
+def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None = None,
+             **options: Any) -> CaseResult:
     """Simulate one scene in memory and return its curves (nothing is written to disk
     except the reduction cache).
 
@@ -160,11 +167,13 @@ def simulate(scene: Scene, name: str = "case", **options: Any) -> CaseResult:
     ``"auto"`` solver keys are filled by model (``flex/config/solver_defaults.toml``), then the
     mechanism is built in Exudyn and integrated at a fixed step from t = 0 to
     ``simulation.end_time_s``. A flexible (``ffrf``) link's Craig-Bampton reduction is built
-    with NGsolve or read from the cache (``~/.cache/flex/reductions``, ``FLEX_CACHE_DIR``).
+    with NGsolve or read from the reduction cache ``cache_dir``.
 
     Inputs:
         scene: a validated scene (:func:`load_scene`, :func:`derive_scene`).
         name: the case name stored with the result (default ``"case"``).
+        cache_dir: the reduction cache folder (default: the user's, read from the
+            environment at this call; module doc).
         options: passed on to :func:`flex.fidelity.simulation.simulate` (``reduction=``,
             ``crank_reduction=``: prebuilt reductions; ``criterion=``, ``crank_criterion=``:
             another fitted law for ``auto``, :func:`flex.fidelity.criteria.load_criterion`); not
@@ -189,12 +198,21 @@ def simulate(scene: Scene, name: str = "case", **options: Any) -> CaseResult:
     """
     from flex.fidelity.simulation import simulate as simulate_scene
 
-    return simulate_scene(scene, name, **options)
+    return simulate_scene(scene, name, cache_dir=_cache_dir(cache_dir), **options)
+
+
+def _cache_dir(given: str | Path | None) -> Path:
+    """``given`` as a folder, or the user's reduction cache folder from the environment."""
+    if given is not None:
+        return Path(given)
+    from flex.bodies.reduction import reduction_cache_dir
+
+    return reduction_cache_dir(os.environ)  # the environment, read at this public edge
 
 
 def run_study(name: str, source: str | Path | None = None, overrides: Overrides | None = None,
               out: str | Path | None = None, figures: bool = True, quiet: bool = False,
-              **options: Any) -> StudyOutput:
+              *, cache_dir: str | Path | None = None, **options: Any) -> StudyOutput:
     """Run a study as ``flex run`` does: its cases, its HDF5 file, its figures and report
     (``reports/<stem>.md`` beside the file, :mod:`flex.tools.report`).
 
@@ -206,8 +224,13 @@ def run_study(name: str, source: str | Path | None = None, overrides: Overrides 
         out: result file, ending in ``.h5`` (default ``results/<name>.h5``).
         figures: draw the study's PNG figures into ``figures/`` beside the result file.
         quiet: print nothing on success (failed cases still go to stderr).
+        cache_dir: the reduction cache folder (default: the user's, read from the
+            environment at this call; module doc).
         options: passed on to :func:`flex.study.run_study` (e.g. ``sweep=``, a
-            :class:`flex.sweep.SweepSettings` saying where a sweep study's cases run).
+            :class:`flex.sweep.SweepSettings` saying where a sweep study's cases run;
+            ``environment=``, the values of the variables the study declares in
+            ``ENVIRONMENT``, by default read from the environment at this call, as
+            ``flex run`` does: ``FLEX_BENCH_MAKE=0`` skips the bench study's ``make all``).
     Output:
         a :class:`flex.study.StudyOutput`: ``results`` (case name -> CaseResult, as
         :func:`simulate` returns), ``summary`` (``datasets`` stored under ``/summary``,
@@ -223,9 +246,14 @@ def run_study(name: str, source: str | Path | None = None, overrides: Overrides 
         (:class:`~flex.base.errors.OutputError`); :class:`flex.study.Interrupted` (a
         :class:`KeyboardInterrupt`) on Ctrl-C, naming the files already written.
     """
+    from flex.study import from_environment
     from flex.study import run_study as _run
 
-    return _run(name, source, override_strings(overrides), out, figures, quiet, **options)
+    edge = from_environment(name, os.environ)  # the environment, read at this public edge
+    options.setdefault("environment", edge["environment"])
+    folder = edge["cache_dir"] if cache_dir is None else Path(cache_dir)
+    return _run(name, source, override_strings(overrides), out, figures, quiet,
+                cache_dir=folder, **options)
 
 
 def open_result(path: str | Path, case: str | None = None) -> xarray.Dataset:

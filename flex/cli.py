@@ -307,7 +307,7 @@ def _dispatch(argv: list[str] | None) -> int:
 def _run(args: argparse.Namespace) -> int:
     import re
 
-    from flex.study import load_study, run_study
+    from flex.study import from_environment, load_study, run_study
 
     if args.workers is not None and args.workers < 1:
         raise FlexError(f"--workers {args.workers}: must be at least 1")
@@ -330,6 +330,8 @@ def _run(args: argparse.Namespace) -> int:
         sweep = settings_from_environment()
         sweep = dataclasses.replace(sweep, scheduler=args.scheduler or sweep.scheduler,
                                     workers=args.workers or sweep.workers)
+    # the reduction cache folder and the study's declared variables: read here, once
     output = run_study(args.study, args.scene, args.overrides, args.out,
-                       figures=not args.no_figures, quiet=args.quiet, sweep=sweep)
+                       figures=not args.no_figures, quiet=args.quiet, sweep=sweep,
+                       **from_environment(args.study, os.environ))
     return EXIT_OK if output.as_expected else EXIT_FAILED

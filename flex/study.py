@@ -16,6 +16,11 @@ what it measures beside its cases goes to ``run.notes``, which ``summarize`` get
 a run succeeds (:attr:`StudyOutput.as_expected`, exit status 0) when exactly those failed.
 :func:`execute` runs a study and returns its :class:`StudyOutput`; :func:`run_study` also
 writes ``results/<study>.h5`` (atomically) and the figures.
+
+Nothing here reads the environment: the reduction cache folder (``cache_dir``) and the
+values of the environment variables a study declares in ``ENVIRONMENT`` (its run-time
+switches, e.g. the bench study's ``FLEX_BENCH_MAKE``) are arguments, in :class:`StudyRun`.
+The command lines and :mod:`flex.api` read them once (:func:`from_environment`).
 """
 
 from __future__ import annotations
@@ -23,7 +28,7 @@ from __future__ import annotations
 import importlib
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import ModuleType
@@ -66,11 +71,19 @@ class StudyRun:
     ``summarize``: the progress callback, the sweep settings (sweep studies:
     :class:`flex.sweep.SweepSettings`, None for their defaults), and ``notes``: what the
     run measured beside its cases (references, verdicts, executor figures), read by
-    ``summarize(scene, results, notes)``. One per run: nothing is kept in a study module."""
+    ``summarize(scene, results, notes)``. One per run: nothing is kept in a study module.
+
+    ``cache_dir``: the reduction cache folder, passed on to everything that builds a
+    reduction (None: reductions are built in memory, with no disk cache; the command lines
+    and :mod:`flex.api` pass the user's folder). ``environment``: the values of the
+    environment variables the study declares in ``ENVIRONMENT``, as the edge read them
+    (:func:`from_environment`; a variable that was not set is absent)."""
 
     progress: Callable[[str, int, int], None] | None = None
     sweep: Any = None
     notes: dict[str, Any] = field(default_factory=dict)
+    cache_dir: Path | None = None
+    environment: Mapping[str, str] = field(default_factory=dict)
 
 
 @dataclass
@@ -97,6 +110,19 @@ class StudyOutput:
     def as_expected(self) -> bool:
         """Whether every case ended as the study declares (ok, or failed if expected)."""
         return not self.unexpected()
+
+
+def from_environment(name: str, environ: Mapping[str, str]) -> dict[str, Any]:
+    """What an edge (a command line, :mod:`flex.api`) reads from ``environ`` (its
+    ``os.environ``) for study ``name``, as keyword arguments of :func:`run_study` and
+    :func:`execute`: ``cache_dir``, the user's reduction cache folder
+    (:func:`flex.bodies.reduction.reduction_cache_dir`), and ``environment``, the values of
+    the variables the study declares in ``ENVIRONMENT`` that are set."""
+    from flex.bodies.reduction import reduction_cache_dir
+
+    declared = getattr(load_study(name), "ENVIRONMENT", ())
+    return {"cache_dir": reduction_cache_dir(environ),
+            "environment": {key: environ[key] for key in declared if key in environ}}
 
 
 def load_study(name: str) -> ModuleType:
@@ -156,32 +182,44 @@ def check_cases(module: ModuleType, scenes: dict[str, Scene],
             raise SceneError(f"{name} = {value!r} would be ignored: {why}")
 
 
+def simulate_each(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
+    """The default ``simulate_cases``: each case on its own
+    (:func:`flex.fidelity.simulation.simulate_case`, reductions cached in ``run.cache_dir``)."""
+    return run_each(scenes, lambda name, case_scene: simulate_case(
+        case_scene, name, cache_dir=run.cache_dir), run.progress)
+
+
 def execute(module: ModuleType, scene: Scene,
             progress: Callable[[str, int, int], None] | None = None,
-            scenes: dict[str, Scene] | None = None, sweep: Any = None) -> StudyOutput:
+            scenes: dict[str, Scene] | None = None, sweep: Any = None, *,
+            cache_dir: Path | None = None,
+            environment: Mapping[str, str] | None = None) -> StudyOutput:
     """Run every case of a study and summarize; nothing is written. ``scenes``: the cases
     (default ``module.cases(scene)``); ``sweep``: where and how a sweep study (``SWEEP =
-    True``) runs its cases (:class:`flex.sweep.SweepSettings`; None: its defaults)."""
+    True``) runs its cases (:class:`flex.sweep.SweepSettings`; None: its defaults);
+    ``cache_dir`` and ``environment``: as :class:`StudyRun` (None: no disk cache, no
+    declared variable set)."""
     start = time.perf_counter()
     scenes = module.cases(scene) if scenes is None else scenes
-    run = StudyRun(progress, sweep)
-    if hasattr(module, "simulate_cases"):
-        results = module.simulate_cases(scenes, run)
-    else:
-        results = run_each(scenes, lambda name, case_scene: simulate_case(case_scene, name),
-                           progress)
+    run = StudyRun(progress, sweep, cache_dir=cache_dir, environment=dict(environment or {}))
+    simulate_cases = getattr(module, "simulate_cases", simulate_each)
+    results = simulate_cases(scenes, run)
     summary = module.summarize(scene, results, run.notes)
     return StudyOutput(module.NAME, scene, results, summary, time.perf_counter() - start)
 
 
 def run_study(name: str, source: str | Path | None = None, overrides: list[str] | None = None,
               out: str | Path | None = None, figures: bool = True, quiet: bool = False,
-              sweep: Any = None) -> StudyOutput:
+              sweep: Any = None, *, cache_dir: Path | None = None,
+              environment: Mapping[str, str] | None = None) -> StudyOutput:
     """Run study ``name``, write its HDF5 file (default ``results/<name>.h5``) and figures
     (``figures/<file stem>-*.png`` beside it) and its report (``reports/<file stem>.md``
     beside it, generated from the file: :func:`flex.tools.report.write_report`), print the
     study's report, and return the output.
-    ``sweep``: where and how a sweep study runs (:class:`flex.sweep.SweepSettings`).
+    ``sweep``: where and how a sweep study runs (:class:`flex.sweep.SweepSettings`);
+    ``cache_dir``: the reduction cache folder (None: reductions built in memory, no disk
+    cache); ``environment``: the study's declared variables (:class:`StudyRun`); the edges
+    pass both from :func:`from_environment`.
 
     Nothing is lost: the output is checked before any case runs (:func:`flex.data.outputs.
     check_output`); a run that does not end as the study declares (an unexpected failed
@@ -203,7 +241,7 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
     written: list[Path] = []
     try:
         output = execute(module, scene, None if quiet else progress_printer(), scenes,
-                         sweep)
+                         sweep, cache_dir=cache_dir, environment=environment)
         output.expected_failures = frozenset(getattr(module, "EXPECTED_FAILURES", ()))
         output.path = _write_output(output, path, scene)
         written.append(output.path)

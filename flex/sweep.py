@@ -13,8 +13,9 @@ sweep and returns the results. Contract:
 - **pure cases, own files**: each case is a function of its scene alone; its result is
   written (by this process, atomically, :func:`flex.data.results.write_results`) to
   ``<folder>/cases/<name>.h5`` as soon as it arrives, with the hash of its scene and case
-  function. A rerun **resumes**: cases whose file holds the same hash are read back, not
-  run; ``retry_failed`` reruns the recorded failures too.
+  function (a ``functools.partial``'s bound arguments count, except ``cache_dir``: where
+  reductions are cached changes no result). A rerun **resumes**: cases whose file holds the
+  same hash are read back, not run; ``retry_failed`` reruns the recorded failures too.
 - **failures are data**: an exception in a case (a diverged run, a bug) or a dead worker
   process (crash, out of memory) is recorded as a ``failed`` case with its message and the
   sweep goes on. A case whose local worker dies is rerun alone in a fresh process to tell it
@@ -32,7 +33,9 @@ A sweep study gets its :class:`SweepSettings` as an argument. The command lines 
 once, at the edge (:func:`settings_from_environment`): ``flex run kfit --scheduler ...
 --workers N`` and ``python -m flex.sweep STUDY --scheduler ... --folder DIR
 --retry-failed``, each over the environment's ``FLEX_SCHEDULER``, ``FLEX_WORKERS``,
-``FLEX_SWEEP_DIR``, ``FLEX_RETRY_FAILED=1`` and ``FLEX_PROGRESS=0``.
+``FLEX_SWEEP_DIR``, ``FLEX_RETRY_FAILED=1`` and ``FLEX_PROGRESS=0``. The reduction cache
+folder is read there too (:func:`flex.bodies.reduction.reduction_cache_dir`) and reaches the
+case functions as their ``cache_dir`` argument (bound with ``functools.partial``).
 """
 
 from __future__ import annotations
@@ -57,6 +60,9 @@ from flex.data.results import CaseResult, Dataset, open_results, write_results
 from flex.data.scene import Scene, to_toml
 
 CaseFunction = Callable[[str, Scene], CaseResult]
+#: keyword arguments of a case function that say where things are kept, not what a case
+#: computes: left out of its identity (:func:`case_hash`), so a moved cache resumes
+LOCATION_ARGUMENTS = frozenset({"cache_dir"})
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
 SWEEP_FORMAT = "flex-sweep-case/1"
 
@@ -64,12 +70,14 @@ SWEEP_FORMAT = "flex-sweep-case/1"
 # ------------------------------------------------------------------------------------------
 # the default case function
 # ------------------------------------------------------------------------------------------
-def simulate_scene_case(name: str, scene: Scene) -> CaseResult:
-    """The default case: :func:`flex.dynamics.solver.simulate_case` of the scene (never raises for a
-    diverged run: that is a ``failed`` case)."""
+def simulate_scene_case(name: str, scene: Scene, *, cache_dir: Path | None = None
+                        ) -> CaseResult:
+    """The default case: :func:`flex.fidelity.simulation.simulate_case` of the scene (never raises
+    for a diverged run: that is a ``failed`` case). ``cache_dir``: the reduction cache folder
+    (None: reductions built in memory, no disk cache); bind it with ``functools.partial``."""
     from flex.fidelity.simulation import simulate_case
 
-    return simulate_case(scene, name)
+    return simulate_case(scene, name, cache_dir=cache_dir)
 
 
 def _guarded(function: Callable[..., Any], name: str, scene: Scene) -> Any:
@@ -191,8 +199,8 @@ class DaskExecutor(Executor):
 
     The local cluster has ``workers`` single-threaded worker processes (default: all cores)
     bound to 127.0.0.1 without a dashboard; :meth:`close` stops it. A remote scheduler is
-    used as it is (its workers need ``flex`` installed and, to share reductions, a common
-    ``FLEX_CACHE_DIR``).
+    used as it is (its workers need ``flex`` installed and, to share reductions, the
+    ``cache_dir`` the case functions get must be a folder they all reach).
     """
 
     def __init__(self, address: str | None = None, workers: int | None = None) -> None:
@@ -263,8 +271,11 @@ def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
     from flex.fidelity.criteria import criteria_in_force_text
 
     function, extra = case_function, ""
-    if isinstance(function, functools.partial):  # bound arguments are part of the identity
-        extra = repr((function.args, sorted(function.keywords.items())))
+    if isinstance(function, functools.partial):  # bound arguments are part of the identity,
+        keywords = sorted((key, value) for key, value in function.keywords.items()
+                          if key not in LOCATION_ARGUMENTS)  # but not where caches live
+        if function.args or keywords:
+            extra = repr((function.args, keywords))
         function = function.func
     if settings.has_auto(scene):  # a changed table must not resume stale cases
         extra += repr(sorted(settings.solver_defaults().items()))
@@ -714,17 +725,19 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--no-figures", action="store_true")
     parser.add_argument("--quiet", action="store_true")
     args = parser.parse_args(argv)
-    from flex.study import run_study
+    from flex.study import from_environment, run_study
 
     try:
         base = settings_from_environment()  # the environment, read once at this edge
+        where = from_environment(args.study, os.environ)  # cache folder, study variables
         sweep = SweepSettings(scheduler=args.scheduler or base.scheduler,
                               workers=args.workers or base.workers,
                               folder=Path(args.folder) if args.folder else base.folder,
                               retry_failed=args.retry_failed or base.retry_failed,
                               progress=base.progress)
         output = run_study(args.study, args.scene, args.overrides, args.out,
-                           figures=not args.no_figures, quiet=args.quiet, sweep=sweep)
+                           figures=not args.no_figures, quiet=args.quiet, sweep=sweep,
+                           **where)
     except FlexError as exc:
         print(f"flex: error: {exc}", file=sys.stderr)
         return 2

@@ -12,12 +12,17 @@ medians of :data:`REPEATS` runs, and each comparison is a ratio of two times mea
   under 0.5 s of integration). Reference: flex's FFRF model with 12 modes on a 2 mm mesh at
   h = 5e-6 s (shown converged by coarsening step, modes and mesh). The untuned first set-up
   (h = 1e-5 s, 6 modes, full Newton at 1e-10) is timed beside the fastest candidate that
-  reaches 1 %, and the nonlinear FE coupler (if installed) at its coarsest setting.
+  reaches 1 %, and the nonlinear FE coupler (if installed; ``FLEX_BENCH_NONLINEAR=0`` skips
+  it) at its coarsest setting.
 - ``profile``: Exudyn's CPU-time statistics of the untuned and the tuned run (share of each
   solver phase) and flex's own phases (reduction, build, integration, output).
 - ``reduction``: build time of the 1 mm plate reduction, cold (empty cache) and from cache.
 - ``make_all``: ``make all`` end to end with an empty reduction cache (cold) and again with
   it filled (warm); ``FLEX_BENCH_MAKE=0`` skips it.
+
+The two switches are environment variables of the command (``FLEX_BENCH_MAKE=0 make bench``):
+declared in :data:`ENVIRONMENT`, read once by the command line (or :func:`flex.api.run_study`)
+and handed to the run as ``run.environment``.
 
 Stored: one case per timed configuration (attrs: knobs, errors, counters; dataset
 ``wall_times``) and ``/summary/table`` (the printed table) plus ``/summary/<part>/...``
@@ -42,6 +47,9 @@ NAME = "bench"
 DESCRIPTION = "speed at a stated accuracy: rigid 1e-7 rad, FFRF 1 mm 1 %, cache, make all"
 OVERRIDES = pinned_overrides()
 REPEATS = 5
+#: environment variables the command line reads for this study (``run.environment``):
+#: ``"0"`` skips the ``make all`` timing / the nonlinear FE coupler; anything else runs it
+ENVIRONMENT = ("FLEX_BENCH_MAKE", "FLEX_BENCH_NONLINEAR")
 PLATE = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.thickness_m=0.001",
          "coupler.mesh_size_m=0.002"]
 S = Setting.of
@@ -112,7 +120,9 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Run the four parts in order; each part's failure is stored, the others still run."""
-    return run_bench(scenes, PLAN, REPEATS, run.progress, run.notes)
+    return run_bench(scenes, PLAN, REPEATS, run.progress, run.notes, cache_dir=run.cache_dir,
+                     make_all=run.environment.get("FLEX_BENCH_MAKE", "1") != "0",
+                     nonlinear=run.environment.get("FLEX_BENCH_NONLINEAR", "1") != "0")
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],

@@ -73,8 +73,10 @@ def cases(scene: Scene) -> dict[str, Scene]:
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Phase 1: fit cases; fit the law, write :data:`CRITERION_PATH`; phase 2: validation
     cases, ``auto`` reading the law just fitted (passed as an argument)."""
-    runner = lawfit.SerialRunner("crank", NAME, len(scenes), run.progress)
-    results, run.notes["analysis"] = crankfit.fit_then_validate(scenes, runner, CRITERION_PATH)
+    runner = lawfit.SerialRunner("crank", NAME, len(scenes), run.progress,
+                                 cache_dir=run.cache_dir)
+    results, run.notes["analysis"] = crankfit.fit_then_validate(scenes, runner, CRITERION_PATH,
+                                                                run.cache_dir)
     return results
 
 

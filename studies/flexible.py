@@ -63,7 +63,7 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Simulate every case; each model's reduction is built (or loaded) once."""
-    return simulate_twins(scenes, run.progress, run.notes)
+    return simulate_twins(scenes, run.progress, run.notes, cache_dir=run.cache_dir)
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],

@@ -105,7 +105,7 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
     settings = run.sweep or SweepSettings()
     folder = settings.folder or RESULTS_DIR / "kfit-cases"
     runner = lawfit.SweepRunner(run_sweep, make_executor(settings.scheduler, settings.workers),
-                                folder, couplerfit.SWEEP_PHASES, NAME,
+                                folder, couplerfit.sweep_phases(run.cache_dir), NAME,
                                 run.notes.setdefault("sweep", {}), settings.retry_failed,
                                 settings.progress)
     results, run.notes["analysis"] = couplerfit.fit_then_validate(scenes, runner, folder)

@@ -154,7 +154,8 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Run every extreme, judge it against its reference; keep the main curves only."""
-    return simulate_extremes(extremes(), scenes, run.progress, run.notes, KEEP, TOLERANCE)
+    return simulate_extremes(extremes(), scenes, run.progress, run.notes, KEEP, TOLERANCE,
+                             cache_dir=run.cache_dir)
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],

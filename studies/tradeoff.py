@@ -178,7 +178,8 @@ def cases(scene: Scene) -> dict[str, Scene]:
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """References first, then every setting, per scene; returns one case per run."""
     plans = {name: settings(name, nonlinear_available()) for name in scenes}
-    return run_work_precision(scenes, plans, REPEATS, run.progress, run.notes)
+    return run_work_precision(scenes, plans, REPEATS, run.progress, run.notes,
+                              cache_dir=run.cache_dir)
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],

@@ -23,7 +23,7 @@ from typing import Any
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.experiments import wing
-from flex.study import Summary
+from flex.study import StudyRun, Summary, simulate_each
 
 NAME = "wing"
 DESCRIPTION = "wing deployment (sec. 6.4): fitted spring, loads, wing flexibility"
@@ -38,9 +38,15 @@ def cases(scene: Scene) -> dict[str, Scene]:
     return {"wing_deployment": wing.fit_spring(scene)[0]}
 
 
+def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
+    """Each case on its own; the summary's ``auto`` decisions get the reduction cache."""
+    run.notes["cache_dir"] = run.cache_dir  # the crank's frequency analysis (in summarize)
+    return simulate_each(scenes, run)
+
+
 def summarize(scene: Scene, results: dict[str, CaseResult],
               notes: dict[str, Any] | None = None) -> Summary:
-    return Summary(*wing.summary(results["wing_deployment"]))
+    return Summary(*wing.summary(results["wing_deployment"], (notes or {}).get("cache_dir")))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:

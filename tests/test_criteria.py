@@ -292,18 +292,19 @@ def test_euler_load_ratio_of_a_compressed_link():
                                      200e9) == 0.0  # tension
 
 
-def test_auto_crank_is_rigid_ffrf_or_refused_with_a_reason():
+def test_auto_crank_is_rigid_ffrf_or_refused_with_a_reason(reduction_cache):
     criterion = _synthetic_criterion()
     scene = load_scene(None, ['crank.model="auto"', "simulation.step_s=1e-4"])
-    resolved, decisions = resolve_fidelity(scene, criterion, criterion)
+    resolved, decisions = resolve_fidelity(scene, criterion, criterion,
+                                           cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "rigid"
     assert decisions[0].link == "crank" and "plate of its mass" in decisions[0].reason
     strict = _synthetic_criterion(c=1e9)  # every link flexible
     with pytest.raises(SceneError, match='set crank.geometry = "plate"'):
-        resolve_fidelity(scene, strict, strict)  # a lumped crank has no mesh
+        resolve_fidelity(scene, strict, strict, cache_dir=reduction_cache)  # lumped: no mesh
     plate = load_scene(None, ['crank.model="auto"', 'crank.geometry="plate"',
                               "simulation.step_s=1e-4"])
-    resolved, decisions = resolve_fidelity(plate, strict, strict)
+    resolved, decisions = resolve_fidelity(plate, strict, strict, cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "ffrf" and resolved["crank"]["modes"] >= 2
 
 

@@ -66,9 +66,9 @@ def check_pngs(paths, folder: Path, expected: set[str] | None = None) -> None:
         assert np.ptp(image[..., :3]) > 0.5, f"{path}: blank image"
 
 
-def run_and_draw(name: str, overrides: list[str], folder: Path):
+def run_and_draw(name: str, overrides: list[str], folder: Path, cache_dir: Path | None = None):
     module = load_study(name)
-    output = execute(module, study_scene(module, None, overrides))
+    output = execute(module, study_scene(module, None, overrides), cache_dir=cache_dir)
     assert output.as_expected, output.unexpected()
     return module.figures(output.results, output.summary, folder)
 
@@ -94,9 +94,9 @@ CHEAP = {
 
 
 @pytest.mark.parametrize("name", list(CHEAP))
-def test_cheap_study_figures(name, tmp_path, reviewed):
+def test_cheap_study_figures(name, tmp_path, reviewed, reduction_cache):
     overrides, expected = CHEAP[name]
-    check_pngs(run_and_draw(name, overrides, tmp_path), tmp_path, expected)
+    check_pngs(run_and_draw(name, overrides, tmp_path, reduction_cache), tmp_path, expected)
 
 
 # ------------------------------------------------------------------------------------------
@@ -293,8 +293,8 @@ def test_bench_figures_synthetic(tmp_path, reviewed):
 # ------------------------------------------------------------------------------------------
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["modal", "flexible", "crank", "kfit"])
-def test_expensive_study_figures(name, tmp_path, monkeypatch, reviewed):
+def test_expensive_study_figures(name, tmp_path, monkeypatch, reviewed, reduction_cache):
     monkeypatch.chdir(tmp_path)  # crank and kfit write results/... beside the run
     folder = tmp_path / "figures"
     folder.mkdir()
-    check_pngs(run_and_draw(name, [], folder), folder)
+    check_pngs(run_and_draw(name, [], folder, reduction_cache), folder)

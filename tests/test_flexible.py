@@ -38,10 +38,10 @@ import h5py
 import numpy as np
 import pytest
 
+from flex.api import simulate  # the public face: reductions cached in the user's folder
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import load_scene, to_toml
-from flex.fidelity.simulation import simulate
 from flex.tools.compare import compare_files
 
 FOLDER = Path(__file__).resolve().parent / "reference_curves"
@@ -156,13 +156,14 @@ def test_deflection_converges_under_mode_refinement(tmp_path):
 # ------------------------------------------------------------------------------------------
 
 
-def test_nonlinear_plate_has_the_reductions_mesh_and_node_sets():
+def test_nonlinear_plate_has_the_reductions_mesh_and_node_sets(reduction_cache):
     from flex.bodies.nonlinear import build_nonlinear_plate
     from flex.dynamics.solver import reduction_for_scene
 
     plate = build_nonlinear_plate(**COARSE_PLATE)
     # the stiff-limit test's steel plate: the reduction comes from the cache
-    reduction = reduction_for_scene(load_scene(overrides=COARSE_PLATE_SCENE + ["coupler.modes=2"]))
+    reduction = reduction_for_scene(load_scene(overrides=COARSE_PLATE_SCENE + ["coupler.modes=2"]),
+                                    cache_dir=reduction_cache)
     assert np.array_equal(plate.node_positions_m, reduction.fem.GetNodePositionsAsArray())
     for name in ("end_a", "end_b", "mid"):
         assert np.array_equal(getattr(plate, f"nodes_{name}"), getattr(reduction, f"nodes_{name}"))

@@ -442,12 +442,12 @@ def test_linear_ffrf_beyond_its_validity_is_flagged():
 
 
 @pytest.mark.slow
-def test_a_thin_ffrf_plate_run_carries_the_validity_warning():
+def test_a_thin_ffrf_plate_run_carries_the_validity_warning(reduction_cache):
     # 0.3 mm plate: its deflection reaches ~4 x its thickness, 1.5 % of the length
     scene = load_scene(overrides=['coupler.geometry="plate"', 'coupler.model="ffrf"',
                                   "coupler.thickness_m=0.0003", "coupler.mesh_size_m=0.006",
                                   "simulation.end_time_s=0.01", "simulation.step_s=1e-5"])
-    case = simulate_case(scene, "thin")
+    case = simulate_case(scene, "thin", cache_dir=reduction_cache)
     assert case.status == "ok"
     assert "linear FFRF" in case.attrs[VALIDITY_WARNING]
 

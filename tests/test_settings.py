@@ -103,8 +103,9 @@ def test_solver_settings_report_the_resolved_values():
     assert settings["steps"] == 75
 
 
-def test_a_default_ffrf_run_uses_and_records_the_chosen_settings():
-    result = simulate(load_scene(None, PLATE + ["simulation.end_time_s=0.004"]), "default")
+def test_a_default_ffrf_run_uses_and_records_the_chosen_settings(reduction_cache):
+    result = simulate(load_scene(None, PLATE + ["simulation.end_time_s=0.004"]), "default",
+                      cache_dir=reduction_cache)
     time_s = result.datasets["time"].data
     assert len(time_s) == 11 and time_s[1] - time_s[0] == pytest.approx(4e-4)  # 0.004 s
     assert result.attrs["solver_defaults_entry"] == "ffrf_coupler"
@@ -113,14 +114,15 @@ def test_a_default_ffrf_run_uses_and_records_the_chosen_settings():
     assert resolved_simulation(load_scene(None, PLATE))["step_s"] == 4e-4
 
 
-def test_inspect_shows_the_resolved_solver_keys_and_no_scene_change(tmp_path, capsys):
+def test_inspect_shows_the_resolved_solver_keys_and_no_scene_change(tmp_path, capsys,
+                                                                   reduction_cache):
     from flex.cli import main
     from flex.data.results import write_results
     from flex.data.scene import to_toml
 
     scene = load_scene(None, PLATE + ["simulation.end_time_s=0.004"])
-    path = write_results(tmp_path / "auto.h5", "simulate", [simulate(scene, "default")],
-                         to_toml(scene))
+    case = simulate(scene, "default", cache_dir=reduction_cache)
+    path = write_results(tmp_path / "auto.h5", "simulate", [case], to_toml(scene))
     assert main(["inspect", str(path)]) == 0
     out = capsys.readouterr().out
     assert 'solver: "auto" -> step_s = 0.0004' in out and "(ffrf_coupler: " in out

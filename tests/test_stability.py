@@ -123,24 +123,27 @@ def test_start_near_a_dead_centre_matches_the_reference(angle_deg, bound_rad):
         assert swing > 10 * abs(math.radians(angle_deg))
 
 
-def test_thin_ffrf_plate_with_a_large_step_fails_cleanly_and_runs_with_a_small_one():
+def test_thin_ffrf_plate_with_a_large_step_fails_cleanly_and_runs_with_a_small_one(
+        reduction_cache):
     # a 0.3 mm plate (first bending mode ~107 Hz, deflection ~4x its thickness) cannot take
     # a 0.1 ms step: Newton fails within the first steps; at 0.01 ms it runs
     plate = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.thickness_m=0.0003",
              "coupler.mesh_size_m=0.006", "simulation.end_time_s=0.001",
              "simulation.newton_relative_tolerance=1e-8"]
-    failed = simulate_case(load_scene(overrides=plate + ["simulation.step_s=1e-4"]), "large")
+    failed = simulate_case(load_scene(overrides=plate + ["simulation.step_s=1e-4"]), "large",
+                           cache_dir=reduction_cache)
     assert failed.status == "failed" and not failed.datasets
     match = re.search(r"diverged at step (\d+) \(t = ([0-9.e-]+) s", failed.message)
     assert "Newton failed" in failed.message and match
     assert int(match[1]) <= 4 and float(match[2]) == pytest.approx((int(match[1]) - 1) * 1e-4)
-    small = simulate_case(load_scene(overrides=plate + ["simulation.step_s=1e-5"]), "small")
+    small = simulate_case(load_scene(overrides=plate + ["simulation.step_s=1e-5"]), "small",
+                          cache_dir=reduction_cache)
     assert small.status == "ok"
     assert np.isfinite(small.datasets["coupler/midpoint_deflection"].data).all()
 
 
 @pytest.mark.slow
-def test_ffrf_coupler_keeps_its_energy_over_a_long_horizon():
+def test_ffrf_coupler_keeps_its_energy_over_a_long_horizon(reduction_cache):
     # undamped plate and spring: kinetic + strain + spring energy is constant in the physics;
     # generalized-alpha with rho < 1 may only dissipate it (the high modes first). Over
     # 0.2 s of free motion (~70 periods of the first bending mode) at the tradeoff study's
@@ -152,8 +155,8 @@ def test_ffrf_coupler_keeps_its_energy_over_a_long_horizon():
              'simulation.newton="modified"', "simulation.newton_relative_tolerance=1e-8"]
     drift = {}
     for rho in (0.9, 0.5):
-        data = simulate(load_scene(overrides=plate + [f"simulation.spectral_radius={rho}"])
-                        ).datasets
+        data = simulate(load_scene(overrides=plate + [f"simulation.spectral_radius={rho}"]),
+                        cache_dir=reduction_cache).datasets
         energy = data["energy/total"].data
         assert data["energy/strain"].data.max() > 1e-4 * energy[0]  # the plate's share counts
         drift[rho] = (energy[-1] - energy[0]) / energy[0]

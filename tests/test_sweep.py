@@ -170,7 +170,7 @@ def test_results_round_trip_keeps_units_and_attributes(tmp_path):
 
 
 @pytest.mark.slow
-def test_kfit_study_small_end_to_end(tmp_path, monkeypatch):
+def test_kfit_study_small_end_to_end(tmp_path, monkeypatch, reduction_cache):
     """A shrunken kfit (3 thicknesses, 1 stiffness family, 1 validation scene) through the
     study runner and the local process pool: cases, fit, criterion file, validation."""
     import studies.kfit as kfit
@@ -187,7 +187,8 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch):
     from flex.sweep import SweepSettings
 
     sweep = SweepSettings(folder=tmp_path / "cases", progress=False)
-    output = run_study("kfit", out=tmp_path / "kfit.h5", figures=True, quiet=True, sweep=sweep)
+    output = run_study("kfit", out=tmp_path / "kfit.h5", figures=True, quiet=True, sweep=sweep,
+                       cache_dir=reduction_cache)
     assert all(c.status == "ok" for c in output.results.values())
     law = analyse(output.results)["fits"][(0.0, "stop", "deflection")]
     assert 1.5 < law.exponent < 3.0  # quasi-static expectation: 2

@@ -275,22 +275,26 @@ def test_bundled_defaults_are_the_fastest_setting_within_the_default_tolerance()
 
 
 @pytest.mark.slow
-def test_ffrf_default_reaches_the_scene_tolerance_much_faster_than_the_scene_settings():
+def test_ffrf_default_reaches_the_scene_tolerance_much_faster_than_the_scene_settings(
+        reduction_cache):
     # README "Defaults": the bundled "auto" solver keys on the 1 mm plate (flex/settings.py:
     # the tradeoff study's certified 1 % pick) against a finer FFRF run (h = 5e-6 s, 1.5 mm,
     # 12 modes: within 1.2e-3 of the study's reference, which is itself estimated accurate to
     # ~2e-3); the margin keeps the check about the default, not the test's reference
     from flex.experiments.defaults_check import default_setting
+    from flex.experiments.tradeoff import ReductionPool
     from studies.tradeoff import FFRF_DEFAULT_SCENE, SCENES
 
     base = load_scene(overrides=pinned_overrides() + SCENES[FFRF_DEFAULT_SCENE])
     tolerance = base["fidelity"]["tolerance"]
+    pool = ReductionPool(reduction_cache)
     reference = converged_reference(base, "ffrf", Setting.of(
         "fine", step_s=5e-6, coupler__mesh_size_m=0.0015, coupler__modes=12,
-        newton="modified", newton_relative_tolerance=1e-10), {}, 1e-2)
-    default = measure(base, default_setting(), reference, repeats=3)
+        newton="modified", newton_relative_tolerance=1e-10), {}, 1e-2, pool)
+    default = measure(base, default_setting(), reference, repeats=3, pool=pool)
     assert default.ok and default.error + 3e-3 < tolerance
-    scene_settings = measure(base, Setting("rigid-model settings"), reference, repeats=1)
+    scene_settings = measure(base, Setting("rigid-model settings"), reference, repeats=1,
+                             pool=pool)
     assert scene_settings.ok and scene_settings.error < tolerance
     assert default.wall_time_s < scene_settings.wall_time_s / 10
 

@@ -433,24 +433,18 @@ def check_drive_steps(scene: Scene) -> None:
     if drive["kind"] != "constant_speed" or sim["step_s"] == "auto":
         return
     speed = abs(drive["crank_speed_rad_per_s"])
-    step = sim["step_s"]
-    if speed * step > MAX_CRANK_TURN_PER_STEP_RAD * (1 + 1e-9):
-        raise SceneError(f"drive.crank_speed_rad_per_s = {drive['crank_speed_rad_per_s']:g} "
-                         f"turns the crank {speed * step:.3g} rad per step of {step:g} s: the "
-                         f"motion is aliased; accepted: at most "
-                         f"{MAX_CRANK_TURN_PER_STEP_RAD:g} rad per step, i.e. "
-                         f"|crank_speed_rad_per_s| <= "
-                         f"{MAX_CRANK_TURN_PER_STEP_RAD / step:.4g} at this step, or "
-                         f"simulation.step_s <= {MAX_CRANK_TURN_PER_STEP_RAD / speed:.3g}")
-    sample = sim["output_step_s"] or step
-    if speed * sample > MAX_CRANK_TURN_PER_SAMPLE_RAD * (1 + 1e-9):
-        raise SceneError(f"simulation.output_step_s = {sample:g} stores a sample every "
-                         f"{speed * sample:.3g} rad of crank rotation at "
-                         f"drive.crank_speed_rad_per_s = {drive['crank_speed_rad_per_s']:g}: "
-                         f"the stored curves are aliased; accepted: at most "
-                         f"{MAX_CRANK_TURN_PER_SAMPLE_RAD:.3g} rad per sample, i.e. "
-                         f"output_step_s <= {MAX_CRANK_TURN_PER_SAMPLE_RAD / speed:.3g} "
-                         f"(or 0: every step)")
+    step, sample = sim["step_s"], sim["output_step_s"] or sim["step_s"]
+    for interval, limit, what, key, aliased, extra in (
+            (step, MAX_CRANK_TURN_PER_STEP_RAD, "per step", "simulation.step_s", "motion is",
+             ""),
+            (sample, MAX_CRANK_TURN_PER_SAMPLE_RAD, "between stored samples",
+             "simulation.output_step_s", "stored curves are", " (or 0: every step)")):
+        if speed * interval > limit * (1 + 1e-9):
+            raise SceneError(f"drive.crank_speed_rad_per_s = {drive['crank_speed_rad_per_s']:g} "
+                             f"turns the crank {speed * interval:.3g} rad {what} ({key} = "
+                             f"{interval:g} s): the {aliased} aliased; accepted: at most "
+                             f"{limit:.3g} rad {what}, i.e. |crank_speed_rad_per_s| <= "
+                             f"{limit / interval:.4g}, or {key} <= {limit / speed:.3g}{extra}")
 
 
 def _check_link(link: str, values: dict[str, Any]) -> None:

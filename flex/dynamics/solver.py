@@ -28,7 +28,6 @@ exploding output the step that produced it and its end time.
 from __future__ import annotations
 
 import io
-import os
 import signal
 import threading
 import time
@@ -357,19 +356,14 @@ def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s:
     return out
 
 
-def reduction_cache_dir() -> Path:
-    """Where reductions are cached: ``$FLEX_CACHE_DIR/reductions`` if set, else the user's
-    cache folder (``$XDG_CACHE_HOME/flex/reductions``, by default
-    ``~/.cache/flex/reductions``), whatever folder the command runs from."""
-    configured = os.environ.get("FLEX_CACHE_DIR")
-    if configured:
-        return Path(configured).expanduser() / "reductions"
-    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
-    return Path(base) / "flex" / "reductions"
+def reduction_for_scene(scene: Scene, link: str = "coupler", *,
+                        cache_dir: Path | None = None):
+    """The Craig-Bampton reduction of the scene's plate ``link`` (coupler or crank).
 
-
-def reduction_for_scene(scene: Scene, link: str = "coupler"):
-    """The (cached) Craig-Bampton reduction of the scene's plate ``link`` (coupler or crank)."""
+    ``cache_dir``: the reduction cache folder (loaded from there if present, written there
+    if built; :func:`flex.bodies.reduction.reduction_cache_dir` names the user's), or None to
+    build it in memory without any disk cache.
+    """
     from flex.bodies.reduction import build_reduction
 
     c = scene[link]
@@ -377,7 +371,7 @@ def reduction_for_scene(scene: Scene, link: str = "coupler"):
     _announce_mesh(link, c, "reduction (instant if cached)")
     return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
                            c["youngs_modulus_Pa"], c["density_kg_per_m3"], c["poisson_ratio"],
-                           c["mesh_size_m"], c["modes"], reduction_cache_dir())
+                           c["mesh_size_m"], c["modes"], cache_dir)
 
 
 #: a mesh whose estimated build takes longer than this is announced on stderr first [s]
@@ -529,13 +523,14 @@ def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any],
 
 
 def integrate(scene: Scene, name: str = "case", reduction: Any = None,
-              crank_reduction: Any = None) -> CaseResult:
+              crank_reduction: Any = None, *, cache_dir: Path | None = None) -> CaseResult:
     """Build, integrate and collect one case of a scene whose links have concrete models
     (rigid, ffrf, nonlinear_fe); raises on divergence (see module doc).
 
     ``model = "auto"`` links are resolved a layer above (:func:`flex.fidelity.simulation.simulate`);
     here they are refused. ``reduction`` / ``crank_reduction``: the reductions of an
-    ``ffrf`` coupler / crank (None: :func:`reduction_for_scene`, cached on disk).
+    ``ffrf`` coupler / crank (None: :func:`reduction_for_scene` builds them, or loads them from
+    ``cache_dir``: the reduction cache folder; None: built in memory, no disk cache).
     ``"auto"`` solver keys are filled by model (:func:`flex.config.settings.
     resolve_solver_settings`; attributes ``solver_defaults_*``). ``scene_toml`` holds the
     resolved scene.
@@ -548,9 +543,9 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     scene, solver_choice = resolve_solver_settings(scene)
     check_runnable(scene)  # the concrete models and steps, before anything is built
     if scene["coupler"]["model"] == "ffrf" and reduction is None:
-        reduction = reduction_for_scene(scene)
+        reduction = reduction_for_scene(scene, cache_dir=cache_dir)
     if scene["crank"]["model"] == "ffrf" and crank_reduction is None:
-        crank_reduction = reduction_for_scene(scene, "crank")
+        crank_reduction = reduction_for_scene(scene, "crank", cache_dir=cache_dir)
     if scene["coupler"]["model"] == "nonlinear_fe" and reduction is None:
         _announce_mesh("coupler", scene["coupler"], "nonlinear FE body")
     mech = build_mechanism(scene, reduction, crank_reduction)

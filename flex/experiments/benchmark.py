@@ -11,11 +11,16 @@ same run. :func:`run_bench` runs the four parts of a :class:`BenchPlan` in order
   reaches it, against a converged reference; with :func:`profile` of the untuned and tuned run;
 - ``ffrf_1mm`` (:func:`bench_ffrf`): the fastest candidate within the peak-deflection
   accuracy, the untuned first set-up, the flex defaults, and the nonlinear FE coupler (if
-  installed and ``FLEX_BENCH_NONLINEAR`` is not ``0``) against its own run at half the step;
+  installed and asked for: ``nonlinear``, the bench study's ``FLEX_BENCH_NONLINEAR`` not
+  ``0``) against its own run at half the step;
 - ``reduction`` (:func:`bench_reduction`): the plate reduction cold (empty cache), from cache,
   and its first FFRF projection;
 - ``make_all`` (:func:`bench_make_all`): ``make all FORCE=1`` with an empty reduction cache and
-  again with it filled (``FLEX_BENCH_MAKE=0`` skips it).
+  again with it filled (``make_all`` False, the bench study's ``FLEX_BENCH_MAKE=0``, skips
+  it).
+
+The run-time switches ``nonlinear`` and ``make_all`` and the reduction cache folder
+``cache_dir`` are arguments of :func:`run_bench`; the command line reads the environment.
 
 :mod:`flex.experiments.benchmark_report` turns the notes into the table and the figures.
 """
@@ -187,9 +192,9 @@ def bench_rigid(scene: Scene, plan: BenchPlan, repeats: int, pool: ReductionPool
 
 
 def bench_ffrf(scene: Scene, plan: BenchPlan, repeats: int, pool: ReductionPool, say: Say,
-               notes: dict[str, Any]) -> dict[str, CaseResult]:
+               notes: dict[str, Any], nonlinear: bool = True) -> dict[str, CaseResult]:
     """FFRF part: the fastest candidate within the peak accuracy, untuned, defaults,
-    nonlinear FE."""
+    nonlinear FE (if installed and ``nonlinear``)."""
     reference = build_reference(scene, "ffrf_1mm", plan.ffrf_reference, pool)
     say(f"ffrf_1mm reference: accuracy {reference.accuracy:.1e}, peak "
         f"{reference.peak_deflection_m * 1e6:.2f} um")
@@ -217,7 +222,7 @@ def bench_ffrf(scene: Scene, plan: BenchPlan, repeats: int, pool: ReductionPool,
         "probes": probes,
         "profile_untuned": profile(scene_for(scene, plan.ffrf_untuned), pool),
         "profile_tuned": profile(scene_for(scene, tuned.setting), pool)}
-    if nonlinear_available() and os.environ.get("FLEX_BENCH_NONLINEAR", "1") != "0":
+    if nonlinear and nonlinear_available():
         out.update(_bench_nonlinear(scene, plan, reference, pool, say, results))
     notes["ffrf_1mm"] = results
     return out
@@ -279,10 +284,12 @@ def bench_reduction(scene: Scene, say: Say, notes: dict[str, Any]) -> None:
         f"{statistics.median(cached):.3f} s")
 
 
-def bench_make_all(say: Say, notes: dict[str, Any]) -> None:
+def bench_make_all(say: Say, notes: dict[str, Any], run: bool = True) -> None:
     """``make all FORCE=1`` [s] in the repository holding flex, with an empty reduction cache
-    (cold) and again with it filled (warm); skipped when ``FLEX_BENCH_MAKE=0``."""
-    if os.environ.get("FLEX_BENCH_MAKE", "1") == "0":
+    (cold) and again with it filled (warm); skipped when not ``run`` (``FLEX_BENCH_MAKE=0``).
+    The child ``make`` gets this process's environment with ``FLEX_CACHE_DIR`` set to a
+    temporary folder."""
+    if not run:
         notes["make_all"] = {"skipped": "FLEX_BENCH_MAKE=0"}
         return
     root = Path(__file__).resolve().parents[2]
@@ -303,19 +310,26 @@ def bench_make_all(say: Say, notes: dict[str, Any]) -> None:
 
 
 def run_bench(scenes: Mapping[str, Scene], plan: BenchPlan, repeats: int,
-              progress: Progress | None = None, notes: dict[str, Any] | None = None
+              progress: Progress | None = None, notes: dict[str, Any] | None = None, *,
+              cache_dir: Path | None = None, nonlinear: bool = True, make_all: bool = True
               ) -> dict[str, CaseResult]:
     """Run the four parts in order on ``scenes["rigid"]`` and ``scenes["ffrf_1mm"]`` (see the
-    module doc); each part's failure is stored, the others still run."""
-    pool = ReductionPool()
+    module doc); each part's failure is stored, the others still run.
+
+    ``cache_dir``: the reduction cache folder of the timed runs (None: reductions built in
+    memory, no disk cache; the ``reduction`` part always times its own empty folders);
+    ``nonlinear``: time the nonlinear FE coupler too (if installed); ``make_all``: time
+    ``make all`` (the ``make_all`` part).
+    """
+    pool = ReductionPool(cache_dir)
     notes = {} if notes is None else notes
     results: dict[str, CaseResult] = {}
     parts: list[tuple[str, Callable[[Say], Any]]] = [
         ("rigid", lambda say: bench_rigid(scenes["rigid"], plan, repeats, pool, say, notes)),
         ("ffrf_1mm", lambda say: bench_ffrf(scenes["ffrf_1mm"], plan, repeats, pool, say,
-                                            notes)),
+                                            notes, nonlinear)),
         ("reduction", lambda say: bench_reduction(scenes["ffrf_1mm"], say, notes)),
-        ("make_all", lambda say: bench_make_all(say, notes))]
+        ("make_all", lambda say: bench_make_all(say, notes, make_all))]
     for index, (name, part) in enumerate(parts):
         if progress:
             progress(name, index, len(parts))

@@ -188,21 +188,22 @@ def geometry_key(scene: Scene) -> tuple | None:
 
 
 @functools.lru_cache(maxsize=3)
-def _reduction(key: tuple) -> Any:
+def _reduction(key: tuple, cache_dir: Path | None) -> Any:
     from flex.bodies.reduction import build_reduction
-    from flex.dynamics.solver import reduction_cache_dir
 
-    return build_reduction(*key, reduction_cache_dir())
-
-
-def reduction_of(scene: Scene) -> Any:
-    """The scene's reduction: built (or loaded from the disk cache) once per worker."""
-    return _reduction(geometry_key(scene))
+    return build_reduction(*key, cache_dir)
 
 
-def prepare_reduction(scene: Scene) -> dict[str, Any]:
-    """Sweep preparation: build (or find) the scene's reduction in the disk cache."""
-    reduction = reduction_of(scene)
+def reduction_of(scene: Scene, cache_dir: Path | None = None) -> Any:
+    """The scene's reduction: built (or loaded from the reduction cache folder ``cache_dir``;
+    None: built in memory, no disk cache) once per worker."""
+    return _reduction(geometry_key(scene), cache_dir)
+
+
+def prepare_reduction(scene: Scene, *, cache_dir: Path | None = None) -> dict[str, Any]:
+    """Sweep preparation: build (or find) the scene's reduction in the reduction cache folder
+    ``cache_dir`` (where the cases then find it; None: in memory, this worker only)."""
+    reduction = reduction_of(scene, cache_dir)
     return {"key": reduction.key, "from_cache": reduction.from_cache,
             "build_time_s": reduction.build_time_s}
 
@@ -217,9 +218,10 @@ def full_geometry_key(scene: Scene) -> tuple | None:
     return geometry_key(full_scene(scene))
 
 
-def prepare_full_reduction(scene: Scene) -> dict[str, Any]:
-    """Validation preparation: the full model's reduction (auto builds its own if FFRF)."""
-    return prepare_reduction(full_scene(scene))
+def prepare_full_reduction(scene: Scene, *, cache_dir: Path | None = None) -> dict[str, Any]:
+    """Validation preparation: the full model's reduction (auto builds its own if FFRF), in
+    the reduction cache folder ``cache_dir`` (as :func:`prepare_reduction`)."""
+    return prepare_reduction(full_scene(scene), cache_dir=cache_dir)
 
 
 def _with(scene: Scene, **changes: Any) -> Scene:
@@ -233,13 +235,15 @@ def _with(scene: Scene, **changes: Any) -> Scene:
 # ------------------------------------------------------------------------------------------
 # one fit case and one validation case (run on a worker)
 # ------------------------------------------------------------------------------------------
-def _run_pair(scene: Scene, reduction: Any) -> tuple[dict, dict, dict[str, float], dict]:
-    """Rigid twin (long enough to stop), then the FFRF run to just past delta_t_stop."""
+def _run_pair(scene: Scene, reduction: Any, cache_dir: Path | None
+              ) -> tuple[dict, dict, dict[str, float], dict]:
+    """Rigid twin (long enough to stop), then the FFRF run to just past delta_t_stop
+    (``cache_dir``: the reduction cache folder of anything else they build)."""
     from flex.fidelity.simulation import simulate
 
     rigid_scene = _with(scene, coupler__model="rigid")
     for _ in range(3):
-        rigid = simulate(rigid_scene, "rigid")
+        rigid = simulate(rigid_scene, "rigid", cache_dir=cache_dir)
         rigid_data = case_data(rigid)
         try:
             times = deployment_times(rigid_data["time"], rigid_data["crank/angle"],
@@ -254,7 +258,7 @@ def _run_pair(scene: Scene, reduction: Any) -> tuple[dict, dict, dict[str, float
     end = min(rigid_scene["simulation"]["end_time_s"],
               step * math.ceil(1.02 * times["stop"] / step + 2))
     ffrf = simulate(_with(scene, coupler__model="ffrf", simulation__end_time_s=end), "ffrf",
-                    reduction)
+                    reduction, cache_dir=cache_dir)
     walls = {"rigid": rigid.counters["wall_time_s"], "ffrf": ffrf.counters["wall_time_s"],
              "ffrf_steps": ffrf.counters["steps"], "rigid_steps": rigid.counters["steps"]}
     return rigid_data, case_data(ffrf), times, walls
@@ -322,16 +326,17 @@ def _case_curves(scene: Scene, rigid: dict, ffrf: dict, stop_s: float) -> dict[s
             for key, (values, unit, text) in curves.items()}
 
 
-def fit_case(name: str, scene: Scene) -> CaseResult:
+def fit_case(name: str, scene: Scene, *, cache_dir: Path | None = None) -> CaseResult:
     """One fit case: FFRF and rigid twin, the error measures, n by every definition.
 
     Stores ``parameters/*``, ``delta_t/<definition>`` [s], ``n_physical/<definition>``,
     ``n_thesis/<definition>``, ``measures/<measure>`` (dimensionless) and absolute values,
-    ``frequency/*`` and downsampled ``curves/*`` with units.
+    ``frequency/*`` and downsampled ``curves/*`` with units. ``cache_dir``: the reduction
+    cache folder (None: built in memory, no disk cache).
     """
     coupler = scene["coupler"]
-    reduction = reduction_of(scene)
-    rigid, ffrf, times, walls = _run_pair(scene, reduction)
+    reduction = reduction_of(scene, cache_dir)
+    rigid, ffrf, times, walls = _run_pair(scene, reduction, cache_dir)
     measures = error_measures(rigid, ffrf, coupler["length_m"], coupler["thickness_m"],
                               coupler["width_m"], times["stop"], coupler["youngs_modulus_Pa"])
     omega = pinned_pinned_omega(coupler["length_m"], coupler["thickness_m"],
@@ -354,24 +359,27 @@ def fit_case(name: str, scene: Scene) -> CaseResult:
                              "reduction_cold_build_time_s": reduction.cold_build_time_s})
 
 
-def validation_case(name: str, scene: Scene, criterion_toml: str | None = None) -> CaseResult:
+def validation_case(name: str, scene: Scene, criterion_toml: str | None = None, *,
+                    cache_dir: Path | None = None) -> CaseResult:
     """``auto`` against the full FFRF model on a scene outside the fit.
 
     The ``auto`` run goes through :func:`flex.fidelity.simulation.simulate` with the law just fitted
     (``criterion_toml``, passed as an argument; None: the installed one). Stores the
     decision, the errors of the auto run against the full FFRF run and both wall times.
+    ``cache_dir``: the reduction cache folder (None: built in memory, no disk cache).
     """
     from flex.fidelity.simulation import simulate
 
     start = time.perf_counter()
     auto = lawfit.simulate_with_law(scene, "auto", "coupler", criterion_toml,
-                                    "kfit (this run's fit)", raising=True)
+                                    "kfit (this run's fit)", raising=True,
+                                    cache_dir=cache_dir)
     auto_total = time.perf_counter() - start
     reference = full_scene(scene)
     start = time.perf_counter()
-    full_reduction = reduction_of(reference)
+    full_reduction = reduction_of(reference, cache_dir)
     full_reduction_s = time.perf_counter() - start
-    full = simulate(reference, "full", full_reduction)
+    full = simulate(reference, "full", full_reduction, cache_dir=cache_dir)
     check = lawfit.against_full(name, "coupler", scene["fidelity"]["tolerance"],
                                 case_data(auto), case_data(full), scene["coupler"]["length_m"],
                                 auto.attrs)
@@ -399,12 +407,21 @@ def validation_case(name: str, scene: Scene, criterion_toml: str | None = None) 
 # ------------------------------------------------------------------------------------------
 # the pipeline on the sweep engine
 # ------------------------------------------------------------------------------------------
-SWEEP_PHASES = {
-    "fit": lawfit.SweepPhase(lambda _: fit_case, prepare_reduction, geometry_key, "fit cases"),
-    "validation": lawfit.SweepPhase(
-        lambda text: functools.partial(validation_case, criterion_toml=text),
-        prepare_full_reduction, full_geometry_key, "validation"),
-}
+def sweep_phases(cache_dir: Path | None = None) -> dict[str, lawfit.SweepPhase]:
+    """The fit and validation phases on the sweep engine. Their case functions and
+    preparations get the reduction cache folder ``cache_dir`` as an argument (so do the
+    workers; None: each worker builds in memory); it is not part of a case's identity
+    (:func:`flex.sweep.case_hash`), so a moved cache resumes the same cases."""
+    where = {"cache_dir": cache_dir}
+    fit = functools.partial(fit_case, **where)
+    return {
+        "fit": lawfit.SweepPhase(lambda _: fit, functools.partial(prepare_reduction, **where),
+                                 geometry_key, "fit cases"),
+        "validation": lawfit.SweepPhase(
+            lambda text: functools.partial(validation_case, criterion_toml=text, **where),
+            functools.partial(prepare_full_reduction, **where), full_geometry_key,
+            "validation"),
+    }
 
 
 def criterion_path(folder: Path) -> Path:

@@ -70,11 +70,13 @@ def cases(scene: Scene, fit: tuple[tuple[float, float], ...],
     return out
 
 
-def analyse(scenes: dict[str, Scene], results: dict[str, CaseResult]) -> dict[str, Any]:
+def analyse(scenes: dict[str, Scene], results: dict[str, CaseResult],
+            cache_dir: Path | None = None) -> dict[str, Any]:
     """Fit table (per fit scene with both runs ok: n = delta_t of the rigid run x the
     crank's in-mechanism frequency / 2 pi, the errors of the rigid crank against the full
     one) and the governing law over it (``fits``, keyed as
-    :func:`flex.experiments.lawfit.fit_laws`)."""
+    :func:`flex.experiments.lawfit.fit_laws`). ``cache_dir``: the reduction cache folder of
+    the frequency analyses (None: built in memory, no disk cache)."""
     rows = {}
     for name, scene in scenes.items():
         name = name.removesuffix("__rigid")
@@ -85,7 +87,7 @@ def analyse(scenes: dict[str, Scene], results: dict[str, CaseResult]) -> dict[st
         rigid_data = case_data(rigid)
         times = deployment_times(rigid_data["time"], rigid_data["crank/angle"],
                                  rigid_data["crank/angular_velocity"])
-        omega = crank_elastic_omega(scene)
+        omega = crank_elastic_omega(scene, cache_dir=cache_dir)
         row = errors_against_full(rigid_data, case_data(full), "crank",
                                   scene["crank"]["length_m"])
         row.update(n=n_values(times["stop"], omega)["physical"], omega=omega,
@@ -107,14 +109,16 @@ def criterion_toml(analysis: dict[str, Any], provenance: bool = False) -> str:
     return lawfit.criterion_toml(analysis["fits"], HEADER, meta, provenance)
 
 
-def fit_then_validate(scenes: dict[str, Scene], runner: lawfit.CaseRunner, path: Path
+def fit_then_validate(scenes: dict[str, Scene], runner: lawfit.CaseRunner, path: Path,
+                      cache_dir: Path | None = None
                       ) -> tuple[dict[str, CaseResult], dict[str, Any]]:
-    """The :mod:`flex.experiments.lawfit` pipeline for the crank: fit cases, :func:`analyse`, the
+    """The :mod:`flex.experiments.lawfit` pipeline for the crank: fit cases, :func:`analyse`
+    (its reductions in the reduction cache folder ``cache_dir``, None: in memory), the
     criterion at ``path``, the validation cases."""
     fit = {n: s for n, s in scenes.items() if n.startswith("fit_")}
     return lawfit.fit_then_validate(scenes, lambda name: name.startswith("fit_"), runner,
-                                    lambda results: analyse(fit, results), criterion_toml,
-                                    path)
+                                    lambda results: analyse(fit, results, cache_dir),
+                                    criterion_toml, path)
 
 
 def _fit_report(analysis: dict[str, Any], path: Path) -> tuple[dict[str, Dataset], list[str]]:
@@ -173,13 +177,15 @@ def _validation_datasets(check: Validation, auto: CaseResult, full: CaseResult,
 
 
 def summarize(scenes: dict[str, Scene], results: dict[str, CaseResult],
-              analysis: dict[str, Any] | None, path: Path
+              analysis: dict[str, Any] | None, path: Path, cache_dir: Path | None = None
               ) -> tuple[dict[str, Dataset], str]:
     """The crank summary's datasets and report: the fit (``analysis``: the run's, else
-    fitted again from ``results``), then auto against the full crank per validation scene
-    (``scenes``: the study's cases; the criterion was written to ``path``)."""
+    fitted again from ``results``, its reductions in the cache folder ``cache_dir``), then
+    auto against the full crank per validation scene (``scenes``: the study's cases; the
+    criterion was written to ``path``)."""
     if analysis is None:
-        analysis = analyse({n: s for n, s in scenes.items() if n.startswith("fit_")}, results)
+        analysis = analyse({n: s for n, s in scenes.items() if n.startswith("fit_")}, results,
+                           cache_dir)
     datasets, lines = _fit_report(analysis, path)
     rows: list = []
     for name, scene in scenes.items():

@@ -57,16 +57,18 @@ def scalar(case: CaseResult, key: str) -> float:
 
 
 def simulate_with_law(scene: Scene, name: str, link: str, criterion_text: str | None,
-                      source: str, raising: bool = False) -> CaseResult:
+                      source: str, raising: bool = False, *,
+                      cache_dir: Path | None = None) -> CaseResult:
     """Simulate ``scene`` with ``link``'s ``auto`` decided by the law in ``criterion_text``
     (criterion TOML; None: the installed file). ``raising``: a failure raises
-    (:func:`flex.fidelity.simulation.simulate`) instead of becoming a failed case."""
+    (:func:`flex.fidelity.simulation.simulate`) instead of becoming a failed case.
+    ``cache_dir``: the reduction cache folder (None: built in memory, no disk cache)."""
     from flex.fidelity.criteria import parse_criterion
     from flex.fidelity.simulation import simulate, simulate_case
 
     law = None if criterion_text is None else parse_criterion(criterion_text, source)
     run = simulate if raising else simulate_case
-    return run(scene, name, **{CRITERION_ARGUMENT[link]: law})
+    return run(scene, name, cache_dir=cache_dir, **{CRITERION_ARGUMENT[link]: law})
 
 
 # ------------------------------------------------------------------------------------------
@@ -90,13 +92,15 @@ class CaseRunner(Protocol):
 @dataclass
 class SerialRunner:
     """Every case in this process, one after the other (:func:`simulate_with_law`);
-    ``progress(case, done, total)`` counts over both phases."""
+    ``progress(case, done, total)`` counts over both phases; ``cache_dir``: the reduction
+    cache folder (None: built in memory, no disk cache)."""
 
     link: str
     label: str
     total: int
     progress: Callable[[str, int, int], None] | None = None
     done: int = 0
+    cache_dir: Path | None = None
 
     def run(self, phase: str, scenes: dict[str, Scene],
             criterion_text: str | None) -> dict[str, CaseResult]:
@@ -105,7 +109,8 @@ class SerialRunner:
             if self.progress:
                 self.progress(name, self.done, self.total)
             results[name] = simulate_with_law(scene, name, self.link, criterion_text,
-                                              f"{self.label} (this run's fit)")
+                                              f"{self.label} (this run's fit)",
+                                              cache_dir=self.cache_dir)
             self.done += 1
         return results
 

@@ -296,7 +296,7 @@ def _run_extreme(extreme: Extreme, scene: Scene, pool: ReductionPool, references
     except FlexError as exc:
         case = CaseResult(extreme.name, to_toml(scene), status="failed", message=str(exc))
     else:
-        case = simulate_case(scene, extreme.name, reduction)
+        case = simulate_case(scene, extreme.name, reduction, cache_dir=pool.cache_dir)
     try:
         verdict = judge(extreme, scene, case, references, tolerance)
     except Exception as exc:  # one broken comparison must not lose a half-hour run
@@ -314,11 +314,13 @@ def _run_extreme(extreme: Extreme, scene: Scene, pool: ReductionPool, references
 
 def simulate_extremes(extremes: Sequence[Extreme], scenes: dict[str, Scene],
                       progress: Progress | None, notes: dict[str, Any], keep: Sequence[str],
-                      tolerance: float) -> dict[str, CaseResult]:
+                      tolerance: float, *, cache_dir: Path | None = None
+                      ) -> dict[str, CaseResult]:
     """Run every extreme, judge it against its reference (``notes["verdicts"][name]``);
     keep only the curves ``keep``. A nonlinear FE reference that cannot be built here makes
-    its case failed ("pending")."""
-    pool = ReductionPool()
+    its case failed ("pending"). ``cache_dir``: the reduction cache folder (None: reductions
+    are built in memory, no disk cache)."""
+    pool = ReductionPool(cache_dir)
     references = References(pool, tolerance)
     by_name = {extreme.name: extreme for extreme in extremes}
     nonlinear = nonlinear_available()

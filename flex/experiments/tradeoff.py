@@ -43,6 +43,7 @@ import statistics
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -334,10 +335,16 @@ def element_order(order: int) -> Iterator[None]:
 
 
 class ReductionPool:
-    """Reductions (and their FFRF interfaces) built once per key and shared by all runs."""
+    """Reductions (and their FFRF interfaces) built once per key and shared by all runs.
 
-    def __init__(self) -> None:
+    ``cache_dir``: the reduction cache folder they are loaded from or written to, also used
+    by the runs of :func:`run_once` for what they build themselves (None: built in memory,
+    no disk cache).
+    """
+
+    def __init__(self, cache_dir: Path | None = None) -> None:
         self._by_key: dict[tuple, Any] = {}
+        self.cache_dir = cache_dir
 
     def for_scene(self, scene: Scene, order: int = 2) -> Any:
         """The scene's reduction (tetrahedra of ``order``) for an ``ffrf`` coupler, else
@@ -352,7 +359,7 @@ class ReductionPool:
                                    "modes")) + (order,)
         if key not in self._by_key:
             with element_order(order):
-                self._by_key[key] = reduction_for_scene(scene)
+                self._by_key[key] = reduction_for_scene(scene, cache_dir=self.cache_dir)
         return self._by_key[key]
 
 
@@ -378,8 +385,9 @@ def run_once(scene: Scene, setting: Setting, pool: ReductionPool | None = None
     else:
         from flex.fidelity.simulation import simulate
 
-        reduction = (pool or ReductionPool()).for_scene(scene, setting.element_order)
-        result = simulate(scene, setting.label, reduction)
+        pool = pool or ReductionPool()
+        reduction = pool.for_scene(scene, setting.element_order)
+        result = simulate(scene, setting.label, reduction, cache_dir=pool.cache_dir)
         observables = Observables.of_datasets(result.datasets, flexible)
         counters = dict(result.counters)
     counters["total_time_s"] = time.perf_counter() - start

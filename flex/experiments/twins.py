@@ -62,16 +62,17 @@ def twin_cases(scene: Scene, plates: Plates, nonlinear_model: str,
     return out
 
 
-def _simulate_one(name: str, scene: Scene, notes: dict[str, Any]) -> CaseResult:
-    """One case with its reduction (FFRF) or mesh (nonlinear FE); their facts in attrs, the
-    reduction's in ``notes["reductions"][name]``."""
+def _simulate_one(name: str, scene: Scene, notes: dict[str, Any],
+                  cache_dir: Path | None) -> CaseResult:
+    """One case with its reduction (FFRF, cached in ``cache_dir``) or mesh (nonlinear FE);
+    their facts in attrs, the reduction's in ``notes["reductions"][name]``."""
     model = scene["coupler"]["model"]
     reduction = None
     if model == "ffrf":
-        reduction = reduction_for_scene(scene)
+        reduction = reduction_for_scene(scene, cache_dir=cache_dir)
     elif model == "nonlinear_fe":
         reduction = nonlinear_plate_for_scene(scene)  # the mesh and its node sets
-    case = simulate_case(scene, name, reduction)
+    case = simulate_case(scene, name, reduction, cache_dir=cache_dir)
     if model == "ffrf":
         case.attrs.update(reduction_key=reduction.key,
                           reduction_from_cache=reduction.from_cache,
@@ -86,10 +87,13 @@ def _simulate_one(name: str, scene: Scene, notes: dict[str, Any]) -> CaseResult:
 
 
 def simulate_twins(scenes: dict[str, Scene], progress: Progress | None,
-                   notes: dict[str, Any]) -> dict[str, CaseResult]:
-    """Simulate every case; each plate's reduction is built (or loaded) once, and what the
-    summary reports of it goes to ``notes`` (the run's, handed on to the summary)."""
-    return run_each(scenes, lambda name, scene: _simulate_one(name, scene, notes), progress)
+                   notes: dict[str, Any], *, cache_dir: Path | None = None
+                   ) -> dict[str, CaseResult]:
+    """Simulate every case; each plate's reduction is built (or loaded from ``cache_dir``,
+    the reduction cache folder; None: built in memory, no disk cache), and what the summary
+    reports of it goes to ``notes`` (the run's, handed on to the summary)."""
+    return run_each(scenes, lambda name, scene: _simulate_one(name, scene, notes, cache_dir),
+                    progress)
 
 
 HEADER = (f"  {'model':14s} {'t [mm]':>6s} {'f_pp [Hz]':>10s} {'n thesis':>9s} "

@@ -142,9 +142,10 @@ def deployment_values(scene: Scene, data: dict[str, np.ndarray]
     }
 
 
-def summary(case: CaseResult) -> tuple[dict[str, Dataset], str]:
+def summary(case: CaseResult, cache_dir: Path | None = None) -> tuple[dict[str, Dataset], str]:
     """The ``wing`` summary of one deployment run (its own, fitted scene): ``wing/*`` and
-    ``auto/*`` datasets and the report."""
+    ``auto/*`` datasets and the report. ``cache_dir``: the reduction cache folder of the
+    ``auto`` decisions (None: built in memory, no disk cache)."""
     if case.status != "ok":
         return {}, f"wing: case failed: {case.message}"
     scene = tomllib.loads(case.scene_toml)  # the fitted scene this case ran
@@ -174,13 +175,15 @@ def summary(case: CaseResult) -> tuple[dict[str, Dataset], str]:
         f"quasi-static tip deflection {value['quasi_static_tip_deflection_m'] * 1e6:.2f}"
         f" um = {value['tip_deflection_over_span']:.1e} of the span -> {verdict}",
     ]
-    lines += auto_decisions(scene, datasets)
+    lines += auto_decisions(scene, datasets, cache_dir)
     return datasets, "\n".join(lines)
 
 
-def auto_decisions(scene: Scene, datasets: dict[str, Dataset]) -> list[str]:
+def auto_decisions(scene: Scene, datasets: dict[str, Dataset],
+                   cache_dir: Path | None = None) -> list[str]:
     """The ``auto`` fidelity decisions for the coupler (as a 3 mm steel plate) and the crank:
-    stored as ``auto/<link>/model`` in ``datasets``; the report lines."""
+    stored as ``auto/<link>/model`` in ``datasets``; the report lines. ``cache_dir``: the
+    reduction cache folder of the crank's frequency analysis (None: built in memory)."""
     try:
         from flex.fidelity.criteria import resolve_fidelity
     except ImportError:
@@ -189,7 +192,7 @@ def auto_decisions(scene: Scene, datasets: dict[str, Dataset]) -> list[str]:
                                     'coupler.model="auto"', 'crank.model="auto"'])
     try:
         validate(trial)
-        _, decisions = resolve_fidelity(trial)
+        _, decisions = resolve_fidelity(trial, cache_dir=cache_dir)
     except Exception as exc:  # a refusal is itself the answer worth reporting
         return [f"  auto fidelity (coupler as a 3 mm plate): {exc}"]
     lines = []

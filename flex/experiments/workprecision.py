@@ -19,6 +19,7 @@ from __future__ import annotations
 import re
 import time
 from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -126,17 +127,18 @@ def _work_precision_case(scene_name: str, scene: Scene, m: Measurement) -> CaseR
 def run_work_precision(scenes: Mapping[str, Scene], settings: Mapping[str, Sequence[Setting]],
                        repeats: int, progress: Progress | None = None,
                        notes: dict[str, Any] | None = None,
-                       plans: Callable[[str], ReferencePlan] = reference_plan
-                       ) -> dict[str, CaseResult]:
+                       plans: Callable[[str], ReferencePlan] = reference_plan, *,
+                       cache_dir: Path | None = None) -> dict[str, CaseResult]:
     """Per scene its reference (``plans(scene name)``) and then each of ``settings[scene
     name]``, measured ``repeats`` times; returns one case per run and stores
-    ``notes["runs"][scene name]`` (:class:`SceneRuns`)."""
+    ``notes["runs"][scene name]`` (:class:`SceneRuns`). ``cache_dir``: the reduction cache
+    folder (None: reductions are built in memory, no disk cache)."""
     total = sum(len(plan) + 1 for plan in settings.values())
     done = 0
     results: dict[str, CaseResult] = {}
     runs: dict[str, SceneRuns] = (notes if notes is not None else {}).setdefault("runs", {})
     for scene_name, scene in scenes.items():
-        pool = ReductionPool()
+        pool = ReductionPool(cache_dir)
         if progress:
             progress(f"{scene_name}: reference", done, total)
         started = time.perf_counter()

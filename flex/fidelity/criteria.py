@@ -765,7 +765,8 @@ def equivalent_crank_plate(scene: Mapping[str, Mapping[str, Any]]) -> dict[str, 
     return out
 
 
-def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]]) -> float:
+def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]], *,
+                        cache_dir: Path | None = None) -> float:
     """First in-plane elastic circular frequency [rad/s] of the crank in the mechanism.
 
     Contract: ``scene`` with a plate crank (see :func:`equivalent_crank_plate`). The
@@ -781,6 +782,9 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]]) -> float:
     A the crank is a cantilever from the wing's inertia carrying the coupler and slider at B
     (measured on a 1 mm crank: 68 Hz in the mechanism, 1430 Hz pinned-pinned); without a
     wing the analysis returns the pinned-pinned value (1442 Hz).
+
+    ``cache_dir``: the reduction cache folder the FFRF crank's reduction is loaded from or
+    written to (None: built in memory, no disk cache).
     """
     import copy
 
@@ -798,7 +802,8 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]]) -> float:
 
     def in_plane_omegas(model: str) -> np.ndarray:
         crank["model"] = model
-        reduction = reduction_for_scene(analysis, "crank") if model == "ffrf" else None
+        reduction = (reduction_for_scene(analysis, "crank", cache_dir=cache_dir)
+                     if model == "ffrf" else None)
         mech = build_mechanism(analysis, None, reduction)
         values, vectors = mech.mbs.ComputeODE2Eigenvalues(useAbsoluteValues=True)
         values, vectors = np.abs(np.asarray(values)), np.asarray(vectors)
@@ -821,7 +826,8 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]]) -> float:
 
 def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
                      criterion: Criterion | None = None,
-                     crank_criterion: Criterion | None = None,
+                     crank_criterion: Criterion | None = None, *,
+                     cache_dir: Path | None = None,
                      ) -> tuple[dict[str, dict[str, Any]], list[FidelityDecision]]:
     """Replace ``"auto"`` link models by concrete ones; return the scene and the decisions.
 
@@ -838,7 +844,8 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
     or a flexible one with a constant-speed drive, is refused with a :class:`SceneError`. A
     coupler loaded beyond :data:`EULER_LOAD_LIMIT` of its
     Euler load is refused too (outside the fit). Scenes without ``auto`` are returned
-    unchanged (a copy).
+    unchanged (a copy). ``cache_dir``: the reduction cache folder of the crank's frequency
+    analysis (None: its reduction is built in memory, no disk cache).
     """
     import copy
 
@@ -858,7 +865,7 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
     if wants_crank:
         decisions.append(_decide_crank(resolved, delta_t_s, how, tolerance,
                                        crank_criterion or load_criterion(
-                                           DEFAULT_CRANK_CRITERION)))
+                                           DEFAULT_CRANK_CRITERION), cache_dir))
     return resolved, decisions
 
 
@@ -901,14 +908,16 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
 
 
 def _decide_crank(resolved: dict[str, dict[str, Any]], delta_t_s: float, how: str,
-                  tolerance: float, crank_criterion: Criterion) -> FidelityDecision:
-    """The crank's decision from its own law and its in-mechanism frequency; a flexible
-    verdict for a lumped crank or with a constant-speed drive is refused."""
+                  tolerance: float, crank_criterion: Criterion,
+                  cache_dir: Path | None = None) -> FidelityDecision:
+    """The crank's decision from its own law and its in-mechanism frequency (its reduction
+    cached in ``cache_dir``, None: in memory); a flexible verdict for a lumped crank or with
+    a constant-speed drive is refused."""
     crank = resolved["crank"]
     lumped = crank["geometry"] == "lumped"
     plate_scene = equivalent_crank_plate(resolved)
     plate = plate_scene["crank"]
-    omega = crank_elastic_omega(plate_scene)
+    omega = crank_elastic_omega(plate_scene, cache_dir=cache_dir)
     if lumped:
         how += (f"; lumped crank as a plate of its mass: {plate['width_m'] * 1e3:g} mm wide, "
                 f"{plate['thickness_m'] * 1e3:.3g} mm high")

@@ -6,11 +6,17 @@ models) and :mod:`flex.fidelity.criteria` (which decides ``auto`` from a rigid p
 means the installed criterion files (:data:`flex.fidelity.criteria.DEFAULT_CRITERION`,
 :data:`flex.fidelity.criteria.DEFAULT_CRANK_CRITERION`); a study that has just fitted a law passes
 it as a :class:`flex.fidelity.criteria.Criterion`.
+
+The reduction cache folder is an argument too (``cache_dir``, keyword): FFRF reductions are
+loaded from it or written to it; ``None`` builds them in memory, with no disk cache. The
+command line and :mod:`flex.api` pass the user's folder
+(:func:`flex.bodies.reduction.reduction_cache_dir` of the environment, read at that edge).
 """
 
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 from typing import Any
 
 from flex.base.errors import FlexError
@@ -22,14 +28,15 @@ from flex.fidelity.criteria import Criterion, FidelityDecision, resolve_fidelity
 
 
 def resolve_auto(scene: Scene, criterion: Criterion | None = None,
-                 crank_criterion: Criterion | None = None
+                 crank_criterion: Criterion | None = None, *, cache_dir: Path | None = None
                  ) -> tuple[Scene, list[FidelityDecision]]:
     """Resolve ``model = "auto"`` links (:func:`flex.fidelity.criteria.resolve_fidelity`) and print
     each choice and its reason to stderr. A scene without ``auto`` links is returned as it
-    is, with no decisions."""
+    is, with no decisions. ``cache_dir``: the reduction cache folder (module doc)."""
     if scene["coupler"]["model"] != "auto" and scene["crank"]["model"] != "auto":
         return scene, []
-    resolved, decisions = resolve_fidelity(scene, criterion, crank_criterion)
+    resolved, decisions = resolve_fidelity(scene, criterion, crank_criterion,
+                                           cache_dir=cache_dir)
     for decision in decisions:
         modes = f" ({decision.modes} modes)" if decision.modes else ""
         print(f"flex: fidelity: {decision.link}.model = auto -> {decision.model}{modes}: "
@@ -39,7 +46,8 @@ def resolve_auto(scene: Scene, criterion: Criterion | None = None,
 
 def simulate(scene: Scene, name: str = "case", reduction: Any = None,
              crank_reduction: Any = None, criterion: Criterion | None = None,
-             crank_criterion: Criterion | None = None) -> CaseResult:
+             crank_criterion: Criterion | None = None, *,
+             cache_dir: Path | None = None) -> CaseResult:
     """One case of any scene; raises :class:`~flex.base.errors.FlexError` on bad input or
     divergence.
 
@@ -48,13 +56,14 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     installed laws); the choice and its reason go to stderr and into the result's
     attributes ``fidelity_<link>_*``. Then :func:`flex.dynamics.solver.integrate` fills the
     ``"auto"`` solver keys and integrates. ``reduction`` / ``crank_reduction``: reductions
-    of ``ffrf`` links (None: built or loaded from the cache).
+    of ``ffrf`` links (None: built, or loaded from ``cache_dir``). ``cache_dir``: the
+    reduction cache folder (None: reductions are built in memory, no disk cache).
     """
     check_runnable(scene)  # before anything is built or probed
-    scene, decisions = resolve_auto(scene, criterion, crank_criterion)
+    scene, decisions = resolve_auto(scene, criterion, crank_criterion, cache_dir=cache_dir)
     if decisions:
         reduction = crank_reduction = None
-    result = integrate(scene, name, reduction, crank_reduction)
+    result = integrate(scene, name, reduction, crank_reduction, cache_dir=cache_dir)
     for decision in decisions:
         result.attrs.update(decision.attrs())
     return result
@@ -62,9 +71,11 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
 
 def simulate_case(scene: Scene, name: str = "case", reduction: Any = None,
                   crank_reduction: Any = None, criterion: Criterion | None = None,
-                  crank_criterion: Criterion | None = None) -> CaseResult:
+                  crank_criterion: Criterion | None = None, *,
+                  cache_dir: Path | None = None) -> CaseResult:
     """Like :func:`simulate`, but a failure becomes a ``failed`` case with its message."""
     try:
-        return simulate(scene, name, reduction, crank_reduction, criterion, crank_criterion)
+        return simulate(scene, name, reduction, crank_reduction, criterion, crank_criterion,
+                        cache_dir=cache_dir)
     except FlexError as exc:
         return CaseResult(name, to_toml(scene), status="failed", message=str(exc))
