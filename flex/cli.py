@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from pathlib import Path
 
 from flex import __version__
 from flex.base.errors import (
@@ -74,6 +75,11 @@ def _parser() -> argparse.ArgumentParser:
                           "scheduler) or 'serial'; default: a process pool on all cores")
     run.add_argument("--workers", type=int, metavar="N",
                      help="sweeps: number of local worker processes (default: all cores)")
+    run.add_argument("--folder", metavar="DIR",
+                     help="sweeps: folder of the per-case files, where a rerun resumes "
+                          "(default: results/<study>-cases)")
+    run.add_argument("--retry-failed", action="store_true",
+                     help="sweeps: rerun the cases that failed last time (default: keep them)")
     scene = commands.add_parser("scene", help="print the fully resolved scene as TOML")
     scene_options(scene)
     _result_tools(commands)
@@ -312,7 +318,10 @@ def _run(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         raise FlexError(f"--workers {args.workers}: must be at least 1")
     sweep_options = [name for name, value in (("--scheduler", args.scheduler),
-                                              ("--workers", args.workers)) if value is not None]
+                                              ("--workers", args.workers),
+                                              ("--folder", args.folder),
+                                              ("--retry-failed", args.retry_failed or None))
+                     if value is not None]
     if sweep_options and not getattr(load_study(args.study), "SWEEP", False):
         raise FlexError(f"{' and '.join(sweep_options)}: study '{args.study}' runs its cases "
                         f"in this process; these options apply to sweep studies (kfit)")
@@ -327,9 +336,12 @@ def _run(args: argparse.Namespace) -> int:
         from flex.sweep import settings_from_environment
 
         # the environment is read here, once, at the edge; the library gets arguments
-        sweep = settings_from_environment()
-        sweep = dataclasses.replace(sweep, scheduler=args.scheduler or sweep.scheduler,
-                                    workers=args.workers or sweep.workers)
+        sweep = settings_from_environment(os.environ)
+        sweep = dataclasses.replace(
+            sweep, scheduler=args.scheduler or sweep.scheduler,
+            workers=args.workers or sweep.workers,
+            folder=Path(args.folder) if args.folder else sweep.folder,
+            retry_failed=args.retry_failed or sweep.retry_failed)
     # the reduction cache folder and the study's declared variables: read here, once
     output = run_study(args.study, args.scene, args.overrides, args.out,
                        figures=not args.no_figures, quiet=args.quiet, sweep=sweep,

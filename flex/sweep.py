@@ -30,17 +30,17 @@ sweep and returns the results. Contract:
   every preparation done, end).
 
 A sweep study gets its :class:`SweepSettings` as an argument. The command lines read them
-once, at the edge (:func:`settings_from_environment`): ``flex run kfit --scheduler ...
---workers N`` and ``python -m flex.sweep STUDY --scheduler ... --folder DIR
---retry-failed``, each over the environment's ``FLEX_SCHEDULER``, ``FLEX_WORKERS``,
-``FLEX_SWEEP_DIR``, ``FLEX_RETRY_FAILED=1`` and ``FLEX_PROGRESS=0``. The reduction cache
-folder is read there too (:func:`flex.bodies.reduction.reduction_cache_dir`) and reaches the
-case functions as their ``cache_dir`` argument (bound with ``functools.partial``).
+once, at the edge (:func:`settings_from_environment` of the command line's environment):
+``flex run kfit --scheduler ... --workers N --folder DIR --retry-failed`` (``python -m
+flex.sweep STUDY ...`` is the same command), each over the environment's
+``FLEX_SCHEDULER``, ``FLEX_WORKERS``, ``FLEX_SWEEP_DIR``, ``FLEX_RETRY_FAILED=1`` and
+``FLEX_PROGRESS=0``. The reduction cache folder is read there too
+(:func:`flex.bodies.reduction.reduction_cache_dir`) and reaches the case functions as their
+``cache_dir`` argument (bound with ``functools.partial``).
 """
 
 from __future__ import annotations
 
-import argparse
 import functools
 import hashlib
 import os
@@ -693,60 +693,23 @@ class SweepSettings:
     progress: bool = True
 
 
-def settings_from_environment() -> SweepSettings:
-    """``FLEX_SCHEDULER``, ``FLEX_WORKERS``, ``FLEX_SWEEP_DIR``, ``FLEX_RETRY_FAILED``,
-    ``FLEX_PROGRESS`` (0 hides the bar)."""
-    workers = os.environ.get("FLEX_WORKERS") or None
+def settings_from_environment(environ: Mapping[str, str]) -> SweepSettings:
+    """The sweep settings an edge reads from ``environ`` (its ``os.environ``):
+    ``FLEX_SCHEDULER``, ``FLEX_WORKERS``, ``FLEX_SWEEP_DIR``, ``FLEX_RETRY_FAILED`` (1: rerun
+    failed cases), ``FLEX_PROGRESS`` (0 hides the bar)."""
+    workers = environ.get("FLEX_WORKERS") or None
     try:
         count = int(workers) if workers else None
     except ValueError:
         raise FlexError(f"FLEX_WORKERS = {workers!r}: must be an integer >= 1") from None
-    folder = os.environ.get("FLEX_SWEEP_DIR") or None
-    return SweepSettings(scheduler=os.environ.get("FLEX_SCHEDULER") or None, workers=count,
+    folder = environ.get("FLEX_SWEEP_DIR") or None
+    return SweepSettings(scheduler=environ.get("FLEX_SCHEDULER") or None, workers=count,
                          folder=Path(folder) if folder else None,
-                         retry_failed=os.environ.get("FLEX_RETRY_FAILED", "") == "1",
-                         progress=os.environ.get("FLEX_PROGRESS", "1") != "0")
+                         retry_failed=environ.get("FLEX_RETRY_FAILED", "") == "1",
+                         progress=environ.get("FLEX_PROGRESS", "1") != "0")
 
 
-def main(argv: list[str] | None = None) -> int:
-    """``python -m flex.sweep STUDY [--scheduler ADDR] [--workers N] [--folder DIR]
-    [--retry-failed] [--set K=V ...] [--out FILE.h5] [--no-figures] [--quiet]``."""
-    parser = argparse.ArgumentParser(prog="python -m flex.sweep",
-                                     description="run a sweep study on a chosen executor")
-    parser.add_argument("study", nargs="?", default="kfit")
-    parser.add_argument("--scheduler", help="processes (default), serial, local (Dask on this "
-                        "machine) or a Dask scheduler address tcp://host:8786")
-    parser.add_argument("--workers", type=int, help="worker processes (default: all cores)")
-    parser.add_argument("--folder", help="folder of the per-case files (resume point)")
-    parser.add_argument("--retry-failed", action="store_true", help="rerun failed cases")
-    parser.add_argument("--scene", metavar="FILE.toml")
-    parser.add_argument("--set", dest="overrides", action="append", default=[])
-    parser.add_argument("--out", metavar="FILE.h5")
-    parser.add_argument("--no-figures", action="store_true")
-    parser.add_argument("--quiet", action="store_true")
-    args = parser.parse_args(argv)
-    from flex.study import from_environment, run_study
+if __name__ == "__main__":  # python -m flex.sweep STUDY [options]: the same as flex run
+    from flex.cli import main
 
-    try:
-        base = settings_from_environment()  # the environment, read once at this edge
-        where = from_environment(args.study, os.environ)  # cache folder, study variables
-        sweep = SweepSettings(scheduler=args.scheduler or base.scheduler,
-                              workers=args.workers or base.workers,
-                              folder=Path(args.folder) if args.folder else base.folder,
-                              retry_failed=args.retry_failed or base.retry_failed,
-                              progress=base.progress)
-        output = run_study(args.study, args.scene, args.overrides, args.out,
-                           figures=not args.no_figures, quiet=args.quiet, sweep=sweep,
-                           **where)
-    except FlexError as exc:
-        print(f"flex: error: {exc}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("flex: interrupted; finished cases are kept in their files (rerun to resume)",
-              file=sys.stderr)
-        return 130
-    return 1 if any(c.status != "ok" for c in output.results.values()) else 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(main(["run", *sys.argv[1:]]))

@@ -1,6 +1,6 @@
 """The environment is read at the edges only: values travel as arguments.
 
-The command line (``flex/cli.py``), ``python -m flex.sweep`` (``flex/sweep.py``) and the public
+The command line (``flex/cli.py``; ``python -m flex.sweep`` is the same command) and the public
 API (``flex/api.py``) read ``os.environ`` once and pass what they read on (the reduction cache
 folder, a study's declared variables); no other library function reads it.
 """
@@ -18,8 +18,6 @@ FLEX = Path(__file__).resolve().parent.parent / "flex"
 EDGES = {
     ("cli.py", "main"): "FLEX_DEBUG: show the traceback of an internal error",
     ("cli.py", "_run"): "flex run: the reduction cache folder and the study's variables",
-    ("sweep.py", "settings_from_environment"): "the sweep settings of the command lines",
-    ("sweep.py", "main"): "python -m flex.sweep: cache folder and study variables",
     ("api.py", "_cache_dir"): "flex.simulate / flex.run_study: the user's cache folder",
     ("api.py", "run_study"): "flex.run_study: the study's declared variables",
     # configures Exudyn itself (no user settings file) before it is imported

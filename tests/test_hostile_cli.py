@@ -63,6 +63,8 @@ ARGUMENT_ERRORS = [
     (["run", "simulate", "--workers", "-3"], ["--workers"]),
     (["run", "simulate", "--workers", "2"], ["--workers", "kfit"]),
     (["run", "dynamics", "--scheduler", "local"], ["--scheduler", "kfit"]),
+    (["run", "dynamics", "--folder", "cases"], ["--folder", "kfit"]),
+    (["run", "simulate", "--retry-failed"], ["--retry-failed", "kfit"]),
     (["run", "kfit", "--scheduler", "bogus"], ["--scheduler"]),
     (["run", "kfit", "--scheduler", "http://x:1"], ["--scheduler"]),
     (["run", "kfit", "--scheduler", ""], ["--scheduler"]),
@@ -263,3 +265,14 @@ def test_signals_at_each_phase_leave_nothing_half_done(tmp_path, phase, sig):
     else:
         assert last == f"flex: {word}; no result file was changed"
         assert {path: after.get(path) for path in before} == before
+
+
+def test_python_m_flex_sweep_is_the_flex_run_command(workspace):
+    """``python -m flex.sweep STUDY ...`` is ``flex run STUDY ...``: the same refusals, the same
+    one line and exit status."""
+    folder, good, scene = workspace
+    done = subprocess.run([sys.executable, "-m", "flex.sweep", "dynamics", "--workers", "2"],
+                          cwd=folder, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2, done
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and "--workers" in lines[0] and "kfit" in lines[0], done.stderr
