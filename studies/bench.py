@@ -16,6 +16,9 @@ medians of :data:`REPEATS` runs, and each comparison is a ratio of two times mea
   it) at its coarsest setting.
 - ``profile``: Exudyn's CPU-time statistics of the untuned and the tuned run (share of each
   solver phase) and flex's own phases (reduction, build, integration, output).
+- ``step_cost``: the cost of an FFRF step (1 mm plate, h = 1e-5 s, 3 ms) against mesh size
+  (4, 2, 1 mm) and mode count (6, 12, 24), joint markers on every face node (before) and on
+  the fewest nodes (now), alternating runs.
 - ``reduction``: build time of the 1 mm plate reduction, cold (empty cache) and from cache.
 - ``make_all``: ``make all`` end to end with an empty reduction cache (cold) and again with
   it filled (warm); ``FLEX_BENCH_MAKE=0`` skips it.
@@ -37,7 +40,7 @@ from typing import Any
 from flex.config.settings import AUTO_OVERRIDES, pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, apply_overrides, validate
-from flex.experiments.benchmark import BenchPlan, run_bench
+from flex.experiments.benchmark import BenchPlan, StepCostPlan, run_bench
 from flex.experiments.benchmark_report import bench_figures, bench_summary
 from flex.experiments.reference_plans import ReferencePlan
 from flex.experiments.tradeoff import Setting
@@ -108,6 +111,8 @@ PLAN = BenchPlan(
     nonlinear_coarse=S("nonlinear FE h=2e-4 mesh=4mm modified tol=1e-8",
                        coupler__model="nonlinear_fe", coupler__mesh_size_m=0.004, step_s=2e-4,
                        newton="modified", newton_relative_tolerance=1e-8),
+    step_cost=StepCostPlan(meshes_m=(0.004, 0.002, 0.001), modes=(6, 12, 24), step_s=1e-5,
+                           end_time_s=0.003),
 )
 
 
@@ -119,7 +124,7 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
-    """Run the four parts in order; each part's failure is stored, the others still run."""
+    """Run the five parts in order; each part's failure is stored, the others still run."""
     return run_bench(scenes, PLAN, REPEATS, run.progress, run.notes, cache_dir=run.cache_dir,
                      make_all=run.environment.get("FLEX_BENCH_MAKE", "1") != "0",
                      nonlinear=run.environment.get("FLEX_BENCH_NONLINEAR", "1") != "0")

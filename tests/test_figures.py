@@ -283,9 +283,22 @@ def test_bench_figures_synthetic(tmp_path, reviewed):
         for which, scale in (("profile_untuned", 1.0), ("profile_tuned", 0.8)):
             for phase, share in (("newton", 40.0), ("jacobian", 30.0), ("output", 10.0)):
                 data[f"{part}/{which}/exudyn_{phase}_percent"] = share * scale
-    paths = bench.figures({}, summary(**data), tmp_path)
+    from flex.experiments.benchmark_report import _step_cost_rows
+
+    step_cost: dict = {}
+    rows = _step_cost_rows([
+        {"mesh_size_m": mesh, "modes": modes, "mesh_nodes": nodes,
+         "fewest_ms_per_step": 0.02 * modes ** 0.8, "fewest_newton_per_step": 6.3,
+         "all_face_nodes_ms_per_step": 0.02 * modes ** 0.8 + nodes * 3e-4,
+         "all_face_nodes_newton_per_step": 6.3}
+        for mesh, nodes in ((0.004, 1080), (0.002, 3209), (0.001, 11935))
+        for modes in (6, 12, 24)], step_cost)
+    assert len(rows) == 9 and "x)" in rows[0][2]
+    np.testing.assert_allclose(step_cost["step_cost/speedup"].data[:3],
+                               [1 + 1080 * 3e-4 / (0.02 * m ** 0.8) for m in (6, 12, 24)])
+    paths = bench.figures({}, summary(**data, **step_cost), tmp_path)
     check_pngs(paths, tmp_path, {"bench-times.png", "bench-profile-rigid.png",
-                                 "bench-profile-ffrf_1mm.png"})
+                                 "bench-profile-ffrf_1mm.png", "bench-step-cost.png"})
 
 
 # ------------------------------------------------------------------------------------------

@@ -32,10 +32,23 @@ def dotted_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
+def _is_main_block(node: ast.AST) -> bool:
+    """``if __name__ == "__main__":`` -- a program's entry, run only as ``python -m``."""
+    test = getattr(node, "test", None)
+    return (isinstance(node, ast.If) and isinstance(test, ast.Compare)
+            and isinstance(test.left, ast.Name) and test.left.id == "__name__"
+            and any(isinstance(c, ast.Constant) and c.value == "__main__"
+                    for c in test.comparators))
+
+
 def flex_imports(path: Path) -> set[str]:
-    """The flex modules ``path`` imports, at any depth (every import is absolute)."""
+    """The flex modules ``path`` imports, at any depth (every import is absolute), except in
+    its ``if __name__ == "__main__":`` block: that is an edge (``python -m flex.sweep`` hands
+    over to the command line), never run when the module is imported."""
     found = set()
-    for node in ast.walk(ast.parse(path.read_text())):
+    tree = ast.parse(path.read_text())
+    tree.body = [node for node in tree.body if not _is_main_block(node)]
+    for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
             assert node.level == 0, f"{path}: relative import (use flex.<layer>.<module>)"
             if node.module and (node.module == "flex" or node.module.startswith("flex.")):

@@ -354,3 +354,54 @@ def test_thesis_plates_pinned_pinned_frequency(thickness, mesh_size, low, high, 
     inertia, area = WIDTH * thickness**3 / 12, WIDTH * thickness
     euler_bernoulli = (np.pi / LENGTH) ** 2 * np.sqrt(E * inertia / (RHO * area)) / (2 * np.pi)
     assert low < reduction.pinned_pinned_frequency_Hz / euler_bernoulli < high
+
+
+# ------------------------------------------------------------------------------------------
+# joint markers: as cheap as the basis allows, the same motion as on every face node
+# ------------------------------------------------------------------------------------------
+def test_joint_markers_use_the_frame_node_and_four_corners_of_the_rigid_face(reduction):
+    from flex.bodies.reduction import _face_corners, _moves_rigidly
+
+    basis = reduction.fem.modeBasis["matrix"]
+    basis = basis.reshape(-1, 3, basis.shape[1])
+    positions = reduction.fem.GetNodePositionsAsArray()
+    assert not np.any(basis[reduction.nodes_end_a])  # the frame is the joint-B face
+    end_b = np.asarray(reduction.nodes_end_b)
+    assert _moves_rigidly(positions[end_b], basis[end_b])
+    corners = _face_corners(positions, end_b)
+    yz = positions[corners][:, 1:]
+    assert len(corners) == 4
+    np.testing.assert_allclose(np.sort(np.abs(yz), axis=0),
+                               np.tile([THICKNESS / 2, WIDTH / 2], (4, 1)), rtol=1e-12)
+    # a bent face is not rigid: the check must say so
+    bent = basis[end_b].copy()
+    bent[:, 0, -1] += positions[end_b][:, 1] ** 2
+    assert not _moves_rigidly(positions[end_b], bent)
+
+
+@pytest.mark.parametrize("link", ["coupler", "crank"])
+def test_fewest_joint_markers_give_the_motion_of_all_face_nodes(reduction, cache_dir, link):
+    """The thesis deployment's first 2 ms with the plate as coupler (or crank): every output
+    of the cheap markers equals the all-node markers' to the Newton tolerance (1e-5 of each
+    curve's range; measured up to ~4e-8 for positions and forces, ~2e-6 for accelerations)."""
+    from flex.data.scene import apply_overrides, default_scene
+    from flex.dynamics.mechanism import build_mechanism
+    from flex.dynamics.solver import collect, reduction_for_scene, run
+
+    scene = apply_overrides(default_scene(), [
+        f'{link}.geometry="plate"', f'{link}.model="ffrf"', f"{link}.thickness_m={THICKNESS}",
+        f"{link}.mesh_size_m={MESH_SIZE}", f"{link}.modes={MODES}", "simulation.step_s=1e-5",
+        "simulation.end_time_s=0.002", 'simulation.newton="modified"',
+        'simulation.spectral_radius=0.9', "simulation.newton_relative_tolerance=1e-8"])
+    reductions = {"reduction": reduction} if link == "coupler" else {  # the crank's length
+        "crank_reduction": reduction_for_scene(scene, "crank", cache_dir=cache_dir)}
+    curves = {}
+    for markers in ("fewest", "all_face_nodes"):
+        mech = build_mechanism(scene, ffrf_joint_markers=markers, **reductions)
+        run(mech)
+        curves[markers] = {k: np.asarray(v.data) for k, v in collect(mech).items()}
+    for key, full in curves["all_face_nodes"].items():
+        if full.dtype.kind != "f" or not full.size or key == "constraint_norm":
+            continue
+        scale = max(np.ptp(full), np.max(np.abs(full)) * 1e-12, 1e-300)
+        assert np.max(np.abs(curves["fewest"][key] - full)) <= 1e-5 * scale, key

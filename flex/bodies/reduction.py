@@ -498,7 +498,7 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
                   damping_ratio: float = 0.0,
                   initial_velocity_B_m_per_s: Sequence[float] = (0.0, 0.0, 0.0),
                   initial_angular_velocity_rad_per_s: float = 0.0,
-                  name: str = "coupler") -> dict[str, Any]:
+                  name: str = "coupler", joint_markers: str = "fewest") -> dict[str, Any]:
     """Add the reduced plate to ``mbs`` as an ``ObjectFFRFreducedOrder`` between B and C.
 
     Written for the coupler (``end_a`` at B, ``end_b`` at C); the crank uses it with
@@ -508,9 +508,13 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
       - placement: the floating frame's origin is the centre of ``end_a`` and is put at
         ``position_B`` [m, global]; its x axis (the link axis) is turned by ``angle_rad`` about
         global z. C's reference position is ``position_B + length * (cos, sin, 0)``.
-      - markers: ``marker_B`` / ``marker_C`` are ``MarkerSuperElementRigid`` on the end faces
-        (area weights; reference point = face centre, orientation = the frame's) for joints
-        B and C; ``marker_mid`` is a ``MarkerSuperElementPosition`` on the mid-length slab
+      - markers: ``marker_B`` / ``marker_C`` for joints B and C, at the end-face centres
+        with the frame's orientation; ``joint_markers = "fewest"`` (default) makes them as
+        cheap as the basis allows (:func:`_ffrf_joint_markers`: the frame node at ``end_a``,
+        four corner nodes of a rigid ``end_b``), ``"all_face_nodes"`` puts a
+        ``MarkerSuperElementRigid`` on every face node (area weights; the same results to
+        the Newton tolerance, several times the cost: kept to measure that); ``marker_mid``
+        is a ``MarkerSuperElementPosition`` on the mid-length slab
         (reference point (L/2, 0, 0) in body coordinates).
       - damping (0 allowed, must be in [0, 1)): stiffness-proportional Rayleigh damping
         ``beta = 2 * damping_ratio / omega_pp`` on the elastic coordinates, with omega_pp the
@@ -550,6 +554,9 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
                              "undefined for thickness > 2 x width: use damping_ratio = 0")
         beta = 2.0 * damping_ratio / omega
 
+    if joint_markers not in JOINT_MARKERS:
+        raise SceneError(f"joint_markers = {joint_markers!r}: must be one of "
+                         f"{', '.join(JOINT_MARKERS)}")
     rotation = np.asarray(RotationMatrixZ(float(angle_rad)))
     added = reduction.ffrf_interface().AddObjectFFRFreducedOrder(
         mbs, positionRef=list(position_B), rotationMatrixRef=rotation,
@@ -562,12 +569,15 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
         "node_frame": added["nRigidBody"],
         "node_modal": added["nGenericODE2"],
         **add_plate_markers(mbs, body, reduction, position_B, rotation, name,
-                            joint_markers=_ffrf_joint_markers(mbs, body, added["nRigidBody"],
-                                                               reduction, name)),
+                            joint_markers=None if joint_markers == "all_face_nodes" else
+                            _ffrf_joint_markers(mbs, body, added["nRigidBody"], reduction,
+                                                name)),
         "stiffness_proportional_damping_s": beta,
     }
 
 
+#: how an FFRF body's joint markers are made (:func:`add_ffrf_link`)
+JOINT_MARKERS = ("fewest", "all_face_nodes")
 #: largest relative non-rigid part of a mode's displacement over a joint face for the face to
 #: count as rigid in the reduced basis (round-off measures ~4e-14)
 RIGID_FACE_TOLERANCE = 1e-9

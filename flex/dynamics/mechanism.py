@@ -182,23 +182,24 @@ def _add_wing(mech: Mechanism, rigid_body, body_marker, crank_root: int) -> int:
         rotationMarker0=crank_rotation.T, rotationMarker1=crank_rotation.T))
 
 
-def build_mechanism(scene: Scene, reduction: Any = None,
-                    crank_reduction: Any = None) -> Mechanism:
+def build_mechanism(scene: Scene, reduction: Any = None, crank_reduction: Any = None, *,
+                    ffrf_joint_markers: str = "fewest") -> Mechanism:
     """Build and assemble the slider-crank of ``scene`` in a new Exudyn system.
 
     ``reduction`` is the Craig-Bampton reduction (:func:`flex.bodies.reduction.build_reduction`)
     for an ``ffrf`` coupler (or the plate of a ``nonlinear_fe`` one; ``None``: built from the
     scene), ``crank_reduction`` the one of an ``ffrf`` crank; ``None`` for rigid links.
     Links with ``model = "auto"`` must be resolved first
-    (:func:`flex.fidelity.simulation.simulate`).
-    Returns a :class:`Mechanism`.
+    (:func:`flex.fidelity.simulation.simulate`). ``ffrf_joint_markers``: how FFRF links attach
+    to their joints (:func:`flex.bodies.reduction.add_ffrf_link`; ``"all_face_nodes"`` only to
+    measure what the default ``"fewest"`` saves). Returns a :class:`Mechanism`.
     """
     for link in ("crank", "coupler"):
         if scene[link]["model"] == "auto":
             raise SceneError('model = "auto" must be resolved before building '
                              "(flex.fidelity.simulation.simulate does it with "
                              "flex.fidelity.criteria.resolve_fidelity)")
-    builder = _Builder(scene)
+    builder = _Builder(scene, ffrf_joint_markers)
     builder.add_crank_and_slider(crank_reduction)
     builder.add_coupler(reduction)
     builder.add_joints()
@@ -212,12 +213,13 @@ class _Builder:
     """Adds the items of one slider-crank to a new Exudyn system, in a fixed order (the
     order numbers the coordinates, so it is kept the same for every scene of a kind)."""
 
-    def __init__(self, scene: Scene) -> None:
+    def __init__(self, scene: Scene, ffrf_joint_markers: str = "fewest") -> None:
         import exudyn as exu
         import exudyn.itemInterface as eii
 
         self.exu, self.eii = exu, eii
         self.scene = scene
+        self.ffrf_joint_markers = ffrf_joint_markers
         self.init = initial_configuration(scene)
         system_container = exu.SystemContainer()
         self.mbs = system_container.AddSystem()
@@ -294,7 +296,8 @@ class _Builder:
         flexible_crank = add_ffrf_link(
             self.mbs, crank_reduction, [0.0, 0.0, 0.0], self.init.crank_angle_rad,
             damping_ratio=self.scene["crank"]["damping_ratio"],
-            initial_angular_velocity_rad_per_s=self.init.crank_speed_rad_per_s, name="crank")
+            initial_angular_velocity_rad_per_s=self.init.crank_speed_rad_per_s, name="crank",
+            joint_markers=self.ffrf_joint_markers)
         self.markers["crank_A"] = flexible_crank["marker_B"]
         self.markers["crank_B"] = flexible_crank["marker_C"]
         self.mech.crank = dict(flexible_crank, reduction=crank_reduction)
@@ -310,7 +313,8 @@ class _Builder:
                 mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
                 damping_ratio=scene["coupler"]["damping_ratio"],
                 initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
-                initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
+                initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s,
+                joint_markers=self.ffrf_joint_markers)
             self.mech.coupler = dict(self.coupler, reduction=reduction)
         elif model == "nonlinear_fe":
             from flex.bodies.nonlinear import add_nonlinear_fe_coupler, nonlinear_plate_for_scene

@@ -2,7 +2,7 @@
 
 Every number is measured by the run, on whatever else the machine is doing: wall times [s]
 are medians of ``repeats`` runs, and each comparison is a ratio of two times measured in the
-same run. :func:`run_bench` runs the four parts of a :class:`BenchPlan` in order, each into
+same run. :func:`run_bench` runs the five parts of a :class:`BenchPlan` in order, each into
 ``notes[<part>]`` (a part that raises :class:`~flex.base.errors.FlexError` is stored as
 ``notes["<part>_failed"]`` and a failed case ``<part>_failed``; the others still run):
 
@@ -15,6 +15,9 @@ same run. :func:`run_bench` runs the four parts of a :class:`BenchPlan` in order
   ``0``) against its own run at half the step;
 - ``reduction`` (:func:`bench_reduction`): the plate reduction cold (empty cache), from cache,
   and its first FFRF projection;
+- ``step_cost`` (:func:`bench_step_cost`, when the plan has a :class:`StepCostPlan`): the cost
+  of an FFRF step against mesh size and mode count, joint markers on every face node (before)
+  and on the fewest nodes (now);
 - ``make_all`` (:func:`bench_make_all`): ``make all FORCE=1`` with an empty reduction cache and
   again with it filled (``make_all`` False, the bench study's ``FLEX_BENCH_MAKE=0``, skips
   it).
@@ -65,6 +68,19 @@ Say = Callable[[str], None]
 
 
 @dataclass(frozen=True)
+class StepCostPlan:
+    """Per-step cost of the FFRF coupler: the thesis deployment's first ``end_time_s`` [s] at
+    ``step_s`` [s] (modified Newton, relative tolerance 1e-8, spectral radius 0.9) on each mesh
+    size [m] and mode count, with the joint markers on every face node (before) and on the
+    fewest nodes (now, :func:`flex.bodies.reduction.add_ffrf_link`)."""
+
+    meshes_m: Sequence[float]
+    modes: Sequence[int]
+    step_s: float
+    end_time_s: float
+
+
+@dataclass(frozen=True)
 class BenchPlan:
     """What the benchmark measures.
 
@@ -90,6 +106,7 @@ class BenchPlan:
     ffrf_defaults: Setting
     nonlinear_fine: Setting
     nonlinear_coarse: Setting
+    step_cost: StepCostPlan | None = None
 
 
 def _g(value: float) -> str:
@@ -254,6 +271,43 @@ def _bench_nonlinear(scene: Scene, plan: BenchPlan, reference: Reference,
         "note": f"errors against the nonlinear FE run at h = {fine_step} s"})}
 
 
+def bench_step_cost(scene: Scene, plan: StepCostPlan, repeats: int, pool: ReductionPool,
+                    say: Say, notes: dict[str, Any]) -> None:
+    """``notes["step_cost"]``: per mesh and mode count, the median wall time per step [ms]
+    and Newton iterations per step of both joint-marker kinds (runs of the two kinds
+    alternate, so a change in the machine's load touches both alike)."""
+    from flex.bodies.reduction import JOINT_MARKERS
+    from flex.data.scene import apply_overrides
+    from flex.dynamics.mechanism import build_mechanism
+    from flex.dynamics.solver import run
+
+    rows = []
+    for mesh in plan.meshes_m:
+        for modes in plan.modes:
+            case = apply_overrides(scene, [
+                f"coupler.mesh_size_m={mesh}", f"coupler.modes={modes}",
+                f"simulation.step_s={plan.step_s}", f"simulation.end_time_s={plan.end_time_s}",
+                'simulation.newton="modified"', "simulation.newton_relative_tolerance=1e-8",
+                "simulation.spectral_radius=0.9"])
+            reduction = pool.for_scene(case)
+            samples: dict[str, list[tuple[float, float]]] = {kind: [] for kind in JOINT_MARKERS}
+            for _ in range(repeats):
+                for kind in JOINT_MARKERS:
+                    counters = run(build_mechanism(case, reduction, ffrf_joint_markers=kind))
+                    samples[kind].append((1e3 * counters["wall_time_s"] / counters["steps"],
+                                          counters["newton_iterations"] / counters["steps"]))
+            row: dict[str, Any] = {"mesh_size_m": mesh, "modes": modes,
+                                   "mesh_nodes": reduction.n_nodes}
+            for kind, values in samples.items():
+                row[f"{kind}_ms_per_step"] = statistics.median(v[0] for v in values)
+                row[f"{kind}_newton_per_step"] = statistics.median(v[1] for v in values)
+            rows.append(row)
+            say(f"step cost, mesh {mesh * 1e3:g} mm, {modes} modes: "
+                f"{row['fewest_ms_per_step']:.3f} ms (all face nodes "
+                f"{row['all_face_nodes_ms_per_step']:.3f} ms)")
+    notes["step_cost"] = rows
+
+
 def bench_reduction(scene: Scene, say: Say, notes: dict[str, Any]) -> None:
     """Build time [s] of the scene's coupler reduction: cold (empty cache, median of 2),
     loaded from cache (median of 6), and its first FFRF projection (median of 2)."""
@@ -313,7 +367,7 @@ def run_bench(scenes: Mapping[str, Scene], plan: BenchPlan, repeats: int,
               progress: Progress | None = None, notes: dict[str, Any] | None = None, *,
               cache_dir: Path | None = None, nonlinear: bool = True, make_all: bool = True
               ) -> dict[str, CaseResult]:
-    """Run the four parts in order on ``scenes["rigid"]`` and ``scenes["ffrf_1mm"]`` (see the
+    """Run the five parts in order on ``scenes["rigid"]`` and ``scenes["ffrf_1mm"]`` (see the
     module doc); each part's failure is stored, the others still run.
 
     ``cache_dir``: the reduction cache folder of the timed runs (None: reductions built in
@@ -329,6 +383,8 @@ def run_bench(scenes: Mapping[str, Scene], plan: BenchPlan, repeats: int,
         ("ffrf_1mm", lambda say: bench_ffrf(scenes["ffrf_1mm"], plan, repeats, pool, say,
                                             notes, nonlinear)),
         ("reduction", lambda say: bench_reduction(scenes["ffrf_1mm"], say, notes)),
+        ("step_cost", lambda say: plan.step_cost and bench_step_cost(
+            scenes["ffrf_1mm"], plan.step_cost, repeats, pool, say, notes)),
         ("make_all", lambda say: bench_make_all(say, notes, make_all))]
     for index, (name, part) in enumerate(parts):
         if progress:

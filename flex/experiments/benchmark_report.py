@@ -3,9 +3,10 @@
 :func:`bench_summary` turns the notes of :func:`flex.experiments.benchmark.run_bench` into datasets
 --
 ``rigid/...``, ``ffrf_1mm/...`` (times [s], errors, ratios, each run's profile),
-``reduction/...``, ``make_all/...`` -- and the printed table (``table/what``, ``table/value``,
-``table/detail``). :func:`bench_figures` draws the integration times at equal accuracy and the
-Exudyn CPU shares of the untuned and tuned runs.
+``step_cost/...``, ``reduction/...``, ``make_all/...`` -- and the printed table
+(``table/what``, ``table/value``, ``table/detail``). :func:`bench_figures` draws the
+integration times at equal accuracy, the Exudyn CPU shares of the untuned and tuned runs,
+and the FFRF cost per step against mesh and modes (before and after the cheap joint markers).
 """
 
 from __future__ import annotations
@@ -177,6 +178,32 @@ def _cache_rows(notes: Mapping[str, Any], datasets: dict[str, Dataset]) -> list[
     return rows
 
 
+def _step_cost_rows(rows: list[Mapping[str, Any]], datasets: dict[str, Dataset]) -> list[Row]:
+    """``step_cost/...`` columns (one entry per mesh and mode count) and a table row each."""
+    if not rows:
+        return []
+    columns = {
+        "mesh_size_m": ("m", "coupler mesh size"),
+        "modes": ("1", "fixed-interface eigenmodes (the body has 6 static modes more)"),
+        "mesh_nodes": ("1", "mesh nodes of the reduction"),
+        "fewest_ms_per_step": ("ms", "wall time per step, joint markers on the fewest nodes "
+                               "(now), median"),
+        "all_face_nodes_ms_per_step": ("ms", "wall time per step, joint markers on every face "
+                                       "node (before), median"),
+        "fewest_newton_per_step": ("1", "Newton iterations per step (now)"),
+        "all_face_nodes_newton_per_step": ("1", "Newton iterations per step (before)")}
+    for key, (units, text) in columns.items():
+        _put(datasets, f"step_cost/{key}", np.array([r[key] for r in rows]), units, text)
+    speedup = np.array([r["all_face_nodes_ms_per_step"] / r["fewest_ms_per_step"] for r in rows])
+    _put(datasets, "step_cost/speedup", speedup, "1",
+         "time per step before / now (both measured in this run)")
+    return [(f"FFRF 1 mm step: mesh {r['mesh_size_m'] * 1e3:g} mm, {r['modes']} modes",
+             f"{r['fewest_ms_per_step']:.3f} ms",
+             f"all face nodes {r['all_face_nodes_ms_per_step']:.3f} ms ({ratio:.1f}x); "
+             f"{r['mesh_nodes']} nodes; {r['fewest_newton_per_step']:.1f} Newton it/step")
+            for r, ratio in zip(rows, speedup, strict=True)]
+
+
 def bench_summary(notes: Mapping[str, Any], plan: BenchPlan) -> tuple[dict[str, Dataset], str]:
     """Datasets and the printed table of a benchmark run (see the module doc)."""
     datasets: dict[str, Dataset] = {}
@@ -188,6 +215,7 @@ def bench_summary(notes: Mapping[str, Any], plan: BenchPlan) -> tuple[dict[str, 
     for part in ("rigid", "ffrf_1mm"):
         if notes.get(part):
             rows += _profile_rows(part, notes[part], datasets)
+    rows += _step_cost_rows(notes.get("step_cost", []), datasets)
     rows += _cache_rows(notes, datasets)
     rows += [(key, "failed", value[:150]) for key, value in notes.items()
              if key.endswith("_failed")]
@@ -256,6 +284,30 @@ def _profile_figure(data: Mapping[str, Dataset], folder: Path, part: str) -> lis
     return [path]
 
 
+def _step_cost_figure(data: Mapping[str, Dataset], folder: Path) -> list[Path]:
+    if "step_cost/modes" not in data:
+        return []
+    modes = np.asarray(data["step_cost/modes"].data)
+    nodes = np.asarray(data["step_cost/mesh_nodes"].data)
+    path = folder / "bench-step-cost.png"
+    with figure(path, "FFRF coupler t = 1 mm: wall time per step against mesh size, joint "
+                "markers on every face node (before, dashed) and on the fewest nodes (now, "
+                "solid)", "mesh nodes of the reduction [-] (log)", "wall time per step [ms] (log)",
+                size=(8.0, 4.8)) as ax:
+        for index, count in enumerate(sorted(set(modes.tolist()))):
+            pick = np.flatnonzero(modes == count)
+            pick = pick[np.argsort(nodes[pick])]
+            color = f"C{index}"
+            ax.plot(nodes[pick], np.asarray(data["step_cost/fewest_ms_per_step"].data)[pick],
+                    "o-", color=color, label=f"{count} modes, now")
+            ax.plot(nodes[pick],
+                    np.asarray(data["step_cost/all_face_nodes_ms_per_step"].data)[pick],
+                    "s--", color=color, label=f"{count} modes, before")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+    return [path]
+
+
 def bench_figures(datasets: Mapping[str, Dataset], folder: Path, target_s: float
                   ) -> list[Path]:
     """``bench-times.png`` (integration times at equal accuracy, log scale, the FFRF target
@@ -263,4 +315,5 @@ def bench_figures(datasets: Mapping[str, Dataset], folder: Path, target_s: float
     phase, untuned against tuned)."""
     return (_times_figure(datasets, folder, target_s)
             + _profile_figure(datasets, folder, "rigid")
-            + _profile_figure(datasets, folder, "ffrf_1mm"))
+            + _profile_figure(datasets, folder, "ffrf_1mm")
+            + _step_cost_figure(datasets, folder))

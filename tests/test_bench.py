@@ -1,0 +1,26 @@
+"""The bench study's step-cost part runs both joint-marker kinds on the plan's meshes and modes
+(its timings are measured by ``make bench``, never asserted here)."""
+
+from __future__ import annotations
+
+import math
+
+from flex.data.scene import apply_overrides, default_scene
+from flex.experiments.benchmark import StepCostPlan, bench_step_cost
+from flex.experiments.tradeoff import ReductionPool
+
+
+def test_step_cost_measures_both_joint_marker_kinds(reduction_cache):
+    scene = apply_overrides(default_scene(), [
+        'coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.thickness_m=0.001"])
+    notes: dict = {}
+    said: list[str] = []
+    bench_step_cost(scene, StepCostPlan((0.004,), (2,), 1e-5, 5e-4), 1,
+                    ReductionPool(reduction_cache), said.append, notes)
+    (row,) = notes["step_cost"]
+    assert (row["mesh_size_m"], row["modes"]) == (0.004, 2) and row["mesh_nodes"] > 100
+    for kind in ("fewest", "all_face_nodes"):
+        assert math.isfinite(row[f"{kind}_ms_per_step"]) and row[f"{kind}_ms_per_step"] > 0
+    # the same equations to the Newton tolerance: the same iteration counts, give or take one
+    assert abs(row["fewest_newton_per_step"] - row["all_face_nodes_newton_per_step"]) <= 1
+    assert said and "mesh 4 mm, 2 modes" in said[0]
