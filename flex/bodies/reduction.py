@@ -14,10 +14,13 @@ Body coordinates (metres) are the mesh's: x along the link from the centre of ``
 (x = 0, joint B) to the centre of ``end_b`` (x = length, joint C), y across the thickness
 (in the mechanism plane, the bending height), z across the width (out of plane).
 
-Mode basis: 6 static modes of ``end_b`` (its rigid-face translations and rotations) followed
+Mode basis: the static modes of ``end_b`` (its rigid-face translations and rotations) followed
 by ``modes`` fixed-interface eigenmodes (both end faces clamped). ``end_a`` gets no static
 modes: its nodes move rigidly with the floating frame, so the frame *is* the joint-B face.
-Both end faces stay rigid (RBE2-like), as a pin through a stiff eye would keep them.
+Both end faces stay rigid (RBE2-like), as a pin through a stiff eye would keep them. By
+default only the in-plane modes are kept (3 static: x, y, rotation about z; the lowest
+``modes`` eigenmodes symmetric about the mechanism plane): a planar mechanism loads its links
+in plane, and torsion and out-of-plane bending are decoupled from that load by symmetry.
 """
 
 from __future__ import annotations
@@ -49,6 +52,8 @@ MID = "mid"  #: node-set name of the mid-length cross-section
 
 _MESH_ORDER = 2  # linear tets lock in bending (notes: first frequency 69-90 % too high)
 _STATIC_MODES = 6  # of end_b: 3 translations + 3 rotations of the rigid face
+#: which modes a reduction keeps (:func:`build_reduction`)
+MODE_SELECTIONS = ("in_plane", "all")
 
 
 # ------------------------------------------------------------------------------------------
@@ -64,7 +69,8 @@ class Reduction(PlateLink):
     """
 
     fem: Any  #: exudyn.FEM.FEMinterface holding mesh, M, K, mode basis, stress modes
-    modes: int  #: number of fixed-interface eigenmodes (the reduced body has 6 more)
+    modes: int  #: number of fixed-interface eigenmodes kept (the static modes come on top)
+    mode_selection: str  #: "in_plane" or "all" (:data:`MODE_SELECTIONS`)
     fixed_interface_frequencies_Hz: np.ndarray  #: both end faces clamped
     pinned_pinned_frequency_Hz: float  #: first in-plane bending mode, ends pinned about z
     mass_kg: float  #: [kg]
@@ -80,8 +86,9 @@ class Reduction(PlateLink):
 
     @property
     def n_modal_coordinates(self) -> int:
-        """Number of elastic coordinates of the reduced body: 6 static + ``modes``."""
-        return _STATIC_MODES + self.modes
+        """Number of elastic coordinates of the reduced body: the static modes of ``end_b``
+        (6, or its 3 in-plane ones) + ``modes``."""
+        return int(self.fem.modeBasis["matrix"].shape[1])
 
     @property
     def has_stress_modes(self) -> bool:
@@ -341,14 +348,103 @@ def _ngsolve_thread_count(threads: int | None) -> Iterator[None]:
         ngsolve.SetNumThreads(previous)
 
 
-def _fix_eigenmode_signs(basis: np.ndarray) -> None:
+def _craig_bampton_basis(fem, mass_form, stiffness_form, interfaces: list[np.ndarray],
+                         modes: int, selection: str) -> int:
+    """Put the Hurty-Craig-Bampton basis in ``fem`` (``modeBasis``, ``eigenValues``): the
+    static modes of ``end_b`` and ``modes`` fixed-interface eigenmodes, all of them or the
+    in-plane ones (``selection``, see :func:`build_reduction`). ``end_a`` goes first: it gets
+    no static modes and becomes the floating frame. Returns the number of static modes.
+
+    In-plane eigenmodes: more eigenmodes are computed than asked (about half of a thin
+    plate's lowest modes are torsion and out-of-plane bending), their in-plane subspace is
+    found (:func:`_in_plane_eigenmodes`), and the count grows until it holds ``modes``.
+    """
+    computed = modes if selection == "all" else 2 * modes + 4
+    while True:
+        fem.ComputeHurtyCraigBamptonModesNGsolve(mass_form, stiffness_form, interfaces,
+                                                 computed)
+        if selection == "all":
+            return _STATIC_MODES
+        basis = fem.modeBasis["matrix"]
+        positions = fem.GetNodePositionsAsArray()
+        found = _in_plane_eigenmodes(fem, positions, basis[:, _STATIC_MODES:], modes)
+        if found is not None:
+            break
+        computed = int(1.5 * computed) + 4
+    static = np.flatnonzero(_mirror_antisymmetry(positions, basis[:, :_STATIC_MODES]) < 0.5)
+    eigenmodes, eigenvalues = found
+    fem.modeBasis["matrix"] = np.ascontiguousarray(
+        np.column_stack([basis[:, static], eigenmodes]))
+    fem.eigenValues = eigenvalues
+    return len(static)
+
+
+def _mirror_parts(positions: np.ndarray, basis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Gram matrices of the columns' mirror differences (u minus its mirror image about the
+    mechanism plane z = 0, u_z sign flipped) and of the columns with their mirror images.
+    Compared at the nodes whose mirror point is a node too (netgen meshes the box's parallel
+    edges alike: a third of a 3 mm plate's nodes), else at the node nearest each mirror
+    point."""
+    from scipy.spatial import cKDTree
+
+    distance, mirror = cKDTree(positions).query(positions * [1.0, 1.0, -1.0])
+    exact = distance <= 1e-9 * np.ptp(positions, axis=0).max()
+    nodes = np.flatnonzero(exact) if np.count_nonzero(exact) >= 12 else np.arange(len(mirror))
+    fields = basis.reshape(len(positions), 3, -1)
+    mirrored = fields[mirror[nodes]] * np.array([1.0, 1.0, -1.0])[None, :, None]
+    fields = fields[nodes]
+    difference = (fields - mirrored).reshape(-1, basis.shape[1])
+    both = np.concatenate([fields, mirrored]).reshape(-1, basis.shape[1])
+    return difference.T @ difference, both.T @ both
+
+
+def _mirror_antisymmetry(positions: np.ndarray, basis: np.ndarray) -> np.ndarray:
+    """Per column: 0 for a mode symmetric about the mechanism plane (in plane: u_x, u_y even,
+    u_z odd in z), 2 for an antisymmetric one (out of plane), between for a mixture."""
+    difference, size = _mirror_parts(positions, basis)
+    return np.diag(difference) / np.maximum(np.diag(size), 1e-300)
+
+
+def _in_plane_eigenmodes(fem, positions: np.ndarray, eigenmodes: np.ndarray, modes: int
+                         ) -> tuple[np.ndarray, np.ndarray] | None:
+    """The lowest ``modes`` in-plane fixed-interface eigenmodes in the span of the computed
+    ``eigenmodes`` (columns) and their eigenvalues [rad^2/s^2], or None if the span holds
+    too few.
+
+    Why a subspace: on a mesh that is not mirror-symmetric, an in-plane and an out-of-plane
+    mode of nearly equal frequency come back mixed. The symmetric subspace (directions whose
+    mirror difference is below 5 % of their size) is found first, then the stiffness and
+    mass are projected on it and its eigenmodes solved (Rayleigh-Ritz, mass-normalised).
+    Directions in between (a mixed pair cut by the computed count) are left out, and modes
+    count only below the lowest such direction's Rayleigh frequency.
+    """
+    from scipy.linalg import eigh
+
+    difference, size = _mirror_parts(positions, eigenmodes)
+    share, directions = eigh(difference, size)  # 0: in plane ... 2: out of plane
+    symmetric = eigenmodes @ directions[:, share < 0.1]
+    stiffness = symmetric.T @ (fem.stiffnessMatrix @ symmetric)
+    mass = symmetric.T @ (fem.massMatrix @ symmetric)
+    eigenvalues, combination = eigh(stiffness, mass)
+    mixed = eigenmodes @ directions[:, (share >= 0.1) & (share <= 1.9)]
+    if mixed.shape[1]:
+        quotients = (np.sum(mixed * (fem.stiffnessMatrix @ mixed), axis=0)
+                     / np.sum(mixed * (fem.massMatrix @ mixed), axis=0))
+        trusted = eigenvalues < quotients.min()
+        eigenvalues, combination = eigenvalues[trusted], combination[:, trusted]
+    if len(eigenvalues) < modes:
+        return None
+    return symmetric @ combination[:, :modes], eigenvalues[:modes]
+
+
+def _fix_eigenmode_signs(basis: np.ndarray, static_modes: int = _STATIC_MODES) -> None:
     """Turn each fixed-interface eigenmode so its largest entry is positive (in place).
 
     PINVIT returns modes of arbitrary sign (and threads change round-off), so two builds of
     one key could give modal coordinates of opposite sign; this makes them comparable. The
     first entry within 1e-6 of the largest is used, so round-off cannot change the pick.
     """
-    for column in range(_STATIC_MODES, basis.shape[1]):
+    for column in range(static_modes, basis.shape[1]):
         magnitude = np.abs(basis[:, column])
         pick = int(np.argmax(magnitude >= (1 - 1e-6) * magnitude.max()))
         if basis[pick, column] < 0:
@@ -359,14 +455,21 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
                     youngs_modulus_Pa: float, density_kg_per_m3: float, poisson_ratio: float,
                     mesh_size_m: float, modes: int,
                     cache_dir: str | os.PathLike | None, *,
+                    mode_selection: str = "in_plane",
                     ngsolve_threads: int | None = 1) -> Reduction:
     """Mesh, reduce and cache a plate link; return the :class:`Reduction`.
 
     Contract:
       - sizes in metres, E in Pa, density in kg/m^3; ``mesh_size_m`` is netgen's maxh
         (recommendation: about the thickness, at most 2 x thickness); ``modes`` >= 1 is the
-        number of fixed-interface (both faces clamped) eigenmodes added to the 6 static modes
+        number of fixed-interface (both faces clamped) eigenmodes added to the static modes
         of ``end_b``. Bad values raise :class:`flex.base.errors.SceneError`.
+      - ``mode_selection``: ``"in_plane"`` (default) keeps only modes symmetric about the
+        mechanism plane z = 0 -- the 3 in-plane static modes of ``end_b`` (x, y, rotation
+        about z) and the lowest ``modes`` in-plane eigenmodes -- since a planar mechanism
+        loads its links in plane and the out-of-plane bending and torsion modes carry
+        nothing (decoupled by symmetry, :func:`_in_plane_eigenmodes`); ``"all"`` keeps the 6
+        static modes and the lowest ``modes`` eigenmodes of any kind.
       - the mesh uses second-order tetrahedra; stress post-processing modes (local stress,
         Pa per unit modal coordinate) are always computed.
       - ``cache_dir``: directory of the cache (created if missing) or None for no caching. The
@@ -385,9 +488,14 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
              "youngs_modulus_Pa": youngs_modulus_Pa, "density_kg_per_m3": density_kg_per_m3,
              "mesh_size_m": mesh_size_m}
     _check_inputs(sizes, poisson_ratio, modes)
+    if mode_selection not in MODE_SELECTIONS:
+        raise SceneError(f"reduction mode_selection = {mode_selection!r}: must be one of "
+                         f"{', '.join(MODE_SELECTIONS)}")
     parameters = {name: float(value) for name, value in sizes.items()}
     parameters.update(poisson_ratio=float(poisson_ratio), modes=int(modes),
                       mesh_order=_MESH_ORDER, stress_modes=True)
+    if mode_selection != "all":  # "all" keeps the keys (and cache entries) it always had
+        parameters["mode_selection"] = mode_selection
     key = _cache_key(parameters)
     cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"
 
@@ -409,6 +517,7 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
 
     return Reduction(
         fem=fem, **sizes, poisson_ratio=float(poisson_ratio), modes=int(modes),
+        mode_selection=mode_selection,
         nodes_end_a=np.asarray(end_a["NodeNumbers"]), weights_end_a=end_a["NodeWeights"],
         nodes_end_b=np.asarray(end_b["NodeNumbers"]), weights_end_b=end_b["NodeWeights"],
         nodes_mid=np.asarray(mid["NodeNumbers"]), weights_mid=mid["NodeWeights"],
@@ -451,10 +560,10 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
         node_set["NodeNumbers"] = nodes
         node_set["NodeWeights"] = fem.GetNodeWeightsFromSurfaceAreas(nodes)
         interfaces.append(nodes)
-    # end_a first: it gets no static modes and becomes the floating frame
-    fem.ComputeHurtyCraigBamptonModesNGsolve(mass_form, stiffness_form, interfaces,
-                                             parameters["modes"])
-    _fix_eigenmode_signs(fem.modeBasis["matrix"])
+    static_modes = _craig_bampton_basis(fem, mass_form, stiffness_form, interfaces,
+                                        parameters["modes"],
+                                        parameters.get("mode_selection", "all"))
+    _fix_eigenmode_signs(fem.modeBasis["matrix"], static_modes)
     material = KirchhoffMaterial(parameters["youngs_modulus_Pa"], parameters["poisson_ratio"],
                                  parameters["density_kg_per_m3"])
     fem.ComputePostProcessingModesNGsolve(space, material=material,

@@ -24,8 +24,8 @@ from flex.data.scene import Scene, default_scene, parse_override, read_source
 AUTO = "auto"
 #: plate keys of a link beyond the mass-giving ones
 _PLATE_MASS = ("thickness_m", "width_m", "density_kg_per_m3")
-_PLATE_ELASTIC = ("youngs_modulus_Pa", "poisson_ratio", "modes", "mesh_size_m",
-                  "damping_ratio")
+_PLATE_ELASTIC = ("youngs_modulus_Pa", "poisson_ratio", "modes", "mode_selection",
+                  "mesh_size_m", "damping_ratio")
 _SOLVER_ALPHA = ("spectral_radius", "formulation", "newton", "newton_relative_tolerance")
 _SOLVER_EXPLICIT = ("explicit_method", "penalty_stiffness_N_per_m")
 _SPRING = ("spring_stiffness_N_per_m", "spring_preload_m", "spring_damping_Ns_per_m")
@@ -103,8 +103,8 @@ def _link_unused(link: str, scene: Scene) -> dict[str, str]:
         mark(_PLATE_ELASTIC, f'{link}.model = "rigid": a rigid link has no elasticity; used '
                              f"with model = {elastic}")
     elif model == "nonlinear_fe":
-        mark(("modes",), f'{link}.model = "nonlinear_fe" moves every mesh node (no modes); '
-                         f'used with model = "ffrf"')
+        mark(("modes", "mode_selection"), f'{link}.model = "nonlinear_fe" moves every mesh '
+                                          f'node (no modes); used with model = "ffrf"')
         mark(("damping_ratio",), f'{link}.model = "nonlinear_fe" has no damping model; used '
                                  f'with model = "ffrf" or "auto"')
     elif model == AUTO:

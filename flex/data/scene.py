@@ -76,6 +76,10 @@ def _plate_fields(link: str) -> dict[str, Field]:
         "density_kg_per_m3": Field(doc="material density", **_POS),
         "poisson_ratio": Field(float, "Poisson's ratio", positive=True, below=0.5),
         "modes": Field(int, "fixed-interface Craig-Bampton modes", minimum=1, maximum=100),
+        "mode_selection": Field(("in_plane", "all"),
+                                "which modes the reduction keeps: in_plane (the modes a planar "
+                                "mechanism loads, symmetric about its plane) or all (the "
+                                "lowest of any kind)"),
         "mesh_size_m": Field(doc="netgen maximum element size", **_POS),
         "damping_ratio": Field(float, "modal damping ratio", minimum=0.0, below=1.0),
     }

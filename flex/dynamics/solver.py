@@ -371,7 +371,8 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
     _announce_mesh(link, c, "reduction (instant if cached)")
     return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
                            c["youngs_modulus_Pa"], c["density_kg_per_m3"], c["poisson_ratio"],
-                           c["mesh_size_m"], c["modes"], cache_dir)
+                           c["mesh_size_m"], c["modes"], cache_dir,
+                           mode_selection=c["mode_selection"])
 
 
 #: a mesh whose estimated build takes longer than this is announced on stderr first [s]

@@ -184,14 +184,16 @@ def geometry_key(scene: Scene) -> tuple | None:
     if c["model"] not in ("ffrf", "auto"):
         return None
     return (c["length_m"], c["thickness_m"], c["width_m"], c["youngs_modulus_Pa"],
-            c["density_kg_per_m3"], c["poisson_ratio"], c["mesh_size_m"], c["modes"])
+            c["density_kg_per_m3"], c["poisson_ratio"], c["mesh_size_m"], c["modes"],
+            c["mode_selection"])
 
 
 @functools.lru_cache(maxsize=3)
 def _reduction(key: tuple, cache_dir: Path | None) -> Any:
     from flex.bodies.reduction import build_reduction
 
-    return build_reduction(*key, cache_dir)
+    *sizes, selection = key
+    return build_reduction(*sizes, cache_dir, mode_selection=selection)
 
 
 def reduction_of(scene: Scene, cache_dir: Path | None = None) -> Any:
