@@ -15,7 +15,8 @@ coordinates, so the z-rotation coordinate is the planar angle). A planar loop of
 is redundant, so joint C constrains only x and y (17 constraints on 18 coordinates: one
 degree of freedom, as Gruebler's count in the thesis, Eq. 1). The same builder makes the
 rigid model and the flexible ones: only the crank and coupler bodies change
-(``crank.model``, ``coupler.model``).
+(``crank.model``, ``coupler.model``). A scene with rigid links and an implicit integrator is
+built planar instead (:mod:`flex.dynamics.planar` extends this builder with 2D items).
 
 Drives: ``spring`` -- a linear spring (and optional damper) on the slider's x coordinate,
 compressed by ``spring_preload_m`` at t = 0 and attached throughout, released from rest;
@@ -92,6 +93,8 @@ class Mechanism:
     #: FFRF links whose energy Exudyn reports: name -> (kinetic sensor, strain sensor)
     flexible_energy: dict[str, tuple[int, int]] = field(default_factory=dict)
     wing: dict[str, Any] = field(default_factory=dict)
+    #: built by :mod:`flex.dynamics.planar` (2D bodies; joint loads read by its own rules)
+    planar: bool = False
 
 
 def _rotation_z(angle_rad: float) -> np.ndarray:
@@ -157,15 +160,9 @@ def wing_mass_properties(scene: Scene) -> tuple[float, float, float]:
         wing["span_m"] / 2.0
 
 
-def _add_wing(mech: Mechanism, rigid_body, body_marker, crank_root: int) -> int:
-    """Add the wing as a rigid body welded to the crank at A; return the weld joint.
-
-    ``crank_root``: the crank's marker at A (a rigid-body marker, or the joint face of a
-    flexible crank). The weld's reaction torque is the wing root bending moment in the
-    mechanism plane.
-    """
-    import exudyn.itemInterface as eii
-
+def _add_wing(mech: Mechanism, rigid_body, body_marker) -> int:
+    """Add the wing as a rigid body with its root at A; return its marker at the root (the
+    builder welds it to the crank: :meth:`_Builder.weld`)."""
     init = mech.initial
     mass_kg, inertia_kgm2, centre_m = wing_mass_properties(mech.scene)
     direction = np.array([np.cos(init.crank_angle_rad), np.sin(init.crank_angle_rad), 0.0])
@@ -175,15 +172,12 @@ def _add_wing(mech: Mechanism, rigid_body, body_marker, crank_root: int) -> int:
                            normal * centre_m * init.crank_speed_rad_per_s,
                            init.crank_speed_rad_per_s)
     mech.wing = {"body": wing_body["bodyNumber"], "node": wing_body["nodeNumber"]}
-    wing_root = body_marker(wing_body, [0.0, 0.0, 0.0])
-    crank_rotation = _rotation_z(init.crank_angle_rad)
-    return mech.mbs.AddObject(eii.ObjectJointGeneric(
-        markerNumbers=[crank_root, wing_root], constrainedAxes=[1, 1, 1, 1, 1, 1],
-        rotationMarker0=crank_rotation.T, rotationMarker1=crank_rotation.T))
+    return body_marker(wing_body, [0.0, 0.0, 0.0])
 
 
 def build_mechanism(scene: Scene, reduction: Any = None, crank_reduction: Any = None, *,
-                    ffrf_joint_markers: str = "fewest") -> Mechanism:
+                    ffrf_joint_markers: str = "fewest", planar: bool | None = None
+                    ) -> Mechanism:
     """Build and assemble the slider-crank of ``scene`` in a new Exudyn system.
 
     ``reduction`` is the Craig-Bampton reduction (:func:`flex.bodies.reduction.build_reduction`)
@@ -192,14 +186,24 @@ def build_mechanism(scene: Scene, reduction: Any = None, crank_reduction: Any = 
     Links with ``model = "auto"`` must be resolved first
     (:func:`flex.fidelity.simulation.simulate`). ``ffrf_joint_markers``: how FFRF links attach
     to their joints (:func:`flex.bodies.reduction.add_ffrf_link`; ``"all_face_nodes"`` only to
-    measure what the default ``"fewest"`` saves). Returns a :class:`Mechanism`.
+    measure what the default ``"fewest"`` saves). ``planar``: build with 2D items
+    (:mod:`flex.dynamics.planar`: the same datasets at a quarter of the cost per step);
+    None: wherever the scene allows it (:func:`flex.dynamics.planar.is_planar`); False:
+    always 3D (for callers that read 3D coordinates, e.g. the out-of-plane modes); True:
+    planar or SceneError. Returns a :class:`Mechanism`.
     """
+    from flex.dynamics.planar import PlanarBuilder, is_planar
+
     for link in ("crank", "coupler"):
         if scene[link]["model"] == "auto":
             raise SceneError('model = "auto" must be resolved before building '
                              "(flex.fidelity.simulation.simulate does it with "
                              "flex.fidelity.criteria.resolve_fidelity)")
-    builder = _Builder(scene, ffrf_joint_markers)
+    if planar and not is_planar(scene):
+        raise SceneError("a planar build needs rigid crank and coupler and an implicit "
+                         "integrator (simulation.integrator != \"explicit_penalty\")")
+    use_planar = is_planar(scene) if planar is None else planar
+    builder = PlanarBuilder(scene) if use_planar else _Builder(scene, ffrf_joint_markers)
     builder.add_crank_and_slider(crank_reduction)
     builder.add_coupler(reduction)
     builder.add_joints()
@@ -212,6 +216,9 @@ def build_mechanism(scene: Scene, reduction: Any = None, crank_reduction: Any = 
 class _Builder:
     """Adds the items of one slider-crank to a new Exudyn system, in a fixed order (the
     order numbers the coordinates, so it is kept the same for every scene of a kind)."""
+
+    #: index of the rotation about z among a rigid-body node's coordinates (x y z rx ry rz)
+    rotation_coordinate = 5
 
     def __init__(self, scene: Scene, ffrf_joint_markers: str = "fewest") -> None:
         import exudyn as exu
@@ -267,10 +274,7 @@ class _Builder:
                 "crank", *plate_mass_properties(scene, "crank"), init.joint_B_m / 2,
                 init.crank_angle_rad, init.joint_B_velocity_m_per_s / 2,
                 init.crank_speed_rad_per_s)
-        slider = scene["slider"]
-        self.slider_body = self.rigid_body(
-            "slider", slider["mass_kg"], slider["inertia_kgm2"], init.joint_C_m, 0.0,
-            init.joint_C_velocity_m_per_s, 0.0)
+        self.slider_body = self.add_slider()
         m = self.markers
         m["ground_A"] = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=self.ground,
                                                           localPosition=[0, 0, 0]))
@@ -283,8 +287,23 @@ class _Builder:
             self._add_flexible_crank(crank_reduction)
         m["slider_C"] = self.body_marker(self.slider_body, init.joint_C_m)
         if scene["wing"]["enabled"]:
-            self.wing_joint = _add_wing(self.mech, self.rigid_body, self.body_marker,
-                                        m["crank_A"])
+            wing_root = _add_wing(self.mech, self.rigid_body, self.body_marker)
+            self.wing_joint = self.weld(m["crank_A"], wing_root)
+
+    def weld(self, crank_root: int, wing_root: int) -> int:
+        """Weld the wing's root marker to the crank's marker at A (a rigid-body marker, or
+        the joint face of a flexible crank); return the joint. Its reaction torque is the
+        wing root bending moment in the mechanism plane."""
+        crank_rotation = _rotation_z(self.init.crank_angle_rad)
+        return self.mbs.AddObject(self.eii.ObjectJointGeneric(
+            markerNumbers=[crank_root, wing_root], constrainedAxes=[1, 1, 1, 1, 1, 1],
+            rotationMarker0=crank_rotation.T, rotationMarker1=crank_rotation.T))
+
+    def add_slider(self) -> dict:
+        """The slider: a rigid body at joint C, not turned (its prismatic joint holds it)."""
+        slider, init = self.scene["slider"], self.init
+        return self.rigid_body("slider", slider["mass_kg"], slider["inertia_kgm2"],
+                               init.joint_C_m, 0.0, init.joint_C_velocity_m_per_s, 0.0)
 
     def _add_flexible_crank(self, crank_reduction: Any) -> None:
         from flex.bodies.reduction import add_ffrf_link
@@ -390,7 +409,7 @@ class _Builder:
                 damping=drive["spring_damping_Ns_per_m"], offset=-drive["spring_preload_m"]))
             return
         crank_rotation = mbs.AddMarker(eii.MarkerNodeCoordinate(  # rigid crank (validate)
-            nodeNumber=self.crank_body["nodeNumber"], coordinate=5))
+            nodeNumber=self.crank_body["nodeNumber"], coordinate=self.rotation_coordinate))
         # velocity-level constraint: no Python callback per step, crank speed held exactly
         mbs.AddObject(eii.ObjectConnectorCoordinate(
             markerNumbers=[ground_coordinate, crank_rotation], velocityLevel=True,
@@ -411,40 +430,52 @@ class _Builder:
             for output in ("Velocity", "Rotation", "AngularVelocity", "AngularAcceleration"):
                 self.add(f"wing.{output}",
                          self.sensor("Node", output, nodeNumber=self.mech.wing["node"]))
-            for output in ("ForceLocal", "TorqueLocal"):
-                self.add(f"joint_W.{output}",
-                         self.sensor("Object", output, objectNumber=self.wing_joint))
+            self._add_weld_sensors()
         for name, body in (("crank", self.crank_body), ("slider", self.slider_body)):
-            if body is None:  # a flexible crank: its markers below
-                continue
-            for output in ("Position", "Velocity", "Acceleration", "Rotation",
-                           "AngularVelocity", "AngularAcceleration"):
-                self.add(f"{name}.{output}",
-                         self.sensor("Node", output, nodeNumber=body["nodeNumber"]))
+            if body is not None:  # None: a flexible crank, its markers below
+                self._add_body_sensors(name, body)
         if self.scene["coupler"]["model"] == "rigid":
             # the centre of mass is the coupler's midpoint
             for output in ("Position", "Velocity", "Acceleration", "Rotation",
                            "AngularVelocity"):
                 self.add(f"coupler.{output}",
                          self.sensor("Node", output, nodeNumber=self.mech.coupler["node"]))
-        self._add_joint_and_marker_sensors()
+        self._add_joint_sensors()
+        self._add_marker_sensors()
         self._add_flexible_sensors()
 
-    def _add_joint_and_marker_sensors(self) -> None:
+    def _add_body_sensors(self, name: str, body: dict) -> None:
+        """Motion of a rigid body's node (its centre of mass), as ``<name>.<output>``."""
+        for output in ("Position", "Velocity", "Acceleration", "Rotation",
+                       "AngularVelocity", "AngularAcceleration"):
+            self.add(f"{name}.{output}",
+                     self.sensor("Node", output, nodeNumber=body["nodeNumber"]))
+
+    def _add_weld_sensors(self) -> None:
+        """The wing weld's force and torque, in the weld frame (read by collect)."""
+        for output in ("ForceLocal", "TorqueLocal"):
+            self.add(f"joint_W.{output}",
+                     self.sensor("Object", output, objectNumber=self.wing_joint))
+
+    def _add_joint_sensors(self) -> None:
+        """The forces of joints A, B, C and P, and the frame B's force is reported in."""
         penalty = self.scene["simulation"]["integrator"] == "explicit_penalty"
         for name, joint in self.joints.items():
             # the spherical joint reports its force in global axes ("Force"), the others in
             # the frame of marker 0 ("ForceLocal")
             output = "Force" if name == "C" or penalty else "ForceLocal"
             self.add(f"joint_{name}.Force", self.sensor("Object", output, objectNumber=joint))
+        if not penalty:
+            self.add("marker_crank_B.Rotation",
+                     self.sensor("Marker", "Rotation", markerNumber=self.markers["crank_B"]))
+
+    def _add_marker_sensors(self) -> None:
+        """Joint-marker positions (the constraint norm in collect)."""
         for name in ("ground_A", "crank_A", "crank_B", "coupler_B", "coupler_C", "slider_C"):
             self.add(f"marker_{name}.Position",
                      self.sensor("Marker", "Position", markerNumber=self.markers[name]))
         self.mech.constraint_points = [("ground_A", "crank_A"), ("crank_B", "coupler_B"),
                                        ("coupler_C", "slider_C")]
-        if not penalty:
-            self.add("marker_crank_B.Rotation",
-                     self.sensor("Marker", "Rotation", markerNumber=self.markers["crank_B"]))
 
     def _add_flexible_sensors(self) -> None:
         model = self.scene["coupler"]["model"]

@@ -41,6 +41,7 @@ from flex.base.errors import FlexError, SimulationError, Terminated
 from flex.config.settings import check_runnable, resolve_solver_settings, resolved_simulation
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, check_meshed_plate, estimate_mesh, to_toml
+from flex.dynamics import planar
 from flex.dynamics.mechanism import Mechanism, _rotation_z, build_mechanism
 
 # a constraint norm above this is a failed assembly, not a tolerance question
@@ -229,22 +230,8 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
     out["slider/displacement"] = Dataset(init.joint_C_m[0] - out["slider/position"].data, "m",
                                          "slider travel toward the crank pivot since t = 0")
 
-    # joint forces: frame of marker 0 -> global axes; Exudyn reports the force acting on
-    # body 0, so the force on body 1 is its negative (checked against the reference DAE)
-    def force(joint: str, frame_sensor: str | None) -> np.ndarray:
-        local = -_sensor(mech, f"joint_{joint}.Force")[:, 1:3]
-        if frame_sensor is None:
-            return local
-        frame_angle = np.unwrap(_sensor(mech, f"{frame_sensor}.Rotation")[:, 3])
-        frame_angle = frame_angle - frame_angle[0]  # joint frames are global at t = 0
-        c, s = np.cos(frame_angle), np.sin(frame_angle)
-        return np.column_stack([c * local[:, 0] - s * local[:, 1],
-                                s * local[:, 0] + c * local[:, 1]])
-
-    on_crank_a = force("A", mech.joint_frames.get("A"))
-    on_coupler_b = force("B", mech.joint_frames.get("B"))
-    on_coupler_c = force("C", mech.joint_frames.get("C"))
-    on_slider_p = force("P", mech.joint_frames.get("P"))
+    forces = planar.joint_forces(mech) if mech.planar else _joint_forces(mech)
+    on_crank_a, on_coupler_b, on_coupler_c, on_slider_p = (forces[j] for j in "ABCP")
     out["joints/A/force_on_crank"] = Dataset(on_crank_a, "N", "frame on crank at A, x y")
     out["joints/A/force_modulus"] = Dataset(np.hypot(*on_crank_a.T), "N", "|force| at A")
     out["joints/B/force_on_crank"] = Dataset(-on_coupler_b, "N", "coupler on crank at B, x y")
@@ -274,6 +261,28 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
         out["coupler/angle"] = Dataset(_sensor(mech, "coupler.Rotation")[:, 3], "rad",
                                        "coupler angle from +x (B to C)")
     out.update(_energy_datasets(mech, out["slider/displacement"].data, time_s))
+    return out
+
+
+def _joint_forces(mech: Mechanism) -> dict[str, np.ndarray]:
+    """Force on each joint's second body [N], (n, 2) in global x, y, from the 3D joints: A
+    (frame on crank), B (crank on coupler), C (slider on coupler), P (frame on slider).
+
+    Joint frames (``mech.joint_frames``) -> global axes; Exudyn reports the force acting on
+    body 0, so the force on body 1 is its negative (checked against the reference DAE).
+    """
+    out = {}
+    for joint in "ABCP":
+        local = -_sensor(mech, f"joint_{joint}.Force")[:, 1:3]
+        frame_sensor = mech.joint_frames.get(joint)
+        if frame_sensor is None:
+            out[joint] = local
+            continue
+        frame_angle = np.unwrap(_sensor(mech, f"{frame_sensor}.Rotation")[:, 3])
+        frame_angle = frame_angle - frame_angle[0]  # joint frames are global at t = 0
+        c, s = np.cos(frame_angle), np.sin(frame_angle)
+        out[joint] = np.column_stack([c * local[:, 0] - s * local[:, 1],
+                                      s * local[:, 0] + c * local[:, 1]])
     return out
 
 
@@ -470,12 +479,17 @@ def _wing_datasets(mech: Mechanism) -> dict[str, Dataset]:
     angle = _sensor(mech, "wing.Rotation")[:, 3]
     span_m = mech.scene["wing"]["span_m"]
     omega = _sensor(mech, "wing.AngularVelocity")[:, 3]
-    # weld frame = crank frame at t = 0 turned with the crank; Exudyn reports the load on
-    # body 0 (the crank), so the load on the wing is its negative
-    turn = angle - mech.initial.crank_angle_rad
-    local = -_sensor(mech, "joint_W.ForceLocal")[:, 1:3]
-    c, s = np.cos(turn), np.sin(turn)
-    force = np.column_stack([c * local[:, 0] - s * local[:, 1], s * local[:, 0] + c * local[:, 1]])
+    if mech.planar:
+        force, moment = planar.weld_loads(mech)
+    else:
+        # weld frame = crank frame at t = 0 turned with the crank; Exudyn reports the load
+        # on body 0 (the crank), so the load on the wing is its negative
+        turn = angle - mech.initial.crank_angle_rad
+        local = -_sensor(mech, "joint_W.ForceLocal")[:, 1:3]
+        c, s = np.cos(turn), np.sin(turn)
+        force = np.column_stack([c * local[:, 0] - s * local[:, 1],
+                                 s * local[:, 0] + c * local[:, 1]])
+        moment = -_sensor(mech, "joint_W.TorqueLocal")[:, 3]
     return {
         "wing/angle": Dataset(angle, "rad", "wing angle from +x (along the crank)"),
         "wing/angular_velocity": Dataset(omega, "rad/s", "wing (and wing-tip) angular velocity"),
@@ -485,7 +499,7 @@ def _wing_datasets(mech: Mechanism) -> dict[str, Dataset]:
                                              "rad/s^2", "wing angular acceleration"),
         "wing/tip_speed": Dataset(np.abs(omega) * span_m, "m/s", "speed of the wing tip"),
         "joints/W/force_on_wing": Dataset(force, "N", "crank on wing at the root (weld), x y"),
-        "joints/W/root_moment": Dataset(-_sensor(mech, "joint_W.TorqueLocal")[:, 3], "N m",
+        "joints/W/root_moment": Dataset(moment, "N m",
                                         "in-plane bending moment at the wing root (about z)"),
     }
 

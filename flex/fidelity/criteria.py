@@ -804,7 +804,8 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]], *,
         crank["model"] = model
         reduction = (reduction_for_scene(analysis, "crank", cache_dir=cache_dir)
                      if model == "ffrf" else None)
-        mech = build_mechanism(analysis, None, reduction)
+        # 3D for both models: the modes are sorted by their out-of-plane coordinates
+        mech = build_mechanism(analysis, None, reduction, planar=False)
         values, vectors = mech.mbs.ComputeODE2Eigenvalues(useAbsoluteValues=True)
         values, vectors = np.abs(np.asarray(values)), np.asarray(vectors)
         index = mech.mbs.GetNodeODE2Index(mech.coupler["node"])
