@@ -51,7 +51,7 @@ from flex.fidelity.simulation import simulate_case
 from flex.tools.report import default_report_path, write_report
 
 STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring", "kfit",
-           "tradeoff", "stability", "bench", "wing", "crank")
+           "tradeoff", "stability", "bench", "wing", "crank", "estimates")
 RESULTS_DIR = Path("results")
 
 

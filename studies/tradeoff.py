@@ -38,7 +38,7 @@ from flex.study import StudyRun, Summary
 
 NAME = "tradeoff"
 DESCRIPTION = "work-precision: every knob against a converged reference, rigid and FFRF 1/10 mm"
-OVERRIDES = pinned_overrides()
+OVERRIDES = pinned_overrides() + ["simulation.error_estimate=false"]  # own references
 # keys the study reads itself (the accuracy levels), beside its cases
 READS = ("fidelity.tolerance",)
 REPEATS = 3

@@ -301,6 +301,25 @@ def test_bench_figures_synthetic(tmp_path, reviewed):
                                  "bench-profile-ffrf_1mm.png", "bench-step-cost.png"})
 
 
+def test_estimates_figure_and_summary_synthetic(tmp_path, reviewed):
+    from studies import estimates
+
+    results = {}
+    for index, (validity, ratio) in enumerate([("asymptotic", 0.95), ("asymptotic", 1.2),
+                                               ("outside the asymptotic range for x", 0.01)]):
+        true = 10.0 ** -(5 + index)
+        results[f"s{index}"] = CaseResult(f"s{index}", "", attrs={
+            "estimated_error_crank_angle_end_rad": ratio * true,
+            "true_error_crank_angle_end_rad": true,
+            "reference_accuracy_crank_angle_end_rad": true / 100,
+            "estimated_error_validity": validity})
+    result = estimates.summarize({}, results)
+    assert "asymptotic runs: 2 pairs, 100% within 3x" in result.report
+    assert "under-resolved runs: 1 pairs, 0% within 3x, most optimistic" in result.report
+    paths = estimates.figures(results, result, tmp_path)
+    check_pngs(paths, tmp_path, {"estimates.png"})
+
+
 # ------------------------------------------------------------------------------------------
 # expensive studies, real runs (make test-slow)
 # ------------------------------------------------------------------------------------------

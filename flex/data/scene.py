@@ -148,6 +148,9 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "newton": Field(("full", "modified"),
                         "Newton iteration: Jacobian every iteration, or reused while it converges",
                         auto=True),
+        "error_estimate": Field(bool, "estimate the run's own step error on its headline "
+                                      "quantities with a companion run at twice (or half) the "
+                                      "step (false: no companion, for speed)"),
         "newton_relative_tolerance": Field(float, "Newton residual reduction per step "
                                            "(absolute tolerance: 1e-2 of it)", positive=True,
                                            maximum=1e-3, auto=True),

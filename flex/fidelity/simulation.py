@@ -20,11 +20,12 @@ from pathlib import Path
 from typing import Any
 
 from flex.base.errors import FlexError
-from flex.config.settings import check_runnable
+from flex.config.settings import check_runnable, resolve_solver_settings
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
-from flex.dynamics.solver import integrate
+from flex.dynamics.solver import integrate, reduction_for_scene, time_scales
 from flex.fidelity.criteria import Criterion, FidelityDecision, resolve_fidelity
+from flex.fidelity.error_estimate import estimate_step_error
 
 
 def resolve_auto(scene: Scene, criterion: Criterion | None = None,
@@ -58,15 +59,43 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     ``"auto"`` solver keys and integrates. ``reduction`` / ``crank_reduction``: reductions
     of ``ffrf`` links (None: built, or loaded from ``cache_dir``). ``cache_dir``: the
     reduction cache folder (None: reductions are built in memory, no disk cache).
+
+    With ``simulation.error_estimate`` (the default), a companion run at twice (or half) the
+    step estimates the run's own step error on its headline quantities
+    (:mod:`flex.fidelity.error_estimate`): case attributes ``estimated_error_*``. A failed
+    companion leaves the run as it is and says why in ``estimated_error_validity``.
     """
     check_runnable(scene)  # before anything is built or probed
     scene, decisions = resolve_auto(scene, criterion, crank_criterion, cache_dir=cache_dir)
     if decisions:
         reduction = crank_reduction = None
+    if scene["simulation"]["error_estimate"]:  # the companion run reuses the reductions
+        reduction, crank_reduction = _reductions(scene, reduction, crank_reduction, cache_dir)
     result = integrate(scene, name, reduction, crank_reduction, cache_dir=cache_dir)
     for decision in decisions:
         result.attrs.update(decision.attrs())
+    if scene["simulation"]["error_estimate"]:
+        resolved, _ = resolve_solver_settings(scene)
+        reductions = {link: built for link, built in (("coupler", reduction),
+                                                       ("crank", crank_reduction))
+                      if built is not None and resolved[link]["model"] == "ffrf"}
+        estimate = estimate_step_error(
+            resolved, result, lambda companion: integrate(
+                companion, f"{name}_companion", reduction, crank_reduction,
+                cache_dir=cache_dir), time_scales(resolved, reductions))
+        result.attrs.update(estimate.attrs())
     return result
+
+
+def _reductions(scene: Scene, reduction: Any, crank_reduction: Any, cache_dir: Path | None
+                ) -> tuple[Any, Any]:
+    """The reductions of the scene's ``ffrf`` links: the given ones, else built or loaded
+    (:func:`flex.dynamics.solver.reduction_for_scene`), so a companion run shares them."""
+    if scene["coupler"]["model"] == "ffrf" and reduction is None:
+        reduction = reduction_for_scene(scene, "coupler", cache_dir=cache_dir)
+    if scene["crank"]["model"] == "ffrf" and crank_reduction is None:
+        crank_reduction = reduction_for_scene(scene, "crank", cache_dir=cache_dir)
+    return reduction, crank_reduction
 
 
 def simulate_case(scene: Scene, name: str = "case", reduction: Any = None,

@@ -208,6 +208,7 @@ def format_description(info: dict[str, Any]) -> str:
             lines.append(f"  message: {case['message']}")
         if case["attributes"].get("validity_warning"):
             lines.append(f"  WARNING: {case['attributes']['validity_warning']}")
+        lines += _estimate_lines(case["attributes"])
         if case["scene_changes"]:
             changes = ", ".join(f"{k} = {_short(v)}" for k, v in case["scene_changes"].items())
             lines.append(f"  scene: the file's scene with {changes}")
@@ -235,6 +236,22 @@ def format_description(info: dict[str, Any]) -> str:
         lines += ["", heading]
         lines += [f"  {line}" if line else "" for line in scene_toml.rstrip().splitlines()]
     return "\n".join(lines)
+
+
+def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
+    """The case's ``estimated_error_*`` attributes (:mod:`flex.fidelity.error_estimate`) as
+    ``estimated error`` lines: the values with units, how they were made, their validity."""
+    from flex.fidelity.error_estimate import HEADLINES, PREFIX
+
+    values = [f"{what} {attrs[PREFIX + name]:.2g} {units}"
+              for name, (units, what, _) in HEADLINES.items() if PREFIX + name in attrs]
+    if not values and f"{PREFIX}validity" not in attrs:
+        return []
+    lines = [f"  estimated error: {'; '.join(values) or 'none'}"]
+    for key in ("method", "validity"):
+        if attrs.get(PREFIX + key):
+            lines.append(f"    {key}: {attrs[PREFIX + key]}")
+    return lines
 
 
 def _case_line(case: dict[str, Any]) -> str:

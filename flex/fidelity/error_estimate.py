@@ -1,0 +1,172 @@
+"""An estimate of a run's own step (time discretization) error on its headline quantities.
+
+Contract of :func:`estimate_step_error`: given a finished run of a concrete scene (links
+rigid, ffrf or nonlinear_fe; ``"auto"`` solver keys resolved) and a way to run a companion
+scene, it runs one companion that differs only in the step -- twice the step when the end
+time is a whole number of doubled steps, else half the step -- and returns an
+:class:`ErrorEstimate`:
+
+- ``values``: for each headline quantity (:data:`HEADLINES`: the crank angle and the slider
+  position at the end time, the peak elastic midpoint deflection of each flexible link), the
+  estimated error of the run's value, by Richardson extrapolation with the integrator's
+  order p (:func:`integrator_order`: 2 for generalized-alpha): ``|q_h - q_2h| / (2^p - 1)``
+  or ``|q_h - q_h/2| * 2^p / (2^p - 1)`` [the quantity's units];
+- ``method``: that sentence, with the companion's step;
+- ``validity``: ``"asymptotic"`` when every time scale of the scene
+  (:func:`flex.dynamics.solver.time_scales`: the spring or crank period, the highest
+  retained mode of each flexible link) has at least :data:`MIN_STEPS_PER_PERIOD` steps per
+  period at the run's step; otherwise the sentence names the time scales below it: their
+  content is numerically damped in both runs, so the estimate does not cover it (it may be
+  optimistic there);
+- ``companion_wall_time_s``: what the estimate cost [s].
+
+It covers the step only: modal truncation and mesh errors are not estimated here. A
+companion that fails (a step the scene cannot take) gives no values and says why in
+``validity``. :func:`ErrorEstimate.attrs` are the case attributes ``estimated_error_*``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from flex.base.errors import FlexError
+from flex.data.results import CaseResult
+from flex.data.scene import Scene, apply_overrides
+
+#: order of accuracy of the explicit Runge-Kutta methods (``simulation.explicit_method``)
+EXPLICIT_ORDERS = {"RK44": 4, "RK67": 6, "ExplicitMidpoint": 2}
+#: a time scale with fewer steps per period than this is outside the asymptotic range
+MIN_STEPS_PER_PERIOD = 10.0
+#: case attribute prefix
+PREFIX = "estimated_error_"
+
+
+def _final(path: str) -> Callable[[dict[str, Any]], float | None]:
+    return lambda datasets: float(datasets[path].data[-1]) if path in datasets else None
+
+
+def _peak(path: str) -> Callable[[dict[str, Any]], float | None]:
+    def read(datasets: dict[str, Any]) -> float | None:
+        if path not in datasets:
+            return None
+        values = np.abs(np.asarray(datasets[path].data, dtype=float))
+        return float(np.max(values)) if values.size and np.any(values) else None
+    return read
+
+
+#: headline quantity -> (units, what, reader of a result's datasets; None: not in this run)
+HEADLINES: dict[str, tuple[str, str, Callable[[dict[str, Any]], float | None]]] = {
+    "crank_angle_end_rad": ("rad", "crank angle at the end time", _final("crank/angle")),
+    "slider_position_end_m": ("m", "slider position at the end time",
+                              _final("slider/position")),
+    "coupler_peak_deflection_m": ("m", "peak elastic midpoint deflection of the coupler",
+                                  _peak("coupler/midpoint_deflection")),
+    "crank_peak_deflection_m": ("m", "peak elastic midpoint deflection of the crank",
+                                _peak("crank/midpoint_deflection")),
+}
+
+
+@dataclass
+class ErrorEstimate:
+    """The estimated step error of one run (see the module doc)."""
+
+    values: dict[str, float] = field(default_factory=dict)
+    method: str = ""
+    validity: str = ""
+    companion_wall_time_s: float = 0.0
+
+    def attrs(self) -> dict[str, Any]:
+        """Case attributes: ``estimated_error_<quantity>`` [its units, in the name] and
+        ``estimated_error_method``, ``_validity``, ``_companion_wall_time_s``."""
+        out: dict[str, Any] = {f"{PREFIX}{name}": value for name, value in self.values.items()}
+        out.update({f"{PREFIX}method": self.method, f"{PREFIX}validity": self.validity,
+                    f"{PREFIX}companion_wall_time_s": self.companion_wall_time_s})
+        return out
+
+
+def integrator_order(simulation: dict[str, Any]) -> int:
+    """Order of accuracy of the scene's integrator (resolved ``[simulation]`` keys):
+    generalized-alpha 2 (Chung and Hulbert, any spectral radius); Newmark with velocity-level
+    constraints 2 at spectral radius 1 (trapezoidal rule), else 1 (gamma > 1/2); explicit
+    Runge-Kutta its own (:data:`EXPLICIT_ORDERS`)."""
+    if simulation["integrator"] == "explicit_penalty":
+        return EXPLICIT_ORDERS[simulation["explicit_method"]]
+    if simulation["formulation"] == "index2" and simulation["spectral_radius"] < 1.0:
+        return 1
+    return 2
+
+
+def companion_step_s(step_s: float, end_time_s: float) -> float:
+    """Twice ``step_s`` if the end time is a whole number of doubled steps, else half."""
+    doubled = 2.0 * step_s
+    count = end_time_s / doubled
+    return doubled if abs(count - round(count)) < 1e-9 * max(count, 1.0) else step_s / 2.0
+
+
+def richardson_error(value: float, companion: float, step_s: float, companion_step: float,
+                     order: int) -> float:
+    """Estimated error of ``value`` (run at ``step_s``) from a ``companion`` at twice or half
+    the step, for a method of ``order``: ``|q_h - q_2h| / (2^p - 1)`` or
+    ``|q_h - q_h/2| 2^p / (2^p - 1)``."""
+    factor = 2.0 ** order
+    difference = abs(value - companion)
+    if companion_step > step_s:
+        return difference / (factor - 1.0)
+    return difference * factor / (factor - 1.0)
+
+
+def unresolved_time_scales(time_scales: list[tuple[float, float, str]], step_s: float
+                           ) -> list[str]:
+    """The time scales (``(period [s], needed, what)``) with fewer than
+    :data:`MIN_STEPS_PER_PERIOD` steps per period at ``step_s``, as phrases."""
+    return [f"{what} ({period:.3g} s: {period / step_s:.3g} steps per period)"
+            for period, _, what in time_scales
+            if math.isfinite(period) and period / step_s < MIN_STEPS_PER_PERIOD]
+
+
+def estimate_step_error(scene: Scene, result: CaseResult,
+                        run_companion: Callable[[Scene], CaseResult],
+                        time_scales: list[tuple[float, float, str]]) -> ErrorEstimate:
+    """The estimated step error of ``result``, the run of ``scene`` (concrete models, solver
+    keys resolved), from one companion run made by ``run_companion`` (see the module doc).
+    ``time_scales``: the scene's (:func:`flex.dynamics.solver.time_scales`)."""
+    sim = scene["simulation"]
+    step = float(sim["step_s"])
+    other = companion_step_s(step, float(sim["end_time_s"]))
+    unresolved = unresolved_time_scales(time_scales, step)
+    validity = ("asymptotic: every time scale of the scene has at least "
+                f"{MIN_STEPS_PER_PERIOD:g} steps per period" if not unresolved else
+                "outside the asymptotic range for " + "; ".join(unresolved)
+                + ": that content is numerically damped in both runs and the estimate does "
+                  "not cover it")
+    order = integrator_order(sim)
+    method = (f"step doubling: a companion run at h = {other:g} s (the run: {step:g} s), "
+              f"Richardson extrapolation with the integrator's order {order}; step error "
+              f"only (modes and mesh not estimated)")
+    companion_scene = apply_overrides(scene, [f"simulation.step_s={other!r}",
+                                              "simulation.output_step_s=0.0",
+                                              "simulation.error_estimate=false"])
+    start = time.perf_counter()
+    try:
+        companion = run_companion(companion_scene)
+    except FlexError as exc:
+        return ErrorEstimate({}, method, f"not estimated: the companion run failed ({exc})",
+                             time.perf_counter() - start)
+    cost = time.perf_counter() - start
+    values = {}
+    for name, (_, _, read) in HEADLINES.items():
+        ours, theirs = read(result.datasets), read(companion.datasets)
+        if ours is not None and theirs is not None:
+            values[name] = richardson_error(ours, theirs, step, other, order)
+    return ErrorEstimate(values, method, validity, cost)
+
+
+__all__ = ["ErrorEstimate", "HEADLINES", "MIN_STEPS_PER_PERIOD", "companion_step_s",
+           "estimate_step_error", "integrator_order", "richardson_error",
+           "unresolved_time_scales"]
