@@ -333,7 +333,8 @@ class _Builder:
                 damping_ratio=scene["coupler"]["damping_ratio"],
                 initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
                 initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s,
-                joint_markers=self.ffrf_joint_markers)
+                joint_markers=self.ffrf_joint_markers,
+                end_b_rotation=False)  # the pin at C constrains x and y only
             self.mech.coupler = dict(self.coupler, reduction=reduction)
         elif model == "nonlinear_fe":
             from flex.bodies.nonlinear import add_nonlinear_fe_coupler, nonlinear_plate_for_scene
