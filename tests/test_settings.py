@@ -50,10 +50,11 @@ def test_the_certified_plate_gets_the_ffrf_entry():
     ("fidelity.tolerance=0.001", "finer than the FFRF coupler's certified 0.01"),
     ('coupler.model="nonlinear_fe"', 'no certified setting for coupler.model = "nonlinear_fe"'),
 ])
-def test_uncertified_flexible_scenes_fall_back_to_the_rigid_entry(change, why):
+def test_uncertified_flexible_scenes_fall_back_to_the_flexible_entry(change, why):
     scene, choice = resolve_solver_settings(load_scene(None, PLATE + [change]))
-    assert choice.entry == "rigid" and why in choice.reason
-    assert scene["simulation"]["step_s"] == 1e-5
+    assert choice.entry == "flexible_fallback" and why in choice.reason
+    assert scene["simulation"]["step_s"] == 1e-5  # the rigid step, with modified Newton
+    assert scene["simulation"]["newton"] == "modified"
 
 
 def test_mesh_and_modes_are_the_scene_s_choice():
@@ -62,10 +63,10 @@ def test_mesh_and_modes_are_the_scene_s_choice():
     assert choice.entry == "ffrf_coupler"
 
 
-def test_an_ffrf_crank_falls_back_to_the_rigid_entry():
+def test_an_ffrf_crank_falls_back_to_the_flexible_entry():
     _, choice = resolve_solver_settings(load_scene(None, [
         'crank.geometry="plate"', 'crank.model="ffrf"']))
-    assert choice.entry == "rigid" and "FFRF crank" in choice.reason
+    assert choice.entry == "flexible_fallback" and "FFRF crank" in choice.reason
 
 
 def test_explicit_values_win_and_only_auto_keys_are_filled():

@@ -48,7 +48,8 @@ AUTO = "auto"
 #: the ``--set`` pairs that leave every solver key to flex (what the bundled scene does)
 AUTO_OVERRIDES = tuple((f"simulation.{key}", AUTO) for key in AUTO_KEYS)
 #: what an uncertified flexible scene runs with, and what is known of it
-FALLBACK = ("the rigid model's 40x smaller step, not certified for it (README \"Defaults\")")
+FALLBACK = ("the flexible fallback (the rigid model's 40x smaller step with modified Newton), "
+            "not certified for it")
 
 
 @dataclass(frozen=True)
@@ -93,7 +94,8 @@ def _bending_omega(plate: dict[str, Any]) -> float:
 
 
 def choose_entry(scene: Scene) -> tuple[str, str]:
-    """The entry (``"rigid"`` or ``"ffrf_coupler"``) for ``scene`` and the reason."""
+    """The entry (``"rigid"``, ``"ffrf_coupler"`` or ``"flexible_fallback"``) for ``scene``
+    and the reason."""
     defaults = solver_defaults()
     crank, coupler = scene["crank"]["model"], scene["coupler"]["model"]
     if AUTO in (crank, coupler):
@@ -104,18 +106,19 @@ def choose_entry(scene: Scene) -> tuple[str, str]:
     level = entry["accuracy"]
     if coupler != "ffrf" or crank != "rigid":
         what = ("an FFRF crank" if crank == "ffrf" else f'coupler.model = "{coupler}"')
-        return "rigid", f"no certified setting for {what}: {FALLBACK}"
+        return "flexible_fallback", f"no certified setting for {what}: {FALLBACK}"
     tolerance = scene["fidelity"]["tolerance"]
     if tolerance < level:
-        return "rigid", (f"fidelity.tolerance = {tolerance:g} is finer than the FFRF coupler's "
+        return "flexible_fallback", (
+            f"fidelity.tolerance = {tolerance:g} is finer than the FFRF coupler's "
                          f"certified {level:g}: {FALLBACK}")
     plate = entry["certified_plate"]
     differs = [f"{key} = {scene['coupler'][key]:g} (certified: {value:g})"
                for key, value in plate.items()
                if not math.isclose(scene["coupler"][key], value, rel_tol=1e-9)]
     if differs:
-        return "rigid", (f"the coupler plate is not the certified one ({', '.join(differs)}): "
-                         f"{FALLBACK}")
+        return "flexible_fallback", (f"the coupler plate is not the certified one "
+                                     f"({', '.join(differs)}): {FALLBACK}")
     omega = _bending_omega(scene["coupler"])
     return "ffrf_coupler", (f"FFRF coupler on a rigid crank, fidelity.tolerance = {tolerance:g} "
                             f">= {level:g}, the certified plate (first bending frequency "
