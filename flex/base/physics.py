@@ -139,6 +139,47 @@ def euler_bernoulli_omega(beta_l: Any, length_m: float, height_m: float,
                                                 / (12.0 * density_kg_per_m3))
 
 
+def pinned_beam_midpoint_deflection_m(transverse_load_N: Any, length_m: float,
+                                      thickness_m: float, width_m: float,
+                                      youngs_modulus_Pa: float) -> Any:
+    """Static midpoint deflection [m] of a pinned-pinned rectangular beam under a linearly
+    distributed transverse load whose total is ``transverse_load_N`` [N], relative to the
+    chord, bending in-plane (``I = w t^3 / 12``).
+
+    Only the load's mean acts at midspan: the antisymmetric part of a linear distribution
+    bends the beam into an odd shape, zero at the middle. A uniform load W: ``delta = 5 W
+    L^3 / (384 E I)`` (Timoshenko & Gere, *Mechanics of Materials*, simply supported beam).
+    The total load of a rigid link's d'Alembert inertia is the sum of its transverse joint
+    reactions, so a rigid run's joint forces give it directly. Arrays broadcast.
+    """
+    _check_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
+                    youngs_modulus_Pa=youngs_modulus_Pa)
+    inertia_m4 = width_m * thickness_m**3 / 12
+    return 5.0 * np.asarray(transverse_load_N) * length_m**3 / (384 * youngs_modulus_Pa
+                                                                 * inertia_m4)
+
+
+def axial_load_amplification(compression_N: Any, euler_load_N: float) -> Any:
+    """Amplification ``1 / (1 - P / P_E)`` of a pinned-pinned beam's bending by an axial
+    compression ``P`` [N] (tension: below 1), the geometric stiffness of the axial load
+    (Timoshenko & Gere 1961, ch. 1, beam-columns; exact for a sine-shaped deflection);
+    infinite at and beyond the Euler load ``P_E`` [N]."""
+    ratio = np.asarray(compression_N, dtype=float) / euler_load_N
+    with np.errstate(divide="ignore"):
+        return np.where(ratio < 1.0, 1.0 / (1.0 - np.minimum(ratio, 1.0)), np.inf)
+
+
+def ramp_load_factor(rise_time_s: Any, period_s: float) -> Any:
+    """Dynamic load factor of an undamped single-degree-of-freedom oscillator of ``period_s``
+    under a load that rises linearly over ``rise_time_s`` and then stays: ``1 + |sin(pi r)|
+    / (pi r)`` with ``r = t_rise / T`` (Biggs, *Introduction to Structural Dynamics*, 1964,
+    ch. 2); 2 for a step (r = 0), towards 1 for a slow rise."""
+    ratio = np.asarray(rise_time_s, dtype=float) / period_s
+    with np.errstate(divide="ignore", invalid="ignore"):
+        factor = 1.0 + np.abs(np.sin(np.pi * ratio)) / (np.pi * ratio)
+    return np.where(ratio > 0, factor, 2.0)
+
+
 def pinned_pinned_omega(length_m: float, height_m: float, youngs_modulus_Pa: float,
                         density_kg_per_m3: float) -> float:
     """First bending circular frequency [rad/s] of a pinned-pinned rectangular beam.

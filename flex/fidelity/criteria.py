@@ -58,6 +58,7 @@ from flex.base.thesis import (  # noqa: F401 - part of this module's face
     THESIS_YOUNGS_MODULUS_PA,
 )
 from flex.config.settings import resolved_simulation
+from flex.fidelity.predictor import predict_deflection
 
 CRITERION_FORMAT = "flex-criterion/1"
 DEFAULT_CRITERION = Path(__file__).with_name("criteria_fit.toml")
@@ -661,6 +662,10 @@ class FidelityDecision:
     k_physical: float
     predicted_error: float
     extrapolated: bool
+    #: the rigid model's deflection error (peak elastic midpoint deflection / length)
+    #: predicted from the rigid probe's own loads (:mod:`flex.fidelity.predictor`); NaN
+    #: where not predicted (the crank, for now)
+    predicted_rigid_error: float = math.nan
 
     def attrs(self) -> dict[str, Any]:
         """Flat attributes ``fidelity_<link>_*`` for :class:`flex.data.results.CaseResult`."""
@@ -672,6 +677,7 @@ class FidelityDecision:
                 prefix + "n_physical": self.n_physical, prefix + "n_thesis": self.n_thesis,
                 prefix + "k_physical": self.k_physical,
                 prefix + "predicted_error": self.predicted_error,
+                prefix + "predicted_rigid_error": self.predicted_rigid_error,
                 prefix + "extrapolated": self.extrapolated}
 
 
@@ -902,6 +908,8 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
     how += f"; compressive load {ratio:.3g} x Euler load"
     decision, k_phys = _decide("coupler", omega, delta_t_s, how, tolerance, criterion,
                                float(coupler["damping_ratio"]))
+    decision.predicted_rigid_error = predict_deflection(probe, coupler).relative_error(
+        coupler["length_m"])
     coupler["model"] = decision.model
     if decision.model == "ffrf":
         _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s)
