@@ -426,3 +426,27 @@ def test_in_plane_selection_keeps_the_in_plane_modes_of_the_full_basis(reduction
     np.testing.assert_allclose(reduction.fixed_interface_frequencies_Hz,
                                full.fixed_interface_frequencies_Hz[in_plane[:MODES]], rtol=1e-4)
     assert reduction.mode_selection == "in_plane" and full.n_modal_coordinates == 6 + 22
+
+
+def test_mirror_comparison_falls_back_when_exact_pairs_miss_a_mode():
+    """A mode that vanishes at every exactly mirrored node (found on a crank plate of the
+    crank study) is compared at all moving nodes instead of breaking the symmetric
+    subspace's eigenproblem."""
+    from scipy.linalg import eigh
+
+    from flex.bodies.reduction import _mirror_antisymmetry, _mirror_parts
+
+    rng = np.random.default_rng(1)
+    pairs = rng.uniform(-1, 1, (20, 3)) * [0.04, 0.001, 0.005]
+    loose = np.array([[0.01, 0.0002, 0.0031], [0.01, 0.0002, -0.0030]])  # near mirrors
+    positions = np.vstack([pairs, pairs * [1, 1, -1], loose])
+    symmetric = np.zeros((len(positions), 3))
+    symmetric[:20] = rng.normal(size=(20, 3))
+    symmetric[20:40] = symmetric[:20] * [1, 1, -1]
+    hidden = np.zeros((len(positions), 3))
+    hidden[40:] = [[1.0, 0.5, 0.2], [1.0, 0.5, -0.2]]  # in plane, only off the exact pairs
+    basis = np.column_stack([symmetric.ravel(), hidden.ravel()])
+    score = _mirror_antisymmetry(positions, basis)
+    assert np.all(np.isfinite(score)) and np.all(score < 0.05)
+    share, _ = eigh(*_mirror_parts(positions, basis))  # needs a positive definite Gram
+    assert np.all(share < 0.05)

@@ -382,20 +382,25 @@ def _craig_bampton_basis(fem, mass_form, stiffness_form, interfaces: list[np.nda
 def _mirror_parts(positions: np.ndarray, basis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Gram matrices of the columns' mirror differences (u minus its mirror image about the
     mechanism plane z = 0, u_z sign flipped) and of the columns with their mirror images.
-    Compared at the nodes whose mirror point is a node too (netgen meshes the box's parallel
-    edges alike: a third of a 3 mm plate's nodes), else at the node nearest each mirror
-    point."""
+    Compared at the moving nodes whose mirror point is a node too (netgen meshes the box's
+    parallel edges alike: a third of a 3 mm plate's nodes), unless they miss a column (a
+    mode still at those nodes), then at every moving node against the node nearest its
+    mirror point."""
     from scipy.spatial import cKDTree
 
     distance, mirror = cKDTree(positions).query(positions * [1.0, 1.0, -1.0])
-    exact = distance <= 1e-9 * np.ptp(positions, axis=0).max()
-    nodes = np.flatnonzero(exact) if np.count_nonzero(exact) >= 12 else np.arange(len(mirror))
     fields = basis.reshape(len(positions), 3, -1)
-    mirrored = fields[mirror[nodes]] * np.array([1.0, 1.0, -1.0])[None, :, None]
-    fields = fields[nodes]
-    difference = (fields - mirrored).reshape(-1, basis.shape[1])
-    both = np.concatenate([fields, mirrored]).reshape(-1, basis.shape[1])
-    return difference.T @ difference, both.T @ both
+    moving = np.any(fields != 0.0, axis=(1, 2))  # interface nodes are fixed in eigenmodes
+    exact = (distance <= 1e-9 * np.ptp(positions, axis=0).max()) & moving
+    for nodes in (np.flatnonzero(exact), np.flatnonzero(moving)):  # exact pairs first
+        mirrored = fields[mirror[nodes]] * np.array([1.0, 1.0, -1.0])[None, :, None]
+        difference = (fields[nodes] - mirrored).reshape(-1, basis.shape[1])
+        both = np.concatenate([fields[nodes], mirrored]).reshape(-1, basis.shape[1])
+        size = both.T @ both
+        scales = np.linalg.eigvalsh(size)
+        if len(nodes) >= 12 and scales[0] > 1e-10 * scales[-1]:  # every column seen
+            break
+    return difference.T @ difference, size
 
 
 def _mirror_antisymmetry(positions: np.ndarray, basis: np.ndarray) -> np.ndarray:
