@@ -230,9 +230,19 @@ def test_kfit_figures_synthetic(tmp_path, reviewed):
             rows = np.isclose(table["parameters/damping_ratio"], z) & table["fitted"]
             fits[(z, "stop", measure)] = criteria.fit_error_law(n[rows], error[rows],
                                                                 floor=floor)
+    deflection = table["measures/deflection"]
+    table["predictor/deflection"] = deflection * np.exp(rng.normal(0, 0.1, len(n)))
+    table["predictor/load_factor_deflection"] = 0.7 * deflection
     analysis = {"table": table, "fits": fits, "thesis_k_physical": {"stop": 108 / 2 / math.pi}}
     paths = kfit.figures({}, Summary({}, "", {"analysis": analysis}), tmp_path)
-    check_pngs(paths, tmp_path, {"kfit-error-vs-n.png", "kfit-k-vs-tolerance.png"})
+    check_pngs(paths, tmp_path, {"kfit-error-vs-n.png", "kfit-k-vs-tolerance.png",
+                                 "kfit-predictors.png"})
+    from flex.experiments.couplerfit import predictor_lines
+
+    datasets: dict = {}
+    lines = predictor_lines(table, fits, datasets)
+    assert "from the rigid twin's loads (oscillator)" in "\n".join(lines)
+    np.testing.assert_allclose(datasets["predictors/load_factor_ratio"].data, 0.7)
 
 
 def test_tradeoff_figures_synthetic(tmp_path, reviewed):

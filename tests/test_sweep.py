@@ -199,7 +199,7 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch, reduction_cache):
     with h5py.File(tmp_path / "kfit.h5") as h5:
         assert "summary/k/zeta_0/stop/governing/central_thesis" in h5
         assert h5["summary/table/measures/deflection"].attrs["units"] == "1"
-    assert {p.name for p in output.figures} == {"kfit-error-vs-n.png",
+    assert {p.name for p in output.figures} >= {"kfit-error-vs-n.png",
                                                  "kfit-k-vs-tolerance.png"}  # named after kfit.h5
 
 

@@ -46,6 +46,7 @@ from flex.fidelity.criteria import (
     EULER_LOAD_LIMIT,
     GOVERNING,
     MEASURES,
+    PRIMARY_DELTA_T,
     THESIS_K,
     TWO_PI,
     ErrorLaw,
@@ -55,6 +56,7 @@ from flex.fidelity.criteria import (
     pinned_pinned_omega,
     quasi_static_stress,
 )
+from flex.fidelity.predictor import predict_deflection
 
 #: thesis Table 5: coupler thickness [m] of models 0-3
 THESIS_MODELS = {"model0": 1e-3, "model1": 3e-3, "model2": 5e-3, "model3": 10e-3}
@@ -328,6 +330,21 @@ def _case_curves(scene: Scene, rigid: dict, ffrf: dict, stop_s: float) -> dict[s
             for key, (values, unit, text) in curves.items()}
 
 
+def _predictor_datasets(rigid: dict, coupler: dict, stop_s: float) -> dict[str, Dataset]:
+    """The rigid model's deflection error predicted from the rigid twin's own loads
+    (:func:`flex.fidelity.predictor.predict_deflection`), and the ramp-load-factor bound."""
+    prediction = predict_deflection(rigid, coupler, "coupler", stop_s)
+    length = coupler["length_m"]
+    return {
+        "predictor/deflection": Dataset(prediction.relative_error(length), "1",
+                                        "predicted peak elastic deflection / L2 (the rigid "
+                                        "twin's loads, first-mode oscillator)"),
+        "predictor/load_factor_deflection": Dataset(
+            prediction.load_factor_peak_m / length, "1",
+            "quasi-static peak deflection x ramp load factor / L2"),
+    }
+
+
 def fit_case(name: str, scene: Scene, *, cache_dir: Path | None = None) -> CaseResult:
     """One fit case: FFRF and rigid twin, the error measures, n by every definition.
 
@@ -354,6 +371,7 @@ def fit_case(name: str, scene: Scene, *, cache_dir: Path | None = None) -> CaseR
     for key, value in measures.items():
         out[f"measures/{key}"] = Dataset(value, _MEASURE_UNITS.get(key, "1"), MEASURES.get(
             key, _MEASURE_NOTES.get(key, key.replace("_", " "))))
+    out.update(_predictor_datasets(rigid, coupler, times["stop"]))
     out.update(_case_curves(scene, rigid, ffrf, times["stop"]))
     counters = {"wall_time_s": walls["ffrf"] + walls["rigid"], "steps": walls["ffrf_steps"]}
     return CaseResult(name, to_toml(scene), out, counters=counters,
@@ -452,7 +470,8 @@ TABLE_KEYS = (["parameters/thickness", "parameters/spring_stiffness",
               + [f"measures/{m}" for m in MEASURES]
               + ["measures/deflection_abs_m", "measures/peak_stress_ffrf_Pa",
                  "measures/peak_stress_quasi_static_Pa", "measures/stress_ratio",
-                 "measures/euler_load_ratio"])
+                 "measures/euler_load_ratio"]
+              + ["predictor/deflection", "predictor/load_factor_deflection"])
 
 
 def table(results: dict[str, CaseResult]) -> dict[str, np.ndarray]:
@@ -644,6 +663,52 @@ def _sweep_lines(sweep: dict[str, Any], datasets: dict[str, Dataset]) -> list[st
             f"{sweep.get('validation_wall_time_s', 0):.0f} s"]
 
 
+#: the band the load-based predictor is held to (issue: predicted / true within [0.67, 2])
+PREDICTOR_BAND = (0.67, 2.0)
+
+
+def predictor_ratios(data: dict[str, np.ndarray], fits: dict[tuple, ErrorLaw]
+                     ) -> dict[str, np.ndarray]:
+    """Per fit case, predicted / measured deflection error of the n-law (central, the case's
+    damping ratio, primary delta_t) and of the load-based predictor and its load-factor
+    bound (NaN where a case lacks a value)."""
+    measured = data["measures/deflection"]
+    n_law = np.full_like(measured, np.nan)
+    for index, zeta in enumerate(data["parameters/damping_ratio"]):
+        law = fits.get((float(zeta), PRIMARY_DELTA_T, "deflection"))
+        if law is not None:
+            n_law[index] = float(law.predict(data[f"n_physical/{PRIMARY_DELTA_T}"][index]))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return {"n_law": n_law / measured,
+                "loads": data["predictor/deflection"] / measured,
+                "load_factor": data["predictor/load_factor_deflection"] / measured}
+
+
+def predictor_lines(data: dict[str, np.ndarray], fits: dict[tuple, ErrorLaw],
+                    datasets: dict[str, Dataset]) -> list[str]:
+    """Report lines and ``predictors/*`` datasets: how far each predictor of the rigid
+    model's deflection error falls from the measured one, over all and the fitted cases."""
+    ratios = predictor_ratios(data, fits)
+    names = {"n_law": "n-law (central fit, this run)",
+             "loads": "from the rigid twin's loads (oscillator)",
+             "load_factor": "from the loads, ramp load factor only"}
+    lines = [f"  predicted / measured deflection error of the rigid model (target "
+             f"{PREDICTOR_BAND[0]:g}-{PREDICTOR_BAND[1]:g}):"]
+    for key, ratio in ratios.items():
+        datasets[f"predictors/{key}_ratio"] = Dataset(ratio, "1", f"{names[key]}: predicted "
+                                                      "/ measured deflection error per case")
+        for label_text, rows in (("all", np.isfinite(ratio)),
+                                 ("fitted", np.isfinite(ratio) & data["fitted"])):
+            if not rows.any():
+                continue
+            inside = np.mean((ratio[rows] >= PREDICTOR_BAND[0])
+                             & (ratio[rows] <= PREDICTOR_BAND[1]))
+            lines.append(f"    {names[key]:42s} {label_text:6s} {int(rows.sum()):4d} cases: "
+                         f"median {np.median(ratio[rows]):.3g}, {np.min(ratio[rows]):.3g}-"
+                         f"{np.max(ratio[rows]):.3g}, {inside:.0%} inside")
+    return lines
+
+
 def summarize(results: dict[str, CaseResult], notes: dict[str, Any]) -> Any:
     """The kfit summary (a :class:`flex.study.Summary`-shaped ``(datasets, report,
     figure_data)`` tuple): fit table, laws, k(tolerance), the thesis's k, the validation,
@@ -660,6 +725,7 @@ def summarize(results: dict[str, CaseResult], notes: dict[str, Any]) -> Any:
     thesis_k = analysis["thesis_k_physical"]
     datasets.update(_law_datasets(fits, ks, thesis_k))
     lines += _law_lines(fits, ks, thesis_k)
+    lines += predictor_lines(data, fits, datasets)
     lines += _validation(results, datasets)
     lines += _sweep_lines(notes.get("sweep", {}), datasets)
     return datasets, "\n".join(lines), {"analysis": analysis}

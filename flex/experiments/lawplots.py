@@ -11,9 +11,23 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 
-from flex.base.plotting import MICRO, decade_ticks, legend_below, log_ticks, panels, save, wrap
+from flex.base.plotting import (
+    MICRO,
+    decade_ticks,
+    figure,
+    legend_below,
+    log_ticks,
+    panels,
+    save,
+    wrap,
+)
 from flex.data.results import CaseResult
-from flex.experiments.couplerfit import THESIS_MODELS, label
+from flex.experiments.couplerfit import (
+    PREDICTOR_BAND,
+    THESIS_MODELS,
+    label,
+    predictor_ratios,
+)
 from flex.experiments.lawfit import FULL_MODES, REPORT_TOLERANCES
 from flex.fidelity.criteria import GOVERNING, TWO_PI
 
@@ -47,7 +61,35 @@ def coupler_figures(analysis: dict[str, Any], folder: Path) -> list[Path]:
     if not analysis["fits"]:
         return []
     return [_error_vs_n(analysis, folder / "kfit-error-vs-n.png"),
-            _k_vs_tolerance(analysis, folder / "kfit-k-vs-tolerance.png")]
+            _k_vs_tolerance(analysis, folder / "kfit-k-vs-tolerance.png"),
+            *_predictors(analysis, folder / "kfit-predictors.png")]
+
+
+def _predictors(analysis: dict[str, Any], path: Path) -> list[Path]:
+    """Predicted against measured deflection error of the rigid model, log-log: the n-law and
+    the load-based predictor, with the target band."""
+    data = analysis["table"]
+    if "predictor/deflection" not in data or not np.isfinite(data["predictor/deflection"]).any():
+        return []
+    measured = data["measures/deflection"]
+    ratios = predictor_ratios(data, analysis["fits"])
+    with figure(path, "Rigid model's deflection error: predicted against measured (FFRF), "
+                "per kfit case", "measured peak deflection / L2 [-] (log)",
+                "predicted peak deflection / L2 [-] (log)", size=(6.8, 6.0)) as ax:
+        finite = measured[np.isfinite(measured) & (measured > 0)]
+        line = np.array([finite.min() / 3, finite.max() * 3])
+        ax.fill_between(line, line * PREDICTOR_BAND[0], line * PREDICTOR_BAND[1], color="0.9",
+                        label=f"target {PREDICTOR_BAND[0]:g}-{PREDICTOR_BAND[1]:g} x measured")
+        ax.plot(line, line, color="0.4", lw=1, label="predicted = measured")
+        for key, style, text in (("n_law", dict(marker="s", color="tab:orange"),
+                                  "n-law (central fit)"),
+                                 ("loads", dict(marker="o", color="tab:blue"),
+                                  "rigid run's loads (oscillator)")):
+            ax.plot(measured, ratios[key] * measured, ls="none", ms=4, label=text, **style)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlim(*line)
+    return [path]
 
 
 def _error_panel(ax, data: dict[str, np.ndarray], fits: dict, measure: str,

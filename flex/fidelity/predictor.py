@@ -80,7 +80,8 @@ def predict_deflection(series: Mapping[str, np.ndarray], plate: Mapping[str, Any
     """The predicted peak elastic midpoint deflection of ``link`` (``"coupler"``) from a
     rigid run's ``series`` (see the module doc); ``plate``: the link's scene values
     (``length_m``, ``thickness_m``, ``width_m``, ``youngs_modulus_Pa``,
-    ``density_kg_per_m3``); samples after ``window_end_s`` [s] are left out."""
+    ``density_kg_per_m3``; ``damping_ratio`` of the first mode if given, else 0); samples
+    after ``window_end_s`` [s] are left out."""
     time_s = np.asarray(series["time"], dtype=float)
     keep = time_s <= window_end_s * (1 + 1e-12)
     transverse, compression = (values[keep] for values in _loads(series, link))
@@ -97,23 +98,25 @@ def predict_deflection(series: Mapping[str, np.ndarray], plate: Mapping[str, Any
     rise = 0.0 if starts_high else float(time_s[keep][peak_index] - time_s[0])
     factor = float(ramp_load_factor(rise, period))
     signed = np.sign(pinned_beam_midpoint_deflection_m(transverse, *sizes)) * amplified
-    response = oscillator_response(time_s[keep], signed, 2 * np.pi / period)
+    response = oscillator_response(time_s[keep], signed, 2 * np.pi / period,
+                                   float(plate.get("damping_ratio", 0.0)))
     return DeflectionPrediction(float(np.max(np.abs(response))), float(amplified[peak_index]),
                                 float(factor * amplified[peak_index]), factor, rise,
                                 float(period), float(max(compression.max(), 0.0) / euler))
 
 
-def oscillator_response(time_s: np.ndarray, quasi_static: np.ndarray, omega_rad_per_s: float
-                        ) -> np.ndarray:
-    """Response x(t) of an undamped oscillator ``x'' + w^2 x = w^2 x_qs(t)`` starting at rest
-    (x = x' = 0 at the first sample) to the quasi-static history ``quasi_static`` sampled at
-    ``time_s`` (linear between samples; scipy.signal.lsim). A step gives 2 x its static
-    value, a slow rise x_qs itself."""
+def oscillator_response(time_s: np.ndarray, quasi_static: np.ndarray, omega_rad_per_s: float,
+                        damping_ratio: float = 0.0) -> np.ndarray:
+    """Response x(t) of an oscillator ``x'' + 2 zeta w x' + w^2 x = w^2 x_qs(t)`` starting at
+    rest (x = x' = 0 at the first sample) to the quasi-static history ``quasi_static`` sampled
+    at ``time_s`` (linear between samples; scipy.signal.lsim). Undamped, a step gives 2 x its
+    static value, a slow rise x_qs itself."""
     from scipy.signal import lsim
 
     if len(time_s) < 2:
         return np.asarray(quasi_static, dtype=float)
-    _, response, _ = lsim(([omega_rad_per_s**2], [1.0, 0.0, omega_rad_per_s**2]),
+    _, response, _ = lsim(([omega_rad_per_s**2],
+                           [1.0, 2.0 * damping_ratio * omega_rad_per_s, omega_rad_per_s**2]),
                           np.asarray(quasi_static, dtype=float),
                           np.asarray(time_s, dtype=float) - time_s[0])
     return np.asarray(response, dtype=float)
