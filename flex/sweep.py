@@ -264,9 +264,10 @@ def make_executor(scheduler: str | None = None, workers: int | None = None) -> E
 # case files
 # ------------------------------------------------------------------------------------------
 def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
-    """Identity of a case: its resolved scene and the case function's qualified name (and
-    what its ``"auto"`` values resolve from: the solver defaults table, the fitted criterion
-    files)."""
+    """Identity of a case: its resolved scene and the case function's qualified name and
+    ``case_version`` attribute (bumped when what the function stores changes: stale case
+    files are then rerun, not resumed), and what its ``"auto"`` values resolve from (the
+    solver defaults table, the fitted criterion files)."""
     from flex.config import settings
     from flex.fidelity.criteria import criteria_in_force_text
 
@@ -280,6 +281,9 @@ def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
     if settings.has_auto(scene):  # a changed table must not resume stale cases
         extra += repr(sorted(settings.solver_defaults().items()))
     extra += criteria_in_force_text(scene)  # a re-fit must not resume stale auto cases
+    version = getattr(function, "case_version", None)
+    if version is not None:
+        extra += f"@{version}"
     label = f"{function.__module__}.{function.__qualname__}{extra}"
     return hashlib.sha256((label + "\n" + to_toml(scene)).encode()).hexdigest()[:24]
 

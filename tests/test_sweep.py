@@ -203,6 +203,20 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch, reduction_cache):
                                                  "kfit-k-vs-tolerance.png"}  # named after kfit.h5
 
 
+def test_case_hash_follows_the_case_function_s_version(monkeypatch):
+    # a case function that stores more (its case_version bumped) must not resume old files
+    import functools
+
+    from flex.experiments import couplerfit
+    from flex.sweep import case_hash
+
+    scene = load_scene()
+    bound = functools.partial(couplerfit.fit_case, cache_dir=None)
+    before = case_hash(scene, bound)
+    monkeypatch.setattr(couplerfit.fit_case, "case_version", couplerfit.fit_case.case_version + 1)
+    assert case_hash(scene, bound) != before
+
+
 def test_case_hash_follows_the_solver_defaults_of_auto_scenes(monkeypatch):
     # a resumed sweep must not reuse cases run with another flex/config/solver_defaults.toml
     import flex.config.settings as settings

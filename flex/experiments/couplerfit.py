@@ -379,6 +379,11 @@ def fit_case(name: str, scene: Scene, *, cache_dir: Path | None = None) -> CaseR
                              "reduction_cold_build_time_s": reduction.cold_build_time_s})
 
 
+#: bumped when what a fit case stores changes (the sweep reruns older case files): 2 adds
+#: the load-based predictor
+fit_case.case_version = 2
+
+
 def validation_case(name: str, scene: Scene, criterion_toml: str | None = None, *,
                     cache_dir: Path | None = None) -> CaseResult:
     """``auto`` against the full FFRF model on a scene outside the fit.
