@@ -432,6 +432,10 @@ def validation_case(name: str, scene: Scene, criterion_toml: str | None = None, 
 # ------------------------------------------------------------------------------------------
 # the pipeline on the sweep engine
 # ------------------------------------------------------------------------------------------
+#: 2: auto decides the coupler by the load-based prediction (older files are rerun)
+validation_case.case_version = 2
+
+
 def sweep_phases(cache_dir: Path | None = None) -> dict[str, lawfit.SweepPhase]:
     """The fit and validation phases on the sweep engine. Their case functions and
     preparations get the reduction cache folder ``cache_dir`` as an argument (so do the

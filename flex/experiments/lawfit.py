@@ -298,23 +298,25 @@ def against_full(name: str, link: str, tolerance: float, auto: Mapping[str, np.n
 
 def validation_lines(rows: list[Validation | tuple[str, str]], full: str) -> list[str]:
     """The report's validation table: per scene tolerance, auto's choice, omega [rad/s],
-    n, k, predicted and measured governing error, within tolerance, wall times [s]; a
-    failed scene is ``(name, message)``. ``full``: what the full model is."""
+    n, k, the n-law's predicted error, the rigid model's error predicted from the loads
+    (``loads``, where predicted), the measured governing error, within tolerance, wall times
+    [s]; a failed scene is ``(name, message)``. ``full``: what the full model is."""
     timing = next((list(r.timings) for r in rows if isinstance(r, Validation)), [])
     lines = [f"  auto validation (scenes not in the fit; governing error of auto's choice "
              f"against {full}; wall times in s):",
              f"    {'scene':28s} {'tol':>6s} {'choice':>8s} {'omega':>9s} {'n':>7s} "
-             f"{'k':>7s} {'predicted':>9s} {'error':>9s} {'ok':>3s} "
+             f"{'k':>7s} {'n-law':>9s} {'loads':>9s} {'error':>9s} {'ok':>3s} "
              + " ".join(f"{t:>9s}" for t in timing)]
     for row in rows:
         if not isinstance(row, Validation):
             lines.append(f"    {row[0]:28s} failed: {row[1]}")
             continue
         numbers = [row.decision(k) for k in ("omega_rad_per_s", "n_physical", "k_physical",
-                                             "predicted_error")]
+                                             "predicted_error", "predicted_rigid_error")]
         lines.append(f"    {row.name:28s} {row.tolerance:6g} {row.choice:>8s} "
                      f"{numbers[0]:9.4g} {numbers[1]:7.3g} {numbers[2]:7.3g} "
-                     f"{numbers[3]:9.2e} {row.error:9.2e} {'yes' if row.ok else 'NO':>3s} "
+                     f"{numbers[3]:9.2e} {numbers[4]:9.2e} {row.error:9.2e} "
+                     f"{'yes' if row.ok else 'NO':>3s} "
                      + " ".join(f"{row.timings[t]:9.2f}" for t in timing))
     failures = [r.name for r in rows if isinstance(r, Validation) and not r.ok]
     lines.append(f"  NOT within tolerance: {', '.join(failures)}" if failures

@@ -58,7 +58,7 @@ from flex.base.thesis import (  # noqa: F401 - part of this module's face
     THESIS_YOUNGS_MODULUS_PA,
 )
 from flex.config.settings import resolved_simulation
-from flex.fidelity.predictor import predict_deflection
+from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection
 
 CRITERION_FORMAT = "flex-criterion/1"
 DEFAULT_CRITERION = Path(__file__).with_name("criteria_fit.toml")
@@ -839,9 +839,12 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
     """Replace ``"auto"`` link models by concrete ones; return the scene and the decisions.
 
     Contract: ``scene`` is validated. ``coupler.model = "auto"`` (plate geometry) becomes
-    ``"rigid"`` when n >= k(tolerance) (conservative k, :meth:`ErrorLaw.k` ``upper``) and
-    ``"ffrf"`` otherwise, with ``coupler.modes`` from :func:`modes_for_cutoff` at
-    ``omega_cut = k / delta_t`` (thesis convention: every mode with n below k is kept).
+    ``"rigid"`` when the deflection error the rigid probe's own loads predict
+    (:mod:`flex.fidelity.predictor`), times its margin, meets the tolerance, and ``"ffrf"``
+    otherwise, with ``coupler.modes`` from :func:`modes_for_cutoff` at ``omega_cut = k /
+    delta_t`` (thesis convention: every mode with n below k is kept); the n-law's verdict
+    (rigid when n >= k(tolerance), conservative k, :meth:`ErrorLaw.k` ``upper``) stays in the
+    reason and the attributes as the baseline.
     ``crank.model = "auto"`` is decided the same way, with the crank's own law
     (``crank_criterion``, default
     :data:`DEFAULT_CRANK_CRITERION`) and its first in-plane elastic frequency in the
@@ -908,12 +911,30 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
     how += f"; compressive load {ratio:.3g} x Euler load"
     decision, k_phys = _decide("coupler", omega, delta_t_s, how, tolerance, criterion,
                                float(coupler["damping_ratio"]))
-    decision.predicted_rigid_error = predict_deflection(probe, coupler).relative_error(
-        coupler["length_m"])
+    _decide_by_loads(decision, predict_deflection(probe, coupler).relative_error(
+        coupler["length_m"]), tolerance)
     coupler["model"] = decision.model
     if decision.model == "ffrf":
         _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s)
     return decision, how
+
+
+def _decide_by_loads(decision: FidelityDecision, predicted_rigid_error: float,
+                     tolerance: float) -> None:
+    """Let the rigid model's error predicted from the probe's loads decide (in place), the
+    n-law's verdict staying in the reason as the baseline: rigid when the prediction times
+    :data:`flex.fidelity.predictor.PREDICTION_MARGIN` meets ``tolerance``."""
+    decision.predicted_rigid_error = predicted_rigid_error
+    bound = predicted_rigid_error * PREDICTION_MARGIN
+    rigid = bound <= tolerance
+    baseline = decision.model
+    decision.model = "rigid" if rigid else "ffrf"
+    decision.reason = (
+        f"{decision.link}: the rigid run's loads predict a deflection error of "
+        f"{predicted_rigid_error:.3g} (x {PREDICTION_MARGIN:g} margin: {bound:.3g} "
+        f"{'<=' if rigid else '>'} tolerance {tolerance:g}); n-law baseline ("
+        f"{'agrees' if baseline == decision.model else f'would pick {baseline}'}): "
+        + decision.reason.split(": ", 1)[1])
 
 
 def _decide_crank(resolved: dict[str, dict[str, Any]], delta_t_s: float, how: str,
