@@ -31,8 +31,8 @@ sweep and returns the results. Contract:
 
 A sweep study gets its :class:`SweepSettings` as an argument. The command lines read them
 once, at the edge (:func:`settings_from_environment` of the command line's environment):
-``flex run kfit --scheduler ... --workers N --folder DIR --retry-failed`` (``python -m
-flex.sweep STUDY ...`` is the same command), each over the environment's
+``flex run kfit --scheduler ... --workers N --folder DIR --retry-failed``, each over the
+environment's
 ``FLEX_SCHEDULER``, ``FLEX_WORKERS``, ``FLEX_SWEEP_DIR``, ``FLEX_RETRY_FAILED=1`` and
 ``FLEX_PROGRESS=0``. The reduction cache folder is read there too
 (:func:`flex.bodies.reduction.reduction_cache_dir`) and reaches the case functions as their
@@ -684,7 +684,7 @@ def _run_isolated(jobs: list[_Job], executor: Executor, scenes: Mapping[str, Sce
 
 
 # ------------------------------------------------------------------------------------------
-# settings from the environment, and ``python -m flex.sweep``
+# settings from the environment, and the old ``python -m flex.sweep`` entry
 # ------------------------------------------------------------------------------------------
 @dataclass
 class SweepSettings:
@@ -713,7 +713,8 @@ def settings_from_environment(environ: Mapping[str, str]) -> SweepSettings:
                          progress=environ.get("FLEX_PROGRESS", "1") != "0")
 
 
-if __name__ == "__main__":  # python -m flex.sweep STUDY [options]: the same as flex run
-    from flex.cli import main
-
-    raise SystemExit(main(["run", *sys.argv[1:]]))
+if __name__ == "__main__":  # the old entry point: one line saying where it went
+    print("flex: error: python -m flex.sweep is now part of 'flex run': run 'flex run STUDY' "
+          "(or 'python -m flex run STUDY') with --scheduler, --workers, --folder, "
+          "--retry-failed", file=sys.stderr)
+    raise SystemExit(2)

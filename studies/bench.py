@@ -39,7 +39,7 @@ from typing import Any
 
 from flex.config.settings import AUTO_OVERRIDES, pinned_overrides
 from flex.data.results import CaseResult
-from flex.data.scene import Scene, apply_overrides, validate
+from flex.data.scene import Scene, derived_scenes
 from flex.experiments.benchmark import BenchPlan, StepCostPlan, run_bench
 from flex.experiments.benchmark_report import bench_figures, bench_summary
 from flex.experiments.reference_plans import ReferencePlan
@@ -117,10 +117,7 @@ PLAN = BenchPlan(
 
 
 def cases(scene: Scene) -> dict[str, Scene]:
-    out = {"rigid": scene, "ffrf_1mm": apply_overrides(scene, PLATE)}
-    for case in out.values():
-        validate(case)
-    return out
+    return derived_scenes(scene, {"rigid": [], "ffrf_1mm": PLATE})
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:

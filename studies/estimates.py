@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from flex.data.results import CaseResult
-from flex.data.scene import Scene, apply_overrides, validate
+from flex.data.scene import Scene, derived_scenes
 from flex.experiments.estimate_check import check_estimates, draw_estimates, estimate_summary
 from flex.study import StudyRun, Summary
 
@@ -46,10 +46,7 @@ SCENES: dict[str, list[str]] = {
 
 
 def cases(scene: Scene) -> dict[str, Scene]:
-    out = {name: apply_overrides(scene, overrides) for name, overrides in SCENES.items()}
-    for case in out.values():
-        validate(case)
-    return out
+    return derived_scenes(scene, SCENES)
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:

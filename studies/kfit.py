@@ -28,7 +28,7 @@ fit and summary from :mod:`flex.experiments.couplerfit` and its figures from
 Every case's file is ``<sweep folder>/cases/<case>.h5`` (default ``results/kfit-cases``);
 the sweep resumes from them. The fit (``results/kfit-criterion.toml``) is what
 ``make kfit-criterion`` copies to ``flex/criteria_fit.toml`` for ``auto``. Executor:
-``flex run kfit --scheduler ...`` / ``python -m flex.sweep kfit ...`` (see :mod:`flex.sweep`).
+``flex run kfit --scheduler ... --folder DIR --retry-failed`` (see :mod:`flex.sweep`).
 """
 
 from __future__ import annotations

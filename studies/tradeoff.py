@@ -28,7 +28,7 @@ from typing import Any
 
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
-from flex.data.scene import Scene, apply_overrides, validate
+from flex.data.scene import Scene, derived_scenes
 from flex.experiments.defaults_check import default_setting
 from flex.experiments.reference_plans import scipy_setting
 from flex.experiments.tradeoff import Setting
@@ -169,10 +169,7 @@ def _ffrf_settings(thin: bool, nonlinear: bool) -> list[Setting]:
 
 def cases(scene: Scene) -> dict[str, Scene]:
     """One scene per work-precision diagram (the references' scenes)."""
-    out = {name: apply_overrides(scene, overrides) for name, overrides in SCENES.items()}
-    for case in out.values():
-        validate(case)
-    return out
+    return derived_scenes(scene, SCENES)
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:

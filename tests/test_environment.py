@@ -1,6 +1,6 @@
 """The environment is read at the edges only: values travel as arguments.
 
-The command line (``flex/cli.py``; ``python -m flex.sweep`` is the same command) and the public
+The command line (``flex/cli.py``) and the public
 API (``flex/api.py``) read ``os.environ`` once and pass what they read on (the reduction cache
 folder, a study's declared variables); no other library function reads it.
 """
@@ -21,7 +21,7 @@ EDGES = {
     ("api.py", "_cache_dir"): "flex.simulate / flex.run_study: the user's cache folder",
     ("api.py", "run_study"): "flex.run_study: the study's declared variables",
     # configures Exudyn itself (no user settings file) before it is imported
-    ("dynamics/mechanism.py", "<module>"): "os.environ.setdefault('EXUDYN_NO_USER_SETTINGS')",
+    ("dynamics/builder.py", "<module>"): "os.environ.setdefault('EXUDYN_NO_USER_SETTINGS')",
     # the environment of a child `make` process (with its own FLEX_CACHE_DIR)
     ("experiments/benchmark.py", "bench_make_all"): "the child make's environment",
 }

@@ -267,12 +267,14 @@ def test_signals_at_each_phase_leave_nothing_half_done(tmp_path, phase, sig):
         assert {path: after.get(path) for path in before} == before
 
 
-def test_python_m_flex_sweep_is_the_flex_run_command(workspace):
-    """``python -m flex.sweep STUDY ...`` is ``flex run STUDY ...``: the same refusals, the same
-    one line and exit status."""
+def test_the_old_python_m_flex_sweep_says_where_it_went(workspace):
+    """``python -m flex.sweep`` became part of ``flex run``: one line saying so, status 2,
+    nothing run or written."""
     folder, good, scene = workspace
-    done = subprocess.run([sys.executable, "-m", "flex.sweep", "dynamics", "--workers", "2"],
+    before = fingerprint([folder])
+    done = subprocess.run([sys.executable, "-m", "flex.sweep", "kfit", "--retry-failed"],
                           cwd=folder, capture_output=True, text=True, timeout=120)
     assert done.returncode == 2, done
     lines = [line for line in done.stderr.splitlines() if line.strip()]
-    assert len(lines) == 1 and "--workers" in lines[0] and "kfit" in lines[0], done.stderr
+    assert len(lines) == 1 and "flex run" in lines[0], done.stderr
+    assert fingerprint([folder]) == before

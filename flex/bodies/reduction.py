@@ -645,7 +645,7 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
 
     Returns a dict:
       ``object`` (ObjectIndex of the ObjectFFRFreducedOrder), ``node_frame`` (NodeIndex of the
-      floating frame, Euler parameters), ``node_modal`` (NodeIndex of the 6 + modes elastic
+      floating frame, Euler parameters), ``node_modal`` (NodeIndex of the modal elastic
       coordinates: sensor ``OutputVariableType.Coordinates`` feeds
       :func:`bending_stress_history`), ``marker_B``, ``marker_C``, ``marker_mid``
       (MarkerIndex), ``position_B``, ``position_C``, ``position_mid`` (reference positions
@@ -661,19 +661,10 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
                           initial_angular_velocity_rad_per_s)):
         if not (_is_number(value) and math.isfinite(value)):
             raise SceneError(f"{label} = {value!r}: must be a finite number")
-    if not (_is_number(damping_ratio) and 0.0 <= damping_ratio < 1.0):
-        raise SceneError(f"damping_ratio = {damping_ratio!r}: must lie in [0, 1)")
-    beta = 0.0
-    if damping_ratio > 0:
-        omega = 2 * np.pi * reduction.pinned_pinned_frequency_Hz
-        if not math.isfinite(omega):
-            raise SceneError("damping_ratio > 0 needs the pinned-pinned frequency, which is "
-                             "undefined for thickness > 2 x width: use damping_ratio = 0")
-        beta = 2.0 * damping_ratio / omega
-
     if joint_markers not in JOINT_MARKERS:
         raise SceneError(f"joint_markers = {joint_markers!r}: must be one of "
                          f"{', '.join(JOINT_MARKERS)}")
+    beta = _stiffness_proportional_damping_s(reduction, damping_ratio)
     rotation = np.asarray(RotationMatrixZ(float(angle_rad)))
     added = reduction.ffrf_interface().AddObjectFFRFreducedOrder(
         mbs, positionRef=list(position_B), rotationMatrixRef=rotation,
@@ -691,6 +682,20 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
                                                 name, end_b_rotation)),
         "stiffness_proportional_damping_s": beta,
     }
+
+
+def _stiffness_proportional_damping_s(reduction: Reduction, damping_ratio: float) -> float:
+    """Rayleigh ``beta`` [s] that gives the first pinned-pinned mode ``damping_ratio`` of
+    critical damping (0 for none); SceneError outside [0, 1) or without that mode."""
+    if not (_is_number(damping_ratio) and 0.0 <= damping_ratio < 1.0):
+        raise SceneError(f"damping_ratio = {damping_ratio!r}: must lie in [0, 1)")
+    if damping_ratio == 0:
+        return 0.0
+    omega = 2 * np.pi * reduction.pinned_pinned_frequency_Hz
+    if not math.isfinite(omega):
+        raise SceneError("damping_ratio > 0 needs the pinned-pinned frequency, which is "
+                         "undefined for thickness > 2 x width: use damping_ratio = 0")
+    return 2.0 * damping_ratio / omega
 
 
 #: how an FFRF body's joint markers are made (:func:`add_ffrf_link`)

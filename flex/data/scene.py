@@ -14,6 +14,7 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
@@ -259,6 +260,16 @@ def apply_overrides(scene: Scene, overrides: list[str]) -> Scene:
         section, key, value = parse_override(item)
         changes.setdefault(section, {})[key] = value
     return merge(scene, changes)
+
+
+def derived_scenes(scene: Scene, overrides_by_name: Mapping[str, list[str]]) -> dict[str, Scene]:
+    """One validated scene per name: ``scene`` with that name's overrides (a study's cases
+    declared as data); raises SceneError naming the first that does not validate."""
+    out = {name: apply_overrides(scene, overrides)
+           for name, overrides in overrides_by_name.items()}
+    for derived in out.values():
+        validate(derived)
+    return out
 
 
 def parse_override(item: str) -> tuple[str, str, Any]:

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from flex.data.scene import Scene
-from flex.dynamics.mechanism import Mechanism, _Builder
+from flex.dynamics.builder import Mechanism, _Builder
 
 
 def is_planar(scene: Scene) -> bool:

@@ -1,0 +1,444 @@
+"""The slider-crank's parts in Exudyn: its initial configuration, the :class:`Mechanism` a
+build returns, and the 3D builder (:class:`_Builder`) that :func:`flex.dynamics.mechanism.
+build_mechanism` drives (:mod:`flex.dynamics.planar` extends it with 2D items for rigid
+scenes). The sketch of the mechanism and the choice of build are in
+:mod:`flex.dynamics.mechanism`.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from flex.base.errors import SceneError
+from flex.base.kinematics import crank_pin, slider_crank
+from flex.base.physics import cuboid_inertia_kgm2, cuboid_mass_kg
+from flex.data.scene import Scene, plate_mass_properties
+
+os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
+
+
+@dataclass
+class InitialConfiguration:
+    """Assembled configuration at t = 0 (metres, radians, per second)."""
+
+    crank_angle_rad: float
+    coupler_angle_rad: float
+    joint_B_m: np.ndarray
+    joint_C_m: np.ndarray
+    crank_speed_rad_per_s: float
+    coupler_speed_rad_per_s: float
+    joint_B_velocity_m_per_s: np.ndarray
+    joint_C_velocity_m_per_s: np.ndarray
+
+
+def initial_configuration(scene: Scene) -> InitialConfiguration:
+    """Positions and consistent velocities of the joints at t = 0 (closed form)."""
+    l1, l2 = scene["crank"]["length_m"], scene["coupler"]["length_m"]
+    offset_m = scene["slider"]["offset_m"]
+    theta = np.radians(scene["crank"]["initial_angle_deg"])
+    drive = scene["drive"]
+    omega = drive["crank_speed_rad_per_s"] if drive["kind"] == "constant_speed" else 0.0
+    state = slider_crank(l1, l2, theta, omega, 0.0, offset_m)
+    pin, pin_velocity = crank_pin(l1, theta, omega)
+    joint_b = np.array([*pin, 0.0])
+    joint_c = np.array([float(state.slider_position_m), offset_m, 0.0])
+    vel_b = np.array([*pin_velocity, 0.0])
+    vel_c = np.array([float(state.slider_velocity_m_per_s), 0.0, 0.0])
+    return InitialConfiguration(float(theta), float(state.coupler_angle_rad), joint_b, joint_c,
+                                float(omega), float(state.coupler_angular_velocity_rad_per_s),
+                                vel_b, vel_c)
+
+
+@dataclass
+class Mechanism:
+    """A built, assembled Exudyn system and the handles the solver reads.
+
+    ``sensors`` maps a name to ``(sensor index, columns)``: the columns of the stored sensor
+    data (after the time column) that hold the quantity. ``joint_frames`` tells how each
+    joint's local force output maps to global axes.
+    """
+
+    system_container: Any
+    mbs: Any
+    scene: Scene
+    initial: InitialConfiguration
+    sensors: dict[str, int] = field(default_factory=dict)
+    joint_frames: dict[str, str | None] = field(default_factory=dict)
+    constraint_points: list[tuple[str, str]] = field(default_factory=list)
+    rigid_bodies: dict[str, tuple[float, np.ndarray]] = field(default_factory=dict)
+    coupler: dict[str, Any] = field(default_factory=dict)
+    crank: dict[str, Any] = field(default_factory=dict)
+    #: FFRF links whose energy Exudyn reports: name -> (kinetic sensor, strain sensor)
+    flexible_energy: dict[str, tuple[int, int]] = field(default_factory=dict)
+    wing: dict[str, Any] = field(default_factory=dict)
+    #: built by :mod:`flex.dynamics.planar` (2D bodies; joint loads read by its own rules)
+    planar: bool = False
+
+
+def _rotation_z(angle_rad: float) -> np.ndarray:
+    c, s = np.cos(angle_rad), np.sin(angle_rad)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+#: damping of the penalty joints, as a fraction of critical for the lightest link's mass
+PENALTY_DAMPING_RATIO = 0.2
+
+
+def _add_penalty_joints(mbs: Any, stiffness_N_per_m: float, lightest_mass_kg: float,
+                        joint_markers: list[tuple[int, int]], nodes: list[int]) -> list[int]:
+    """Joints A, B, C and the slide line as stiff springs, for Exudyn's explicit solvers.
+
+    ``joint_markers``: (marker 0, marker 1) of A, B, C and of the slide line (ground, slider);
+    ``nodes``: the rigid-body nodes (Tait-Bryan, coordinates x y z rx ry rz) of crank,
+    coupler and slider. A, B, C become ``CartesianSpringDamper``s of stiffness
+    ``stiffness_N_per_m`` in x and y, the slide line one in y only, damped with
+    :data:`PENALTY_DAMPING_RATIO` of critical for ``lightest_mass_kg`` (undamped, the
+    joint forces ring at the penalty frequency about their true values: measured +-20 N on
+    ~25 N at 1e8 N/m; damped, 1e-2 N, with the same crank angle). The out-of-plane
+    coordinates (z, rx, ry of every body) and the slider's angle are held by
+    ``CoordinateConstraint``s to ground, which the explicit solvers eliminate
+    (``timeIntegration.explicit.eliminateConstraints``). The joints then open by about
+    force / stiffness: the crank-angle error falls as 1 / stiffness, while the explicit
+    stability limit of the step falls as 1 / sqrt(stiffness). Returns the four connector
+    indices (their ``Force`` output is in global axes, acting on marker 0's body).
+    """
+    import exudyn.itemInterface as eii
+
+    ground_node = mbs.AddNode(eii.NodePointGround())
+    ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node,
+                                                               coordinate=0))
+    held = {node: [2, 3, 4] for node in nodes}
+    held[nodes[-1]].append(5)  # the slider does not turn
+    for node, coordinates in held.items():
+        for coordinate in coordinates:
+            marker = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=node,
+                                                            coordinate=coordinate))
+            mbs.AddObject(eii.ObjectConnectorCoordinate(markerNumbers=[ground_coordinate,
+                                                                       marker]))
+    k = stiffness_N_per_m
+    d = 2.0 * PENALTY_DAMPING_RATIO * np.sqrt(k * lightest_mass_kg)
+    springs = []
+    for index, markers in enumerate(joint_markers):
+        axes = np.array([1.0, 1.0, 0.0] if index < 3 else [0.0, 1.0, 0.0])
+        springs.append(mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
+            markerNumbers=list(markers), stiffness=list(k * axes), damping=list(d * axes))))
+    return springs
+
+
+def wing_mass_properties(scene: Scene) -> tuple[float, float, float]:
+    """Wing plate mass [kg], inertia about its centre [kg m^2] and centre distance from A [m].
+
+    The wing is a flat plate in the mechanism plane (switchblade wing): root at the crank
+    pivot A, span along the crank direction, chord across it, thickness out of plane.
+    """
+    wing = scene["wing"]
+    mass_kg = cuboid_mass_kg(wing["span_m"], wing["chord_m"], wing["thickness_m"],
+                             wing["density_kg_per_m3"])
+    return mass_kg, cuboid_inertia_kgm2(mass_kg, wing["span_m"], wing["chord_m"]), \
+        wing["span_m"] / 2.0
+
+
+def _add_wing(mech: Mechanism, rigid_body, body_marker) -> int:
+    """Add the wing as a rigid body with its root at A; return its marker at the root (the
+    builder welds it to the crank: :meth:`_Builder.weld`)."""
+    init = mech.initial
+    mass_kg, inertia_kgm2, centre_m = wing_mass_properties(mech.scene)
+    direction = np.array([np.cos(init.crank_angle_rad), np.sin(init.crank_angle_rad), 0.0])
+    normal = np.array([-direction[1], direction[0], 0.0])
+    wing_body = rigid_body("wing", mass_kg, inertia_kgm2, direction * centre_m,
+                           init.crank_angle_rad,
+                           normal * centre_m * init.crank_speed_rad_per_s,
+                           init.crank_speed_rad_per_s)
+    mech.wing = {"body": wing_body["bodyNumber"], "node": wing_body["nodeNumber"]}
+    return body_marker(wing_body, [0.0, 0.0, 0.0])
+
+
+class _Builder:
+    """Adds the items of one slider-crank to a new Exudyn system, in a fixed order (the
+    order numbers the coordinates, so it is kept the same for every scene of a kind)."""
+
+    #: index of the rotation about z among a rigid-body node's coordinates (x y z rx ry rz)
+    rotation_coordinate = 5
+
+    def __init__(self, scene: Scene, ffrf_joint_markers: str = "fewest") -> None:
+        import exudyn as exu
+        import exudyn.itemInterface as eii
+
+        self.exu, self.eii = exu, eii
+        self.scene = scene
+        self.ffrf_joint_markers = ffrf_joint_markers
+        self.init = initial_configuration(scene)
+        system_container = exu.SystemContainer()
+        self.mbs = system_container.AddSystem()
+        self.mech = Mechanism(system_container, self.mbs, scene, self.init)
+        self.ground = self.mbs.CreateGround()
+        self.markers: dict[str, int] = {}
+        self.crank_body: dict | None = None
+        self.slider_body: dict = {}
+        self.coupler: dict = {}
+        self.wing_joint: int | None = None
+        self.joints: dict[str, int] = {}
+
+    def rigid_body(self, name: str, mass_kg: float, inertia_kgm2: float, position,
+                   angle_rad: float, velocity, angular_velocity_rad_per_s: float) -> dict:
+        """A planar rigid body [kg, kg m^2, m, rad, m/s, rad/s]."""
+        from exudyn.utilities import RigidBodyInertia
+
+        # out-of-plane inertias do not enter planar motion; any positive, physically
+        # admissible values will do, so take the in-plane one
+        inertia = RigidBodyInertia(mass=mass_kg, inertiaTensor=np.eye(3) * inertia_kgm2)
+        body = self.mbs.CreateRigidBody(
+            name=name, inertia=inertia, referencePosition=list(position),
+            referenceRotationMatrix=_rotation_z(angle_rad), initialVelocity=list(velocity),
+            initialAngularVelocity=[0.0, 0.0, angular_velocity_rad_per_s],
+            nodeType=self.exu.NodeType.RotationRxyz, returnDict=True)
+        self.mech.rigid_bodies[name] = (mass_kg, np.eye(3) * inertia_kgm2)
+        return body
+
+    def body_marker(self, body: dict, global_point) -> int:
+        """A marker on ``body`` at ``global_point`` [m] (reference configuration)."""
+        node = self.mbs.GetNode(body["nodeNumber"])
+        reference = np.asarray(node["referenceCoordinates"][:3])
+        rotation = _rotation_z(node["referenceCoordinates"][5])
+        local = rotation.T @ (np.asarray(global_point) - reference)
+        return self.mbs.AddMarker(self.eii.MarkerBodyRigid(bodyNumber=body["bodyNumber"],
+                                                           localPosition=list(local)))
+
+    def add_crank_and_slider(self, crank_reduction: Any) -> None:
+        """The crank (rigid body or FFRF plate), the slider, the ground markers at A and C,
+        and the wing welded at A when enabled."""
+        scene, init, mbs, eii = self.scene, self.init, self.mbs, self.eii
+        crank = scene["crank"]
+        if crank["model"] == "rigid":
+            self.crank_body = self.rigid_body(
+                "crank", *plate_mass_properties(scene, "crank"), init.joint_B_m / 2,
+                init.crank_angle_rad, init.joint_B_velocity_m_per_s / 2,
+                init.crank_speed_rad_per_s)
+        self.slider_body = self.add_slider()
+        m = self.markers
+        m["ground_A"] = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=self.ground,
+                                                          localPosition=[0, 0, 0]))
+        m["ground_C"] = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=self.ground,
+                                                          localPosition=list(init.joint_C_m)))
+        if self.crank_body is not None:
+            m["crank_A"] = self.body_marker(self.crank_body, [0.0, 0.0, 0.0])
+            m["crank_B"] = self.body_marker(self.crank_body, init.joint_B_m)
+        else:
+            self._add_flexible_crank(crank_reduction)
+        m["slider_C"] = self.body_marker(self.slider_body, init.joint_C_m)
+        if scene["wing"]["enabled"]:
+            wing_root = _add_wing(self.mech, self.rigid_body, self.body_marker)
+            self.wing_joint = self.weld(m["crank_A"], wing_root)
+
+    def weld(self, crank_root: int, wing_root: int) -> int:
+        """Weld the wing's root marker to the crank's marker at A (a rigid-body marker, or
+        the joint face of a flexible crank); return the joint. Its reaction torque is the
+        wing root bending moment in the mechanism plane."""
+        crank_rotation = _rotation_z(self.init.crank_angle_rad)
+        return self.mbs.AddObject(self.eii.ObjectJointGeneric(
+            markerNumbers=[crank_root, wing_root], constrainedAxes=[1, 1, 1, 1, 1, 1],
+            rotationMarker0=crank_rotation.T, rotationMarker1=crank_rotation.T))
+
+    def add_slider(self) -> dict:
+        """The slider: a rigid body at joint C, not turned (its prismatic joint holds it)."""
+        slider, init = self.scene["slider"], self.init
+        return self.rigid_body("slider", slider["mass_kg"], slider["inertia_kgm2"],
+                               init.joint_C_m, 0.0, init.joint_C_velocity_m_per_s, 0.0)
+
+    def _add_flexible_crank(self, crank_reduction: Any) -> None:
+        from flex.bodies.reduction import add_ffrf_link
+
+        if crank_reduction is None:
+            raise SceneError('crank.model = "ffrf" needs its reduction (flex.fidelity.simulation.'
+                             "simulate builds it from the scene)")
+        # the plate's end_a face is the pivot A (the floating frame), end_b the joint B
+        flexible_crank = add_ffrf_link(
+            self.mbs, crank_reduction, [0.0, 0.0, 0.0], self.init.crank_angle_rad,
+            damping_ratio=self.scene["crank"]["damping_ratio"],
+            initial_angular_velocity_rad_per_s=self.init.crank_speed_rad_per_s, name="crank",
+            joint_markers=self.ffrf_joint_markers)
+        self.markers["crank_A"] = flexible_crank["marker_B"]
+        self.markers["crank_B"] = flexible_crank["marker_C"]
+        self.mech.crank = dict(flexible_crank, reduction=crank_reduction)
+
+    def add_coupler(self, reduction: Any) -> None:
+        """The coupler B-C: FFRF body, nonlinear FE body or rigid body."""
+        scene, init, mbs = self.scene, self.init, self.mbs
+        model = scene["coupler"]["model"]
+        if model == "ffrf":
+            from flex.bodies.reduction import add_ffrf_link
+
+            self.coupler = add_ffrf_link(
+                mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
+                damping_ratio=scene["coupler"]["damping_ratio"],
+                initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+                initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s,
+                joint_markers=self.ffrf_joint_markers,
+                end_b_rotation=False)  # the pin at C constrains x and y only
+            self.mech.coupler = dict(self.coupler, reduction=reduction)
+        elif model == "nonlinear_fe":
+            from flex.bodies.nonlinear import add_nonlinear_fe_coupler, nonlinear_plate_for_scene
+
+            plate = reduction if reduction is not None else nonlinear_plate_for_scene(scene)
+            self.coupler = add_nonlinear_fe_coupler(
+                mbs, plate, list(init.joint_B_m), init.coupler_angle_rad,
+                initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+                initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
+            self.mech.coupler = dict(self.coupler, plate=plate)
+        else:
+            mass_kg, inertia_kgm2 = plate_mass_properties(scene)
+            body = self.rigid_body(
+                "coupler", mass_kg, inertia_kgm2, (init.joint_B_m + init.joint_C_m) / 2,
+                init.coupler_angle_rad,
+                (init.joint_B_velocity_m_per_s + init.joint_C_velocity_m_per_s) / 2,
+                init.coupler_speed_rad_per_s)
+            self.coupler = {"marker_B": self.body_marker(body, init.joint_B_m),
+                            "marker_C": self.body_marker(body, init.joint_C_m)}
+            self.mech.coupler = {"body": body["bodyNumber"], "node": body["nodeNumber"]}
+        self.markers["coupler_B"] = self.coupler["marker_B"]
+        self.markers["coupler_C"] = self.coupler["marker_C"]
+
+    def add_joints(self) -> None:
+        """Revolute A and B, the in-plane pin C, the prismatic slide (or penalty springs for
+        the explicit integrator)."""
+        scene, mbs, eii, m = self.scene, self.mbs, self.eii, self.markers
+        if scene["simulation"]["integrator"] == "explicit_penalty":
+            # explicit solvers take no joint constraints (validate: rigid coupler only)
+            joints = _add_penalty_joints(
+                mbs, scene["simulation"]["penalty_stiffness_N_per_m"],
+                min(plate_mass_properties(scene, "crank")[0], scene["slider"]["mass_kg"],
+                    plate_mass_properties(scene)[0]),
+                [(m["ground_A"], m["crank_A"]), (m["crank_B"], m["coupler_B"]),
+                 (m["slider_C"], m["coupler_C"]), (m["ground_C"], m["slider_C"])],
+                [self.crank_body["nodeNumber"], self.mech.coupler["node"],
+                 self.slider_body["nodeNumber"]])
+            self.joints = dict(zip("ABCP", joints, strict=True))
+            self.mech.joint_frames = {"A": None, "B": None, "C": None, "P": None}
+            return
+        crank_ref = _rotation_z(self.init.crank_angle_rad)
+        coupler_ref = _rotation_z(self.init.coupler_angle_rad)
+        # joint frames coincide with the global axes at t = 0; force outputs are in the frame
+        # of marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where
+        # it can
+        self.joints = {
+            "A": mbs.AddObject(eii.ObjectJointRevoluteZ(
+                markerNumbers=[m["ground_A"], m["crank_A"]], rotationMarker1=crank_ref.T)),
+            "B": mbs.AddObject(eii.ObjectJointRevoluteZ(
+                markerNumbers=[m["crank_B"], m["coupler_B"]], rotationMarker0=crank_ref.T,
+                rotationMarker1=coupler_ref.T)),
+            "C": mbs.AddObject(eii.ObjectJointSpherical(
+                markerNumbers=[m["slider_C"], m["coupler_C"]], constrainedAxes=[1, 1, 0])),
+            "P": mbs.AddObject(eii.ObjectJointPrismaticX(
+                markerNumbers=[m["ground_C"], m["slider_C"]]))}
+        # B's force is reported in the frame of the crank's marker at B (its joint face when
+        # the crank is flexible): collect turns it with that marker's rotation
+        self.mech.joint_frames = {"A": None, "B": "marker_crank_B", "C": None, "P": None}
+
+    def add_drive(self) -> None:
+        """The preloaded spring on the slider, or the crank held at constant speed."""
+        drive, mbs, eii = self.scene["drive"], self.mbs, self.eii
+        ground_node = mbs.AddNode(eii.NodePointGround())
+        ground_coordinate = mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=ground_node,
+                                                                   coordinate=0))
+        if drive["kind"] == "spring":
+            slider_x = mbs.AddMarker(eii.MarkerNodeCoordinate(
+                nodeNumber=self.slider_body["nodeNumber"], coordinate=0))
+            # slider coordinate = displacement from t = 0; spring force k (q + preload) pushes -x
+            mbs.AddObject(eii.ObjectConnectorCoordinateSpringDamper(
+                markerNumbers=[ground_coordinate, slider_x],
+                stiffness=drive["spring_stiffness_N_per_m"],
+                damping=drive["spring_damping_Ns_per_m"], offset=-drive["spring_preload_m"]))
+            return
+        crank_rotation = mbs.AddMarker(eii.MarkerNodeCoordinate(  # rigid crank (validate)
+            nodeNumber=self.crank_body["nodeNumber"], coordinate=self.rotation_coordinate))
+        # velocity-level constraint: no Python callback per step, crank speed held exactly
+        mbs.AddObject(eii.ObjectConnectorCoordinate(
+            markerNumbers=[ground_coordinate, crank_rotation], velocityLevel=True,
+            offset=drive["crank_speed_rad_per_s"]))
+
+    def add(self, name: str, sensor) -> None:
+        self.mech.sensors[name] = self.mbs.AddSensor(sensor)
+
+    def sensor(self, kind: str, output: str, **item: int):
+        """An Exudyn sensor (``kind``: Node, Object, Marker, Body) stored internally."""
+        return getattr(self.eii, f"Sensor{kind}")(
+            storeInternal=True, outputVariableType=getattr(self.exu.OutputVariableType,
+                                                           output), **item)
+
+    def add_sensors(self) -> None:
+        """What :func:`flex.dynamics.solver.collect` reads: bodies, joints, markers, energies."""
+        if self.wing_joint is not None:
+            for output in ("Velocity", "Rotation", "AngularVelocity", "AngularAcceleration"):
+                self.add(f"wing.{output}",
+                         self.sensor("Node", output, nodeNumber=self.mech.wing["node"]))
+            self._add_weld_sensors()
+        for name, body in (("crank", self.crank_body), ("slider", self.slider_body)):
+            if body is not None:  # None: a flexible crank, its markers below
+                self._add_body_sensors(name, body)
+        if self.scene["coupler"]["model"] == "rigid":
+            # the centre of mass is the coupler's midpoint
+            for output in ("Position", "Velocity", "Acceleration", "Rotation",
+                           "AngularVelocity"):
+                self.add(f"coupler.{output}",
+                         self.sensor("Node", output, nodeNumber=self.mech.coupler["node"]))
+        self._add_joint_sensors()
+        self._add_marker_sensors()
+        self._add_flexible_sensors()
+
+    def _add_body_sensors(self, name: str, body: dict) -> None:
+        """Motion of a rigid body's node (its centre of mass), as ``<name>.<output>``."""
+        for output in ("Position", "Velocity", "Acceleration", "Rotation",
+                       "AngularVelocity", "AngularAcceleration"):
+            self.add(f"{name}.{output}",
+                     self.sensor("Node", output, nodeNumber=body["nodeNumber"]))
+
+    def _add_weld_sensors(self) -> None:
+        """The wing weld's force and torque, in the weld frame (read by collect)."""
+        for output in ("ForceLocal", "TorqueLocal"):
+            self.add(f"joint_W.{output}",
+                     self.sensor("Object", output, objectNumber=self.wing_joint))
+
+    def _add_joint_sensors(self) -> None:
+        """The forces of joints A, B, C and P, and the frame B's force is reported in."""
+        penalty = self.scene["simulation"]["integrator"] == "explicit_penalty"
+        for name, joint in self.joints.items():
+            # the spherical joint reports its force in global axes ("Force"), the others in
+            # the frame of marker 0 ("ForceLocal")
+            output = "Force" if name == "C" or penalty else "ForceLocal"
+            self.add(f"joint_{name}.Force", self.sensor("Object", output, objectNumber=joint))
+        if not penalty:
+            self.add("marker_crank_B.Rotation",
+                     self.sensor("Marker", "Rotation", markerNumber=self.markers["crank_B"]))
+
+    def _add_marker_sensors(self) -> None:
+        """Joint-marker positions (the constraint norm in collect)."""
+        for name in ("ground_A", "crank_A", "crank_B", "coupler_B", "coupler_C", "slider_C"):
+            self.add(f"marker_{name}.Position",
+                     self.sensor("Marker", "Position", markerNumber=self.markers[name]))
+        self.mech.constraint_points = [("ground_A", "crank_A"), ("crank_B", "coupler_B"),
+                                       ("coupler_C", "slider_C")]
+
+    def _add_flexible_sensors(self) -> None:
+        model = self.scene["coupler"]["model"]
+        flexible = {"coupler": self.coupler} if model in ("ffrf", "nonlinear_fe") else {}
+        if self.mech.crank:
+            flexible["crank"] = self.mech.crank
+            for name in ("crank_A", "crank_B"):
+                self.add(f"marker_{name}.Velocity",
+                         self.sensor("Marker", "Velocity", markerNumber=self.markers[name]))
+        for name, link in flexible.items():
+            for output in ("Position", "Velocity"):
+                self.add(f"marker_{name}_mid.{output}",
+                         self.sensor("Marker", output, markerNumber=link["marker_mid"]))
+            if "node_modal" not in link:  # nonlinear FE: nodal coordinates only
+                continue
+            self.add(f"{name}.modal_coordinates",
+                     self.sensor("Node", "Coordinates", nodeNumber=link["node_modal"]))
+            # Exudyn's FFRF body reports its kinetic (rigid + elastic motion) and strain energy
+            sensors = [self.mbs.AddSensor(self.sensor("Body", kind, bodyNumber=link["object"]))
+                       for kind in ("KineticEnergy", "PotentialEnergy")]
+            self.mech.flexible_energy[name] = (sensors[0], sensors[1])
