@@ -47,3 +47,14 @@ def test_exudyn_constant_speed_matches_closed_form(offset_m):
     radius = np.hypot(*data["crank/midpoint_position"].T)
     assert np.abs(radius - 0.02).max() < 1e-12
     assert data["constraint_norm"].max() < 1e-12
+
+
+def test_chord_components_of_forces_along_and_across_a_turned_link():
+    from flex.base.kinematics import chord_components
+
+    angle = np.array([0.3, 0.3, 2.0])
+    along = np.column_stack([np.cos(angle), np.sin(angle)]) * [[2.0], [0.0], [-1.5]]
+    across = np.column_stack([-np.sin(angle), np.cos(angle)]) * [[0.0], [3.0], [0.5]]
+    axial, transverse = chord_components(along + across, angle)
+    np.testing.assert_allclose(axial, [2.0, 0.0, -1.5], atol=1e-15)
+    np.testing.assert_allclose(transverse, [0.0, 3.0, 0.5], atol=1e-15)

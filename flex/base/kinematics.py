@@ -82,3 +82,13 @@ def constant_speed_motion(crank_length_m: float, coupler_length_m: float,
     theta = initial_angle_rad + crank_speed_rad_per_s * np.asarray(time_s, dtype=float)
     return theta, slider_crank(crank_length_m, coupler_length_m, theta, crank_speed_rad_per_s,
                                0.0, offset_m)
+
+
+def chord_components(force_N, angle_rad) -> tuple[np.ndarray, np.ndarray]:
+    """Components [N] of global x-y forces ``force_N`` (n, 2) along a link's chord at
+    ``angle_rad`` (n,) from +x and along the chord's in-plane normal (the chord turned by
+    +90 deg): ``(axial, transverse)``, each (n,)."""
+    force = np.asarray(force_N, dtype=float)
+    angle = np.asarray(angle_rad, dtype=float)
+    cos, sin = np.cos(angle), np.sin(angle)
+    return force[:, 0] * cos + force[:, 1] * sin, -force[:, 0] * sin + force[:, 1] * cos

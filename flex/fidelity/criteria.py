@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import FlexError, SceneError
+from flex.base.kinematics import chord_components
 from flex.base.physics import (  # noqa: F401 - part of this module's face
     TWO_PI,
     clamped_plate_frequencies,
@@ -173,13 +174,8 @@ def quasi_static_stress(force_B_N: np.ndarray, force_C_N: np.ndarray,
     the outer-fibre value, maximised over ``x_range_m`` (default: one thickness away from
     each end, as :func:`flex.bodies.reduction.bending_stress_history`).
     """
-    force_b = np.asarray(force_B_N, dtype=float)
-    force_c = np.asarray(force_C_N, dtype=float)
-    angle = np.asarray(coupler_angle_rad, dtype=float)
-    axis = np.column_stack([np.cos(angle), np.sin(angle)])
-    normal = np.column_stack([-axis[:, 1], axis[:, 0]])
-    transverse_b, transverse_c = (np.sum(f * normal, axis=1) for f in (force_b, force_c))
-    axial_b, axial_c = (np.sum(f * axis, axis=1) for f in (force_b, force_c))
+    axial_b, transverse_b = chord_components(force_B_N, coupler_angle_rad)
+    axial_c, transverse_c = chord_components(force_C_N, coupler_angle_rad)
     if x_range_m is None:
         x_range_m = (thickness_m, length_m - thickness_m)
     xi = np.linspace(x_range_m[0], x_range_m[1], points) / length_m
@@ -209,10 +205,9 @@ def euler_load_ratio(force_B_N: np.ndarray, force_C_N: np.ndarray,
     [rad], as :func:`quasi_static_stress`; I = w t^3 / 12 (in-plane bending). The axial
     force is linear between the joints, so its largest compression is at one of them.
     """
-    angle = np.asarray(coupler_angle_rad, dtype=float)
-    axis = np.column_stack([np.cos(angle), np.sin(angle)])
-    compression = max(float(np.max(np.sum(np.asarray(force_B_N) * axis, axis=1))),
-                      float(np.max(-np.sum(np.asarray(force_C_N) * axis, axis=1))), 0.0)
+    axial_b, _ = chord_components(force_B_N, coupler_angle_rad)
+    axial_c, _ = chord_components(force_C_N, coupler_angle_rad)
+    compression = max(float(np.max(axial_b)), float(np.max(-axial_c)), 0.0)
     return compression / euler_buckling_load_N(length_m, thickness_m, width_m,
                                                youngs_modulus_Pa)
 

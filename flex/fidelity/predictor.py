@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from flex.base.kinematics import chord_components
 from flex.base.physics import (
     axial_load_amplification,
     euler_buckling_load_N,
@@ -65,17 +66,12 @@ class DeflectionPrediction:
 
 def _loads(series: Mapping[str, np.ndarray], link: str) -> tuple[np.ndarray, np.ndarray]:
     """Transverse load total [N] and midspan compression [N] of a rigid link per sample."""
-    angle = np.asarray(series[f"{link}/angle"], dtype=float)
-    axis = np.column_stack([np.cos(angle), np.sin(angle)])
-    normal = np.column_stack([-axis[:, 1], axis[:, 0]])
     first, second = (("joints/B/force_on_coupler", "joints/C/force_on_coupler")
                      if link == "coupler" else ("joints/A/force_on_crank",
                                                 "joints/B/force_on_crank"))
-    force_a = np.asarray(series[first], dtype=float)
-    force_b = np.asarray(series[second], dtype=float)
-    transverse = np.sum(force_a * normal, axis=1) + np.sum(force_b * normal, axis=1)
-    compression = (np.sum(force_a * axis, axis=1) - np.sum(force_b * axis, axis=1)) / 2
-    return transverse, compression
+    axial_a, transverse_a = chord_components(series[first], series[f"{link}/angle"])
+    axial_b, transverse_b = chord_components(series[second], series[f"{link}/angle"])
+    return transverse_a + transverse_b, (axial_a - axial_b) / 2
 
 
 def predict_deflection(series: Mapping[str, np.ndarray], plate: Mapping[str, Any],

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from flex.base.kinematics import chord_components
 from flex.base.physics import euler_buckling_load_N
 from flex.data.results import CaseResult, Dataset
 
@@ -29,9 +30,9 @@ def coupler_compression_N(data: dict[str, np.ndarray], samples: int | None = Non
     The slider pushes on the coupler at C: compression is the joint C force on the coupler
     pointing from C toward B. ``samples``: only the first that many samples (None: all).
     """
-    angle = data["coupler/angle"][:samples]
-    chord = np.column_stack([np.cos(angle), np.sin(angle)])
-    return np.einsum("ij,ij->i", data["joints/C/force_on_coupler"][:samples], -chord)
+    axial, _ = chord_components(data["joints/C/force_on_coupler"][:samples],
+                                data["coupler/angle"][:samples])
+    return -axial
 
 
 def coupler_euler_load_N(coupler: dict[str, Any]) -> float:
