@@ -384,6 +384,17 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
                            mode_selection=c["mode_selection"])
 
 
+def scene_reductions(scene: Scene, reduction: Any = None, crank_reduction: Any = None, *,
+                     cache_dir: Path | None = None) -> tuple[Any, Any]:
+    """The reductions of the scene's ``ffrf`` coupler and crank: the given ones, else built
+    or loaded from ``cache_dir`` (:func:`reduction_for_scene`); None for other links."""
+    if scene["coupler"]["model"] == "ffrf" and reduction is None:
+        reduction = reduction_for_scene(scene, cache_dir=cache_dir)
+    if scene["crank"]["model"] == "ffrf" and crank_reduction is None:
+        crank_reduction = reduction_for_scene(scene, "crank", cache_dir=cache_dir)
+    return reduction, crank_reduction
+
+
 #: a mesh whose estimated build takes longer than this is announced on stderr first [s]
 ANNOUNCE_MESH_S = 30.0
 
@@ -557,10 +568,8 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
                             f"flex.dynamics.solver.integrate")
     scene, solver_choice = resolve_solver_settings(scene)
     check_runnable(scene)  # the concrete models and steps, before anything is built
-    if scene["coupler"]["model"] == "ffrf" and reduction is None:
-        reduction = reduction_for_scene(scene, cache_dir=cache_dir)
-    if scene["crank"]["model"] == "ffrf" and crank_reduction is None:
-        crank_reduction = reduction_for_scene(scene, "crank", cache_dir=cache_dir)
+    reduction, crank_reduction = scene_reductions(scene, reduction, crank_reduction,
+                                                  cache_dir=cache_dir)
     if scene["coupler"]["model"] == "nonlinear_fe" and reduction is None:
         _announce_mesh("coupler", scene["coupler"], "nonlinear FE body")
     mech = build_mechanism(scene, reduction, crank_reduction)
@@ -790,4 +799,5 @@ def divergence_advice(scene: Scene, reductions: dict[str, Any] | None = None) ->
 
 
 __all__ = ["integrate", "solver_settings", "run", "collect", "_rotation_z",
-           "divergence_advice", "time_scales", "validity_warning", "VALIDITY_WARNING"]
+           "divergence_advice", "time_scales", "validity_warning", "VALIDITY_WARNING",
+           "reduction_for_scene", "scene_reductions"]

@@ -23,7 +23,7 @@ from flex.base.errors import FlexError
 from flex.config.settings import check_runnable, resolve_solver_settings
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
-from flex.dynamics.solver import integrate, reduction_for_scene, time_scales
+from flex.dynamics.solver import integrate, scene_reductions, time_scales
 from flex.fidelity.criteria import Criterion, FidelityDecision, resolve_fidelity
 from flex.fidelity.error_estimate import estimate_step_error
 
@@ -70,7 +70,8 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     if decisions:
         reduction = crank_reduction = None
     if scene["simulation"]["error_estimate"]:  # the companion run reuses the reductions
-        reduction, crank_reduction = _reductions(scene, reduction, crank_reduction, cache_dir)
+        reduction, crank_reduction = scene_reductions(scene, reduction, crank_reduction,
+                                                      cache_dir=cache_dir)
     result = integrate(scene, name, reduction, crank_reduction, cache_dir=cache_dir)
     for decision in decisions:
         result.attrs.update(decision.attrs())
@@ -85,17 +86,6 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
                 cache_dir=cache_dir), time_scales(resolved, reductions))
         result.attrs.update(estimate.attrs())
     return result
-
-
-def _reductions(scene: Scene, reduction: Any, crank_reduction: Any, cache_dir: Path | None
-                ) -> tuple[Any, Any]:
-    """The reductions of the scene's ``ffrf`` links: the given ones, else built or loaded
-    (:func:`flex.dynamics.solver.reduction_for_scene`), so a companion run shares them."""
-    if scene["coupler"]["model"] == "ffrf" and reduction is None:
-        reduction = reduction_for_scene(scene, "coupler", cache_dir=cache_dir)
-    if scene["crank"]["model"] == "ffrf" and crank_reduction is None:
-        crank_reduction = reduction_for_scene(scene, "crank", cache_dir=cache_dir)
-    return reduction, crank_reduction
 
 
 def simulate_case(scene: Scene, name: str = "case", reduction: Any = None,
