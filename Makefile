@@ -12,7 +12,7 @@ STUDIES := kinematics dynamics modal flexible spring wing crank kfit
 # shared cores: tradeoff ~65 min, stability ~10 min, bench ~23 min (it times `make all FORCE=1`
 # twice); `make all` itself takes 8-11 min when every study reruns.
 # `flex run stability` exits 0 when exactly its runs built to diverge fail.
-LONG := tradeoff stability bench estimates
+LONG := tradeoff stability bench estimates calibrate design validation
 
 # A study's result, results/<study>.h5 (and its figures, results/figures/<study>-*.png),
 # is remade only when one of its inputs is newer: its module studies/<study>.py, or one of
@@ -27,7 +27,8 @@ LONG_RESULTS := $(LONG:%=results/%.h5)
 MAKEFLAGS += --no-builtin-rules
 .SUFFIXES:
 
-.PHONY: all test test-slow lint setup clean kfit-criterion crank-criterion $(STUDIES) $(LONG) \
+.PHONY: all test test-slow lint setup clean kfit-criterion crank-criterion rule-install \
+	$(STUDIES) $(LONG) \
 	force-rerun
 
 all: $(RESULTS)
@@ -88,6 +89,11 @@ crank-criterion: results/crank-criterion.toml
 	@cmp -s $< flex/fidelity/crank_criteria_fit.toml && echo "flex/fidelity/crank_criteria_fit.toml is already $<" \
 		|| { cp $< flex/fidelity/crank_criteria_fit.toml && echo "cp $< flex/fidelity/crank_criteria_fit.toml"; }
 
+# after make calibrate: install its fitted FFRF settings rule (flex/config/ffrf_rule.toml, read
+# by every "auto" modes, mesh and step of an FFRF coupler; commit it). Every study reads it.
+rule-install: results/calibrate.h5 | $(STAMP)
+	$(PY) -m flex.experiments.calibration_report $< flex/config/ffrf_rule.toml
+
 test: $(STAMP)
 	$(PY) -m pytest -q
 
@@ -99,4 +105,4 @@ lint: $(STAMP)
 
 clean:
 	rm -rf results/*.h5 results/.*.h5.before results/figures results/reports .cache \
-		results/kfit-cases results/kfit-criterion.toml results/crank-criterion.toml
+		results/kfit-cases results/calibrate-cases results/kfit-criterion.toml results/crank-criterion.toml

@@ -83,7 +83,54 @@ def _parser() -> argparse.ArgumentParser:
     scene = commands.add_parser("scene", help="print the fully resolved scene as TOML")
     scene_options(scene)
     _result_tools(commands)
+    _design_command(commands)
     return parser
+
+
+def _design_command(commands) -> None:
+    """The ``design`` subcommand (docs/design.md)."""
+    design = commands.add_parser(
+        "design", help="vary one input of a scene to meet a target within the stress limit",
+        description="Answer a design question about a scene (coupler.model = auto): the "
+                    "smallest coupler thickness, preload or rate, or the initial angle nearest "
+                    "the scene's, that meets the target while peak coupler stress x safety "
+                    "factor <= allowable. Prints the answer with every case behind it and "
+                    "writes them to an HDF5 file. An unreachable target: one line, exit 2.",
+        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    design.add_argument("--vary", required=True, choices=("thickness", "angle", "preload", "rate"))
+    target = design.add_mutually_exclusive_group(required=True)
+    target.add_argument("--peak-speed", type=float, metavar="RAD_PER_S", help="at least")
+    target.add_argument("--deployment-time", type=float, metavar="S", help="at most")
+    target.add_argument("--final-angle", type=float, metavar="DEG", help="at least")
+    design.add_argument("--allowable-stress", type=float, default=250e6, metavar="PA",
+                        help="allowable coupler stress (default 250e6, ASTM A36 yield)")
+    design.add_argument("--safety-factor", type=float, default=1.5, help="default 1.5")
+    design.add_argument("--range", nargs=2, type=float, metavar=("MIN", "MAX"),
+                        help="values searched, in the input's unit (m, deg, m, N/m)")
+    design.add_argument("--scene", metavar="FILE.toml", help="scene file (default cavezza2012)")
+    design.add_argument("--set", dest="overrides", action="append", default=[],
+                        metavar="SECTION.KEY=VALUE", help="override one scene value (TOML)")
+    design.add_argument("--out", default="results/design-question.h5", metavar="FILE.h5",
+                        help="evidence file (default results/design-question.h5)")
+
+
+def _design(args: argparse.Namespace) -> int:
+    from flex.bodies.reduction import reduction_cache_dir
+    from flex.data.outputs import check_output
+    from flex.data.scene import load_scene
+    from flex.experiments import design_question as dq
+    from flex.experiments.design import BASE_OVERRIDES
+
+    target = next(name for name in dq.TARGETS if getattr(args, name) is not None)
+    question = dq.Question(args.vary, target, getattr(args, target), args.allowable_stress,
+                           args.safety_factor, tuple(args.range) if args.range else None)
+    question.check()
+    path = check_output(args.out, [args.scene] if args.scene else [])
+    scene = load_scene(args.scene, BASE_OVERRIDES + list(args.overrides))
+    result = dq.answer(scene, question, reduction_cache_dir(os.environ))
+    _print(dq.answer_text(result))
+    _print(f"wrote {dq.write_answer(result, scene, path)}")
+    return EXIT_OK
 
 
 PATH_HELP = ("path inside the file: cases/<case>/crank/angle, <case>/crank/angle, or "
@@ -289,7 +336,7 @@ def _dispatch(argv: list[str] | None) -> int:
     args, extra = parser.parse_known_args(argv)
     if args.command is None:
         parser.error(f"unrecognized arguments: {' '.join(extra)}" if extra else
-                     "a COMMAND is required: run, scene, inspect, plot, compare or report")
+                     "a COMMAND is required: run, scene, design, inspect, plot, compare or report")
     if extra:  # PATHs after options (compare A B --rtol 1e-6 PATH): argparse leaves them over
         if args.command in ("plot", "compare") and not any(e.startswith("-") for e in extra):
             args.paths += extra
@@ -297,6 +344,8 @@ def _dispatch(argv: list[str] | None) -> int:
             parser.error(f"unrecognized arguments: {' '.join(extra)}")
     if args.command == "run":
         return _run(args)
+    if args.command == "design":
+        return _design(args)
     if args.command == "scene":
         from flex.config.usage import explicit_keys
         from flex.data.scene import to_toml

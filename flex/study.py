@@ -51,7 +51,8 @@ from flex.fidelity.simulation import simulate_case
 from flex.tools.report import default_report_path, write_report
 
 STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring", "kfit",
-           "tradeoff", "stability", "bench", "wing", "crank", "estimates")
+           "tradeoff", "stability", "bench", "wing", "crank", "estimates",
+           "calibrate", "design", "validation")
 RESULTS_DIR = Path("results")
 
 

@@ -280,6 +280,10 @@ def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
         function = function.func
     if settings.has_auto(scene):  # a changed table must not resume stale cases
         extra += repr(sorted(settings.solver_defaults().items()))
+    if settings.has_auto(scene) or settings.has_auto_link_keys(scene):  # nor a changed rule
+        from flex.config.ffrf_rule import rule_constants
+
+        extra += repr(sorted(rule_constants().items()))
     extra += criteria_in_force_text(scene)  # a re-fit must not resume stale auto cases
     version = getattr(function, "case_version", None)
     if version is not None:

@@ -249,7 +249,12 @@ def test_modes_for_cutoff_follow_the_beam_estimates():
                                                    "in_plane"]
     assert hz == pytest.approx([827, 2282, 4113, 4487], rel=0.1)
     assert criteria.modes_for_cutoff(scene, 2 * math.pi * 1000) == 2  # at least 2
-    assert criteria.modes_for_cutoff(scene, 2 * math.pi * 4300) == 3
+    # in_plane reductions keep no torsion mode: below 4300 Hz only the two bending modes
+    assert criteria.modes_for_cutoff(scene, 2 * math.pi * 4300) == 2
+    assert criteria.modes_for_cutoff(scene, 2 * math.pi * 4600) == 3
+    every_kind = load_scene(None, ['coupler.geometry="plate"', "coupler.thickness_m=0.001",
+                                   'coupler.mode_selection="all"'])
+    assert criteria.modes_for_cutoff(every_kind, 2 * math.pi * 4300) == 3
     assert criteria.modes_for_cutoff(scene, 1e9) == criteria.MAX_AUTO_MODES
 
 

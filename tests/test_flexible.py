@@ -197,7 +197,8 @@ def test_nonlinear_fe_coupler_follows_its_ffrf_twin():
     # coarse 5 mm plate (1.4k coordinates), first 0.5 ms: geometric nonlinearity is
     # negligible here (compression / Euler load ~ 0.01), so the two flexible models must agree
     # with each other much better than with the rigid twin
-    plate = COARSE_PLATE_SCENE + ["simulation.end_time_s=0.0005"]
+    plate = COARSE_PLATE_SCENE + ["simulation.end_time_s=0.0005", "coupler.modes=6",
+                                  "simulation.step_s=1e-5"]
     data = {model: {k: v.data for k, v in simulate(load_scene(
         overrides=plate + [f'coupler.model="{model}"'])).datasets.items()}
         for model in ("ffrf", "nonlinear_fe", "rigid")}

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from flex.base.errors import SceneError
+from flex.config.ffrf_rule import level_for, load_time_scale_s, steps_per_first_period
 from flex.config.settings import (
     AUTO_KEYS,
     pinned_overrides,
@@ -33,34 +36,59 @@ def test_rigid_links_get_the_rigid_entry():
     assert scene["simulation"]["step_s"] == 1e-5  # the thesis table's grid
 
 
-def test_the_certified_plate_gets_the_ffrf_entry():
+def _rule_step(thickness_m=0.001, tolerance=0.01):
+    """The step the rule should give an 80 mm steel plate: T1 / N of the level (closed form
+    pinned-pinned period, independent of flex.config.ffrf_rule)."""
+    import math
+
+    omega = (math.pi / 0.080) ** 2 * math.sqrt(200e9 * thickness_m**2 / 12 / 7850.0)
+    level = level_for(tolerance)
+    scene = load_scene(None, PLATE + [f"coupler.thickness_m={thickness_m}"])
+    per = steps_per_first_period(level, load_time_scale_s(scene) * omega / (2 * math.pi))
+    return 2 * math.pi / omega / per, level
+
+
+def test_an_ffrf_coupler_gets_the_rule_s_step_modes_and_mesh():
     scene, choice = resolve_solver_settings(load_scene(None, PLATE))
-    assert choice.entry == "ffrf_coupler"
-    assert scene["simulation"]["step_s"] == 4e-4
+    step, level = _rule_step()
+    assert choice.entry == "ffrf_rule" and choice.accuracy == level["tolerance"]
+    assert scene["simulation"]["step_s"] == pytest.approx(step, rel=1e-9)
     assert scene["simulation"]["newton"] == "modified"
-    assert "357.6 Hz" in choice.reason  # 1 mm steel plate, 80 mm pinned-pinned
+    assert scene["coupler"]["modes"] == level["modes"]
+    assert scene["coupler"]["mesh_size_m"] == pytest.approx(0.002)  # min(2 t, L / 16)
+    assert choice.keys["coupler.modes"] == level["modes"]
+    assert "T1 = 0.002796 s" in choice.reason  # 357.6 Hz: 1 mm steel, 80 mm pinned-pinned
+
+
+@pytest.mark.parametrize("thickness_m, mesh_m", [(0.003, 0.005), (0.01, 0.005)])
+def test_the_rule_scales_with_the_plate(thickness_m, mesh_m):
+    scene, choice = resolve_solver_settings(load_scene(None, PLATE + [
+        f"coupler.thickness_m={thickness_m}"]))
+    step, _ = _rule_step(thickness_m)
+    assert choice.entry == "ffrf_rule"
+    assert scene["simulation"]["step_s"] == pytest.approx(step, rel=1e-9)
+    assert scene["coupler"]["mesh_size_m"] == pytest.approx(mesh_m)  # L / 16 caps 2 t
 
 
 @pytest.mark.parametrize("change, why", [
-    ("coupler.thickness_m=0.003", "thickness_m = 0.003 (certified: 0.001)"),
-    # thinner plates deflect more: 0.3 mm fails Newton at the second 4e-4 s step, 0.5 mm at
-    # 21 ms (measured with flex run simulate); they keep the rigid model's step
-    ("coupler.thickness_m=0.0005", "thickness_m = 0.0005 (certified: 0.001)"),
-    ("coupler.width_m=0.02", "width_m = 0.02 (certified: 0.01)"),
-    ("fidelity.tolerance=0.001", "finer than the FFRF coupler's certified 0.01"),
-    ('coupler.model="nonlinear_fe"', 'no certified setting for coupler.model = "nonlinear_fe"'),
+    # 0.2 mm: L / t = 400, beyond the calibrated slenderness
+    ("coupler.thickness_m=0.0002", "outside the calibrated family (length_m / thickness_m"),
+    ("fidelity.tolerance=1e-5", "finer than the finest calibrated level"),
+    ('coupler.model="nonlinear_fe"', 'no calibrated rule for coupler.model = "nonlinear_fe"'),
 ])
-def test_uncertified_flexible_scenes_fall_back_to_the_flexible_entry(change, why):
+def test_flexible_scenes_outside_the_rule_fall_back_visibly(change, why):
     scene, choice = resolve_solver_settings(load_scene(None, PLATE + [change]))
     assert choice.entry == "flexible_fallback" and why in choice.reason
     assert scene["simulation"]["step_s"] == 1e-5  # the rigid step, with modified Newton
     assert scene["simulation"]["newton"] == "modified"
 
 
-def test_mesh_and_modes_are_the_scene_s_choice():
-    _, choice = resolve_solver_settings(load_scene(None, PLATE + [
-        "coupler.mesh_size_m=0.004", "coupler.modes=2"]))
-    assert choice.entry == "ffrf_coupler"
+def test_mesh_and_modes_given_by_the_scene_are_kept():
+    scene, choice = resolve_solver_settings(load_scene(None, PLATE + [
+        "coupler.mesh_size_m=0.004", "coupler.modes=12"]))
+    assert choice.entry == "ffrf_rule"
+    assert scene["coupler"]["modes"] == 12 and scene["coupler"]["mesh_size_m"] == 0.004
+    assert "coupler.modes = 12 is more than the rule's" in choice.reason
 
 
 def test_an_ffrf_crank_falls_back_to_the_flexible_entry():
@@ -73,7 +101,8 @@ def test_explicit_values_win_and_only_auto_keys_are_filled():
     scene, choice = resolve_solver_settings(load_scene(None, PLATE + [
         "simulation.step_s=1e-4", "simulation.spectral_radius=0.5"]))
     assert scene["simulation"]["step_s"] == 1e-4 and scene["simulation"]["spectral_radius"] == 0.5
-    assert set(choice.keys) == {"newton", "newton_relative_tolerance"}
+    assert set(choice.keys) == {"newton", "newton_relative_tolerance", "coupler.modes",
+                                "coupler.mesh_size_m"}
     assert scene["simulation"]["newton"] == "modified"
 
 
@@ -84,9 +113,10 @@ def test_pinned_overrides_leave_nothing_to_resolve():
 
 
 def test_an_output_interval_below_the_chosen_step_is_one_clear_error():
-    scene = load_scene(None, PLATE + ["simulation.output_step_s=1e-5"])
-    with pytest.raises(SceneError, match=r"output_step_s = 1e-05 must be >= simulation.step_s "
-                                         r"= 0.0004.*step_s = \"auto\" chose 0.0004 s"):
+    scene = load_scene(None, PLATE + ["simulation.output_step_s=1e-6"])
+    step = re.escape(f"{_rule_step()[0]:g}")
+    with pytest.raises(SceneError, match=rf"output_step_s = 1e-06 must be >= simulation.step_s "
+                                         rf"= {step}.*step_s = \"auto\" chose {step} s"):
         resolve_solver_settings(scene)
 
 
@@ -100,19 +130,22 @@ def test_auto_is_refused_where_flex_has_no_choice():
 
 def test_solver_settings_report_the_resolved_values():
     settings = solver_settings(load_scene(None, PLATE))
-    assert settings["step_s"] == 4e-4 and settings["modified_newton"] is True
-    assert settings["steps"] == 75
+    step = _rule_step()[0]
+    assert settings["step_s"] == pytest.approx(step, rel=1e-9)
+    assert settings["modified_newton"] is True
+    assert settings["steps"] == round(0.03 / step)
 
 
 def test_a_default_ffrf_run_uses_and_records_the_chosen_settings(reduction_cache):
-    result = simulate(load_scene(None, PLATE + ["simulation.end_time_s=0.004"]), "default",
-                      cache_dir=reduction_cache)
+    step = _rule_step()[0]
+    result = simulate(load_scene(None, PLATE + [f"simulation.end_time_s={10 * step!r}"]),
+                      "default", cache_dir=reduction_cache)
     time_s = result.datasets["time"].data
-    assert len(time_s) == 11 and time_s[1] - time_s[0] == pytest.approx(4e-4)  # 0.004 s
-    assert result.attrs["solver_defaults_entry"] == "ffrf_coupler"
-    assert "step_s = 0.0004" in result.attrs["solver_defaults_keys"]
-    assert 'step_s = 0.0004' in result.scene_toml and '"auto"' not in result.scene_toml
-    assert resolved_simulation(load_scene(None, PLATE))["step_s"] == 4e-4
+    assert len(time_s) == 11 and time_s[1] - time_s[0] == pytest.approx(step)
+    assert result.attrs["solver_defaults_entry"] == "ffrf_rule"
+    assert f"step_s = {step!r}" in result.attrs["solver_defaults_keys"]
+    assert f"step_s = {step!r}" in result.scene_toml and '"auto"' not in result.scene_toml
+    assert resolved_simulation(load_scene(None, PLATE))["step_s"] == pytest.approx(step)
 
 
 def test_inspect_shows_the_resolved_solver_keys_and_no_scene_change(tmp_path, capsys,
@@ -121,12 +154,14 @@ def test_inspect_shows_the_resolved_solver_keys_and_no_scene_change(tmp_path, ca
     from flex.data.results import write_results
     from flex.data.scene import to_toml
 
-    scene = load_scene(None, PLATE + ["simulation.end_time_s=0.004"])
+    step = _rule_step()[0]
+    scene = load_scene(None, PLATE + [f"simulation.end_time_s={10 * step!r}"])
     case = simulate(scene, "default", cache_dir=reduction_cache)
     path = write_results(tmp_path / "auto.h5", "simulate", [case], to_toml(scene))
     assert main(["inspect", str(path)]) == 0
     out = capsys.readouterr().out
-    assert 'solver: "auto" -> step_s = 0.0004' in out and "(ffrf_coupler: " in out
+    assert 'solver: "auto" -> coupler.modes = ' in out and f"step_s = {step!r}" in out
+    assert "(ffrf_rule: " in out
     assert "the file's scene with" not in out  # flex's choices are not the user's changes
 
 
@@ -138,7 +173,9 @@ def test_flex_scene_says_what_auto_resolves_to(capsys):
     assert main(["scene", "simulate", "--set", 'coupler.geometry="plate"',
                  "--set", 'coupler.model="ffrf"']) == 0
     out = capsys.readouterr().out
-    assert out.startswith('# [simulation] "auto" keys -> step_s = 0.0004')
+    head = out.splitlines()[0]
+    assert head.startswith('# [simulation] "auto" keys -> coupler.modes = ')
+    assert f"step_s = {_rule_step()[0]!r}" in head
     assert tomllib.loads(out)["simulation"]["step_s"] == "auto"  # still valid TOML
     assert main(["scene", "simulate", "--set", 'coupler.geometry="plate"',
                  "--set", 'coupler.model="auto"']) == 0

@@ -276,3 +276,18 @@ def clamped_plate_frequencies(length_m: float, thickness_m: float, width_m: floa
                       "torsion"))
         modes.append((axial_omega(index + 1, length, e, rho), "axial"))
     return sorted(modes)[:count]
+
+
+#: mode kinds symmetric about the mechanism plane: what an ``in_plane`` reduction keeps
+IN_PLANE_KINDS = ("in_plane", "axial")
+
+
+def in_plane_fixed_interface_omegas(length_m: float, thickness_m: float, width_m: float,
+                                    youngs_modulus_Pa: float, density_kg_per_m3: float,
+                                    poisson_ratio: float, count: int) -> list[float]:
+    """The ``count`` lowest estimated fixed-interface circular frequencies [rad/s] of the
+    modes symmetric about the mechanism plane (in-plane bending and axial): the eigenmodes
+    an ``in_plane`` reduction keeps (:func:`clamped_plate_frequencies`, ascending)."""
+    estimates = clamped_plate_frequencies(length_m, thickness_m, width_m, youngs_modulus_Pa,
+                                          density_kg_per_m3, poisson_ratio, 4 * count + 8)
+    return [omega for omega, kind in estimates if kind in IN_PLANE_KINDS][:count]

@@ -40,6 +40,7 @@ from importlib import resources
 from typing import Any
 
 from flex.base.errors import SceneError
+from flex.config.ffrf_rule import LINK_KEYS, RulePick, fill_link_keys, pick
 from flex.data.scene import MAX_STEPS, Scene, check_drive_steps, check_meshed_plate, check_steps
 
 #: the ``[simulation]`` keys that may be ``"auto"``
@@ -86,56 +87,62 @@ def has_auto(scene: Scene) -> bool:
     return any(scene["simulation"].get(key) == AUTO for key in AUTO_KEYS)
 
 
-def _bending_omega(plate: dict[str, Any]) -> float:
-    from flex.base.physics import pinned_pinned_omega
+def has_auto_link_keys(scene: Scene) -> bool:
+    """Whether a link's ``modes`` or ``mesh_size_m`` is ``"auto"`` (flex.config.ffrf_rule)."""
+    return any(scene[link].get(key) == AUTO for link in ("crank", "coupler")
+               for key in LINK_KEYS)
 
-    return pinned_pinned_omega(plate["length_m"], plate["thickness_m"],
-                               plate["youngs_modulus_Pa"], plate["density_kg_per_m3"])
+
+def resolve_link_keys(scene: Scene) -> tuple[Scene, dict[str, Any]]:
+    """``scene`` (a copy) with the links' ``"auto"`` modes and mesh size filled by the rule
+    (:func:`flex.config.ffrf_rule.fill_link_keys` at ``fidelity.tolerance``), and what was
+    filled (``"coupler.modes"`` -> value)."""
+    resolved = copy.deepcopy(scene)
+    filled: dict[str, Any] = {}
+    tolerance = float(scene["fidelity"]["tolerance"])
+    for link in ("crank", "coupler"):
+        for key, value in fill_link_keys(resolved, link, tolerance).items():
+            filled[f"{link}.{key}"] = value
+    return resolved, filled
 
 
-def choose_entry(scene: Scene) -> tuple[str, str]:
-    """The entry (``"rigid"``, ``"ffrf_coupler"`` or ``"flexible_fallback"``) for ``scene``
-    and the reason."""
-    defaults = solver_defaults()
+def choose_entry(scene: Scene) -> tuple[str, str, RulePick | None]:
+    """The entry (``"rigid"``, ``"ffrf_rule"`` or ``"flexible_fallback"``) for ``scene``,
+    the reason, and the rule's pick (``ffrf_rule`` only)."""
     crank, coupler = scene["crank"]["model"], scene["coupler"]["model"]
     if AUTO in (crank, coupler):
         raise ValueError('resolve model = "auto" links before the solver settings')
     if crank == "rigid" and coupler == "rigid":
-        return "rigid", "rigid links"
-    entry = defaults["ffrf_coupler"]
-    level = entry["accuracy"]
+        return "rigid", "rigid links", None
     if coupler != "ffrf" or crank != "rigid":
         what = ("an FFRF crank" if crank == "ffrf" else f'coupler.model = "{coupler}"')
-        return "flexible_fallback", f"no certified setting for {what}: {FALLBACK}"
-    tolerance = scene["fidelity"]["tolerance"]
-    if tolerance < level:
-        return "flexible_fallback", (
-            f"fidelity.tolerance = {tolerance:g} is finer than the FFRF coupler's "
-                         f"certified {level:g}: {FALLBACK}")
-    plate = entry["certified_plate"]
-    differs = [f"{key} = {scene['coupler'][key]:g} (certified: {value:g})"
-               for key, value in plate.items()
-               if not math.isclose(scene["coupler"][key], value, rel_tol=1e-9)]
-    if differs:
-        return "flexible_fallback", (f"the coupler plate is not the certified one "
-                                     f"({', '.join(differs)}): {FALLBACK}")
-    omega = _bending_omega(scene["coupler"])
-    return "ffrf_coupler", (f"FFRF coupler on a rigid crank, fidelity.tolerance = {tolerance:g} "
-                            f">= {level:g}, the certified plate (first bending frequency "
-                            f"{omega / (2 * math.pi):.4g} Hz)")
+        return "flexible_fallback", f"no calibrated rule for {what}: {FALLBACK}", None
+    tolerance = float(scene["fidelity"]["tolerance"])
+    chosen = pick(scene, tolerance)
+    if chosen.step_s is None:
+        return "flexible_fallback", f"FFRF coupler {chosen.reason}: {FALLBACK}", None
+    reason = f"FFRF coupler on a rigid crank at fidelity.tolerance = {tolerance:g}: {chosen.reason}"
+    if scene["coupler"]["modes"] > chosen.modes:
+        reason += (f"; coupler.modes = {scene['coupler']['modes']} is more than the rule's "
+                   f"{chosen.modes}: the step is calibrated for {chosen.modes} (modes the step "
+                   f"does not resolve can move the peak, set simulation.step_s smaller)")
+    return "ffrf_rule", reason, chosen
 
 
 def resolve_solver_settings(scene: Scene) -> tuple[Scene, SolverChoice | None]:
-    """``scene`` with its ``"auto"`` solver keys filled in (see module doc)."""
-    if not has_auto(scene):
+    """``scene`` with its ``"auto"`` solver and link keys filled in (see module doc)."""
+    if not (has_auto(scene) or has_auto_link_keys(scene)):
         return scene, None
-    name, reason = choose_entry(scene)
+    resolved, filled = resolve_link_keys(scene)
+    name, reason, chosen = choose_entry(resolved)
     entry = solver_defaults()[name]
-    resolved = copy.deepcopy(scene)
-    filled = {}
+    values = dict(entry)
+    accuracy = entry["accuracy"]
+    if chosen is not None:
+        values["step_s"], accuracy = chosen.step_s, chosen.level
     for key in AUTO_KEYS:
         if resolved["simulation"][key] == AUTO:
-            resolved["simulation"][key] = filled[key] = entry[key]
+            resolved["simulation"][key] = filled[key] = values[key]
     step, end = resolved["simulation"]["step_s"], resolved["simulation"]["end_time_s"]
     if step > end:  # a short run: one step over the whole span
         resolved["simulation"]["step_s"] = filled["step_s"] = end
@@ -144,7 +151,7 @@ def resolve_solver_settings(scene: Scene) -> tuple[Scene, SolverChoice | None]:
     except SceneError as exc:
         raise SceneError(f"{exc} (step_s = \"auto\" chose {filled.get('step_s', step):g} s "
                          f"for {name}: set simulation.step_s explicitly)") from None
-    return resolved, SolverChoice(name, entry["accuracy"], filled, reason)
+    return resolved, SolverChoice(name, accuracy, filled, reason)
 
 
 def resolved_simulation(scene: Scene) -> dict[str, Any]:
@@ -162,15 +169,23 @@ def resolved_simulation(scene: Scene) -> dict[str, Any]:
     return resolve_solver_settings(probe)[0]["simulation"]
 
 
+#: the coupler's modes and mesh size the bundled scene had before they became "auto" (6
+#: fixed-interface modes, 2 mm): pinned with the solver keys, so a pinned study's numbers do not
+#: move with the rule (flex.config.ffrf_rule)
+PINNED_COUPLER_DISCRETIZATION = ("coupler.modes=6", "coupler.mesh_size_m=0.002")
+
+
 def pinned_overrides(entry: str = "rigid") -> list[str]:
-    """``--set`` overrides that fix the solver keys to an entry's values.
+    """``--set`` overrides that fix the solver keys to an entry's values (and the coupler's
+    modes and mesh size to :data:`PINNED_COUPLER_DISCRETIZATION`).
 
     For studies whose numbers must not move with the defaults (a knob study varies one
     setting around a fixed base; a thesis figure needs the 1e-5 s grid).
     """
     values = solver_defaults()[entry]
     return [f"simulation.{key}={values[key]!r}" if not isinstance(values[key], str)
-            else f'simulation.{key}="{values[key]}"' for key in AUTO_KEYS]
+            else f'simulation.{key}="{values[key]}"' for key in AUTO_KEYS] + list(
+        PINNED_COUPLER_DISCRETIZATION)
 
 
 def check_runnable(scene: Scene) -> None:
@@ -194,6 +209,7 @@ def check_runnable(scene: Scene) -> None:
       must pass for at least one model ``auto`` may choose (a check that fails for only
       some choices is left to the run, which then stores a failed case naming it).
     """
+    scene, _ = resolve_link_keys(scene)
     for link in ("crank", "coupler"):
         check_meshed_plate(link, scene[link])
     candidates = _model_candidates(scene)

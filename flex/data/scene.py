@@ -76,12 +76,15 @@ def _plate_fields(link: str) -> dict[str, Field]:
         "youngs_modulus_Pa": Field(doc="Young's modulus", **_POS),
         "density_kg_per_m3": Field(doc="material density", **_POS),
         "poisson_ratio": Field(float, "Poisson's ratio", positive=True, below=0.5),
-        "modes": Field(int, "fixed-interface Craig-Bampton modes", minimum=1, maximum=100),
+        "modes": Field(int, "fixed-interface Craig-Bampton modes (auto: from "
+                       "fidelity.tolerance, flex.config.ffrf_rule)", minimum=1, maximum=100,
+                       auto=True),
         "mode_selection": Field(("in_plane", "all"),
                                 "which modes the reduction keeps: in_plane (the modes a planar "
                                 "mechanism loads, symmetric about its plane) or all (the "
                                 "lowest of any kind)"),
-        "mesh_size_m": Field(doc="netgen maximum element size", **_POS),
+        "mesh_size_m": Field(doc="netgen maximum element size (auto: min(2 t, L / 16), "
+                             "flex.config.ffrf_rule)", auto=True, **_POS),
         "damping_ratio": Field(float, "modal damping ratio", minimum=0.0, below=1.0),
     }
 
@@ -632,6 +635,8 @@ def check_meshed_plate(link: str, values: dict[str, Any]) -> None:
             raise SceneError(f"{name} = {thickness:g}: a meshed plate link must be at "
                              f"{word} {link}.length_m / {ratio:g} = {bound:g} m thick "
                              f"({why}){as_mass(relation, bound)}; {meaning}")
+    if mesh == "auto":  # checked once resolved (flex.config.settings.check_runnable)
+        return
     if mesh > length * (1 + 1e-9):
         raise SceneError(f"{link}.mesh_size_m = {mesh:g} must be <= {link}.length_m = "
                          f"{length:g} ({why}); about 1-2 x thickness_m is accurate")

@@ -38,7 +38,13 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import FlexError, SimulationError, Terminated
-from flex.config.settings import check_runnable, resolve_solver_settings, resolved_simulation
+from flex.config.settings import (
+    check_runnable,
+    has_auto_link_keys,
+    resolve_link_keys,
+    resolve_solver_settings,
+    resolved_simulation,
+)
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, check_meshed_plate, estimate_mesh, to_toml
 from flex.dynamics import planar
@@ -375,6 +381,8 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
     """
     from flex.bodies.reduction import build_reduction
 
+    if has_auto_link_keys(scene):  # "auto" modes and mesh: the rule's (flex.config.ffrf_rule)
+        scene, _ = resolve_link_keys(scene)
     c = scene[link]
     check_meshed_plate(link, dict(c, model="ffrf"))  # refused before any meshing
     _announce_mesh(link, c, "reduction (instant if cached)")
@@ -393,6 +401,18 @@ def scene_reductions(scene: Scene, reduction: Any = None, crank_reduction: Any =
     if scene["crank"]["model"] == "ffrf" and crank_reduction is None:
         crank_reduction = reduction_for_scene(scene, "crank", cache_dir=cache_dir)
     return reduction, crank_reduction
+
+
+def _highest_retained_omega(values: dict[str, Any]) -> float:
+    """Beam estimate of the highest fixed-interface circular frequency [rad/s] a link's
+    reduction keeps (its ``modes`` lowest of the kinds its ``mode_selection`` keeps)."""
+    from flex.base.physics import clamped_plate_frequencies, in_plane_fixed_interface_omegas
+
+    plate = (values["length_m"], values["thickness_m"], values["width_m"],
+             values["youngs_modulus_Pa"], values["density_kg_per_m3"], values["poisson_ratio"])
+    if values["mode_selection"] == "in_plane":
+        return in_plane_fixed_interface_omegas(*plate, count=values["modes"])[-1]
+    return clamped_plate_frequencies(*plate, count=values["modes"])[-1][0]
 
 
 #: a mesh whose estimated build takes longer than this is announced on stderr first [s]
@@ -678,7 +698,7 @@ def time_scales(scene: Scene, reductions: dict[str, Any] | None = None
     """The scene's time scales a fixed step must resolve: ``(period [s], steps per period
     needed, what)``, shortest first. ``reductions``: the built reductions by link (their
     highest retained mode is then known, else estimated from the plate)."""
-    from flex.base.physics import clamped_plate_frequencies, pinned_pinned_omega
+    from flex.base.physics import pinned_pinned_omega
     from flex.data.scene import plate_mass_properties
 
     reductions = reductions or {}
@@ -699,10 +719,7 @@ def time_scales(scene: Scene, reductions: dict[str, Any] | None = None
                     hertz = float(np.max(reductions[link].fixed_interface_frequencies_Hz))
                     omega, how = 2 * np.pi * hertz, "highest retained mode"
                 else:
-                    omega = clamped_plate_frequencies(
-                        values["length_m"], values["thickness_m"], values["width_m"],
-                        values["youngs_modulus_Pa"], values["density_kg_per_m3"],
-                        values["poisson_ratio"], count=values["modes"])[-1][0]
+                    omega = _highest_retained_omega(values)
                     how = "highest retained mode (beam estimate)"
                 out.append((2 * np.pi / omega, STEPS_PER_PERIOD, f"period of the {link}'s {how}"))
             elif values["model"] == "nonlinear_fe":

@@ -46,6 +46,7 @@ import numpy as np
 from flex.base.errors import FlexError, SceneError
 from flex.base.kinematics import chord_components
 from flex.base.physics import (  # noqa: F401 - part of this module's face
+    IN_PLANE_KINDS,
     TWO_PI,
     clamped_plate_frequencies,
     euler_buckling_load_N,
@@ -633,9 +634,13 @@ def modes_for_cutoff(scene: Mapping[str, Mapping[str, Any]], omega_cut_rad_per_s
     :data:`MAX_AUTO_MODES`. ``link``: ``"coupler"`` or ``"crank"`` (plate geometry).
     """
     c = scene[link]
+    in_plane = c.get("mode_selection") == "in_plane"  # the reduction keeps only these kinds
     estimates = clamped_plate_frequencies(c["length_m"], c["thickness_m"], c["width_m"],
                                           c["youngs_modulus_Pa"], c["density_kg_per_m3"],
-                                          c["poisson_ratio"], count=MAX_AUTO_MODES + 10)
+                                          c["poisson_ratio"],
+                                          count=(4 if in_plane else 1) * (MAX_AUTO_MODES + 10))
+    if in_plane:
+        estimates = [(omega, kind) for omega, kind in estimates if kind in IN_PLANE_KINDS]
     first_in_plane = next(i for i, (_, kind) in enumerate(estimates) if kind == "in_plane")
     below = sum(1 for omega, _ in estimates if omega < omega_cut_rad_per_s)
     return int(min(MAX_AUTO_MODES, max(MIN_AUTO_MODES, first_in_plane + 1, below)))
@@ -876,7 +881,16 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
 
 def _mode_cut(decision: FidelityDecision, resolved: dict[str, dict[str, Any]], link: str,
               k_phys: float, delta_t_s: float) -> None:
-    """An ``ffrf`` decision keeps every estimated mode below omega_cut = k / delta_t."""
+    """An ``ffrf`` decision keeps every estimated mode below omega_cut = k / delta_t; a link
+    whose ``modes`` is ``"auto"`` gets the tolerance rule's instead (:mod:`flex.config.
+    ffrf_rule`, with the mesh and the step)."""
+    if resolved[link]["modes"] == "auto":
+        from flex.config.ffrf_rule import fill_link_keys
+
+        decision.modes = fill_link_keys(resolved, link, decision.tolerance)["modes"]
+        decision.reason += (f"; modes = {decision.modes}: the tolerance rule's "
+                            f"(flex.config.ffrf_rule)")
+        return
     omega_cut = k_phys * TWO_PI / delta_t_s
     decision.modes = modes_for_cutoff(resolved, omega_cut, link)
     resolved[link]["modes"] = decision.modes

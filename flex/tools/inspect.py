@@ -125,9 +125,9 @@ def _parse_toml(text: str) -> dict[str, Any] | None:
 
 def _changes(base: dict[str, Any] | None, scene: dict[str, Any] | None,
              filled_by_flex: str = "") -> dict[str, Any]:
-    """``{"section.key": value}`` where ``scene`` differs from ``base``; ``"auto"`` simulation
-    keys that flex filled (``filled_by_flex``: the case's ``solver_defaults_keys``) are not
-    changes."""
+    """``{"section.key": value}`` where ``scene`` differs from ``base``; ``"auto"`` keys that
+    flex filled (``filled_by_flex``: the case's ``solver_defaults_keys``: simulation keys by
+    name, link keys as ``coupler.modes``) are not changes."""
     if base is None or scene is None:
         return {}
     filled = {item.split(" = ")[0] for item in filled_by_flex.split(", ") if item}
@@ -136,8 +136,8 @@ def _changes(base: dict[str, Any] | None, scene: dict[str, Any] | None,
         if not isinstance(table, dict):
             continue
         for key, value in table.items():
-            if section == "simulation" and key in filled:
-                continue
+            if (section == "simulation" and key in filled) or f"{section}.{key}" in filled:
+                continue  # a solver key, or a link's modes / mesh size, that flex filled
             if not isinstance(base.get(section), dict) or base[section].get(key) != value:
                 out[f"{section}.{key}"] = value
     return out

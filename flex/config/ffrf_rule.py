@@ -1,0 +1,204 @@
+"""Settings from the tolerance for an FFRF link: modes, mesh and step from the scene's physics.
+
+Given ``fidelity.tolerance`` (relative error of the peak elastic midpoint deflection, the
+most demanding headline quantity), the rule chooses for an FFRF coupler on a rigid crank:
+
+- the **step** from the link's first bending period ``T1`` (pinned-pinned, Euler-Bernoulli,
+  :func:`flex.base.physics.pinned_pinned_omega`): ``h = T1 / steps_per_first_period``. The
+  deflection is the first mode's response to the joint loads; generalized-alpha resolves a
+  period with an error that falls with the square of ``h / T``, so one dimensionless number
+  per tolerance holds for every plate whose spectrum has the same shape (a beam's);
+- the **modes**: the ``modes`` lowest in-plane fixed-interface eigenmodes (symmetric about
+  the mechanism plane: what a planar load excites). More modes than the step resolves do not
+  help: generalized-alpha damps a mode of period below a few steps, and an unresolved mode
+  rings with a step-dependent phase that moves the peak (measured: 16 modes at T1/8 erred
+  by 1.4 %, 2 modes at T1/8 by less than 0.3 %);
+- the **mesh** from the element size the retained modes need: ``min(MESH_PER_THICKNESS t,
+  L / MESH_PER_LENGTH)`` -- quadratic tetrahedra resolve bending across a thin plate at
+  about twice its thickness (modal study: first frequency within 0.1 %), and a thick one
+  needs elements along its length (a half wavelength of the highest retained mode spans
+  L / (modes + 1)).
+
+The two numbers per tolerance level (``modes``, ``steps_per_first_period``) are calibrated by
+``make calibrate`` (:mod:`flex.experiments.calibration`) over a family of plates, materials,
+springs and drives: the cheapest pair whose error stays within the level, with a margin, on
+every calibration scene; they live in ``flex/config/ffrf_rule.toml`` with the family's bounds
+and the errors measured. A tolerance between levels uses the next finer level. Outside the
+calibrated family (slenderness, tolerance finer than the finest level, an FFRF crank, the
+nonlinear FE coupler) the rule says so and :mod:`flex.config.settings` falls back visibly.
+
+Contract: pure functions of the scene's values; nothing is meshed or run.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+from typing import Any
+
+from flex.base.physics import pinned_pinned_omega
+from flex.data.scene import plate_mass_properties
+
+#: steps per first bending period the rule chooses from (make calibrate's grid)
+STEP_GRID = (4, 8, 16, 32, 64, 128)
+#: scene keys of a link the rule may fill when they are ``"auto"``
+LINK_KEYS = ("modes", "mesh_size_m")
+AUTO = "auto"
+
+
+@cache
+def rule_constants() -> dict[str, Any]:
+    """The calibrated constants (``flex/config/ffrf_rule.toml``, read once)."""
+    text = resources.files("flex.config").joinpath("ffrf_rule.toml").read_text("utf-8")
+    return tomllib.loads(text)
+
+
+@dataclass(frozen=True)
+class RulePick:
+    """What the rule chose for one FFRF link: ``step_s`` [s], ``modes`` (in-plane
+    fixed-interface eigenmodes), ``mesh_size_m`` [m], the calibrated ``level`` applied
+    (relative; None outside the calibrated family, then ``step_s`` is None) and one sentence
+    ``reason``."""
+
+    step_s: float | None
+    modes: int
+    mesh_size_m: float
+    level: float | None
+    reason: str
+
+
+def first_period_s(link: Mapping[str, Any]) -> float:
+    """First in-plane bending period [s] of a plate link, pinned-pinned (Euler-Bernoulli)."""
+    omega = pinned_pinned_omega(link["length_m"], link["thickness_m"],
+                                link["youngs_modulus_Pa"], link["density_kg_per_m3"])
+    return 2.0 * math.pi / omega
+
+
+def rule_mesh_size_m(link: Mapping[str, Any]) -> float:
+    """Element size [m] the rule gives a plate link: ``min(MESH_PER_THICKNESS t, L /
+    MESH_PER_LENGTH)``, and at most 20 x the plate's smaller side (netgen aspect limit)."""
+    mesh = rule_constants()["mesh"]
+    size = min(mesh["per_thickness"] * link["thickness_m"],
+               link["length_m"] / mesh["per_length"])
+    return float(min(size, 20.0 * min(link["thickness_m"], link["width_m"])))
+
+
+def outside_family(link: Mapping[str, Any], tolerance: float) -> str:
+    """Why a plate link and tolerance lie outside the calibrated family ("" if inside)."""
+    family = rule_constants()["family"]
+    slenderness = link["length_m"] / link["thickness_m"]
+    damping = damping_class(link)
+    levels = _levels(damping)
+    if not levels:
+        return f"no level is calibrated for {damping} links"
+    finest = levels[0]["tolerance"]
+    if not family["slenderness_min"] <= slenderness <= family["slenderness_max"]:
+        return (f"length_m / thickness_m = {slenderness:.4g} is outside the calibrated "
+                f"[{family['slenderness_min']:g}, {family['slenderness_max']:g}]")
+    if tolerance < finest * (1 - 1e-9):
+        return (f"fidelity.tolerance = {tolerance:g} is finer than the finest calibrated "
+                f"level {finest:g} for {damping} links")
+    return ""
+
+
+def damping_class(link: Mapping[str, Any]) -> str:
+    """``"damped"`` if the link's ``damping_ratio`` reaches the calibrated damped class's
+    (``family.damped_ratio_min``), else ``"undamped"``.
+
+    Why two classes: damped, the free vibration the release starts decays within about
+    1 / (2 pi zeta) first-mode periods (stiffness-proportional damping kills the higher modes
+    faster), so the peak is an early crest and only the first period needs resolving;
+    undamped, the peak is the highest of many crests over the whole run, and the step must
+    keep the first mode's phase and the retained modes' ringing over every period of it.
+    """
+    minimum = rule_constants()["family"].get("damped_ratio_min", math.inf)
+    return "damped" if link.get("damping_ratio", 0.0) >= minimum * (1 - 1e-9) else "undamped"
+
+
+def _levels(damping: str) -> list[dict[str, Any]]:
+    return sorted((level for level in rule_constants()["levels"]
+                   if level.get("damping", damping) == damping),
+                  key=lambda level: level["tolerance"])
+
+
+def level_for(tolerance: float, damping: str = "undamped") -> dict[str, Any]:
+    """The calibrated level of the ``damping`` class (:func:`damping_class`) that serves
+    ``tolerance``: the coarsest level at or below it (the finest level when ``tolerance``
+    is finer than every level)."""
+    levels = _levels(damping)
+    within = [level for level in levels if level["tolerance"] <= tolerance * (1 + 1e-9)]
+    return within[-1] if within else levels[0]
+
+
+def load_time_scale_s(scene: Mapping[str, Mapping[str, Any]]) -> float:
+    """The time scale [s] on which the mechanism loads its links: a spring drive's quarter
+    period ``(pi / 2) sqrt(m / k)`` with m the slider's, coupler's and crank's masses (the
+    spring pushing the whole mechanism), a constant-speed crank's half turn ``pi / |w|``."""
+    drive = scene["drive"]
+    if drive["kind"] == "constant_speed":
+        speed = abs(drive["crank_speed_rad_per_s"])
+        return math.pi / speed if speed > 0 else float(scene["simulation"]["end_time_s"])
+    mass = scene["slider"]["mass_kg"] + sum(plate_mass_properties(scene, link)[0]
+                                            for link in ("crank", "coupler"))
+    return 0.5 * math.pi * math.sqrt(mass / drive["spring_stiffness_N_per_m"])
+
+
+def steps_per_first_period(level: Mapping[str, Any], n_load: float) -> float | None:
+    """The grid value of steps per first period the level gives a link ``n_load = t_load /
+    T1`` first periods per load time scale: the smallest of :data:`STEP_GRID` at or above
+    ``steps_coefficient x n_load^(-steps_exponent)`` (None beyond the grid's finest)."""
+    # a level with a fixed count (no law) reads as coefficient N, exponent 0
+    coefficient = level.get("steps_coefficient", level.get("steps_per_first_period"))
+    wanted = coefficient * n_load ** (-level.get("steps_exponent", 0.0))
+    return next((float(n) for n in STEP_GRID if n >= wanted * (1 - 1e-9)), None)
+
+
+def pick(scene: Mapping[str, Mapping[str, Any]], tolerance: float, link: str = "coupler"
+         ) -> RulePick:
+    """The rule's settings for the FFRF plate ``link`` of ``scene`` at ``tolerance``."""
+    values = scene[link]
+    damping = damping_class(values)
+    mesh = rule_mesh_size_m(values)
+    outside = outside_family(values, tolerance)
+    if outside:
+        levels = _levels(damping) or _levels("undamped") or rule_constants()["levels"]
+        return RulePick(None, int(levels[0]["modes"]), mesh, None,
+                        f"outside the calibrated family ({outside})")
+    level = level_for(tolerance, damping)
+    period = first_period_s(values)
+    n_load = load_time_scale_s(scene) / period
+    per = steps_per_first_period(level, n_load)
+    if per is None:
+        return RulePick(None, int(level["modes"]), mesh, None, (
+            f"outside the calibrated family (n = t_load / T1 = {n_load:.3g} would need more "
+            f"than {STEP_GRID[-1]} steps per first period)"))
+    step = period / per
+    return RulePick(step, int(level["modes"]), mesh, float(level["tolerance"]), (
+        f"calibrated level {level['tolerance']:g} for {damping} links (make calibrate; "
+        f"worst calibration error {level['worst_error']:.2g}): n = t_load / T1 = "
+        f"{n_load:.3g} (load time scale {load_time_scale_s(scene):.3g} s), step T1 / {per:g} "
+        f"= {step:.3g} s (first bending period T1 = {period:.4g} s), {level['modes']} "
+        f"in-plane modes, mesh min({rule_constants()['mesh']['per_thickness']:g} t, L / "
+        f"{rule_constants()['mesh']['per_length']:g}) = {mesh * 1e3:.3g} mm"))
+
+
+def fill_link_keys(scene: dict[str, dict[str, Any]], link: str, tolerance: float
+                   ) -> dict[str, Any]:
+    """Fill the ``"auto"`` modes and mesh size of ``scene[link]`` in place with the rule's;
+    return what was filled (key -> value)."""
+    values = scene[link]
+    wanted = [key for key in LINK_KEYS if values.get(key) == AUTO]
+    if not wanted:
+        return {}
+    if values.get("geometry") != "plate":  # never meshed: left "auto"
+        return {}
+    chosen = pick(scene, tolerance, link)
+    chosen_modes, chosen_mesh = chosen.modes, chosen.mesh_size_m
+    choice = {"modes": chosen_modes, "mesh_size_m": chosen_mesh}
+    filled = {key: choice[key] for key in wanted}
+    values.update(filled)
+    return filled

@@ -1,0 +1,386 @@
+"""Calibrating and validating the FFRF settings rule (:mod:`flex.config.ffrf_rule`).
+
+For every scene of a family (FFRF coupler on a rigid crank: plates of several thicknesses
+and materials, springs and drives) :func:`measure_scene` runs
+
+- a **converged reference**: 12 in-plane modes, a mesh of about the thickness (at most L /
+  32, at least :data:`REFERENCE_MESH_FLOOR_M`) and a step that resolves the 12th mode
+  (:data:`REFERENCE_STEPS_PER_TOP_PERIOD` steps per period, at most T1 / 400), with the
+  evidence of three one-level coarsenings (8 modes, twice the step, 1.5 x the mesh; their
+  changes summed are the reference's accuracy, :func:`flex.experiments.tradeoff.
+  converged_reference`);
+- the **grid**: every pair of :data:`GRID_MODES` and :data:`GRID_STEPS_PER_PERIOD` (step T1 /
+  N) on the rule's mesh, each timed as a user runs it (whole ``simulate``, warm reduction
+  cache, median of ``repeats``) and measured against the reference (relative error of the
+  peak midpoint deflection, crank angle and slider position).
+
+:func:`fit_levels` picks, per tolerance level, the pair with the least total time over the
+calibration scenes whose certified error (measured + reference accuracy) stays within
+:data:`MARGIN` x the level on every one of them; :func:`validate` applies the fitted rule
+to scenes outside the calibration and compares it with the fastest grid pair that meets
+the level (target: within the level, at most :data:`SLOWDOWN_LIMIT` x slower).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.base.errors import FlexError
+from flex.base.physics import in_plane_fixed_interface_omegas
+from flex.config.ffrf_rule import (
+    STEP_GRID,
+    first_period_s,
+    load_time_scale_s,
+    rule_mesh_size_m,
+    steps_per_first_period,
+)
+from flex.data.results import CaseResult, Dataset
+from flex.data.scene import Scene, to_toml
+from flex.experiments.tradeoff import (
+    REFERENCE_MARGIN,
+    ReductionPool,
+    Reference,
+    Setting,
+    converged_reference,
+    measure,
+    scene_for,
+)
+
+#: the grid: in-plane eigenmodes and steps per first bending period
+GRID_MODES = (1, 2, 4, 8)
+GRID_STEPS_PER_PERIOD = tuple(float(n) for n in STEP_GRID)
+#: the tolerance levels calibrated (relative error of the peak midpoint deflection)
+LEVELS = (0.01, 0.001)
+#: a calibrated pair must keep every calibration scene within this fraction of the level
+#: (robustly: at its step and every finer one, :func:`robustly_within`)
+MARGIN = 0.7
+#: the rule's damping classes (flex.config.ffrf_rule.damping_class) and the smallest damping
+#: ratio of the damped class (the calibration's damped scenes carry exactly this)
+DAMPING_CLASSES = ("undamped", "damped")
+DAMPED_RATIO_MIN = 0.01
+#: a level of a class is calibrated only if at least this many references can certify it
+MIN_SCENES = 3
+#: validation target: the rule's pick at most this many times slower than the grid's fastest
+SLOWDOWN_LIMIT = 3.0
+#: reference discretization
+REFERENCE_MODES = 12
+REFERENCE_STEPS_PER_TOP_PERIOD = 16.0
+REFERENCE_MESH_FLOOR_M = 0.00075
+#: solver keys of every run (make tradeoff's fastest FFRF choices)
+SOLVER = {"newton": "modified", "newton_relative_tolerance": 1e-8, "spectral_radius": 0.9}
+
+Progress = Callable[[str], None]
+
+
+def _setting(label: str, step_s: float, modes: int, mesh_m: float) -> Setting:
+    return Setting.of(label, step_s=step_s, coupler__modes=modes,
+                      coupler__mesh_size_m=mesh_m, output_step_s=0.0, **SOLVER)
+
+
+def reference_discretization(coupler: Mapping[str, Any]) -> tuple[float, int, float]:
+    """Step [s], modes and mesh size [m] of a scene's reference (see the module doc)."""
+    omegas = in_plane_fixed_interface_omegas(
+        coupler["length_m"], coupler["thickness_m"], coupler["width_m"],
+        coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"], coupler["poisson_ratio"],
+        REFERENCE_MODES)
+    top_period = 2 * math.pi / omegas[-1]
+    step = min(first_period_s(coupler) / 400.0, top_period / REFERENCE_STEPS_PER_TOP_PERIOD)
+    mesh = max(min(coupler["thickness_m"], coupler["length_m"] / 32.0), REFERENCE_MESH_FLOOR_M)
+    return step, REFERENCE_MODES, mesh
+
+
+def scene_reference(scene: Scene, pool: ReductionPool, progress: Progress | None = None
+                    ) -> Reference:
+    """The converged reference of ``scene`` with its evidence (see the module doc)."""
+    step, modes, mesh = reference_discretization(scene["coupler"])
+    finest = _setting("reference", step, modes, mesh)
+    coarsenings = {f"modes {modes} -> 8": _setting("modes 8", step, 8, mesh),
+                   "step_s x2": _setting("step x2", 2 * step, modes, mesh),
+                   "mesh x1.5": _setting("mesh x1.5", step, modes, 1.5 * mesh)}
+    return converged_reference(scene, "reference", finest, coarsenings, min(LEVELS) / 3,
+                               pool, progress=progress)
+
+
+def grid_settings(scene: Scene) -> list[tuple[int, float, Setting]]:
+    """The grid's (modes, steps per first period, setting) on the rule's mesh."""
+    coupler = scene["coupler"]
+    period, mesh = first_period_s(coupler), rule_mesh_size_m(coupler)
+    return [(modes, per, _setting(f"modes={modes} T1/{per:g}", period / per, modes, mesh))
+            for modes in GRID_MODES for per in GRID_STEPS_PER_PERIOD]
+
+
+def measure_scene(name: str, scene: Scene, repeats: int = 3, cache_dir: Path | None = None,
+                  progress: Progress | None = None) -> CaseResult:
+    """Reference and grid of one scene, as a case (datasets ``grid/*``, ``reference/*``;
+    attributes ``reference_accuracy``, ``first_period_s``, ``rule_mesh_size_m``)."""
+    pool = ReductionPool(cache_dir)
+    try:
+        reference = scene_reference(scene, pool, progress)
+    except FlexError as exc:
+        return CaseResult(name, to_toml(scene), status="failed",
+                          message=f"reference failed: {exc}")
+    rows = []
+    for modes, per, setting in grid_settings(scene):
+        if progress:
+            progress(f"{name}: {setting.label}")
+        try:  # loaded before the clock starts: every timed run finds it in memory
+            pool.for_scene(scene_for(scene, setting))
+        except FlexError:
+            pass  # measure() reports it as a failed setting
+        m = measure(scene, setting, reference, repeats, pool)
+        rows.append((modes, per, m))
+    return CaseResult(name, to_toml(scene), _datasets(reference, rows), attrs={
+        "reference_accuracy": reference.accuracy,
+        "reference_peak_deflection_m": reference.peak_deflection_m,
+        "first_period_s": first_period_s(scene["coupler"]),
+        "rule_mesh_size_m": rule_mesh_size_m(scene["coupler"])})
+
+
+def measure_case(name: str, scene: Scene, *, repeats: int = 3,
+                 cache_dir: Path | None = None) -> CaseResult:
+    """:func:`measure_scene` as a sweep case function (:func:`flex.sweep.run_sweep`)."""
+    return measure_scene(name, scene, repeats, cache_dir)
+
+
+measure_case.case_version = 2  # type: ignore[attr-defined]
+
+
+def measure_scenes(scenes: Mapping[str, Scene], repeats: int = 3,
+                   cache_dir: Path | None = None,
+                   progress: Callable[[str, int, int], None] | None = None
+                   ) -> dict[str, CaseResult]:
+    """:func:`measure_scene` for every scene, in order (progress: ``[done/total] text``)."""
+    out = {}
+    for done, (name, scene) in enumerate(scenes.items()):
+        def say(text: str, at: int = done) -> None:
+            if progress:
+                progress(text, at, len(scenes))
+        say(f"{name}: reference")
+        out[name] = measure_scene(name, scene, repeats, cache_dir, say)
+    if progress:
+        progress("done", len(scenes), len(scenes))
+    return out
+
+
+def _datasets(reference: Reference, rows: Sequence[tuple[int, float, Any]]
+              ) -> dict[str, Dataset]:
+    def column(values: Sequence[Any], units: str, text: str) -> Dataset:
+        return Dataset(np.array(values, dtype=float), units, text)
+
+    def error(m: Any, key: str) -> float:
+        return m.errors.get(key, math.nan) if m.ok else math.nan
+
+    out = {
+        "grid/modes": column([r[0] for r in rows], "1", "in-plane fixed-interface eigenmodes"),
+        "grid/steps_per_first_period": column([r[1] for r in rows], "1",
+                                              "step = first bending period / this"),
+        "grid/step": column([dict(r[2].setting.overrides)["simulation.step_s"] for r in rows],
+                            "s", "time step"),
+        "grid/peak_deflection_error": column([error(r[2], "peak_deflection_relative")
+                                              for r in rows], "1",
+                                             "relative error of the peak midpoint deflection "
+                                             "against the reference (NaN: failed)"),
+        "grid/crank_angle_error": column([error(r[2], "crank_angle_relative") for r in rows],
+                                         "1", "largest crank angle error / its swing"),
+        "grid/slider_position_error": column([error(r[2], "slider_position_relative")
+                                              for r in rows], "1",
+                                             "largest slider error / its travel"),
+        "grid/total_time": column([r[2].total_time_s for r in rows], "s",
+                                  "median time of the whole run (warm reduction cache)"),
+        "grid/newton_per_step": column([r[2].newton_iterations / max(r[2].steps, 1)
+                                        for r in rows], "1", "Newton iterations per step"),
+    }
+    for knob, evidence in reference.evidence.items():
+        safe = knob.replace(" ", "_").replace(">", "").replace("-", "to")
+        out[f"reference/evidence/{safe}"] = Dataset(
+            float(evidence.get("error", math.nan)), "1",
+            f"relative change of the reference for {knob}")
+    out["reference/time"] = Dataset(reference.observables.time_s, "s", "time")
+    out["reference/midpoint_deflection"] = Dataset(reference.observables.deflection_m, "m",
+                                                   "elastic midpoint deflection")
+    return out
+
+
+# ------------------------------------------------------------------------------------------
+# fitting and validating the rule
+# ------------------------------------------------------------------------------------------
+def grid_table(case: CaseResult) -> dict[str, np.ndarray]:
+    """A case's grid as arrays, with ``certified`` = error + reference accuracy."""
+    table = {key.split("/", 1)[1]: np.asarray(d.data) for key, d in case.datasets.items()
+             if key.startswith("grid/")}
+    table["certified"] = table["peak_deflection_error"] + case.attrs["reference_accuracy"]
+    return table
+
+
+def robustly_within(table: Mapping[str, np.ndarray], bound: float) -> np.ndarray:
+    """Per grid pair: its certified error and that of every finer step with the same modes
+    are within ``bound`` (a pair that meets it only by a lucky phase at a coarse step, with
+    larger errors at finer ones, is not a setting a user can rely on)."""
+    out = np.zeros(len(table["modes"]), dtype=bool)
+    for index, (modes, per) in enumerate(zip(table["modes"], table["steps_per_first_period"],
+                                             strict=True)):
+        finer = (table["modes"] == modes) & (table["steps_per_first_period"] >= per)
+        errors = table["certified"][finer]
+        out[index] = bool(np.all(np.isfinite(errors)) and np.all(errors <= bound))
+    return out
+
+
+def certifiable(case: CaseResult, level: float) -> bool:
+    """Whether the case's reference is accurate enough to certify ``level``: its accuracy at
+    most 1 / REFERENCE_MARGIN of it (:data:`flex.experiments.tradeoff.REFERENCE_MARGIN`)."""
+    return (case.status == "ok"
+            and case.attrs["reference_accuracy"] * REFERENCE_MARGIN <= level)
+
+
+def damping_of(case: CaseResult) -> str:
+    """The rule's damping class of a case's coupler (``"damped"`` from
+    :data:`DAMPED_RATIO_MIN`), from its stored scene."""
+    ratio = tomllib.loads(case.scene_toml)["coupler"]["damping_ratio"] if case.scene_toml else 0
+    return "damped" if ratio >= DAMPED_RATIO_MIN * (1 - 1e-9) else "undamped"
+
+
+def n_load_of(case: CaseResult) -> float:
+    """``t_load / T1`` of a case's coupler (:func:`flex.config.ffrf_rule.load_time_scale_s`),
+    from its stored scene."""
+    scene = tomllib.loads(case.scene_toml)
+    return load_time_scale_s(scene) / first_period_s(scene["coupler"])
+
+
+def needed_steps(table: Mapping[str, np.ndarray], modes: int, bound: float) -> float:
+    """The fewest grid steps per first period that keep ``modes`` robustly within ``bound``
+    (inf if none)."""
+    ok = robustly_within(table, bound) & (table["modes"] == modes)
+    return float(np.min(table["steps_per_first_period"][ok])) if ok.any() else math.inf
+
+
+def fit_levels(calibration: Mapping[str, CaseResult], levels: Sequence[float] = LEVELS
+               ) -> list[dict[str, Any]]:
+    """Per damping class (:func:`damping_of`) and level, the modes and step law fitted on the
+    class's calibration scenes that can certify the level (:func:`certifiable`, at least
+    :data:`MIN_SCENES`); ``modes`` None (with ``reason``) where too few scenes can certify
+    it or no modes count keeps every scene within the margin on the grid. ``scenes``: the
+    scenes the level rests on. See :func:`_fit_one`."""
+    out = []
+    for damping in DAMPING_CLASSES:
+        for level in levels:
+            usable = {name: (grid_table(case), n_load_of(case))
+                      for name, case in calibration.items()
+                      if certifiable(case, level) and damping_of(case) == damping}
+            out.append({"damping": damping, **_fit_one(level, usable)})
+    return out
+
+
+def _fit_one(level: float, usable: Mapping[str, tuple[Mapping[str, np.ndarray], float]]
+             ) -> dict[str, Any]:
+    """Per modes count: each scene's fewest robust steps per period N_i within MARGIN x level
+    at its n_i = t_load / T1; the law N = C n^-B with B the least-squares slope of log N_i on
+    log n_i (clipped to [0, 1.5]) and C the smallest that covers every scene; its picks
+    (rounded up to the grid) timed over the scenes. The modes count with the least total time
+    wins."""
+    scenes = sorted(usable)
+    if len(usable) < MIN_SCENES:
+        return {"tolerance": level, "modes": None, "scenes": scenes,
+                "reason": f"{len(usable)} calibration references can certify it (at least "
+                          f"{MIN_SCENES} needed)"}
+    best: dict[str, Any] | None = None
+    for modes in GRID_MODES:
+        needed = np.array([needed_steps(t, modes, MARGIN * level) for t, _ in usable.values()])
+        if not np.all(np.isfinite(needed)):
+            continue
+        n_load = np.array([n for _, n in usable.values()])
+        slope = (np.polyfit(np.log(n_load), np.log(needed), 1)[0]
+                 if np.ptp(np.log(n_load)) > 0 else 0.0)
+        exponent = float(np.clip(-slope, 0.0, 1.5))
+        law = {"steps_coefficient": float(np.max(needed * n_load**exponent)),
+               "steps_exponent": exponent}
+        picks = [steps_per_first_period(law, n) for n in n_load]
+        rows = [int(np.flatnonzero((t["modes"] == modes)
+                                   & np.isclose(t["steps_per_first_period"], per))[0])
+                for (t, _), per in zip(usable.values(), picks, strict=True)]
+        time = float(sum(t["total_time"][r] for (t, _), r in zip(usable.values(), rows,
+                                                                  strict=True)))
+        if best is None or time < best["total_time_s"]:
+            best = {"tolerance": level, "modes": modes, **law, "total_time_s": time,
+                    "worst_error": float(max(t["certified"][r] for (t, _), r in
+                                             zip(usable.values(), rows, strict=True)))}
+    return {**(best or {"tolerance": level, "modes": None, "reason":
+                        f"no modes count keeps every scene robustly within {MARGIN:g} x "
+                        f"{level:g} on the grid"}), "scenes": scenes}
+
+
+def validate(cases: Mapping[str, CaseResult], levels: Sequence[Mapping[str, Any]]
+             ) -> list[dict[str, Any]]:
+    """Per scene and calibrated level of its damping class: the rule's pick (its modes, the
+    law's steps per period at the scene's n) against the fastest grid pair robustly within
+    the level. Row keys: ``scene``, ``damping``, ``n_load``, ``tolerance``,
+    ``certifiable``, ``rule_pair``, ``rule_error`` (certified: measured + reference
+    accuracy), ``rule_time_s``, ``best_time_s``, ``best_pair``, ``slowdown`` (rule / best),
+    ``meets`` (robustly within the level and at most :data:`SLOWDOWN_LIMIT` x slower); a
+    failed scene: ``failed``; a scene beyond the law's grid: ``outside``."""
+    rows: list[dict[str, Any]] = []
+    for name, case in cases.items():
+        if case.status != "ok":
+            rows.append({"scene": name, "failed": case.message})
+            continue
+        table, damping, n_load = grid_table(case), damping_of(case), n_load_of(case)
+        for level in levels:
+            if level.get("modes") is None or level.get("damping", damping) != damping:
+                continue
+            per = steps_per_first_period(level, n_load)
+            if per is None:
+                rows.append({"scene": name, "tolerance": level["tolerance"], "outside":
+                             f"n = {n_load:.3g} needs more than {STEP_GRID[-1]} steps"})
+                continue
+            row = _validation_row(name, table, level["tolerance"], (level["modes"], per),
+                                  certifiable(case, level["tolerance"]))
+            rows.append({"damping": damping, "n_load": n_load, **row})
+    return rows
+
+
+def _validation_row(name: str, table: Mapping[str, np.ndarray], tol: float,
+                    pair: tuple[int, float], can_certify: bool) -> dict[str, Any]:
+    rule = int(np.flatnonzero((table["modes"] == pair[0]) & np.isclose(
+        table["steps_per_first_period"], pair[1]))[0])
+    within = np.flatnonzero(robustly_within(table, tol))
+    best = int(within[np.argmin(table["total_time"][within])]) if within.size else None
+    row = {"scene": name, "tolerance": tol, "certifiable": can_certify,
+           "rule_pair": f"{pair[0]} modes, T1/{pair[1]:g}",
+           "rule_error": float(table["certified"][rule]),
+           "rule_time_s": float(table["total_time"][rule]),
+           "best_time_s": math.nan if best is None else float(table["total_time"][best]),
+           "best_pair": "" if best is None else
+           f"{int(table['modes'][best])} modes, T1/{table['steps_per_first_period'][best]:g}"}
+    row["slowdown"] = row["rule_time_s"] / row["best_time_s"]
+    row["meets"] = bool(can_certify and robustly_within(table, tol)[rule]
+                        and row["slowdown"] <= SLOWDOWN_LIMIT)
+    return row
+
+
+def family_bounds(scenes: Mapping[str, Scene]) -> dict[str, float]:
+    """The calibrated family's slenderness range (coupler length_m / thickness_m)."""
+    slenderness = [scene["coupler"]["length_m"] / scene["coupler"]["thickness_m"]
+                   for scene in scenes.values()]
+    return {"slenderness_min": float(min(slenderness)),
+            "slenderness_max": float(max(slenderness)), "damped_ratio_min": DAMPED_RATIO_MIN}
+
+
+def rule_toml(levels: Sequence[Mapping[str, Any]], bounds: Mapping[str, float],
+              mesh: Mapping[str, float]) -> str:
+    """The rule's constants as ``flex/config/ffrf_rule.toml`` text (calibrated levels only)."""
+    import tomli_w
+
+    fitted = [{"damping": level["damping"], "tolerance": level["tolerance"],
+               "modes": level["modes"], "steps_coefficient": level["steps_coefficient"],
+               "steps_exponent": level["steps_exponent"],
+               "worst_error": level["worst_error"], "scenes": list(level["scenes"])}
+              for level in levels if level.get("modes") is not None]
+    head = ("# Constants of the FFRF settings rule (flex/config/ffrf_rule.py), written by make "
+            "calibrate\n# (results/calibrate.h5, /summary attribute rule_toml) and installed "
+            "by make rule-install.\n")
+    return head + tomli_w.dumps({"mesh": dict(mesh), "family": dict(bounds), "levels": fitted})

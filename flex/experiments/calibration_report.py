@@ -1,0 +1,255 @@
+"""Report, summary datasets and figures of the FFRF rule's calibration (``make calibrate``).
+
+:func:`calibration_summary` fits the rule on the calibration scenes
+(:func:`flex.experiments.calibration.fit_levels`), validates it on the others
+(:func:`flex.experiments.calibration.validate`) and returns the datasets stored under
+``/summary`` (``rule/toml``: the constants to install, ``levels/*``, ``validation/*``) and
+the report text; :func:`draw_calibration` draws one work-precision panel per scene with the
+rule's picks marked on the Pareto front of the grid.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.base.plotting import panels
+from flex.config.ffrf_rule import rule_constants, steps_per_first_period
+from flex.data.results import CaseResult, Dataset
+from flex.data.scene import Scene
+from flex.experiments.calibration import (
+    MARGIN,
+    SLOWDOWN_LIMIT,
+    damping_of,
+    family_bounds,
+    fit_levels,
+    grid_table,
+    n_load_of,
+    rule_toml,
+    validate,
+)
+from flex.experiments.tradeoff import pareto_front
+
+
+def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[str, Scene],
+                        validation: Mapping[str, Scene]) -> tuple[dict[str, Dataset], str]:
+    """Fit on ``calibration``'s cases, validate on ``validation``'s (see module doc)."""
+    fitted = fit_levels({name: results[name] for name in calibration if name in results})
+    rows = validate({name: results[name] for name in validation if name in results}, fitted)
+    toml = rule_toml(fitted, family_bounds(calibration), rule_constants()["mesh"])
+    datasets = {"rule/toml": Dataset(toml, "1", "the rule's constants (make rule-install)")}
+    for index, level in enumerate(fitted):
+        prefix = f"levels/{index}"
+        datasets[f"{prefix}/damping"] = Dataset(level["damping"], "1", "damping class")
+        datasets[f"{prefix}/tolerance"] = Dataset(level["tolerance"], "1", "level")
+        datasets[f"{prefix}/modes"] = Dataset(level.get("modes") or -1, "1",
+                                              "in-plane modes (-1: not calibrated)")
+        datasets[f"{prefix}/steps_coefficient"] = Dataset(
+            level.get("steps_coefficient", math.nan), "1", "C of N = C n^-B")
+        datasets[f"{prefix}/steps_exponent"] = Dataset(
+            level.get("steps_exponent", math.nan), "1", "B of N = C n^-B")
+        datasets[f"{prefix}/worst_error"] = Dataset(level.get("worst_error", math.nan), "1",
+                                                    "largest certified calibration error")
+    judged = [row for row in rows if "failed" not in row and "outside" not in row]
+    for key, units, text in (("rule_error", "1", "certified error of the rule's pick"),
+                             ("rule_time_s", "s", "time of the rule's pick"),
+                             ("best_time_s", "s", "fastest grid pair within the level"),
+                             ("slowdown", "1", "rule / fastest")):
+        datasets[f"validation/{key}"] = Dataset(np.array([row[key] for row in judged]),
+                                                units, text)
+    datasets["validation/scene"] = Dataset(np.array([row["scene"] for row in judged],
+                                                    dtype=object), "1", "scene")
+    datasets["validation/tolerance"] = Dataset(np.array([row["tolerance"] for row in judged]),
+                                               "1", "level")
+    datasets["validation/meets"] = Dataset(np.array([row["meets"] for row in judged]), "1",
+                                           "within the level and the slowdown limit")
+    return datasets, _report(results, fitted, rows, toml)
+
+
+def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any]],
+            rows: Sequence[Mapping[str, Any]], toml: str) -> str:
+    lines = ["# FFRF settings rule: calibration and validation", "",
+             "Error: relative error of the peak elastic midpoint deflection against each "
+             "scene's converged reference, plus the reference's own accuracy (certified). "
+             f"A level is fitted on the calibration scenes whose reference can certify it, "
+             f"within {MARGIN:g} x the level on every one.", "",
+             "## References", "", "| scene | first period T1 [s] | reference accuracy | "
+             "peak deflection [m] |", "|---|---|---|---|"]
+    for name, case in results.items():
+        if case.status != "ok":
+            lines.append(f"| {name} | failed: {case.message[:120]} | | |")
+            continue
+        lines.append(f"| {name} | {case.attrs['first_period_s']:.3g} | "
+                     f"{case.attrs['reference_accuracy']:.2g} | "
+                     f"{case.attrs['reference_peak_deflection_m']:.4g} |")
+    lines += ["", "## Fitted levels", ""]
+    for level in fitted:
+        if level.get("modes") is None:
+            lines.append(f"- {level['damping']}, {level['tolerance']:g}: not calibrated "
+                         f"({level['reason']}; "
+                         f"scenes: {', '.join(level['scenes']) or 'none'})")
+            continue
+        lines.append(f"- {level['damping']}, {level['tolerance']:g}: {level['modes']} "
+                     f"in-plane modes, N = {level['steps_coefficient']:.3g} n^-"
+                     f"{level['steps_exponent']:.2f} steps per first period (rounded up to the "
+                     f"grid); worst certified error {level['worst_error']:.2g} over "
+                     f"{len(level['scenes'])} scenes ({', '.join(level['scenes'])})")
+    lines += ["", "## Validation (scenes not used in the fit)", "",
+              "| scene | n = t_load / T1 | level | certifiable | rule pick | rule error | rule "
+              "time [s] | fastest within [s] (pair) | slowdown | meets |",
+              "|---|---|---|---|---|---|---|---|---|---|"]
+    for row in rows:
+        if "failed" in row or "outside" in row:
+            why = f"failed: {row['failed'][:100]}" if "failed" in row else row["outside"]
+            lines.append(f"| {row['scene']} | {why} | | | | | | | | |")
+            continue
+        lines.append(f"| {row['scene']} | {row['n_load']:.3g} | {row['tolerance']:g} | "
+                     f"{row['certifiable']} | {row['rule_pair']} | "
+                     f"{row['rule_error']:.2g} | {row['rule_time_s']:.3g} | "
+                     f"{row['best_time_s']:.3g} ({row['best_pair'] or 'none'}) | "
+                     f"{row['slowdown']:.2g} | {row['meets']} |")
+    lines += _target_lines(rows)
+    judged = [row for row in rows if "failed" not in row and "outside" not in row
+              and row["certifiable"]]
+    met = sum(row["meets"] for row in judged)
+    lines += ["", f"Validation: {met} of {len(judged)} certifiable (scene, level) pairs meet "
+              f"their level at most {SLOWDOWN_LIMIT:g}x slower than the fastest grid pair.",
+              "", "## Rule constants (make rule-install)", "", "```toml", toml.strip(), "```"]
+    return "\n".join(lines)
+
+
+#: issue 15's time targets for the rule's picks [s] per level (in process, warm reduction)
+TIME_TARGETS_S = {0.01: 0.3, 0.001: 2.0}
+
+
+def _target_lines(rows: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The rule's picks against the time targets, per validation scene and level."""
+    lines = ["", "Time targets (in process, reduction in memory; "
+             + ", ".join(f"{level:g}: at most {limit:g} s" for level, limit in
+                         TIME_TARGETS_S.items()) + "):", ""]
+    for row in rows:
+        if "failed" in row or "outside" in row or row["tolerance"] not in TIME_TARGETS_S:
+            continue
+        limit = TIME_TARGETS_S[row["tolerance"]]
+        verdict = "met" if row["rule_time_s"] <= limit else "missed"
+        lines.append(f"- {row['scene']} at {row['tolerance']:g}: {row['rule_time_s']:.3g} s "
+                     f"({verdict}), certified error {row['rule_error']:.2g}")
+    return lines
+
+
+def draw_calibration(results: Mapping[str, CaseResult], datasets: Mapping[str, Dataset],
+                     folder: Path) -> list[Path]:
+    """``calibrate-work-precision.png``: per scene, certified error against time of every
+    grid pair (log-log), the grid's Pareto front, the levels, and the rule's picks for the
+    scene's damping class (from the fitted ``levels/*`` summary datasets)."""
+    cases = {name: case for name, case in results.items() if case.status == "ok"}
+    if not cases:
+        return []
+    levels = fitted_levels(datasets)
+    cols = 4
+    rows = math.ceil(len(cases) / cols)
+    path = folder / "calibrate-work-precision.png"
+    with panels(path, "FFRF grid per scene: certified error of the peak deflection against "
+                "run time; Pareto front (line), levels (dotted), the rule's picks (stars)",
+                rows, cols, size=(13.0, 1.0 + 2.6 * rows)) as (_, axes):
+        for ax, (name, case) in zip(axes, cases.items(), strict=False):
+            picks = {level["tolerance"]: (level["modes"], steps_per_first_period(
+                level, n_load_of(case))) for level in levels
+                if level["damping"] == damping_of(case)}
+            _panel(ax, name, grid_table(case), sorted({lv["tolerance"] for lv in levels}),
+                   picks)
+        for ax in axes[len(cases):]:
+            ax.set_visible(False)
+    return [path]
+
+
+def _panel(ax: Any, name: str, table: Mapping[str, np.ndarray], levels: Sequence[float],
+           picks: Mapping[float, tuple[int, float | None]]) -> None:
+    time, error = table["total_time"], table["certified"]
+    ok = np.isfinite(time) & np.isfinite(error) & (error > 0)
+    for modes, marker in zip((1, 2, 4, 8), "o^sD", strict=False):
+        chosen = ok & (table["modes"] == modes)
+        ax.plot(time[chosen], error[chosen], marker, ms=3, ls="none", label=f"{modes} modes")
+    front = pareto_front(list(zip(time[ok], error[ok], strict=True)))
+    ax.plot(time[ok][front], error[ok][front], color="0.3", lw=1)
+    for level in levels:
+        ax.axhline(level, color="tab:red", lw=0.8, ls=":")
+    for level, (modes, per) in picks.items():
+        index = np.flatnonzero((table["modes"] == modes)
+                               & np.isclose(table["steps_per_first_period"], per or -1))
+        if index.size and ok[index[0]]:
+            ax.plot(time[index[0]], error[index[0]], "*", ms=11, color="tab:red",
+                    label=f"rule {level:g}")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_title(name, fontsize="small")
+    ax.set_xlabel("run time [s]")
+    ax.set_ylabel("certified error [1]")
+
+
+def fitted_levels(datasets: Mapping[str, Dataset]) -> list[dict[str, Any]]:
+    """The calibrated levels (damping, tolerance, modes, steps law) from the summary."""
+    out = []
+    index = 0
+    while f"levels/{index}/tolerance" in datasets:
+        def value(key: str, at: int = index) -> Any:
+            data = datasets[f"levels/{at}/{key}"].data
+            return data.decode() if isinstance(data, bytes) else data
+        if int(value("modes")) > 0:
+            out.append({"damping": str(value("damping")),
+                        "tolerance": float(value("tolerance")), "modes": int(value("modes")),
+                        "steps_coefficient": float(value("steps_coefficient")),
+                        "steps_exponent": float(value("steps_exponent"))})
+        index += 1
+    return out
+
+
+def install_rule(result_path: Path, rule_path: Path) -> str:
+    """Copy the fitted rule of a ``calibrate`` result file to ``rule_path`` (atomically);
+    return what was done. Raises :class:`flex.base.errors.FlexError` for a file that is not
+    a finished calibrate result or a rule without any calibrated level."""
+    import os
+    import tempfile
+    import tomllib
+
+    from flex.base.errors import FlexError
+    from flex.data.results import open_results
+
+    with open_results(result_path) as h5:
+        if h5.attrs.get("study") != "calibrate":
+            raise FlexError(f"'{result_path}' holds study {h5.attrs.get('study')!r}, not "
+                            f"calibrate: run make calibrate first")
+        if "summary/rule/toml" not in h5:
+            raise FlexError(f"'{result_path}' has no /summary/rule/toml (a failed run?)")
+        text = h5["summary/rule/toml"][()]
+    text = text.decode() if isinstance(text, bytes) else str(text)
+    if not tomllib.loads(text).get("levels"):
+        raise FlexError(f"'{result_path}': the fit calibrated no level; "
+                        f"{rule_path} is left as it is")
+    if rule_path.exists() and rule_path.read_text("utf-8") == text:
+        return f"{rule_path} is already the rule of {result_path}"
+    handle, staged = tempfile.mkstemp(dir=rule_path.parent, prefix=".rule-")
+    with os.fdopen(handle, "w", encoding="utf-8") as stream:
+        stream.write(text)
+    os.replace(staged, rule_path)
+    return f"installed the rule of {result_path} as {rule_path}"
+
+
+if __name__ == "__main__":
+    import sys
+
+    from flex.base.errors import FlexError
+
+    if len(sys.argv) != 3:
+        print("usage: python -m flex.experiments.calibration_report RESULT.h5 RULE.toml "
+              "(install a calibrate run's fitted FFRF rule)", file=sys.stderr)
+        raise SystemExit(2)
+    try:
+        print(install_rule(Path(sys.argv[1]), Path(sys.argv[2])))
+    except FlexError as exc:
+        print(f"flex: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None

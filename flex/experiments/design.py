@@ -1,0 +1,656 @@
+"""Design charts of the spring-driven slider-crank: the sweep, each case's measures, the
+constraint lines through the design point, the thesis's optimum-angle claim and the mechanism
+checks (``make design``, ``studies/design.py``; docs/design.md).
+
+**The design point** is the study's base scene: its initial crank angle theta0, spring
+preload delta0 and rate k0, coupler thickness t0 (the thesis's: 34.19 deg, 22 mm, 1500 N/m,
+and the steel plate of Table 1's coupler mass, 12.37 mm). Every case runs with
+``coupler.model = "auto"`` at the scene's ``[fidelity] tolerance``. The :class:`Grid` spans
+
+- ``angle_preload``: initial angle x preload (rate k0, thickness t0);
+- ``angle_rate``: initial angle x rate at the design point's stored spring energy
+  E0 = k0 delta0^2 / 2 (preload sqrt(2 E0 / k));
+- ``thickness_rate``: coupler thickness x rate (angle theta0, preload delta0);
+- ``final_angle``: initial angle with the preload that brings the crank to rest at the design
+  point's own final angle (closed form, :func:`rest_angle_rad`, :func:`preload_for_rest_angle_m`).
+
+A case (:func:`design_case`, on the sweep engine) stores its resolved scene, downsampled
+curves (``curves/...``: every n-th stored sample, so they are the run's own values) and its
+measures (``measures/...``, :data:`MEASURES`) over the deployment: from release to the
+first crank-angle maximum. A scene ``auto`` refuses (a coupler near buckling) is stored as a
+``refused`` case (status ok, attribute ``design_outcome``, no measures): a region of the
+chart, not a failure.
+
+Peak coupler stress: an FFRF coupler's own peak bending stress; a rigid one's is the
+quasi-static beam stress of its joint loads (:func:`flex.fidelity.criteria.quasi_static_stress`)
+times the dynamic factor of the first-mode oscillator driven by the same loads
+(:func:`flex.fidelity.predictor.predict_deflection`: peak / quasi-static peak), because the
+sudden release makes the quasi-static stress an under-estimate (docs/criterion.md).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import math
+import tomllib
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.optimize import brentq
+
+from flex.base.errors import SceneError
+from flex.base.kinematics import slider_crank
+from flex.base.mechanism_checks import (
+    Joint,
+    angle_to_dead_centres_rad,
+    counted_mobility,
+    dead_centre_angles_rad,
+    jacobian_mobility,
+    smallest_singular_value,
+    transmission_angle_rad,
+)
+from flex.base.thesis import THESIS_ANGLE_MAX_TIME_S, THESIS_SPRING_RATE_N_PER_M
+from flex.data.results import CaseResult, Dataset
+from flex.data.scene import Scene, apply_overrides, validate
+from flex.experiments.couplerfit import mesh_size_m
+from flex.experiments.lawfit import case_data
+from flex.fidelity.criteria import first_maximum_index, quasi_static_stress
+from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection
+
+CASE_VERSION = 1
+#: what the design charts and ``flex design`` put on the scene before the user's values: the
+#: coupler as the steel plate of Table 1's 77.67 g (12.37 mm thick), decided by ``auto``;
+#: no companion error run (the measures are compared at the tolerance of ``auto``)
+BASE_OVERRIDES = ['coupler.geometry="plate"', 'coupler.model="auto"',
+                  "coupler.thickness_m=0.01237", "simulation.error_estimate=false",
+                  "simulation.output_step_s=0.0"]
+#: curve samples kept per case (every n-th stored sample)
+CURVE_SAMPLES = 400
+#: ASTM A36 minimum yield strength [Pa] (36 ksi): the thesis's steel (Tables 6 and 8) names
+#: the grade, not its strength; the default allowable of the charts and of ``flex design``
+A36_YIELD_STRESS_PA = 250e6
+#: end time of a case: this many times the thesis half swing scaled by sqrt(k0 / k)
+END_TIME_FACTOR = 2.4
+#: measure -> (unit, description); all over the deployment (release to first angle maximum)
+MEASURES: dict[str, tuple[str, str]] = {
+    "peak_crank_speed": ("rad/s", "largest crank angular velocity"),
+    "peak_crank_speed_time": ("s", "time of the largest crank angular velocity"),
+    "deployment_time": ("s", "time of the first crank-angle maximum (the crank at rest)"),
+    "final_crank_angle": ("rad", "crank angle at the first maximum"),
+    "slider_travel": ("m", "slider displacement at the first crank-angle maximum"),
+    "peak_joint_force_A": ("N", "largest joint force modulus at A (frame-crank)"),
+    "peak_joint_force_B": ("N", "largest joint force modulus at B (crank-coupler)"),
+    "peak_joint_force_C": ("N", "largest joint force modulus at C (coupler-slider)"),
+    "peak_joint_force": ("N", "largest of the peak joint forces at A, B and C"),
+    "peak_coupler_stress": ("Pa", "peak coupler bending stress (FFRF: the body's own; rigid: "
+                                  "quasi-static x the oscillator's dynamic factor)"),
+    "peak_coupler_stress_quasi_static": ("Pa", "peak quasi-static beam stress of the joint "
+                                               "loads"),
+    "peak_coupler_deflection": ("m", "peak elastic coupler midpoint deflection (FFRF: "
+                                     "simulated; rigid: predicted from the loads)"),
+    "predicted_rigid_error": ("1", "auto's predicted rigid deflection error x its margin"),
+    "min_transmission_angle": ("rad", "smallest transmission angle at the crank pin"),
+    "min_dead_centre_distance": ("rad", "smallest crank-angle distance to a dead centre"),
+    "stored_spring_energy": ("J", "spring energy at release, k delta^2 / 2"),
+    "deployment_complete": ("1", "1 if the crank angle reached its maximum within the run"),
+}
+
+
+# ------------------------------------------------------------------------------------------
+# closed forms of the attached linear spring (rigid links: energy conservation)
+# ------------------------------------------------------------------------------------------
+def slider_position_m(scene: Scene, crank_angle_rad: Any) -> np.ndarray:
+    """Slider position [m] of the scene's linkage at ``crank_angle_rad`` (closed form)."""
+    return slider_crank(scene["crank"]["length_m"], scene["coupler"]["length_m"],
+                        crank_angle_rad, offset_m=scene["slider"]["offset_m"]).slider_position_m
+
+
+def rest_angle_rad(scene: Scene) -> float:
+    """Crank angle [rad] where a rigid deployment comes to rest: the attached linear spring
+    has given back its energy, ``k (delta s - s^2 / 2) = 0``, at slider travel s = 2 delta,
+    so ``x(theta_f) = x(theta0) - 2 delta`` (between theta0 and the folded dead centre;
+    SceneError if the travel passes the dead centre)."""
+    theta0 = math.radians(scene["crank"]["initial_angle_deg"])
+    fold = dead_centre_angles_rad(scene["crank"]["length_m"], scene["coupler"]["length_m"],
+                                  scene["slider"]["offset_m"])[1]
+    target = float(slider_position_m(scene, theta0)) - 2 * scene["drive"]["spring_preload_m"]
+    if float(slider_position_m(scene, fold)) > target:
+        raise SceneError("the slider travel 2 x preload passes the folded dead centre: the "
+                         "crank does not come to rest before it")
+    return float(brentq(lambda t: float(slider_position_m(scene, t)) - target, theta0, fold,
+                        xtol=1e-13))
+
+
+def preload_for_rest_angle_m(scene: Scene, initial_angle_rad: float,
+                             rest_angle: float) -> float:
+    """Preload [m] that brings a rigid deployment from ``initial_angle_rad`` to rest at
+    ``rest_angle`` [rad]: half the slider travel between them (:func:`rest_angle_rad`)."""
+    return float(slider_position_m(scene, initial_angle_rad)
+                 - slider_position_m(scene, rest_angle)) / 2
+
+
+# ------------------------------------------------------------------------------------------
+# the plan: which scenes, in which families
+# ------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Grid:
+    """The sweep's axes: initial angles [deg]; preloads as factors of delta0; rates as factors
+    of k0 (at the stored energy E0: ``energy_rate_factors``; with thickness:
+    ``thickness_rate_factors``); coupler thicknesses [m]; ``final_angle_step_deg``: the
+    initial-angle step of the final-angle line."""
+
+    angles_deg: tuple[float, ...]
+    preload_factors: tuple[float, ...]
+    energy_rate_factors: tuple[float, ...]
+    thicknesses_m: tuple[float, ...]
+    thickness_rate_factors: tuple[float, ...]
+    final_angle_step_deg: float = 5.0
+
+
+@dataclass(frozen=True)
+class DesignPoint:
+    """The design point of a base scene (see the module doc)."""
+
+    angle_deg: float
+    preload_m: float
+    rate_N_per_m: float
+    thickness_m: float
+
+    @classmethod
+    def of(cls, scene: Scene) -> DesignPoint:
+        return cls(float(scene["crank"]["initial_angle_deg"]),
+                   float(scene["drive"]["spring_preload_m"]),
+                   float(scene["drive"]["spring_stiffness_N_per_m"]),
+                   float(scene["coupler"]["thickness_m"]))
+
+    @property
+    def energy_J(self) -> float:
+        return 0.5 * self.rate_N_per_m * self.preload_m**2
+
+
+Point = tuple[float, float, float, float]  # angle [deg], preload [m], rate [N/m], thickness [m]
+
+
+def _rounded(angle: float, preload: float, rate: float, thickness: float) -> Point:
+    return (round(float(angle), 4), round(float(preload), 7), round(float(rate), 3),
+            round(float(thickness), 7))
+
+
+def case_name(point: Point) -> str:
+    """``a34p19_p22_k1500_t12p37``: angle [deg], preload [mm], rate [N/m], thickness [mm]."""
+    angle, preload, rate, thickness = point
+    parts = (f"a{angle:.4g}", f"p{preload * 1e3:.4g}", f"k{rate:.5g}", f"t{thickness * 1e3:.4g}")
+    return "_".join(parts).replace(".", "p").replace("+", "")
+
+
+def family_points(scene: Scene, grid: Grid) -> dict[str, list[Point]]:
+    """The points of every family of the module doc (rounded; duplicates across families)."""
+    d = DesignPoint.of(scene)
+    angles = sorted(set(grid.angles_deg) | {d.angle_deg})
+    out: dict[str, list[Point]] = {
+        "angle_preload": [_rounded(a, f * d.preload_m, d.rate_N_per_m, d.thickness_m)
+                          for f in grid.preload_factors for a in angles],
+        "angle_rate": [_rounded(a, math.sqrt(2 * d.energy_J / (f * d.rate_N_per_m)),
+                                f * d.rate_N_per_m, d.thickness_m)
+                       for f in grid.energy_rate_factors for a in angles],
+        "thickness_rate": [_rounded(d.angle_deg, d.preload_m, f * d.rate_N_per_m, t)
+                           for f in grid.thickness_rate_factors
+                           for t in sorted(set(grid.thicknesses_m) | {d.thickness_m})]}
+    rest = rest_angle_rad(scene)
+    start = np.arange(grid.angles_deg[0], math.degrees(rest) - grid.final_angle_step_deg / 2,
+                      grid.final_angle_step_deg)
+    out["final_angle"] = [_rounded(a, preload_for_rest_angle_m(scene, math.radians(a), rest),
+                                   d.rate_N_per_m, d.thickness_m)
+                          for a in sorted(set(start.round(4)) | {d.angle_deg})]
+    return out
+
+
+def point_scene(scene: Scene, point: Point) -> Scene:
+    """The case scene of a point: its inputs, the coupler's mesh for its thickness
+    (:func:`flex.experiments.couplerfit.mesh_size_m`), and an end time long enough for the
+    deployment (:data:`END_TIME_FACTOR`)."""
+    angle, preload, rate, thickness = point
+    end = END_TIME_FACTOR * THESIS_ANGLE_MAX_TIME_S * math.sqrt(THESIS_SPRING_RATE_N_PER_M / rate)
+    case = apply_overrides(scene, [f"crank.initial_angle_deg={angle!r}",
+                                   f"drive.spring_preload_m={preload!r}",
+                                   f"drive.spring_stiffness_N_per_m={rate!r}",
+                                   f"coupler.thickness_m={thickness!r}",
+                                   f"coupler.mesh_size_m={mesh_size_m(thickness)!r}",
+                                   f"simulation.end_time_s={float(f'{end:.3g}')!r}"])
+    validate(case)
+    return case
+
+
+def plan(scene: Scene, grid: Grid) -> tuple[dict[str, Scene], dict[str, list[str]]]:
+    """The sweep's scenes by case name and each family's case names (in axis order)."""
+    families = family_points(scene, grid)
+    points = dict.fromkeys(p for members in families.values() for p in members)
+    names = {p: case_name(p) for p in points}
+    if len(set(names.values())) != len(names):
+        raise SceneError("design grid: two points share a case name; use coarser values")
+    return ({names[p]: point_scene(scene, p) for p in points},
+            {family: [names[p] for p in members] for family, members in families.items()})
+
+
+# ------------------------------------------------------------------------------------------
+# one case
+# ------------------------------------------------------------------------------------------
+def _window(data: Mapping[str, np.ndarray]) -> tuple[int, bool]:
+    stop = first_maximum_index(data["crank/angle"])
+    return (len(data["time"]) - 1, False) if stop is None else (stop, True)
+
+
+def coupler_stress(data: Mapping[str, np.ndarray], coupler: Mapping[str, Any], stop: int
+                   ) -> dict[str, Any]:
+    """Peak stress [Pa], quasi-static peak [Pa], peak deflection [m] and the stress curve over
+    the whole run (see the module doc) of a case's coupler, over samples 0..``stop``."""
+    window = slice(0, stop + 1)
+    quasi = quasi_static_stress(data["joints/B/force_on_coupler"],
+                                data["joints/C/force_on_coupler"], data["coupler/angle"],
+                                coupler["length_m"], coupler["thickness_m"], coupler["width_m"])
+    if "coupler/peak_bending_stress" in data:
+        curve = np.asarray(data["coupler/peak_bending_stress"])
+        deflection = float(np.abs(data["coupler/midpoint_deflection"][window]).max())
+        return {"peak": float(curve[window].max()), "quasi_static": float(quasi[window].max()),
+                "deflection": deflection, "curve": curve}
+    series = {key: np.asarray(value)[window] for key, value in data.items()
+              if np.ndim(value) and len(value) == len(data["time"])}
+    prediction = predict_deflection(series, coupler, "coupler")
+    factor = (prediction.peak_deflection_m / prediction.quasi_static_peak_m
+              if prediction.quasi_static_peak_m > 0 else 1.0)
+    return {"peak": float(quasi[window].max()) * factor, "quasi_static": float(quasi[window].max()),
+            "deflection": prediction.peak_deflection_m, "curve": quasi * factor}
+
+
+def case_measures(data: Mapping[str, np.ndarray], scene: Scene, attrs: Mapping[str, Any]
+                  ) -> tuple[dict[str, float], np.ndarray]:
+    """The :data:`MEASURES` of one simulated case (``data``: its stored curves; ``scene``:
+    its resolved scene; ``attrs``: its fidelity attributes) and its stress curve [Pa]."""
+    stop, complete = _window(data)
+    window = slice(0, stop + 1)
+    speed = np.asarray(data["crank/angular_velocity"])[window]
+    angle = np.asarray(data["crank/angle"])[window]
+    stress = coupler_stress(data, scene["coupler"], stop)
+    forces = {j: float(np.max(data[f"joints/{j}/force_modulus"][window])) for j in "ABC"}
+    dead = dead_centre_angles_rad(scene["crank"]["length_m"], scene["coupler"]["length_m"],
+                                  scene["slider"]["offset_m"])
+    drive = scene["drive"]
+    values = {
+        "peak_crank_speed": float(speed.max()),
+        "peak_crank_speed_time": float(data["time"][int(np.argmax(speed))]),
+        "deployment_time": float(data["time"][stop]), "final_crank_angle": float(angle[-1]),
+        "slider_travel": float(data["slider/displacement"][stop]),
+        **{f"peak_joint_force_{j}": value for j, value in forces.items()},
+        "peak_joint_force": max(forces.values()), "peak_coupler_stress": stress["peak"],
+        "peak_coupler_stress_quasi_static": stress["quasi_static"],
+        "peak_coupler_deflection": stress["deflection"],
+        "predicted_rigid_error": float(attrs.get("fidelity_coupler_predicted_rigid_error",
+                                                 math.nan)) * PREDICTION_MARGIN,
+        "min_transmission_angle": float(transmission_angle_rad(
+            angle, np.asarray(data["coupler/angle"])[window]).min()),
+        "min_dead_centre_distance": float(angle_to_dead_centres_rad(angle, dead).min()),
+        "stored_spring_energy": 0.5 * drive["spring_stiffness_N_per_m"]
+        * drive["spring_preload_m"] ** 2,
+        "deployment_complete": float(complete)}
+    return values, stress["curve"]
+
+
+#: curves a case keeps (downsampled), and their units
+CURVES = {"time": "s", "crank/angle": "rad", "crank/angular_velocity": "rad/s",
+          "slider/position": "m", "coupler/angle": "rad", "joints/A/force_modulus": "N",
+          "joints/B/force_modulus": "N", "joints/C/force_modulus": "N",
+          "joints/B/force_on_coupler": "N"}
+
+
+def _case_datasets(data: Mapping[str, np.ndarray], values: dict[str, float],
+                   stress_curve: np.ndarray) -> dict[str, Dataset]:
+    pick = slice(None, None, max(1, math.ceil(len(data["time"]) / CURVE_SAMPLES)))
+    out = {f"measures/{key}": Dataset(values[key], unit, text)
+           for key, (unit, text) in MEASURES.items()}
+    out.update({f"curves/{key}": Dataset(np.asarray(data[key])[pick], unit,
+                                         f"{key} (every {pick.step}th stored sample)")
+                for key, unit in CURVES.items()})
+    out["curves/coupler/stress"] = Dataset(np.asarray(stress_curve)[pick], "Pa",
+                                           "peak coupler stress (basis: measures doc)")
+    return out
+
+
+def design_case(name: str, scene: Scene, *, cache_dir: Path | None = None) -> CaseResult:
+    """One design case: :func:`flex.fidelity.simulation.simulate` (``auto`` resolved; its
+    reason stored in ``fidelity_coupler_*``, not printed), then its measures and curves; a
+    scene ``auto`` refuses is a ``refused`` case (module doc). ``cache_dir``: the reduction
+    cache folder (None: built in memory)."""
+    from flex.data.scene import to_toml
+    from flex.fidelity.simulation import simulate
+
+    try:
+        with contextlib.redirect_stderr(io.StringIO()):
+            case = simulate(scene, name, cache_dir=cache_dir)
+    except SceneError as exc:
+        return CaseResult(name, to_toml(scene), attrs={"design_outcome": "refused",
+                                                       "design_reason": str(exc)})
+    data = case_data(case)
+    resolved = tomllib.loads(case.scene_toml)
+    values, stress_curve = case_measures(data, resolved, case.attrs)
+    case.datasets = _case_datasets(data, values, stress_curve)
+    case.attrs.update(design_outcome="simulated",
+                      design_model=resolved["coupler"]["model"])
+    return case
+
+
+design_case.case_version = CASE_VERSION
+
+
+# ------------------------------------------------------------------------------------------
+# the table of every case
+# ------------------------------------------------------------------------------------------
+INPUTS = {"angle_deg": ("deg", "crank", "initial_angle_deg"),
+          "preload_m": ("m", "drive", "spring_preload_m"),
+          "rate_N_per_m": ("N/m", "drive", "spring_stiffness_N_per_m"),
+          "thickness_m": ("m", "coupler", "thickness_m")}
+
+
+def table(results: Mapping[str, CaseResult]) -> dict[str, np.ndarray]:
+    """One row per case (in ``results`` order): ``case``, ``outcome``, ``model``, the
+    :data:`INPUTS`, every measure (NaN where refused or failed) and ``valid``: 1 for a
+    deployment that comes to rest before the folded dead centre (a crank that turns through
+    it is no deployment: its speeds are left out of the extrema)."""
+    rows: dict[str, list] = {key: [] for key in ("case", "outcome", "model", *INPUTS, *MEASURES,
+                                                 "valid")}
+    for name, case in results.items():
+        scene = tomllib.loads(case.scene_toml)
+        fold = dead_centre_angles_rad(scene["crank"]["length_m"], scene["coupler"]["length_m"],
+                                      scene["slider"]["offset_m"])[1]
+        rows["case"].append(name)
+        outcome = case.attrs.get("design_outcome", "failed") if case.status == "ok" else "failed"
+        rows["outcome"].append(outcome)
+        rows["model"].append(str(case.attrs.get("design_model", "-")))
+        for key, (_, section, field_name) in INPUTS.items():
+            rows[key].append(float(scene[section][field_name]))
+        for key in MEASURES:
+            dataset = case.datasets.get(f"measures/{key}")
+            rows[key].append(float(np.asarray(dataset.data)) if dataset is not None else np.nan)
+        rows["valid"].append(float(rows["deployment_complete"][-1] == 1
+                                   and rows["final_crank_angle"][-1] < fold))
+    return {key: np.asarray(values, dtype=object if key in ("case", "outcome", "model")
+                            else float) for key, values in rows.items()}
+
+
+def table_datasets(rows: Mapping[str, np.ndarray]) -> dict[str, Dataset]:
+    """The table as ``table/<column>`` datasets with units."""
+    units = {**{k: (u, f"case input: {s}.{f}") for k, (u, s, f) in INPUTS.items()},
+             **MEASURES, "case": ("1", "case name"),
+             "outcome": ("1", "simulated, or refused by auto (near buckling)"),
+             "model": ("1", "the coupler model auto chose"),
+             "valid": ("1", "1: comes to rest before the folded dead centre")}
+    return {f"table/{key}": Dataset(values, *units[key]) for key, values in rows.items()}
+
+
+def rows_of(rows: Mapping[str, np.ndarray], names: list[str]) -> dict[str, np.ndarray]:
+    """The table restricted to ``names`` (in that order)."""
+    index = {name: i for i, name in enumerate(rows["case"])}
+    keep = np.array([index[name] for name in names if name in index], dtype=int)
+    return {key: np.asarray(values)[keep] for key, values in rows.items()}
+
+
+# ------------------------------------------------------------------------------------------
+# extrema along a line, and the thesis claim
+# ------------------------------------------------------------------------------------------
+def vertex(x: np.ndarray, y: np.ndarray, i: int) -> tuple[float, float]:
+    """The extremum of the parabola through points i-1, i, i+1 (``(x[i], y[i])`` at an end)."""
+    if i <= 0 or i >= len(x) - 1:
+        return float(x[i]), float(y[i])
+    a, b, c = np.polyfit(x[i - 1:i + 2], y[i - 1:i + 2], 2)
+    if a == 0:
+        return float(x[i]), float(y[i])
+    at = -b / (2 * a)
+    return float(at), float(np.polyval([a, b, c], at))
+
+
+def extrema(x: Any, y: Any) -> dict[str, float]:
+    """Largest and smallest of ``y(x)`` (finite points, x ascending), each refined by a
+    parabola through its neighbours; ``*_interior`` 1 when not at an end of the range."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    ok = np.isfinite(y)
+    x, y = x[ok], y[ok]
+    out: dict[str, float] = {}
+    for kind, index in (("max", int(np.argmax(y))), ("min", int(np.argmin(y)))):
+        out[f"{kind}_x"], out[f"{kind}_y"] = vertex(x, y, index)
+        out[f"{kind}_interior"] = float(0 < index < len(x) - 1)
+    return out
+
+
+def line(rows: Mapping[str, np.ndarray], names: list[str], select: Mapping[str, float]
+         ) -> dict[str, np.ndarray]:
+    """The rows of ``names`` whose inputs equal ``select`` (relative 1e-6), sorted by angle."""
+    part = rows_of(rows, names)
+    keep = np.ones(len(part["case"]), dtype=bool)
+    for key, value in select.items():
+        keep &= np.isclose(part[key], value, rtol=1e-6, atol=0)
+    order = np.argsort(part["angle_deg"][keep])
+    return {key: values[keep][order] for key, values in part.items()}
+
+
+def line_name(family: str, value: float) -> str:
+    """``preload_p22``, ``energy_k3000``: a line's name from its family and fixed value."""
+    if family == "angle_preload":
+        return f"preload_p{value * 1e3:.4g}".replace(".", "p")
+    return f"energy_k{value:.5g}".replace(".", "p")
+
+
+def claim_lines(rows: Mapping[str, np.ndarray], families: Mapping[str, list[str]]
+                ) -> dict[str, dict[str, np.ndarray]]:
+    """The lines of measures against initial angle: ``preload_p<mm>`` (the spring as given,
+    one preload: fixed preload = fixed stored energy = fixed slider travel 2 delta at that
+    rate), ``energy_k<N/m>`` (the design point's stored energy with that rate) and
+    ``final_angle`` (rest at the design point's own final angle); lines of 3 points or more."""
+    out = {"final_angle": line(rows, families["final_angle"], {})}
+    for family, key in (("angle_preload", "preload_m"), ("angle_rate", "rate_N_per_m")):
+        for value in sorted(set(rows_of(rows, families[family])[key])):
+            out[line_name(family, value)] = line(rows, families[family], {key: value})
+    return {name: part for name, part in out.items() if np.sum(part["valid"] == 1) >= 3}
+
+
+def claim_verdict(part: Mapping[str, np.ndarray], point: DesignPoint,
+                  measure: str = "peak_crank_speed") -> dict[str, float]:
+    """Where ``measure`` peaks and dips along one line, its value at the design angle, and
+    ``design_is_max`` (1 when the interior maximum lies within half a grid step of the design
+    angle)."""
+    x, y = part["angle_deg"], np.where(part["valid"] == 1, part[measure], np.nan)
+    found = extrema(x, y)
+    at = float(np.interp(point.angle_deg, x, part[measure]))
+    step = float(np.median(np.diff(x))) if len(x) > 1 else math.inf
+    found.update(design_value=at, design_angle=point.angle_deg,
+                 design_is_max=float(bool(found["max_interior"])
+                                     and abs(found["max_x"] - point.angle_deg) <= step / 2),
+                 design_is_min=float(bool(found["min_interior"])
+                                     and abs(found["min_x"] - point.angle_deg) <= step / 2),
+                 gain_over_design=found["max_y"] / at - 1)
+    return found
+
+
+# ------------------------------------------------------------------------------------------
+# mechanism checks from the scene
+# ------------------------------------------------------------------------------------------
+def topology(scene: Scene) -> tuple[list[str], list[Joint]]:
+    """Bodies (with the frame) and joints of the scene's mechanism (docs/model.md): revolute
+    A, B, C, prismatic P; a welded wing adds a body and weld W. The drive is an input, not a
+    joint (a constant-speed crank is a driving constraint that takes the one freedom)."""
+    bodies = ["frame", "crank", "coupler", "slider"]
+    joints = [Joint("A", ("frame", "crank"), "revolute"),
+              Joint("B", ("crank", "coupler"), "revolute"),
+              Joint("C", ("coupler", "slider"), "revolute"),
+              Joint("P", ("slider", "frame"), "prismatic")]
+    if scene.get("wing", {}).get("enabled", False):
+        bodies.append("wing")
+        joints.append(Joint("W", ("crank", "wing"), "weld"))
+    return bodies, joints
+
+
+def jacobian_along(scene: Scene, crank_angles_rad: np.ndarray) -> dict[str, np.ndarray]:
+    """The reference DAE's constraint Jacobian (:class:`flex.dynamics.reference.SliderCrankDAE`,
+    9 coordinates) at the closed-form configuration of each crank angle: its rank, smallest
+    singular value, and the smallest singular value of the square Jacobian of the other
+    coordinates with the slider position as the input (0 at a dead centre)."""
+    from flex.dynamics.reference import SliderCrankDAE
+
+    dae = SliderCrankDAE(scene)
+    ranks, smallest, slider_input = [], [], []
+    for theta in np.asarray(crank_angles_rad, dtype=float):
+        dae.initial_crank_angle_rad = theta
+        q, _ = dae.initial_state()
+        jac = dae.jacobian(q)
+        found = jacobian_mobility(jac)
+        ranks.append(found["rank"])
+        smallest.append(float(found["singular_values"].min()))
+        slider_input.append(smallest_singular_value(np.delete(jac, 6, axis=1)[:8]))
+    return {"rank": np.asarray(ranks), "smallest_singular_value": np.asarray(smallest),
+            "slider_input_smallest_singular_value": np.asarray(slider_input),
+            "rows": np.asarray(dae.n_constraints), "coordinates": np.asarray(9)}
+
+
+def mechanism_checks(scene: Scene, deployment_angles_rad: np.ndarray) -> dict[str, Dataset]:
+    """Mobility by Gruebler and Kutzbach from the scene's bodies and joints, by the rank of
+    the constraint Jacobian along the deployment and over a full turn, the dead centres and
+    the transmission angle over a full turn: ``mechanism/*`` datasets."""
+    bodies, joints = topology(scene)
+    counted = counted_mobility(bodies, joints)
+    turn = np.radians(np.arange(0.0, 360.0, 1.0))
+    along = jacobian_along(scene, deployment_angles_rad)
+    full = jacobian_along(scene, turn)
+    coupler = slider_crank(scene["crank"]["length_m"], scene["coupler"]["length_m"], turn,
+                           offset_m=scene["slider"]["offset_m"]).coupler_angle_rad
+    dead = dead_centre_angles_rad(scene["crank"]["length_m"], scene["coupler"]["length_m"],
+                                  scene["slider"]["offset_m"])
+    return {
+        "mechanism/bodies": Dataset(np.array(bodies, dtype=object), "1", "bodies with frame"),
+        "mechanism/joints": Dataset(np.array([f"{j.name}:{j.kind}" for j in joints],
+                                             dtype=object), "1", "joints and kinds"),
+        "mechanism/gruebler_mobility": Dataset(counted["gruebler"], "1", "thesis Eq. 1"),
+        "mechanism/kutzbach_mobility": Dataset(counted["kutzbach"], "1", "thesis Eq. 2"),
+        "mechanism/jacobian_rows": Dataset(along["rows"], "1", "reference DAE constraints"),
+        "mechanism/jacobian_rank_min": Dataset(int(min(along["rank"].min(), full["rank"].min())),
+                                               "1", "smallest rank, deployment and full turn"),
+        "mechanism/jacobian_mobility": Dataset(int(9 - along["rank"].min()), "1",
+                                               "9 coordinates - rank (deployment)"),
+        "mechanism/redundant_constraints": Dataset(int(along["rows"] - along["rank"].min()), "1",
+                                                   "constraint rows - rank"),
+        "mechanism/dead_centre_angles": Dataset(np.degrees(dead), "deg",
+                                                "extended and folded dead centres"),
+        "mechanism/turn_angle": Dataset(np.degrees(turn), "deg", "crank angle, full turn"),
+        "mechanism/turn_transmission_angle": Dataset(
+            np.degrees(transmission_angle_rad(turn, coupler)), "deg", "transmission angle"),
+        "mechanism/turn_slider_input_singular_value": Dataset(
+            full["slider_input_smallest_singular_value"], "1",
+            "smallest singular value, Jacobian with the slider as input"),
+        "mechanism/deployment_angle": Dataset(np.degrees(deployment_angles_rad), "deg",
+                                              "crank angle over the design deployment"),
+        "mechanism/deployment_slider_input_singular_value": Dataset(
+            along["slider_input_smallest_singular_value"], "1",
+            "smallest singular value along the design deployment")}
+
+
+# ------------------------------------------------------------------------------------------
+# the independent reference DAE at a few points
+# ------------------------------------------------------------------------------------------
+def reference_check(case: CaseResult) -> dict[str, tuple[float, str]]:
+    """A rigid case's stored curves against the reference DAE of its resolved scene
+    (:func:`flex.dynamics.reference.deviations_from_reference` at the stored samples), and
+    both peak crank speeds over those samples: ``{name: (value, unit)}``."""
+    from flex.dynamics.reference import deviations_from_reference
+
+    data = {key.removeprefix("curves/"): np.asarray(value.data)
+            for key, value in case.datasets.items() if key.startswith("curves/")}
+    reference, deviations = deviations_from_reference(tomllib.loads(case.scene_toml), data)
+    stop, _ = _window(data)
+    deviations["peak_crank_speed_reference"] = (float(reference.q_dot[:stop + 1, 2].max()),
+                                                "rad/s")
+    deviations["peak_crank_speed_flex"] = (float(data["crank/angular_velocity"][:stop + 1].max()),
+                                           "rad/s")
+    deviations["reference_wall_time"] = (reference.wall_time_s, "s")
+    return deviations
+
+
+# ------------------------------------------------------------------------------------------
+# the study's summary
+# ------------------------------------------------------------------------------------------
+def design_case_name(scene: Scene) -> str:
+    """The case name of the design point itself."""
+    d = DesignPoint.of(scene)
+    return case_name(_rounded(d.angle_deg, d.preload_m, d.rate_N_per_m, d.thickness_m))
+
+
+def _line_datasets(name: str, part: Mapping[str, np.ndarray], point: DesignPoint
+                   ) -> dict[str, Dataset]:
+    out = {f"lines/{name}/{key}": Dataset(part[key], MEASURES[key][0] if key in MEASURES
+                                          else INPUTS.get(key, ("1",))[0], f"along line {name}")
+           for key in ("angle_deg", "preload_m", "rate_N_per_m", "peak_crank_speed",
+                       "deployment_time", "peak_joint_force", "peak_coupler_stress",
+                       "min_transmission_angle", "valid")}
+    for measure, unit in (("peak_crank_speed", "rad/s"), ("deployment_time", "s")):
+        verdict = claim_verdict(part, point, measure)
+        for key, value in verdict.items():
+            kind = unit if key.endswith("_y") or key == "design_value" else (
+                "deg" if key.endswith("_x") or key == "design_angle" else "1")
+            out[f"lines/{name}/{measure}_{key}"] = Dataset(value, kind, f"{measure}: {key}")
+    return out
+
+
+def summary_datasets(scene: Scene, grid: Grid, results: Mapping[str, CaseResult],
+                     references: Mapping[str, Mapping[str, tuple[float, str]]]
+                     ) -> dict[str, Dataset]:
+    """Everything the report and the figures read: the table, the families, the lines with
+    their extrema, the mechanism checks along the design deployment, the reference checks
+    (``references``: :func:`reference_check` by case) and the design inputs."""
+    rows = table(results)
+    _, families = plan(scene, grid)
+    point = DesignPoint.of(scene)
+    out = table_datasets(rows)
+    out.update({f"families/{name}": Dataset(np.array(names, dtype=object), "1",
+                                            f"cases of family {name}")
+                for name, names in families.items()})
+    for name, part in claim_lines(rows, families).items():
+        out.update(_line_datasets(name, part, point))
+    design = results.get(design_case_name(scene))
+    if design is not None and design.status == "ok" and "curves/crank/angle" in design.datasets:
+        angles = np.asarray(design.datasets["curves/crank/angle"].data)
+        stop = first_maximum_index(angles)
+        out.update(mechanism_checks(tomllib.loads(design.scene_toml), angles[:None if stop is None
+                                                                             else stop + 1]))
+    for name, values in references.items():
+        out.update({f"reference/{name}/{key}": Dataset(value, unit, "against the reference DAE")
+                    for key, (value, unit) in values.items()})
+    out.update({
+        "design/point": Dataset(np.array([point.angle_deg, point.preload_m, point.rate_N_per_m,
+                                          point.thickness_m]), "deg, m, N/m, m",
+                                "design point: initial angle, preload, rate, thickness"),
+        "design/stored_energy": Dataset(point.energy_J, "J", "design point spring energy"),
+        "design/rest_angle": Dataset(math.degrees(rest_angle_rad(scene)), "deg",
+                                     "closed-form rest angle of the design point"),
+        "design/tolerance": Dataset(float(scene["fidelity"]["tolerance"]), "1",
+                                    "auto's tolerance"),
+        "design/allowable_stress": Dataset(A36_YIELD_STRESS_PA, "Pa", "ASTM A36 yield"),
+        "design/design_case": Dataset(design_case_name(scene), "1", "the design point's case")})
+    return out
+
+
+def reference_names(scene: Scene, grid: Grid, angles_deg: tuple[float, ...]) -> list[str]:
+    """Cases checked against the reference DAE: the design point, the preload line at
+    ``angles_deg``, and the design angle on the stiffest fixed-energy line."""
+    d = DesignPoint.of(scene)
+    stiff = max(grid.energy_rate_factors) * d.rate_N_per_m
+    points = [_rounded(d.angle_deg, d.preload_m, d.rate_N_per_m, d.thickness_m),
+              *(_rounded(a, d.preload_m, d.rate_N_per_m, d.thickness_m) for a in angles_deg),
+              _rounded(d.angle_deg, math.sqrt(2 * d.energy_J / stiff), stiff, d.thickness_m)]
+    return [case_name(p) for p in dict.fromkeys(points)]
+
+
+def run_references(results: Mapping[str, CaseResult], names: list[str]
+                   ) -> dict[str, dict[str, tuple[float, str]]]:
+    """:func:`reference_check` of each named case that ran with a rigid coupler."""
+    return {name: reference_check(results[name]) for name in names
+            if name in results and results[name].attrs.get("design_model") == "rigid"}

@@ -1,0 +1,310 @@
+"""Validation against the IVP test set's flexible slider-crank ("crank"): the ``validation``
+study's scenes, independent two-mode runs, comparisons, report and figures.
+
+The benchmark (:mod:`flex.dynamics.ivp_crank`: source, parameters, published values) is a
+steel rod 0.3 m x 8 x 8 mm on a 0.15 m crank turned at 150 rad/s, slider 0.075552 kg, no
+gravity, undamped. Three kinds of runs meet here:
+
+- the published reference values at t = 0.1 s (crank.f SOLN), from the published initial
+  state, which starts the rod "close to smooth motion" (deflected, with the velocities of
+  the quasi-static response);
+- :func:`flex.dynamics.ivp_crank.solve`, an independent implementation of the published
+  two-mode model (same matrices, derived here from the shape functions): it must reproduce
+  the published values, and it runs the variants that isolate each modelling choice;
+- flex's Exudyn runs: a rigid rod (against the closed form,
+  :func:`flex.base.kinematics.constant_speed_motion`), the FFRF rod (a meshed 3-D steel
+  bar, Craig-Bampton modes) under mode, mesh and step refinement, and the nonlinear FE rod.
+
+flex starts every run on the rigid motion, undeformed (the test set's second initial state,
+INIT2): it has no scene key for an initial deflection. So flex is compared with the two-mode
+model started there too, and with the nonlinear FE rod, the most complete model here (3-D
+solid, large rotations, geometric stiffening), as the reference "closer to the truth".
+Units: m, s, rad, Hz; deflections and positions in m (reports in um).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.base.kinematics import constant_speed_motion
+from flex.base.physics import euler_buckling_load_N, pinned_pinned_omega
+from flex.data.results import CaseResult, Dataset
+from flex.data.scene import Scene, derived_scenes
+from flex.dynamics import ivp_crank
+from flex.dynamics.ivp_crank import (
+    PUBLISHED_AT_0P1S,
+    PUBLISHED_PI,
+    PUBLISHED_TIME_S,
+    CrankBenchmark,
+    CrankSolution,
+)
+
+BENCH = CrankBenchmark()
+#: the published components compared, index into PUBLISHED_AT_0P1S, and unit
+COMPONENTS = (("phi2", 1, "rad"), ("x3", 2, "m"), ("q1", 3, "m"), ("q2", 4, "m"),
+              ("q3", 5, "m"), ("q4", 6, "m"), ("phi2_rate", 8, "rad/s"),
+              ("x3_rate", 9, "m/s"), ("q1_rate", 10, "m/s"), ("q2_rate", 11, "m/s"))
+#: stored sample interval of every run [s]
+OUTPUT_STEP_S = 1e-4
+
+
+def benchmark_overrides(bench: CrankBenchmark = BENCH) -> list[str]:
+    """The benchmark as flex scene keys: constant crank speed from angle 0, a steel plate
+    rod (in-plane height ``thickness_m``, out-of-plane ``width_m``), the slider mass, 0.1 s.
+    Not expressible in a scene, and irrelevant here: the crank's mass and inertia (its speed
+    is prescribed; set from M1, J1 anyway) and the rod's initial deflection (flex starts
+    undeformed on the rigid motion)."""
+    crank_inertia_about_centre = (bench.crank_inertia_about_A_kgm2
+                                  - bench.crank_mass_kg * (bench.crank_length_m / 2) ** 2)
+    return [f"crank.length_m={bench.crank_length_m!r}", "crank.initial_angle_deg=0.0",
+            f"crank.mass_kg={bench.crank_mass_kg!r}",
+            f"crank.inertia_kgm2={crank_inertia_about_centre!r}",
+            f"coupler.length_m={bench.rod_length_m!r}", 'coupler.geometry="plate"',
+            f"coupler.thickness_m={bench.rod_height_m!r}",
+            f"coupler.width_m={bench.rod_width_m!r}",
+            f"coupler.youngs_modulus_Pa={bench.youngs_modulus_Pa!r}",
+            f"coupler.density_kg_per_m3={bench.density_kg_per_m3!r}",
+            f"coupler.poisson_ratio={bench.poisson_ratio!r}", "coupler.damping_ratio=0.0",
+            f"slider.mass_kg={bench.slider_mass_kg!r}", "slider.offset_m=0.0",
+            'drive.kind="constant_speed"',
+            f"drive.crank_speed_rad_per_s={bench.crank_speed_rad_per_s!r}",
+            f"simulation.end_time_s={PUBLISHED_TIME_S!r}",
+            f"simulation.output_step_s={OUTPUT_STEP_S!r}", "simulation.error_estimate=false"]
+
+
+def flex_cases(scene: Scene, runs: dict[str, tuple[str, float, int, float]]) -> dict[str, Scene]:
+    """One scene per flex run: name -> (coupler model, mesh size [m], modes, step [s])."""
+    return derived_scenes(scene, {
+        name: [f'coupler.model="{model}"', f"coupler.mesh_size_m={mesh!r}",
+               f"coupler.modes={modes}", f"simulation.step_s={step!r}"]
+        for name, (model, mesh, modes, step) in runs.items()})
+
+
+#: the two-mode runs: name -> (lateral modes, axial mass factor, geometric stiffening,
+#: initial state, pi of the stiffness) -- the published model, then one change at a time
+#: (``fixed``: axial mass block / 15; ``cross``: the published nonlinear term alone;
+#: ``stiffened``: the consistent one, :mod:`flex.dynamics.ivp_crank`)
+TWO_MODE_RUNS: dict[str, tuple[int, float, str, str, float]] = {
+    "published": (2, 15.0, "none", "published", PUBLISHED_PI),
+    "published_mass_fixed": (2, 1.0, "none", "published", math.pi),
+    "published_cross": (2, 15.0, "published", "published", PUBLISHED_PI),
+    "published_stiffened": (2, 1.0, "consistent", "published", math.pi),
+    "rigid_start": (2, 15.0, "none", "rigid", PUBLISHED_PI),
+    "rigid_start_mass_fixed": (2, 1.0, "none", "rigid", math.pi),
+    "rigid_start_8_modes": (8, 1.0, "none", "rigid", math.pi),
+    "rigid_start_cross": (2, 1.0, "published", "rigid", math.pi),
+    "rigid_start_8_modes_stiffened": (8, 1.0, "consistent", "rigid", math.pi),
+}
+#: the best beam: 8 modes, consistent axial mass, consistent geometric stiffening
+BEST_BEAM = "two-mode rigid_start_8_modes_stiffened"
+
+
+def two_mode_runs(runs: dict[str, tuple[int, float, str, str, float]] | None = None,
+                  rtol: float = 1e-10) -> dict[str, CrankSolution]:
+    """The independent model's runs (:data:`TWO_MODE_RUNS` by default), 5-20 s each."""
+    return {name: ivp_crank.solve(BENCH, modes, factor, stiffened, initial,
+                                  output_step_s=OUTPUT_STEP_S, rtol=rtol, atol=rtol * 1e-3,
+                                  pi_value=pi_value)
+            for name, (modes, factor, stiffened, initial, pi_value)
+            in (runs or TWO_MODE_RUNS).items()}
+
+
+def dominant_frequency_hz(time_s: np.ndarray, signal: np.ndarray,
+                          band_hz: tuple[float, float] = (100.0, 1000.0)) -> float:
+    """Frequency [Hz] of the largest spectral peak of ``signal`` within ``band_hz``
+    (Hann window, 64x zero padding, parabolic interpolation of the peak)."""
+    step = float(time_s[1] - time_s[0])
+    detrended = signal - np.polyval(np.polyfit(time_s, signal, 1), time_s)
+    padded = 64 * detrended.size
+    spectrum = np.abs(np.fft.rfft(detrended * np.hanning(detrended.size), padded))
+    freqs = np.fft.rfftfreq(padded, step)
+    inside = np.flatnonzero((freqs >= band_hz[0]) & (freqs <= band_hz[1]))
+    i = inside[np.argmax(spectrum[inside])]
+    a, b, c = np.log(spectrum[i - 1:i + 2])
+    return float(freqs[i] + 0.5 * (a - c) / (a - 2 * b + c) * (freqs[1] - freqs[0]))
+
+
+def _curves(case: CaseResult | CrankSolution) -> dict[str, np.ndarray]:
+    """Time, midpoint deflection, slider position and chord change of a run."""
+    if isinstance(case, CrankSolution):
+        return {"time": case.time_s, "deflection": case.midpoint_deflection_m,
+                "slider": case.slider_position_m, "chord": case.chord_change_m}
+    data = case.datasets
+    return {"time": data["time"].data, "deflection": data["coupler/midpoint_deflection"].data,
+            "slider": data["slider/position"].data,
+            "chord": (data["coupler/chord_change"].data if "coupler/chord_change" in data
+                      else np.zeros_like(data["time"].data))}
+
+
+def _against(curves: dict[str, np.ndarray], reference: dict[str, np.ndarray]
+             ) -> dict[str, float]:
+    """Deflection and slider differences from ``reference`` (same time grid): RMS over the
+    run relative to the reference's largest |deflection|, and the largest |slider
+    difference| [m]."""
+    peak = np.abs(reference["deflection"]).max()
+    return {"deflection_rms_rel": float(np.sqrt(np.mean(
+                (curves["deflection"] - reference["deflection"]) ** 2)) / peak),
+            "slider_max_diff_m": float(np.abs(curves["slider"] - reference["slider"]).max())}
+
+
+def analyse(scene: Scene, results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
+            reference: str) -> tuple[dict[str, Dataset], str]:
+    """The study's datasets and report: the rigid limit, the published values against the
+    independent model, every run at t = 0.1 s and over time against ``reference`` (a flex
+    case, the nonlinear FE rod), with the frequencies that explain the differences."""
+    lines = ["validation: the IVP test set's flexible slider-crank (Simeon; Mazzia & "
+             "Magherini, Test Set for IVP Solvers, Bari: problem crank, crank.f)"]
+    datasets: dict[str, Dataset] = {}
+    # 1. rigid limit
+    rigid = results["rigid"].datasets
+    time = rigid["time"].data
+    _, exact = constant_speed_motion(BENCH.crank_length_m, BENCH.rod_length_m, 0.0,
+                                     BENCH.crank_speed_rad_per_s, time)
+    position_error = rigid["slider/position"].data - exact.slider_position_m
+    velocity_error = rigid["slider/velocity"].data - exact.slider_velocity_m_per_s
+    lines += ["", "1. Rigid limit at t = 0.1 s (phi1 = 150 t = 15 rad) against the closed form",
+              f"   slider x: flex {rigid['slider/position'].data[-1]:.12f} m, closed form "
+              f"{exact.slider_position_m[-1]:.12f} m (diff {position_error[-1]:.2e} m; "
+              f"max over the run {np.abs(position_error).max():.2e} m)",
+              f"   slider v: flex {rigid['slider/velocity'].data[-1]:.9f} m/s, closed form "
+              f"{exact.slider_velocity_m_per_s[-1]:.9f} m/s (max diff "
+              f"{np.abs(velocity_error).max():.2e} m/s)",
+              f"   rod angle: closed form {exact.coupler_angle_rad[-1]:.10f} rad; published "
+              f"(flexible) {PUBLISHED_AT_0P1S[1]:.10f} rad",
+              f"   published flexible x3 - rigid x3 = "
+              f"{(PUBLISHED_AT_0P1S[2] - exact.slider_position_m[-1]) * 1e6:.3f} um"]
+    datasets.update({
+        "rigid_limit/slider_position_error": Dataset(position_error, "m", "flex - closed form"),
+        "rigid_limit/slider_velocity_error": Dataset(velocity_error, "m/s",
+                                                     "flex - closed form"),
+        "rigid_limit/closed_form_slider_position": Dataset(exact.slider_position_m, "m",
+                                                           "closed form, phi1 = 150 t")})
+    # 2. published values against the independent implementation
+    published = solutions["published"].state[-1]
+    index = [i for _, i, _ in COMPONENTS]
+    relative = np.abs(published[index] - PUBLISHED_AT_0P1S[index]) / np.abs(
+        PUBLISHED_AT_0P1S[index])
+    lines += ["", "2. Published reference at t = 0.1 s (crank.f SOLN) against flex's "
+              "independent implementation of the two-mode model (scipy DOP853, rtol 1e-10)",
+              f"   {'component':10s} {'published':>16s} {'independent':>16s} {'rel. diff':>9s}"]
+    lines += [f"   {name:10s} {PUBLISHED_AT_0P1S[i]:16.9e} {published[i]:16.9e} {r:9.1e}"
+              for (name, i, _), r in zip(COMPONENTS, relative, strict=True)]
+    datasets.update({
+        "published/component": Dataset(np.array([c[0] for c in COMPONENTS], dtype=object),
+                                       "1", "crank.f solution component"),
+        "published/value": Dataset(PUBLISHED_AT_0P1S[index], "SI (see component)",
+                                   "crank.f SOLN at t = 0.1 s"),
+        "published/independent": Dataset(published[index], "SI (see component)",
+                                         "flex.dynamics.ivp_crank, published settings"),
+        "published/relative_difference": Dataset(relative, "1", "|independent - published| "
+                                                 "/ |published|")})
+    lines.append("   one change at a time from the published model, same published start:")
+    for name, label in (("published_mass_fixed", "axial mass block / 15 (consistent mass)"),
+                        ("published_cross", "published nonlinear term (IPAR(1) = 1)"),
+                        ("published_stiffened", "consistent mass and consistent stiffening")):
+        state = solutions[name].state[-1]
+        lines.append(f"   {label:42s} q1 = {state[3] * 1e6:8.3f} um "
+                     f"({(state[3] / PUBLISHED_AT_0P1S[3] - 1) * 100:+6.2f} %), x3 - published "
+                     f"= {(state[2] - PUBLISHED_AT_0P1S[2]) * 1e6:+.3f} um")
+    # 3. every run from the rigid start, against two references
+    height = BENCH.rod_height_m
+    omega_eb = pinned_pinned_omega(BENCH.rod_length_m, height, BENCH.youngs_modulus_Pa,
+                                   BENCH.density_kg_per_m3)
+    buckling = euler_buckling_load_N(BENCH.rod_length_m, height, BENCH.rod_width_m,
+                                     BENCH.youngs_modulus_Pa)
+    runs: dict[str, Any] = {f"two-mode {k}": v for k, v in solutions.items()
+                            if k.startswith("rigid_start")}
+    runs.update({k: v for k, v in results.items() if v.status == "ok" and k != "rigid"})
+    references = {"beam": _curves(runs[BEST_BEAM]), "fe": _curves(results[reference])}
+    lines += ["", "3. From the rigid start (undeformed, as flex starts), t = 0.1 s and over "
+              "0-0.1 s, against two references:",
+              f"   beam = '{BEST_BEAM}' (8 modes, consistent mass and stiffening); "
+              f"fe = '{reference}' (nonlinear FE rod)",
+              f"   Euler-Bernoulli pinned-pinned first bending: {omega_eb / (2 * math.pi):.1f} "
+              f"Hz; Euler buckling load {buckling:.0f} N; crank harmonics 8 and 9: "
+              f"{8 * BENCH.crank_speed_rad_per_s / (2 * math.pi):.1f}, "
+              f"{9 * BENCH.crank_speed_rad_per_s / (2 * math.pi):.1f} Hz",
+              f"   {'run':36s} {'q_mid(0.1)':>10s} {'x3(0.1)':>12s} {'peak':>6s} {'rms/beam':>8s} "
+              f"{'rms/fe':>6s} {'dx3/beam':>8s} {'dx3/fe':>7s} {'oop':>6s} {'wall':>5s}",
+              f"   {'':36s} {'[um]':>10s} {'[m]':>12s} {'[Hz]':>6s} {'[1]':>8s} {'[1]':>6s} "
+              f"{'[um]':>8s} {'[um]':>7s} {'[um]':>6s} {'[s]':>5s}"]
+    rows = []
+    for name, run in runs.items():
+        curves = _curves(run)
+        beam, fe = _against(curves, references["beam"]), _against(curves, references["fe"])
+        out_of_plane = (float(np.abs(run.datasets["coupler/midpoint_out_of_plane"].data).max())
+                        if isinstance(run, CaseResult)
+                        and "coupler/midpoint_out_of_plane" in run.datasets else 0.0)
+        wall = (run.counters.get("wall_time_s", float("nan")) if isinstance(run, CaseResult)
+                else run.wall_time_s)
+        row = (name, curves["deflection"][-1], curves["slider"][-1],
+               dominant_frequency_hz(curves["time"], curves["deflection"]),
+               beam["deflection_rms_rel"], fe["deflection_rms_rel"], beam["slider_max_diff_m"],
+               fe["slider_max_diff_m"], out_of_plane, wall)
+        rows.append(row)
+        lines.append(f"   {name:36s} {row[1] * 1e6:10.2f} {row[2]:12.9f} {row[3]:6.1f} "
+                     f"{row[4]:8.3f} {row[5]:6.3f} {row[6] * 1e6:8.2f} {row[7] * 1e6:7.2f} "
+                     f"{row[8] * 1e6:6.0f} {row[9]:5.1f}")
+        key = name.replace(" ", "_")
+        datasets[f"runs/{key}/midpoint_deflection"] = Dataset(curves["deflection"], "m",
+                                                              f"{name}: v(L2/2) from chord B-C")
+        datasets[f"runs/{key}/slider_position"] = Dataset(curves["slider"], "m", name)
+        datasets[f"runs/{key}/chord_change"] = Dataset(curves["chord"], "m", name)
+    datasets["runs/time"] = Dataset(references["fe"]["time"], "s", "sample times of every run")
+    datasets["table/run"] = Dataset(np.array([r[0] for r in rows], dtype=object), "1", "run")
+    for column, (name, unit, what) in enumerate((
+            ("deflection_at_0p1s", "m", "midpoint deflection at 0.1 s"),
+            ("slider_at_0p1s", "m", "slider position at 0.1 s"),
+            ("spectral_peak", "Hz", "largest spectral peak of the deflection in 100-1000 Hz "
+             "(free vibration mixed with crank harmonics 8, 9)"),
+            ("deflection_rms_rel_beam", "1", f"RMS deflection difference from {BEST_BEAM} / "
+             "its peak |deflection|"),
+            ("deflection_rms_rel_fe", "1", f"RMS deflection difference from {reference} / its "
+             "peak |deflection|"),
+            ("slider_max_diff_beam", "m", f"largest |slider difference| from {BEST_BEAM}"),
+            ("slider_max_diff_fe", "m", f"largest |slider difference| from {reference}"),
+            ("out_of_plane_max", "m", "largest midpoint displacement out of the mechanism "
+             "plane (nonlinear FE)"),
+            ("wall_time", "s", "wall time")), start=1):
+        datasets[f"table/{name}"] = Dataset(np.array([r[column] for r in rows]), unit, what)
+    datasets["published/two_mode_published_start/midpoint_deflection"] = Dataset(
+        solutions["published"].midpoint_deflection_m, "m", "independent two-mode model from "
+        "the published initial state, published settings")
+    datasets["published/euler_bernoulli_frequency"] = Dataset(
+        omega_eb / (2 * math.pi), "Hz", "pinned-pinned first bending, 8 mm steel, 0.3 m")
+    return datasets, "\n".join(lines)
+
+
+def draw_figures(summary_data: dict[str, Dataset], folder: Path,
+                 shown: tuple[str, ...]) -> list[Path]:
+    """``validation-deflection.png`` (midpoint deflection of the ``shown`` runs over time,
+    and their difference from the first) and ``validation-slider.png`` (slider position minus
+    the rigid closed form)."""
+    from flex.base.plotting import MICRO, panels
+
+    data = {k: v.data for k, v in summary_data.items()}
+    time = data["runs/time"]
+    rigid = data["rigid_limit/closed_form_slider_position"]
+    paths = []
+    for stem, key, label, baseline in (
+            ("deflection", "midpoint_deflection", "midpoint deflection", 0.0),
+            ("slider", "slider_position", "slider x \u2212 rigid closed form", rigid)):
+        path = folder / f"validation-{stem}.png"
+        with panels(path, f"IVP test set crank, rigid start: {label}", rows=2,
+                    size=(7.5, 6.0), sharex=True) as (_, (ax, difference)):
+            first = None
+            for name in shown:
+                values = (data[f"runs/{name}/{key}"] - baseline) * 1e6
+                first = values if first is None else first
+                ax.plot(time, values, lw=1.0, label=name.replace("_", " "))
+                difference.plot(time, values - first, lw=0.8)
+            ax.set_ylabel(f"{label} [{MICRO}m]")
+            difference.set_ylabel(f"\u2212 {shown[0].replace('_', ' ')}\n[{MICRO}m]")
+            difference.set_xlabel("time [s]")
+        paths.append(path)
+    return paths
+

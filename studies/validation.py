@@ -1,0 +1,71 @@
+"""Study ``validation``: flex against a published benchmark, the flexible slider-crank of the
+IVP test set (Mazzia & Magherini, *Test Set for IVP Solvers*, Bari; problem "crank", B.
+Simeon's two-mode model, reference values at t = 0.1 s).
+
+Crank 0.15 m at 150 rad/s, steel rod 0.3 m x 8 x 8 mm, slider 0.075552 kg, no gravity, no
+damping. Runs: flex's rigid rod (against the closed form), FFRF rod under step, mode and mesh
+refinement, the nonlinear FE rod at two steps (the reference), and the independent
+two-mode model (:mod:`flex.dynamics.ivp_crank`) with the published settings and one change
+at a time. What each comparison means: :mod:`flex.experiments.validation`, docs/validation.md.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from flex.data.results import CaseResult
+from flex.data.scene import Scene
+from flex.experiments import validation
+from flex.study import StudyRun, Summary, simulate_each
+
+NAME = "validation"
+DESCRIPTION = "IVP test set flexible slider-crank (Simeon): published values, FFRF, nonlinear FE"
+OVERRIDES = validation.benchmark_overrides()
+#: flex runs: name -> (coupler model, mesh size [m], Craig-Bampton modes, step [s]). The FFRF
+#: base is mesh 8 mm (the rod's height), 6 modes; each group refines one knob.
+RUNS: dict[str, tuple[str, float, int, float]] = {
+    "rigid": ("rigid", 0.008, 6, 1e-4),
+    "ffrf_h1e-4": ("ffrf", 0.008, 6, 1e-4),
+    "ffrf_h5e-5": ("ffrf", 0.008, 6, 5e-5),
+    "ffrf_h2e-5": ("ffrf", 0.008, 6, 2e-5),
+    "ffrf_h1e-5": ("ffrf", 0.008, 6, 1e-5),
+    "ffrf_modes2_h1e-5": ("ffrf", 0.008, 2, 1e-5),
+    "ffrf_modes12_h1e-5": ("ffrf", 0.008, 12, 1e-5),
+    "ffrf_mesh4mm_h1e-5": ("ffrf", 0.004, 6, 1e-5),
+    "nonlinear_fe_h5e-5": ("nonlinear_fe", 0.008, 6, 5e-5),
+    "nonlinear_fe_h2p5e-5": ("nonlinear_fe", 0.008, 6, 2.5e-5),
+}
+#: the most complete model, finest step: what the other runs are measured against
+REFERENCE = "nonlinear_fe_h2p5e-5"
+#: the curves drawn (summary datasets runs/<name>/...)
+SHOWN = ("two-mode_rigid_start_8_modes_stiffened", "two-mode_rigid_start", "ffrf_h1e-5",
+         REFERENCE)
+
+
+def cases(scene: Scene) -> dict[str, Scene]:
+    return validation.flex_cases(scene, RUNS)
+
+
+def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
+    """flex's runs (reductions cached in ``run.cache_dir``), then the independent two-mode
+    runs into ``run.notes``."""
+    results = simulate_each(scenes, run)
+    run.notes["two_mode"] = validation.two_mode_runs()
+    return results
+
+
+def summarize(scene: Scene, results: dict[str, CaseResult],
+              notes: dict[str, Any] | None = None) -> Summary:
+    solutions = (notes or {}).get("two_mode") or validation.two_mode_runs()
+    return Summary(*validation.analyse(scene, results, solutions, REFERENCE))
+
+
+def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
+    return validation.draw_figures(summary.datasets, folder, SHOWN)
+
+
+if __name__ == "__main__":
+    from flex.cli import main
+
+    raise SystemExit(main(["run", NAME]))

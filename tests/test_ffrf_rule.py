@@ -1,0 +1,213 @@
+"""The FFRF settings rule (flex/config/ffrf_rule.py) and its calibration's fit and validation
+(flex/experiments/calibration.py) on synthetic grids whose answer is known."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from flex.base.errors import FlexError
+from flex.base.physics import in_plane_fixed_interface_omegas
+from flex.config.ffrf_rule import (
+    STEP_GRID,
+    fill_link_keys,
+    first_period_s,
+    level_for,
+    load_time_scale_s,
+    outside_family,
+    pick,
+    rule_constants,
+    rule_mesh_size_m,
+    steps_per_first_period,
+)
+from flex.data.results import CaseResult, Dataset
+from flex.data.scene import load_scene
+from flex.experiments.calibration import (
+    GRID_MODES,
+    GRID_STEPS_PER_PERIOD,
+    fit_levels,
+    robustly_within,
+    validate,
+)
+
+STEEL_1MM = {"length_m": 0.08, "thickness_m": 0.001, "width_m": 0.01,
+             "youngs_modulus_Pa": 200e9, "density_kg_per_m3": 7850.0}
+
+
+def test_first_period_is_the_pinned_pinned_euler_bernoulli_period():
+    # f = (pi / 2) / L^2 sqrt(E t^2 / (12 rho)) = 357.6 Hz for the thesis's 1 mm steel plate
+    hertz = math.pi / 2 / 0.08**2 * math.sqrt(200e9 * 0.001**2 / 12 / 7850.0)
+    assert first_period_s(STEEL_1MM) == pytest.approx(1 / hertz, rel=1e-12)
+    assert hertz == pytest.approx(357.6, abs=0.1)  # thesis Table 5, model 0
+
+
+@pytest.mark.parametrize("thickness_m, expected_m", [
+    (0.001, 0.002),   # 2 t
+    (0.002, 0.004),   # 2 t
+    (0.003, 0.005),   # L / 16
+    (0.02, 0.005),    # L / 16
+])
+def test_mesh_rule(thickness_m, expected_m):
+    assert rule_mesh_size_m(dict(STEEL_1MM, thickness_m=thickness_m)) == pytest.approx(expected_m)
+
+
+def test_levels_serve_every_tolerance_at_or_above_them():
+    levels = sorted(level["tolerance"] for level in rule_constants()["levels"])
+    for tolerance in levels:
+        assert level_for(tolerance)["tolerance"] == tolerance
+        assert level_for(tolerance * 3)["tolerance"] == tolerance  # the next finer level
+    assert outside_family(STEEL_1MM, levels[0] / 10).startswith("fidelity.tolerance")
+
+
+def _scene(thickness_m=0.001, *extra):
+    return load_scene(None, ['coupler.geometry="plate"', 'coupler.model="ffrf"',
+                             f"coupler.thickness_m={thickness_m}", *extra])
+
+
+def test_the_load_time_scale_is_the_spring_s_quarter_period_or_half_a_turn():
+    scene = _scene()
+    mass = 0.0264 + 0.01432 + 7850.0 * 0.08 * 0.001 * 0.01  # slider, lumped crank, plate
+    assert load_time_scale_s(scene) == pytest.approx(math.pi / 2 * math.sqrt(mass / 1500.0))
+    turning = _scene(0.001, 'drive.kind="constant_speed"', "drive.crank_speed_rad_per_s=40.0")
+    assert load_time_scale_s(turning) == pytest.approx(math.pi / 40.0)
+
+
+def test_a_pick_outside_the_family_has_no_step_and_says_why():
+    foil = 0.08 / (rule_constants()["family"]["slenderness_max"] * 2)
+    chosen = pick(_scene(foil), 0.01)
+    assert chosen.step_s is None and chosen.level is None
+    assert "outside the calibrated family" in chosen.reason
+
+
+def test_a_pick_inside_the_family_is_t1_over_the_law_s_grid_count():
+    scene = _scene()
+    level = level_for(0.01)
+    n_load = load_time_scale_s(scene) / first_period_s(scene["coupler"])
+    per = steps_per_first_period(level, n_load)
+    chosen = pick(scene, 0.01)
+    assert per in STEP_GRID
+    assert chosen.step_s == pytest.approx(first_period_s(scene["coupler"]) / per)
+    assert chosen.modes == level["modes"] and chosen.level == level["tolerance"]
+
+
+def test_the_step_law_rounds_up_to_the_grid():
+    law = {"steps_coefficient": 100.0, "steps_exponent": 0.5}
+    assert steps_per_first_period(law, 4.0) == 64  # 50 -> 64
+    assert steps_per_first_period(law, 100.0) == 16  # 10 -> 16
+    assert steps_per_first_period(law, 0.1) is None  # 316: beyond the grid
+
+
+def test_only_auto_link_keys_are_filled():
+    scene = _scene(0.001, 'coupler.modes="auto"', "coupler.mesh_size_m=0.003")
+    filled = fill_link_keys(scene, "coupler", 0.01)
+    assert filled == {"modes": level_for(0.01)["modes"]}
+    assert scene["coupler"]["mesh_size_m"] == 0.003
+
+
+def test_a_lumped_link_keeps_auto():
+    scene = load_scene(None, ['crank.modes="auto"'])
+    assert fill_link_keys(scene, "crank", 0.01) == {} and scene["crank"]["modes"] == "auto"
+
+
+def test_bundled_scene_leaves_the_coupler_discretization_to_the_rule():
+    coupler = load_scene()["coupler"]
+    assert coupler["modes"] == "auto" and coupler["mesh_size_m"] == "auto"
+
+
+def test_in_plane_estimates_skip_the_antisymmetric_modes():
+    # beam theory: clamped-clamped in-plane bending 22.37/L^2 sqrt(EI/rho A) = 811 Hz for
+    # 1 mm (FE 823 Hz), the first axial mode c / 2L = 31.5 kHz after the 8th bending mode
+    omegas = in_plane_fixed_interface_omegas(0.08, 0.001, 0.01, 200e9, 7850.0, 0.3, 10)
+    hertz = np.array(omegas) / (2 * math.pi)
+    assert hertz[0] == pytest.approx(4.7300**2 / 0.08**2 * math.sqrt(
+        200e9 * 0.001**2 / 12 / 7850.0) / (2 * math.pi), rel=1e-4)
+    assert hertz[8] == pytest.approx(math.sqrt(200e9 / 7850.0) / 0.16, rel=1e-9)  # axial
+
+
+# ------------------------------------------------------------------------------------------
+# fit and validation on synthetic grids
+# ------------------------------------------------------------------------------------------
+def _case(name, thickness_m, error_of, time_of, reference_accuracy=1e-4):
+    """A calibration case of the 80 mm steel plate ``thickness_m`` thick whose grid errors and
+    times are ``error_of(modes, steps per period, n_load)`` and ``time_of(...)``."""
+    from flex.data.scene import to_toml
+
+    scene = _scene(thickness_m)
+    n_load = load_time_scale_s(scene) / first_period_s(scene["coupler"])
+    modes = np.repeat(GRID_MODES, len(GRID_STEPS_PER_PERIOD)).astype(float)
+    per = np.tile(GRID_STEPS_PER_PERIOD, len(GRID_MODES))
+    triples = [(m, n, n_load) for m, n in zip(modes, per, strict=True)]
+    datasets = {"grid/modes": Dataset(modes, "1"),
+                "grid/steps_per_first_period": Dataset(per, "1"),
+                "grid/peak_deflection_error": Dataset(np.array([error_of(*t) for t in triples]),
+                                                      "1"),
+                "grid/total_time": Dataset(np.array([time_of(*t) for t in triples]), "s")}
+    return CaseResult(name, to_toml(scene), datasets,
+                      attrs={"reference_accuracy": reference_accuracy})
+
+
+def step_law_error(m, n, n_load):
+    """(h / T1)^2 error falling with n_load^-1 (a stiffer plate follows its load), plus a
+    modal truncation term: needs N ~ n_load^-0.5."""
+    return 4.0 / (n**2 * n_load) + 1e-4 / m
+
+
+def cost(m, n, n_load):
+    return 1e-3 * n * (1 + 0.1 * m)
+
+
+def test_robustly_within_refuses_a_lucky_coarse_step():
+    from flex.experiments.calibration import grid_table
+
+    case = _case("lucky", 0.001, lambda m, n, _: 1e-4 if n == 4 else (0.05 if n == 8 else 1e-4),
+                 cost)
+    table = grid_table(case)
+    ok = robustly_within(table, 0.01)
+    assert not ok[(table["modes"] == 1) & (table["steps_per_first_period"] == 4)].any()
+    assert ok[(table["modes"] == 1) & (table["steps_per_first_period"] == 16)].all()
+
+
+def test_the_fitted_law_covers_every_calibration_scene():
+    from flex.experiments.calibration import MARGIN, grid_table, n_load_of
+
+    cases = {f"t{t}": _case(f"t{t}", t, step_law_error, cost) for t in (0.001, 0.002, 0.005)}
+    level = next(lv for lv in fit_levels(cases, [0.01]) if lv["damping"] == "undamped")
+    assert level["modes"] == 1  # the truncation term is small: the fewest modes are cheapest
+    assert 0.2 < level["steps_exponent"] < 0.8  # the law's n_load^-0.5, through the grid
+    for case in cases.values():
+        table, per = grid_table(case), steps_per_first_period(level, n_load_of(case))
+        row = (table["modes"] == 1) & (table["steps_per_first_period"] == per)
+        assert robustly_within(table, MARGIN * 0.01)[row].all()
+
+
+def test_a_level_too_few_references_can_certify_is_not_fitted():
+    levels = fit_levels({"a": _case("a", 0.001, step_law_error, cost,
+                                    reference_accuracy=1e-2)}, [1e-3])
+    assert all(level["modes"] is None for level in levels)
+    assert "at least" in levels[0]["reason"]
+
+
+def test_validation_compares_the_rule_with_the_fastest_robust_pair():
+    cases = {"v": _case("v", 0.002, step_law_error, cost)}
+    law = {"damping": "undamped", "tolerance": 0.01, "modes": 8, "steps_coefficient": 128.0,
+           "steps_exponent": 0.0}
+    (row,) = validate(cases, [law])
+    assert row["rule_pair"] == "8 modes, T1/128"
+    best_modes, best_per = row["best_pair"].split(" modes, T1/")
+    assert int(best_modes) == 1 and row["slowdown"] == pytest.approx(
+        cost(8, 128, 0) / cost(1, float(best_per), 0))
+    assert not row["meets"]  # far slower than needed
+
+
+def test_install_refuses_a_foreign_result_file(tmp_path):
+    from flex.data.results import write_results
+    from flex.experiments.calibration_report import install_rule
+
+    path = write_results(tmp_path / "other.h5", "simulate", [], "")
+    rule = tmp_path / "rule.toml"
+    rule.write_text("kept")
+    with pytest.raises(FlexError, match="not calibrate"):
+        install_rule(path, rule)
+    assert rule.read_text() == "kept"
