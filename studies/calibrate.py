@@ -50,13 +50,16 @@ CALIBRATION: dict[str, list[str]] = {
     "steel_1mm": t(1), "steel_2mm": t(2), "steel_10mm": t(10),
     "steel_0.5mm_damped_preload_11mm": t(0.5) + DAMPED + ["drive.spring_preload_m=0.011"],
     "steel_5mm_damped": t(5) + DAMPED, "steel_10mm_damped": t(10) + DAMPED,
-    "steel_20mm_damped": t(20) + DAMPED, "aluminium_3mm": t(3) + AL,
+    "aluminium_3mm": t(3) + AL,
     "titanium_1.5mm": t(1.5) + TI,
     "steel_1mm_spring_5000": t(1) + ["drive.spring_stiffness_N_per_m=5000.0"],
     "steel_2mm_speed_60": t(2) + ['drive.kind="constant_speed"',
                                   "drive.crank_speed_rad_per_s=60.0"],
 }
+#: the 20 mm plate (L / t = 4) is measured and shown beyond the calibrated family: its
+#: shear- and axial-crowded spectrum needs 8 modes resolved at T1 / 64 (make calibrate)
 VALIDATION: dict[str, list[str]] = {
+    "steel_20mm_damped": t(20) + DAMPED,
     "steel_0.7mm_damped": t(0.7) + DAMPED, "steel_1.5mm": t(1.5), "steel_3mm": t(3),
     "steel_7mm_damped": t(7) + DAMPED, "steel_15mm_damped": t(15) + DAMPED,
     "aluminium_1mm": t(1) + AL, "aluminium_8mm_damped": t(8) + AL + DAMPED,

@@ -15,12 +15,14 @@ from flex.config.ffrf_rule import (
     fill_link_keys,
     first_period_s,
     level_for,
+    level_modes,
     load_time_scale_s,
     outside_family,
     pick,
     rule_constants,
     rule_mesh_size_m,
     steps_per_first_period,
+    top_mode_ratio,
 )
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import load_scene
@@ -85,11 +87,12 @@ def test_a_pick_inside_the_family_is_t1_over_the_law_s_grid_count():
     scene = _scene()
     level = level_for(0.01)
     n_load = load_time_scale_s(scene) / first_period_s(scene["coupler"])
-    per = steps_per_first_period(level, n_load)
+    per = steps_per_first_period(level, n_load, top_mode_ratio(level, scene["coupler"]))
     chosen = pick(scene, 0.01)
     assert per in STEP_GRID
     assert chosen.step_s == pytest.approx(first_period_s(scene["coupler"]) / per)
-    assert chosen.modes == level["modes"] and chosen.level == level["tolerance"]
+    assert chosen.modes == level_modes(level, scene["coupler"])
+    assert chosen.level == level["tolerance"]
 
 
 def test_the_step_law_rounds_up_to_the_grid():
@@ -99,10 +102,27 @@ def test_the_step_law_rounds_up_to_the_grid():
     assert steps_per_first_period(law, 0.1) is None  # 316: beyond the grid
 
 
+def test_modes_up_to_a_multiple_of_the_first_rounded_up_to_the_grid():
+    thin, thick = STEEL_1MM | {"poisson_ratio": 0.3}, STEEL_1MM | {"thickness_m": 0.01,
+                                                                    "poisson_ratio": 0.3}
+    # beam estimates, 1 mm: 811, 2235, 4381, 7242 Hz; 10 mm: 8107, 22347, 31547 (axial) Hz
+    assert level_modes({"mode_cutoff_ratio": 1.0}, thin) == 1
+    assert level_modes({"mode_cutoff_ratio": 3.0}, thin) == 2
+    assert level_modes({"mode_cutoff_ratio": 6.0}, thin) == 4  # 3 modes -> grid 4
+    assert level_modes({"mode_cutoff_ratio": 4.0}, thick) == 4  # the axial mode crowds in
+    assert level_modes({"modes": 8}, thin) == 8  # a fixed count
+
+
+def test_the_highest_retained_mode_bounds_the_step():
+    level = {"steps_coefficient": 4.0, "steps_exponent": 0.0, "steps_per_top_period": 8.0}
+    assert steps_per_first_period(level, 10.0, 1.0) == 8
+    assert steps_per_first_period(level, 10.0, 5.4) == 64  # 43.2 -> 64
+
+
 def test_only_auto_link_keys_are_filled():
     scene = _scene(0.001, 'coupler.modes="auto"', "coupler.mesh_size_m=0.003")
     filled = fill_link_keys(scene, "coupler", 0.01)
-    assert filled == {"modes": level_for(0.01)["modes"]}
+    assert filled == {"modes": level_modes(level_for(0.01), scene["coupler"])}
     assert scene["coupler"]["mesh_size_m"] == 0.003
 
 
@@ -170,14 +190,16 @@ def test_robustly_within_refuses_a_lucky_coarse_step():
 
 
 def test_the_fitted_law_covers_every_calibration_scene():
-    from flex.experiments.calibration import MARGIN, grid_table, n_load_of
+    from flex.experiments.calibration import MARGIN, coupler_of, grid_table, n_load_of
 
     cases = {f"t{t}": _case(f"t{t}", t, step_law_error, cost) for t in (0.001, 0.002, 0.005)}
     level = next(lv for lv in fit_levels(cases, [0.01]) if lv["damping"] == "undamped")
     assert level["modes"] == 1  # the truncation term is small: the fewest modes are cheapest
     assert 0.2 < level["steps_exponent"] < 0.8  # the law's n_load^-0.5, through the grid
     for case in cases.values():
-        table, per = grid_table(case), steps_per_first_period(level, n_load_of(case))
+        coupler = coupler_of(case)
+        table = grid_table(case)
+        per = steps_per_first_period(level, n_load_of(case), top_mode_ratio(level, coupler))
         row = (table["modes"] == 1) & (table["steps_per_first_period"] == per)
         assert robustly_within(table, MARGIN * 0.01)[row].all()
 

@@ -287,7 +287,13 @@ def in_plane_fixed_interface_omegas(length_m: float, thickness_m: float, width_m
                                     poisson_ratio: float, count: int) -> list[float]:
     """The ``count`` lowest estimated fixed-interface circular frequencies [rad/s] of the
     modes symmetric about the mechanism plane (in-plane bending and axial): the eigenmodes
-    an ``in_plane`` reduction keeps (:func:`clamped_plate_frequencies`, ascending)."""
-    estimates = clamped_plate_frequencies(length_m, thickness_m, width_m, youngs_modulus_Pa,
-                                          density_kg_per_m3, poisson_ratio, 4 * count + 8)
-    return [omega for omega, kind in estimates if kind in IN_PLANE_KINDS][:count]
+    an ``in_plane`` reduction keeps (the in-plane and axial modes of
+    :func:`clamped_plate_frequencies`, ascending; a wide plate's torsion and out-of-plane
+    modes, however low, are not among them)."""
+    del width_m, poisson_ratio  # in-plane bending and axial modes do not depend on them
+    bending = [euler_bernoulli_omega(beta_l, length_m, thickness_m, youngs_modulus_Pa,
+                                     density_kg_per_m3)
+               for beta_l in euler_bernoulli_beta_l("clamped-clamped", count)]
+    axial = [axial_omega(index + 1, length_m, youngs_modulus_Pa, density_kg_per_m3)
+             for index in range(count)]
+    return sorted(bending + axial)[:count]

@@ -3,29 +3,32 @@
 Given ``fidelity.tolerance`` (relative error of the peak elastic midpoint deflection, the
 most demanding headline quantity), the rule chooses for an FFRF coupler on a rigid crank:
 
-- the **step** from the link's first bending period ``T1`` (pinned-pinned, Euler-Bernoulli,
-  :func:`flex.base.physics.pinned_pinned_omega`): ``h = T1 / steps_per_first_period``. The
-  deflection is the first mode's response to the joint loads; generalized-alpha resolves a
-  period with an error that falls with the square of ``h / T``, so one dimensionless number
-  per tolerance holds for every plate whose spectrum has the same shape (a beam's);
-- the **modes**: the ``modes`` lowest in-plane fixed-interface eigenmodes (symmetric about
-  the mechanism plane: what a planar load excites). More modes than the step resolves do not
-  help: generalized-alpha damps a mode of period below a few steps, and an unresolved mode
-  rings with a step-dependent phase that moves the peak (measured: 16 modes at T1/8 erred
-  by 1.4 %, 2 modes at T1/8 by less than 0.3 %);
-- the **mesh** from the element size the retained modes need: ``min(MESH_PER_THICKNESS t,
-  L / MESH_PER_LENGTH)`` -- quadratic tetrahedra resolve bending across a thin plate at
-  about twice its thickness (modal study: first frequency within 0.1 %), and a thick one
-  needs elements along its length (a half wavelength of the highest retained mode spans
-  L / (modes + 1)).
+- the **step** as a fraction of the link's first bending period ``T1`` (pinned-pinned,
+  Euler-Bernoulli, :func:`flex.base.physics.pinned_pinned_omega`): ``h = T1 / N`` with ``N =
+  C n^-B`` rounded up to :data:`STEP_GRID`, where ``n = t_load / T1`` counts first periods
+  per time scale of the load (:func:`load_time_scale_s`: the spring's quarter period, or
+  half a crank turn) -- the thesis's rigid-or-flexible number. The deflection is the first
+  mode's response to the joint loads; a plate that vibrates many times while its load
+  changes follows it nearly quasi-statically, and its peak is less sensitive to the phase
+  of that vibration, so it needs fewer steps per period;
+- the **modes**: the in-plane fixed-interface eigenmodes (symmetric about the mechanism
+  plane: what a planar load excites) up to a calibrated multiple of the first
+  (:func:`level_modes`; a thick plate's axial and shear-softened modes crowd towards it).
+  More modes than the step resolves do not help: generalized-alpha damps a mode of period
+  below a few steps, and an unresolved mode rings with a step-dependent phase that moves
+  the peak;
+- the **mesh**: ``min(MESH_PER_THICKNESS t, L / MESH_PER_LENGTH)`` -- quadratic tetrahedra
+  resolve bending across a thin plate at about twice its thickness (modal study: first
+  frequency within 0.1 %), and a thick one needs elements along its length.
 
-The two numbers per tolerance level (``modes``, ``steps_per_first_period``) are calibrated by
-``make calibrate`` (:mod:`flex.experiments.calibration`) over a family of plates, materials,
-springs and drives: the cheapest pair whose error stays within the level, with a margin, on
-every calibration scene; they live in ``flex/config/ffrf_rule.toml`` with the family's bounds
-and the errors measured. A tolerance between levels uses the next finer level. Outside the
-calibrated family (slenderness, tolerance finer than the finest level, an FFRF crank, the
-nonlinear FE coupler) the rule says so and :mod:`flex.config.settings` falls back visibly.
+The mode cut-off ratio, ``C`` and ``B`` are calibrated per tolerance level and per damping class
+(:func:`damping_class`) by ``make calibrate`` (:mod:`flex.experiments.calibration`) over a
+family of plates, materials, springs and drives, and live in ``flex/config/ffrf_rule.toml``
+with the family's bounds and the worst calibration error. A tolerance between levels uses
+the next finer level. Outside the calibrated family (slenderness, a tolerance finer than the
+finest level of the class, an ``n`` that would need more steps than the grid, an FFRF crank,
+the nonlinear FE coupler) the rule says so and :mod:`flex.config.settings` falls back
+visibly.
 
 Contract: pure functions of the scene's values; nothing is meshed or run.
 """
@@ -40,11 +43,13 @@ from functools import cache
 from importlib import resources
 from typing import Any
 
-from flex.base.physics import pinned_pinned_omega
+from flex.base.physics import in_plane_fixed_interface_omegas, pinned_pinned_omega
 from flex.data.scene import plate_mass_properties
 
 #: steps per first bending period the rule chooses from (make calibrate's grid)
 STEP_GRID = (4, 8, 16, 32, 64, 128)
+#: in-plane eigenmode counts the rule chooses from (make calibrate's grid)
+MODE_GRID = (1, 2, 4, 8)
 #: scene keys of a link the rule may fill when they are ``"auto"``
 LINK_KEYS = ("modes", "mesh_size_m")
 AUTO = "auto"
@@ -147,13 +152,42 @@ def load_time_scale_s(scene: Mapping[str, Mapping[str, Any]]) -> float:
     return 0.5 * math.pi * math.sqrt(mass / drive["spring_stiffness_N_per_m"])
 
 
-def steps_per_first_period(level: Mapping[str, Any], n_load: float) -> float | None:
-    """The grid value of steps per first period the level gives a link ``n_load = t_load /
-    T1`` first periods per load time scale: the smallest of :data:`STEP_GRID` at or above
-    ``steps_coefficient x n_load^(-steps_exponent)`` (None beyond the grid's finest)."""
+def level_modes(level: Mapping[str, Any], link: Mapping[str, Any]) -> int:
+    """The in-plane eigenmodes a level keeps for ``link``: every estimated in-plane
+    fixed-interface mode (:func:`flex.base.physics.in_plane_fixed_interface_omegas`) up to
+    ``mode_cutoff_ratio`` x the first, rounded up to :data:`MODE_GRID`. A thick plate's
+    axial and shear-softened modes crowd towards its first bending mode, so it keeps more.
+    (A level with a fixed ``modes`` count keeps that.)"""
+    if "mode_cutoff_ratio" not in level:
+        return int(level["modes"])
+    omegas = in_plane_fixed_interface_omegas(
+        link["length_m"], link["thickness_m"], link["width_m"], link["youngs_modulus_Pa"],
+        link["density_kg_per_m3"], link.get("poisson_ratio", 0.3), MODE_GRID[-1] + 1)
+    below = sum(1 for omega in omegas if omega <= level["mode_cutoff_ratio"] * omegas[0])
+    return next((m for m in MODE_GRID if m >= below), MODE_GRID[-1])
+
+
+def top_mode_ratio(level: Mapping[str, Any], link: Mapping[str, Any]) -> float:
+    """Estimated frequency of the highest in-plane mode the level keeps for ``link`` over the
+    first's (1 for one mode)."""
+    modes = level_modes(level, link)
+    omegas = in_plane_fixed_interface_omegas(
+        link["length_m"], link["thickness_m"], link["width_m"], link["youngs_modulus_Pa"],
+        link["density_kg_per_m3"], link.get("poisson_ratio", 0.3), modes)
+    return omegas[-1] / omegas[0]
+
+
+def steps_per_first_period(level: Mapping[str, Any], n_load: float,
+                           top_ratio: float = 1.0) -> float | None:
+    """The grid value of steps per first period the level gives a link with ``n_load = t_load
+    / T1`` first periods per load time scale and its highest retained mode ``top_ratio``
+    times the first: the smallest of :data:`STEP_GRID` at or above both ``steps_coefficient
+    x n_load^(-steps_exponent)`` and ``steps_per_top_period x top_ratio`` (every retained
+    mode resolved); None beyond the grid's finest."""
     # a level with a fixed count (no law) reads as coefficient N, exponent 0
     coefficient = level.get("steps_coefficient", level.get("steps_per_first_period"))
-    wanted = coefficient * n_load ** (-level.get("steps_exponent", 0.0))
+    wanted = max(coefficient * n_load ** (-level.get("steps_exponent", 0.0)),
+                 level.get("steps_per_top_period", 0.0) * top_ratio)
     return next((float(n) for n in STEP_GRID if n >= wanted * (1 - 1e-9)), None)
 
 
@@ -166,24 +200,35 @@ def pick(scene: Mapping[str, Mapping[str, Any]], tolerance: float, link: str = "
     outside = outside_family(values, tolerance)
     if outside:
         levels = _levels(damping) or _levels("undamped") or rule_constants()["levels"]
-        return RulePick(None, int(levels[0]["modes"]), mesh, None,
+        return RulePick(None, level_modes(levels[0], values), mesh, None,
                         f"outside the calibrated family ({outside})")
     level = level_for(tolerance, damping)
+    modes = level_modes(level, values)
     period = first_period_s(values)
     n_load = load_time_scale_s(scene) / period
-    per = steps_per_first_period(level, n_load)
+    per = steps_per_first_period(level, n_load, top_mode_ratio(level, values))
     if per is None:
-        return RulePick(None, int(level["modes"]), mesh, None, (
+        return RulePick(None, modes, mesh, None, (
             f"outside the calibrated family (n = t_load / T1 = {n_load:.3g} would need more "
             f"than {STEP_GRID[-1]} steps per first period)"))
     step = period / per
-    return RulePick(step, int(level["modes"]), mesh, float(level["tolerance"]), (
+    return RulePick(step, modes, mesh, float(level["tolerance"]), (
         f"calibrated level {level['tolerance']:g} for {damping} links (make calibrate; "
         f"worst calibration error {level['worst_error']:.2g}): n = t_load / T1 = "
         f"{n_load:.3g} (load time scale {load_time_scale_s(scene):.3g} s), step T1 / {per:g} "
-        f"= {step:.3g} s (first bending period T1 = {period:.4g} s), {level['modes']} "
-        f"in-plane modes, mesh min({rule_constants()['mesh']['per_thickness']:g} t, L / "
-        f"{rule_constants()['mesh']['per_length']:g}) = {mesh * 1e3:.3g} mm"))
+        f"= {step:.3g} s (first bending period T1 = {period:.4g} s), {modes} "
+        f"in-plane modes ({_modes_text(level)}), mesh {_mesh_text()} = {mesh * 1e3:.3g} mm"))
+
+
+def _mesh_text() -> str:
+    mesh = rule_constants()["mesh"]
+    return f"min({mesh['per_thickness']:g} t, L / {mesh['per_length']:g})"
+
+
+def _modes_text(level: Mapping[str, Any]) -> str:
+    if "mode_cutoff_ratio" in level:
+        return f"every one up to {level['mode_cutoff_ratio']:g} x the first"
+    return "the level's count"
 
 
 def fill_link_keys(scene: dict[str, dict[str, Any]], link: str, tolerance: float

@@ -38,6 +38,9 @@ class Field:
     maximum: float | None = None  # inclusive upper bound
     below: float | None = None  # strictly < below
     auto: bool = False  # "auto" accepted too: flex chooses (flex.config.settings)
+    #: value of a key the bundled parameter set does not state (a flex model choice added
+    #: after it was written, not a thesis value): :func:`default_scene` fills it in
+    default: Any = None
 
     def accepted(self) -> str:
         """Human-readable accepted range, used in error messages."""
@@ -111,6 +114,9 @@ SCHEMA: dict[str, dict[str, Field]] = {
                        "(accuracy reference, ~50x slower per step); auto: rigid or "
                        "ffrf (and modes) from the fitted criterion and fidelity.tolerance"),
         **_plate_fields("coupler"),
+        "geometric_stiffness": Field(bool, "model = ffrf: add the geometric stiffness of the "
+                                     "link's axial force to its modes (stress-stiffening; "
+                                     "flex.bodies.geometric_stiffness)", default=False),
     },
     "wing": {
         "enabled": Field(bool, "weld a wing plate to the crank at A (sec. 6.4 application)"),
@@ -200,8 +206,14 @@ def load_scene(source: str | Path | None = None, overrides: list[str] | None = N
 
 
 def default_scene() -> Scene:
-    """The bundled default parameter set (:data:`DEFAULT_SCENE`), as read from its file."""
-    return _read_toml(_scene_path(DEFAULT_SCENE), DEFAULT_SCENE)
+    """The bundled default parameter set (:data:`DEFAULT_SCENE`), as read from its file,
+    with the schema default of every key the file does not state (:attr:`Field.default`)."""
+    scene = _read_toml(_scene_path(DEFAULT_SCENE), DEFAULT_SCENE)
+    for section, fields in SCHEMA.items():
+        for key, field in fields.items():
+            if field.default is not None:
+                scene.setdefault(section, {}).setdefault(key, field.default)
+    return scene
 
 
 def read_source(source: str | Path | None) -> Scene | None:

@@ -302,6 +302,21 @@ class _Builder:
         self.markers["coupler_B"] = self.coupler["marker_B"]
         self.markers["coupler_C"] = self.coupler["marker_C"]
 
+    def _add_geometric_stiffness(self) -> None:
+        """The stress-stiffening of the FFRF coupler's modes under its axial force
+        (``coupler.geometric_stiffness``; :mod:`flex.bodies.geometric_stiffness`): the mean
+        from the coupler's stretch, the value at C from joint C's reaction."""
+        from flex.bodies.geometric_stiffness import (
+            add_geometric_stiffness,
+            geometric_stiffness,
+            joint_tension,
+        )
+
+        stiffness = geometric_stiffness(self.mech.coupler["reduction"])
+        self.coupler["geometric_stiffness"] = add_geometric_stiffness(
+            self.mbs, self.coupler["node_modal"], stiffness,
+            end_b_tension=joint_tension(self.joints["C"], self.coupler["node_frame"]))
+
     def add_joints(self) -> None:
         """Revolute A and B, the in-plane pin C, the prismatic slide (or penalty springs for
         the explicit integrator)."""
@@ -337,6 +352,9 @@ class _Builder:
         # B's force is reported in the frame of the crank's marker at B (its joint face when
         # the crank is flexible): collect turns it with that marker's rotation
         self.mech.joint_frames = {"A": None, "B": "marker_crank_B", "C": None, "P": None}
+        coupler = scene["coupler"]
+        if coupler["model"] == "ffrf" and coupler["geometric_stiffness"]:
+            self._add_geometric_stiffness()
 
     def add_drive(self) -> None:
         """The preloaded spring on the slider, or the crank held at constant speed."""

@@ -101,9 +101,9 @@ PUBLISHED_TIME_S = 0.1
 
 @dataclass(frozen=True)
 class RodMatrices:
-    """The rod's matrices in its floating frame, coordinates ``q = (q_1..q_n lateral,
-    q_a axial mid, q_e axial end)`` [m]: mass [kg], stiffness [N/m], the first moments
-    ``c1 = A int u-shapes``, ``c2 = A int v-shapes``, ``c12 = A int x u-shapes``,
+    """The rod's matrices in its floating frame, coordinates ``q = (q_1..q_n lateral, axial
+    bubbles if any, q_a axial mid, q_e axial end)`` [m]: mass [kg], stiffness [N/m], the
+    first moments ``c1 = A int u-shapes``, ``c2 = A int v-shapes``, ``c12 = A int x u-shapes``,
     ``c21 = A int x v-shapes`` [m^2, m^3] (times rho: kg), the gyroscopic coupling ``B = A
     int (u_i v_j - v_i u_j)`` [m^3], ``stiffening[i, j, k]`` [N/m^2]: the generalized force
     of the cross strain term is ``-stiffening @ q @ q``, and ``quartic[i, j, k, l]``
@@ -332,7 +332,8 @@ def solve(bench: CrankBenchmark = CrankBenchmark(), lateral_modes: int = 2,
           axial_mass_factor: float = 1.0, geometric_stiffening: str = "none",
           initial: str = "published", end_time_s: float = PUBLISHED_TIME_S,
           output_step_s: float = 1e-4, rtol: float = 1e-10, atol: float = 1e-13,
-          pi_value: float = math.pi, axial_bubbles: int = 0) -> CrankSolution:
+          pi_value: float = math.pi, axial_bubbles: int = 0, method: str = "DOP853"
+          ) -> CrankSolution:
     """Integrate the benchmark (scipy ``DOP853``) from ``initial`` = ``"published"`` (the
     test set's INIT) or ``"rigid"`` (INIT2, undeformed on the rigid motion) to
     ``end_time_s`` [s], sampled every ``output_step_s`` [s]; ``axial_bubbles``: axial
@@ -346,7 +347,7 @@ def solve(bench: CrankBenchmark = CrankBenchmark(), lateral_modes: int = 2,
     start = time.perf_counter()
     samples = int(round(end_time_s / output_step_s))
     times = np.linspace(0.0, end_time_s, samples + 1)
-    out = solve_ivp(model.rhs, (0.0, end_time_s), y0, method="DOP853", t_eval=times,
+    out = solve_ivp(model.rhs, (0.0, end_time_s), y0, method=method, t_eval=times,
                     rtol=rtol, atol=atol)
     if not out.success:
         raise RuntimeError(f"IVP crank: {out.message}")

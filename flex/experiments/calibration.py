@@ -23,6 +23,7 @@ the level (target: within the level, at most :data:`SLOWDOWN_LIMIT` x slower).
 
 from __future__ import annotations
 
+import itertools
 import math
 import tomllib
 from collections.abc import Callable, Mapping, Sequence
@@ -34,11 +35,14 @@ import numpy as np
 from flex.base.errors import FlexError
 from flex.base.physics import in_plane_fixed_interface_omegas
 from flex.config.ffrf_rule import (
+    MODE_GRID,
     STEP_GRID,
     first_period_s,
+    level_modes,
     load_time_scale_s,
     rule_mesh_size_m,
     steps_per_first_period,
+    top_mode_ratio,
 )
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
@@ -53,17 +57,22 @@ from flex.experiments.tradeoff import (
 )
 
 #: the grid: in-plane eigenmodes and steps per first bending period
-GRID_MODES = (1, 2, 4, 8)
+GRID_MODES = MODE_GRID
 GRID_STEPS_PER_PERIOD = tuple(float(n) for n in STEP_GRID)
 #: the tolerance levels calibrated (relative error of the peak midpoint deflection)
 LEVELS = (0.01, 0.001)
-#: a calibrated pair must keep every calibration scene within this fraction of the level
-#: (robustly: at its step and every finer one, :func:`robustly_within`)
-MARGIN = 0.7
+#: a calibrated law must keep every calibration scene's certified error (measured + the
+#: reference's own accuracy, itself a sum of one-level changes: conservative) within this
+#: fraction of the level (robustly: at its step and every finer one, :func:`robustly_within`)
+MARGIN = 1.0
 #: the rule's damping classes (flex.config.ffrf_rule.damping_class) and the smallest damping
 #: ratio of the damped class (the calibration's damped scenes carry exactly this)
 DAMPING_CLASSES = ("undamped", "damped")
 DAMPED_RATIO_MIN = 0.01
+#: mode cut-off ratios tried (flex.config.ffrf_rule.level_modes)
+MODE_CUTOFF_RATIOS = (1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0)
+#: steps per period of the highest retained mode tried (0: no such bound)
+STEPS_PER_TOP_PERIOD = (0.0, 4.0, 8.0)
 #: a level of a class is calibrated only if at least this many references can certify it
 MIN_SCENES = 3
 #: validation target: the rule's pick at most this many times slower than the grid's fastest
@@ -269,75 +278,116 @@ def fit_levels(calibration: Mapping[str, CaseResult], levels: Sequence[float] = 
     out = []
     for damping in DAMPING_CLASSES:
         for level in levels:
-            usable = {name: (grid_table(case), n_load_of(case))
+            usable = {name: (grid_table(case), n_load_of(case), coupler_of(case))
                       for name, case in calibration.items()
                       if certifiable(case, level) and damping_of(case) == damping}
             out.append({"damping": damping, **_fit_one(level, usable)})
     return out
 
 
-def _fit_one(level: float, usable: Mapping[str, tuple[Mapping[str, np.ndarray], float]]
+def coupler_of(case: CaseResult) -> dict[str, Any]:
+    """The coupler section of a case's stored scene."""
+    return dict(tomllib.loads(case.scene_toml)["coupler"])
+
+
+def _fit_one(level: float,
+             usable: Mapping[str, tuple[Mapping[str, np.ndarray], float, dict[str, Any]]]
              ) -> dict[str, Any]:
-    """Per modes count: each scene's fewest robust steps per period N_i within MARGIN x level
-    at its n_i = t_load / T1; the law N = C n^-B with B the least-squares slope of log N_i on
-    log n_i (clipped to [0, 1.5]) and C the smallest that covers every scene; its picks
-    (rounded up to the grid) timed over the scenes. The modes count with the least total time
-    wins."""
+    """Per mode cut-off ratio of :data:`MODE_CUTOFF_RATIOS` (each scene's modes:
+    :func:`flex.config.ffrf_rule.level_modes`): each scene's fewest robust steps per period
+    N_i within MARGIN x level at its n_i = t_load / T1; the law N = C n^-B with B the
+    least-squares slope of log N_i on log n_i (clipped to [0, 1.5]) and C the smallest that
+    covers every scene; its picks (rounded up to the grid) timed over the scenes. The ratio
+    with the least total time wins."""
     scenes = sorted(usable)
     if len(usable) < MIN_SCENES:
         return {"tolerance": level, "modes": None, "scenes": scenes,
                 "reason": f"{len(usable)} calibration references can certify it (at least "
                           f"{MIN_SCENES} needed)"}
     best: dict[str, Any] | None = None
-    for modes in GRID_MODES:
-        needed = np.array([needed_steps(t, modes, MARGIN * level) for t, _ in usable.values()])
+    tables = [table for table, _, _ in usable.values()]
+    n_load = np.array([n for _, n, _ in usable.values()])
+    for ratio, per_top in itertools.product(MODE_CUTOFF_RATIOS, STEPS_PER_TOP_PERIOD):
+        cut = {"mode_cutoff_ratio": ratio}
+        modes = [level_modes(cut, c) for _, _, c in usable.values()]
+        top = np.array([top_mode_ratio(cut, c) for _, _, c in usable.values()])
+        needed = np.array([needed_steps(t, m, MARGIN * level)
+                           for t, m in zip(tables, modes, strict=True)])
         if not np.all(np.isfinite(needed)):
             continue
-        n_load = np.array([n for _, n in usable.values()])
-        slope = (np.polyfit(np.log(n_load), np.log(needed), 1)[0]
-                 if np.ptp(np.log(n_load)) > 0 else 0.0)
-        exponent = float(np.clip(-slope, 0.0, 1.5))
-        law = {"steps_coefficient": float(np.max(needed * n_load**exponent)),
-               "steps_exponent": exponent}
-        picks = [steps_per_first_period(law, n) for n in n_load]
-        rows = [int(np.flatnonzero((t["modes"] == modes)
-                                   & np.isclose(t["steps_per_first_period"], per))[0])
-                for (t, _), per in zip(usable.values(), picks, strict=True)]
-        time = float(sum(t["total_time"][r] for (t, _), r in zip(usable.values(), rows,
-                                                                  strict=True)))
+        law = {"steps_per_top_period": per_top, **_step_law(needed, n_load, per_top * top)}
+        picks = [steps_per_first_period(law, n, r) for n, r in zip(n_load, top, strict=True)]
+        if None in picks:  # the law leaves the grid on some scene: not a usable fit
+            continue
+        rows = [_row(t, m, per) for t, m, per in zip(tables, modes, picks, strict=True)]
+        time = float(sum(t["total_time"][r] for t, r in zip(tables, rows, strict=True)))
         if best is None or time < best["total_time_s"]:
-            best = {"tolerance": level, "modes": modes, **law, "total_time_s": time,
-                    "worst_error": float(max(t["certified"][r] for (t, _), r in
-                                             zip(usable.values(), rows, strict=True)))}
+            best = {"tolerance": level, "modes": max(modes), **cut, **law,
+                    "total_time_s": time,
+                    "worst_error": float(max(t["certified"][r]
+                                             for t, r in zip(tables, rows, strict=True)))}
     return {**(best or {"tolerance": level, "modes": None, "reason":
-                        f"no modes count keeps every scene robustly within {MARGIN:g} x "
+                        f"no mode cut-off keeps every scene robustly within {MARGIN:g} x "
                         f"{level:g} on the grid"}), "scenes": scenes}
 
 
-def validate(cases: Mapping[str, CaseResult], levels: Sequence[Mapping[str, Any]]
-             ) -> list[dict[str, Any]]:
+def _step_law(needed: np.ndarray, n_load: np.ndarray, resolved: np.ndarray
+              ) -> dict[str, float]:
+    """``N = C n^-B`` through the scenes whose needed steps the top-mode resolution
+    (``resolved``, steps per first period) does not already give: B the least-squares slope
+    of log N on log n (clipped to [0, 1.5]; 0 with fewer than two such scenes), C the
+    smallest that covers them."""
+    open_ = needed > resolved * (1 + 1e-9)
+    if not open_.any():
+        return {"steps_coefficient": float(STEP_GRID[0]), "steps_exponent": 0.0}
+    x, y = np.log(n_load[open_]), np.log(needed[open_])
+    slope = np.polyfit(x, y, 1)[0] if open_.sum() >= 2 and np.ptp(x) > 0 else 0.0
+    exponent = float(np.clip(-slope, 0.0, 1.5))
+    return {"steps_coefficient": float(np.max(needed[open_] * n_load[open_] ** exponent)),
+            "steps_exponent": exponent}
+
+
+def _row(table: Mapping[str, np.ndarray], modes: int, per: float) -> int:
+    """Index of the grid pair (modes, steps per first period)."""
+    return int(np.flatnonzero((table["modes"] == modes)
+                              & np.isclose(table["steps_per_first_period"], per))[0])
+
+
+def validate(cases: Mapping[str, CaseResult], levels: Sequence[Mapping[str, Any]],
+             bounds: Mapping[str, float] | None = None) -> list[dict[str, Any]]:
     """Per scene and calibrated level of its damping class: the rule's pick (its modes, the
     law's steps per period at the scene's n) against the fastest grid pair robustly within
     the level. Row keys: ``scene``, ``damping``, ``n_load``, ``tolerance``,
     ``certifiable``, ``rule_pair``, ``rule_error`` (certified: measured + reference
     accuracy), ``rule_time_s``, ``best_time_s``, ``best_pair``, ``slowdown`` (rule / best),
     ``meets`` (robustly within the level and at most :data:`SLOWDOWN_LIMIT` x slower); a
-    failed scene: ``failed``; a scene beyond the law's grid: ``outside``."""
+    failed scene: ``failed``; a scene outside the calibrated slenderness ``bounds`` or beyond
+    the law's grid: ``outside``."""
     rows: list[dict[str, Any]] = []
     for name, case in cases.items():
         if case.status != "ok":
             rows.append({"scene": name, "failed": case.message})
             continue
         table, damping, n_load = grid_table(case), damping_of(case), n_load_of(case)
+        coupler = coupler_of(case)
+        slenderness = coupler["length_m"] / coupler["thickness_m"]
+        if bounds and not (bounds["slenderness_min"] <= slenderness
+                           <= bounds["slenderness_max"]):
+            rows.append({"scene": name, "outside": f"L / t = {slenderness:.3g} outside the "
+                         f"calibrated [{bounds['slenderness_min']:g}, "
+                         f"{bounds['slenderness_max']:g}]"})
+            continue
         for level in levels:
             if level.get("modes") is None or level.get("damping", damping) != damping:
                 continue
-            per = steps_per_first_period(level, n_load)
+            per = steps_per_first_period(level, n_load, top_mode_ratio(level,
+                                                                       coupler_of(case)))
             if per is None:
                 rows.append({"scene": name, "tolerance": level["tolerance"], "outside":
                              f"n = {n_load:.3g} needs more than {STEP_GRID[-1]} steps"})
                 continue
-            row = _validation_row(name, table, level["tolerance"], (level["modes"], per),
+            pair = (level_modes(level, coupler_of(case)), per)
+            row = _validation_row(name, table, level["tolerance"], pair,
                                   certifiable(case, level["tolerance"]))
             rows.append({"damping": damping, "n_load": n_load, **row})
     return rows
@@ -345,8 +395,7 @@ def validate(cases: Mapping[str, CaseResult], levels: Sequence[Mapping[str, Any]
 
 def _validation_row(name: str, table: Mapping[str, np.ndarray], tol: float,
                     pair: tuple[int, float], can_certify: bool) -> dict[str, Any]:
-    rule = int(np.flatnonzero((table["modes"] == pair[0]) & np.isclose(
-        table["steps_per_first_period"], pair[1]))[0])
+    rule = _row(table, *pair)
     within = np.flatnonzero(robustly_within(table, tol))
     best = int(within[np.argmin(table["total_time"][within])]) if within.size else None
     row = {"scene": name, "tolerance": tol, "certifiable": can_certify,
@@ -376,11 +425,13 @@ def rule_toml(levels: Sequence[Mapping[str, Any]], bounds: Mapping[str, float],
     import tomli_w
 
     fitted = [{"damping": level["damping"], "tolerance": level["tolerance"],
-               "modes": level["modes"], "steps_coefficient": level["steps_coefficient"],
+               "mode_cutoff_ratio": level["mode_cutoff_ratio"], "modes_max": level["modes"],
+               "steps_per_top_period": level["steps_per_top_period"],
+               "steps_coefficient": level["steps_coefficient"],
                "steps_exponent": level["steps_exponent"],
                "worst_error": level["worst_error"], "scenes": list(level["scenes"])}
               for level in levels if level.get("modes") is not None]
     head = ("# Constants of the FFRF settings rule (flex/config/ffrf_rule.py), written by make "
-            "calibrate\n# (results/calibrate.h5, /summary attribute rule_toml) and installed "
+            "calibrate\n# (results/calibrate.h5, dataset /summary/rule/toml) and installed "
             "by make rule-install.\n")
     return head + tomli_w.dumps({"mesh": dict(mesh), "family": dict(bounds), "levels": fitted})

@@ -17,13 +17,19 @@ from typing import Any
 
 import numpy as np
 
-from flex.base.plotting import panels
-from flex.config.ffrf_rule import rule_constants, steps_per_first_period
+from flex.base.plotting import legend_below, log_ticks, panels
+from flex.config.ffrf_rule import (
+    level_modes,
+    rule_constants,
+    steps_per_first_period,
+    top_mode_ratio,
+)
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.experiments.calibration import (
     MARGIN,
     SLOWDOWN_LIMIT,
+    coupler_of,
     damping_of,
     family_bounds,
     fit_levels,
@@ -39,15 +45,26 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
                         validation: Mapping[str, Scene]) -> tuple[dict[str, Dataset], str]:
     """Fit on ``calibration``'s cases, validate on ``validation``'s (see module doc)."""
     fitted = fit_levels({name: results[name] for name in calibration if name in results})
-    rows = validate({name: results[name] for name in validation if name in results}, fitted)
-    toml = rule_toml(fitted, family_bounds(calibration), rule_constants()["mesh"])
+    bounds = family_bounds(calibration)
+    rows = validate({name: results[name] for name in validation if name in results}, fitted,
+                    bounds)
+    in_sample = validate({name: results[name] for name in calibration if name in results},
+                         fitted)
+    toml = rule_toml(fitted, bounds, rule_constants()["mesh"])
     datasets = {"rule/toml": Dataset(toml, "1", "the rule's constants (make rule-install)")}
     for index, level in enumerate(fitted):
         prefix = f"levels/{index}"
         datasets[f"{prefix}/damping"] = Dataset(level["damping"], "1", "damping class")
         datasets[f"{prefix}/tolerance"] = Dataset(level["tolerance"], "1", "level")
         datasets[f"{prefix}/modes"] = Dataset(level.get("modes") or -1, "1",
-                                              "in-plane modes (-1: not calibrated)")
+                                              "most in-plane modes a calibration scene got "
+                                              "(-1: not calibrated)")
+        datasets[f"{prefix}/steps_per_top_period"] = Dataset(
+            level.get("steps_per_top_period", math.nan), "1",
+            "steps per period of the highest retained mode, at least")
+        datasets[f"{prefix}/mode_cutoff_ratio"] = Dataset(
+            level.get("mode_cutoff_ratio", math.nan), "1",
+            "in-plane modes kept up to this multiple of the first")
         datasets[f"{prefix}/steps_coefficient"] = Dataset(
             level.get("steps_coefficient", math.nan), "1", "C of N = C n^-B")
         datasets[f"{prefix}/steps_exponent"] = Dataset(
@@ -67,11 +84,12 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
                                                "1", "level")
     datasets["validation/meets"] = Dataset(np.array([row["meets"] for row in judged]), "1",
                                            "within the level and the slowdown limit")
-    return datasets, _report(results, fitted, rows, toml)
+    return datasets, _report(results, fitted, rows, toml, in_sample)
 
 
 def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any]],
-            rows: Sequence[Mapping[str, Any]], toml: str) -> str:
+            rows: Sequence[Mapping[str, Any]], toml: str,
+            in_sample: Sequence[Mapping[str, Any]] = ()) -> str:
     lines = ["# FFRF settings rule: calibration and validation", "",
              "Error: relative error of the peak elastic midpoint deflection against each "
              "scene's converged reference, plus the reference's own accuracy (certified). "
@@ -93,10 +111,13 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
                          f"({level['reason']}; "
                          f"scenes: {', '.join(level['scenes']) or 'none'})")
             continue
-        lines.append(f"- {level['damping']}, {level['tolerance']:g}: {level['modes']} "
-                     f"in-plane modes, N = {level['steps_coefficient']:.3g} n^-"
-                     f"{level['steps_exponent']:.2f} steps per first period (rounded up to the "
-                     f"grid); worst certified error {level['worst_error']:.2g} over "
+        lines.append(f"- {level['damping']}, {level['tolerance']:g}: in-plane modes up to "
+                     f"{level['mode_cutoff_ratio']:g} x the first (at most {level['modes']} "
+                     f"on these scenes), N = {level['steps_coefficient']:.3g} n^-"
+                     f"{level['steps_exponent']:.2f} steps per first period and at least "
+                     f"{level['steps_per_top_period']:g} per period of the highest retained "
+                     f"mode (rounded up to the grid); worst certified error "
+                     f"{level['worst_error']:.2g} over "
                      f"{len(level['scenes'])} scenes ({', '.join(level['scenes'])})")
     lines += ["", "## Validation (scenes not used in the fit)", "",
               "| scene | n = t_load / T1 | level | certifiable | rule pick | rule error | rule "
@@ -112,7 +133,8 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
                      f"{row['rule_error']:.2g} | {row['rule_time_s']:.3g} | "
                      f"{row['best_time_s']:.3g} ({row['best_pair'] or 'none'}) | "
                      f"{row['slowdown']:.2g} | {row['meets']} |")
-    lines += _target_lines(rows)
+    lines += _target_lines([*rows, *({**row, "scene": f"{row['scene']} (calibration)"}
+                                     for row in in_sample)])
     judged = [row for row in rows if "failed" not in row and "outside" not in row
               and row["certifiable"]]
     met = sum(row["meets"] for row in judged)
@@ -155,15 +177,18 @@ def draw_calibration(results: Mapping[str, CaseResult], datasets: Mapping[str, D
     path = folder / "calibrate-work-precision.png"
     with panels(path, "FFRF grid per scene: certified error of the peak deflection against "
                 "run time; Pareto front (line), levels (dotted), the rule's picks (stars)",
-                rows, cols, size=(13.0, 1.0 + 2.6 * rows)) as (_, axes):
+                rows, cols, size=(13.0, 1.6 + 2.6 * rows)) as (fig, axes):
         for ax, (name, case) in zip(axes, cases.items(), strict=False):
-            picks = {level["tolerance"]: (level["modes"], steps_per_first_period(
-                level, n_load_of(case))) for level in levels
+            coupler = coupler_of(case)
+            picks = {level["tolerance"]: (level_modes(level, coupler), steps_per_first_period(
+                level, n_load_of(case), top_mode_ratio(level, coupler)))
+                     for level in levels
                 if level["damping"] == damping_of(case)}
             _panel(ax, name, grid_table(case), sorted({lv["tolerance"] for lv in levels}),
                    picks)
         for ax in axes[len(cases):]:
             ax.set_visible(False)
+        legend_below(fig, ncol=6)
     return [path]
 
 
@@ -183,9 +208,11 @@ def _panel(ax: Any, name: str, table: Mapping[str, np.ndarray], levels: Sequence
                                & np.isclose(table["steps_per_first_period"], per or -1))
         if index.size and ok[index[0]]:
             ax.plot(time[index[0]], error[index[0]], "*", ms=11, color="tab:red",
-                    label=f"rule {level:g}")
+                    label=f"rule's pick at {level:g}")
     ax.set_xscale("log")
     ax.set_yscale("log")
+    log_ticks(ax, "x")
+    log_ticks(ax, "y")
     ax.set_title(name, fontsize="small")
     ax.set_xlabel("run time [s]")
     ax.set_ylabel("certified error [1]")
@@ -202,6 +229,8 @@ def fitted_levels(datasets: Mapping[str, Dataset]) -> list[dict[str, Any]]:
         if int(value("modes")) > 0:
             out.append({"damping": str(value("damping")),
                         "tolerance": float(value("tolerance")), "modes": int(value("modes")),
+                        "mode_cutoff_ratio": float(value("mode_cutoff_ratio")),
+                        "steps_per_top_period": float(value("steps_per_top_period")),
                         "steps_coefficient": float(value("steps_coefficient")),
                         "steps_exponent": float(value("steps_exponent"))})
         index += 1
