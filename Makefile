@@ -12,7 +12,7 @@ STUDIES := kinematics dynamics modal flexible spring wing crank kfit
 # shared cores: tradeoff ~65 min, stability ~10 min, bench ~23 min (it times `make all FORCE=1`
 # twice); `make all` itself takes 8-11 min when every study reruns.
 # `flex run stability` exits 0 when exactly its runs built to diverge fail.
-LONG := tradeoff stability bench estimates calibrate design validation ladder
+LONG := tradeoff stability bench estimates calibrate design validation ladder spring_mass
 
 # A study's result, results/<study>.h5 (and its figures, results/figures/<study>-*.png),
 # is remade only when one of its inputs is newer: its module studies/<study>.py, or one of

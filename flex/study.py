@@ -52,7 +52,7 @@ from flex.tools.report import default_report_path, write_report
 
 STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring", "kfit",
            "tradeoff", "stability", "bench", "wing", "crank", "estimates",
-           "calibrate", "design", "validation", "ladder")
+           "calibrate", "design", "validation", "ladder", "spring_mass")
 RESULTS_DIR = Path("results")
 
 

@@ -275,7 +275,8 @@ def test_auto_decides_rigid_for_a_stiff_coupler_and_ffrf_for_a_soft_one():
     assert decision.delta_t_s == pytest.approx(0.0246, abs=5e-4)  # 10 mm plate's stop time
     thin, decisions = resolve_fidelity(_auto_scene(0.0008, 0.001), criterion)
     assert thin["coupler"]["model"] == "ffrf"
-    assert decisions[0].modes == thin["coupler"]["modes"] >= 2
+    assert decisions[0].modes == thin["coupler"]["modes"] >= 1  # the tolerance rule's
+    assert "tolerance rule" in decisions[0].reason
     assert decisions[0].n_physical < decisions[0].k_physical
     assert decisions[0].attrs()["fidelity_coupler_model"] == "ffrf"
     assert "Euler load" in decisions[0].reason

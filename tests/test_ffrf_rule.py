@@ -165,7 +165,8 @@ def _case(name, thickness_m, error_of, time_of, reference_accuracy=1e-4):
                                                       "1"),
                 "grid/total_time": Dataset(np.array([time_of(*t) for t in triples]), "s")}
     return CaseResult(name, to_toml(scene), datasets,
-                      attrs={"reference_accuracy": reference_accuracy})
+                      attrs={"reference_accuracy": reference_accuracy,
+                             "reference_peak_deflection_m": 1e-4})  # within 1 % of L
 
 
 def step_law_error(m, n, n_load):
@@ -209,6 +210,15 @@ def test_a_level_too_few_references_can_certify_is_not_fitted():
                                     reference_accuracy=1e-2)}, [1e-3])
     assert all(level["modes"] is None for level in levels)
     assert "at least" in levels[0]["reason"]
+
+
+def test_a_scene_beyond_the_linear_ffrf_validity_does_not_certify():
+    from flex.experiments.calibration import certifiable
+
+    case = _case("big", 0.001, step_law_error, cost)
+    assert certifiable(case, 0.01)
+    case.attrs["reference_peak_deflection_m"] = 0.02 * 0.08  # 2 % of the length
+    assert not certifiable(case, 0.01)
 
 
 def test_validation_compares_the_rule_with_the_fastest_robust_pair():

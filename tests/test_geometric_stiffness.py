@@ -184,3 +184,39 @@ def test_deployment_peak_matches_the_nonlinear_fe_coupler(reduction_cache):
     assert not rung.failures
     assert rung.difference_to_reference["ffrf"] < -0.05
     assert abs(rung.difference_to_reference["ffrf_geometric"]) < 0.01
+
+
+def test_the_ladder_takes_the_lowest_rung_that_meets_the_tolerance():
+    from flex.fidelity.criteria import (
+        GEOMETRIC_FFRF_ERROR,
+        LINEAR_FFRF_ERROR_FLOOR,
+        LINEAR_FFRF_ERROR_PER_LOAD,
+        flexible_rung,
+    )
+
+    deflection, load_ratio = 0.01, 0.1  # predicted peak / length, compression / Euler load
+    linear = deflection * (LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio)
+    geometric = deflection * GEOMETRIC_FFRF_ERROR
+    assert geometric < linear
+    assert flexible_rung(deflection, load_ratio, linear) == ("ffrf", pytest.approx(linear))
+    assert flexible_rung(deflection, load_ratio, 0.99 * linear) == (
+        "ffrf_geometric", pytest.approx(geometric))
+    assert flexible_rung(deflection, load_ratio, 0.99 * geometric)[0] == "nonlinear_fe"
+
+
+def test_auto_switches_the_geometric_stiffness_on_for_a_tight_tolerance():
+    # 1 mm plate: the rigid probe predicts ~0.2 % of the length, 0.05 of the Euler load;
+    # at a tolerance of 1e-4 the linear FFRF's predicted error does not meet it, the
+    # geometric rung's does; at 1e-3 linear FFRF is kept (at 1e-2 it is rigid)
+    from flex.fidelity.criteria import resolve_fidelity
+
+    def scene(tolerance: float):
+        return load_scene(overrides=['coupler.geometry="plate"', 'coupler.model="auto"',
+                                     f"fidelity.tolerance={tolerance!r}"])
+
+    tight, (decision,) = resolve_fidelity(scene(1e-4))
+    assert tight["coupler"]["model"] == "ffrf" and tight["coupler"]["geometric_stiffness"]
+    assert "ladder: ffrf_geometric" in decision.reason
+    loose, (decision,) = resolve_fidelity(scene(1e-3))
+    assert loose["coupler"]["model"] == "ffrf" and not loose["coupler"]["geometric_stiffness"]
+    assert "ladder: ffrf " in decision.reason

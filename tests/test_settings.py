@@ -7,7 +7,13 @@ import re
 import pytest
 
 from flex.base.errors import SceneError
-from flex.config.ffrf_rule import level_for, load_time_scale_s, steps_per_first_period
+from flex.config.ffrf_rule import (
+    level_for,
+    level_modes,
+    load_time_scale_s,
+    steps_per_first_period,
+    top_mode_ratio,
+)
 from flex.config.settings import (
     AUTO_KEYS,
     pinned_overrides,
@@ -44,7 +50,8 @@ def _rule_step(thickness_m=0.001, tolerance=0.01):
     omega = (math.pi / 0.080) ** 2 * math.sqrt(200e9 * thickness_m**2 / 12 / 7850.0)
     level = level_for(tolerance)
     scene = load_scene(None, PLATE + [f"coupler.thickness_m={thickness_m}"])
-    per = steps_per_first_period(level, load_time_scale_s(scene) * omega / (2 * math.pi))
+    per = steps_per_first_period(level, load_time_scale_s(scene) * omega / (2 * math.pi),
+                                 top_mode_ratio(level, scene["coupler"]))
     return 2 * math.pi / omega / per, level
 
 
@@ -54,9 +61,9 @@ def test_an_ffrf_coupler_gets_the_rule_s_step_modes_and_mesh():
     assert choice.entry == "ffrf_rule" and choice.accuracy == level["tolerance"]
     assert scene["simulation"]["step_s"] == pytest.approx(step, rel=1e-9)
     assert scene["simulation"]["newton"] == "modified"
-    assert scene["coupler"]["modes"] == level["modes"]
+    assert scene["coupler"]["modes"] == level_modes(level, scene["coupler"])
     assert scene["coupler"]["mesh_size_m"] == pytest.approx(0.002)  # min(2 t, L / 16)
-    assert choice.keys["coupler.modes"] == level["modes"]
+    assert choice.keys["coupler.modes"] == scene["coupler"]["modes"]
     assert "T1 = 0.002796 s" in choice.reason  # 357.6 Hz: 1 mm steel, 80 mm pinned-pinned
 
 

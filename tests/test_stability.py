@@ -129,7 +129,7 @@ def test_thin_ffrf_plate_with_a_large_step_fails_cleanly_and_runs_with_a_small_o
     # a 0.1 ms step: Newton fails within the first steps (measured: step 4 with all modes,
     # 6 with the in-plane ones); at 0.01 ms it runs
     plate = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.thickness_m=0.0003",
-             "coupler.mesh_size_m=0.006", "simulation.end_time_s=0.001",
+             "coupler.mesh_size_m=0.006", "coupler.modes=6", "simulation.end_time_s=0.001",
              "simulation.newton_relative_tolerance=1e-8"]
     failed = simulate_case(load_scene(overrides=plate + ["simulation.step_s=1e-4"]), "large",
                            cache_dir=reduction_cache)

@@ -28,7 +28,9 @@ _PLATE_ELASTIC = ("youngs_modulus_Pa", "poisson_ratio", "modes", "mode_selection
                   "mesh_size_m", "damping_ratio")
 _SOLVER_ALPHA = ("spectral_radius", "formulation", "newton", "newton_relative_tolerance")
 _SOLVER_EXPLICIT = ("explicit_method", "penalty_stiffness_N_per_m")
-_SPRING = ("spring_stiffness_N_per_m", "spring_preload_m", "spring_damping_Ns_per_m")
+_SPRING = ("spring_stiffness_N_per_m", "spring_preload_m", "spring_damping_Ns_per_m",
+           "spring_model", "spring_mass_kg", "spring_segments")
+_SPRING_CHAIN = ("spring_mass_kg", "spring_segments")
 _WING = ("span_m", "chord_m", "thickness_m", "density_kg_per_m3", "youngs_modulus_Pa")
 
 
@@ -58,6 +60,10 @@ def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset()) -> dic
     if drive["kind"] == "spring":
         unused["drive.crank_speed_rad_per_s"] = ('drive.kind = "spring": the spring moves the '
                                                  'crank; used with kind = "constant_speed"')
+        if drive["spring_model"] == "massless":
+            for key in _SPRING_CHAIN:
+                unused[f"drive.{key}"] = ('drive.spring_model = "massless": the spring has no '
+                                          'mass; used with spring_model = "chain"')
     else:
         for key in _SPRING:
             unused[f"drive.{key}"] = ('drive.kind = "constant_speed": no spring; used with '

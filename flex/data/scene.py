@@ -138,6 +138,15 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "spring_damping_Ns_per_m": Field(float, "viscous damper beside the spring",
                                          minimum=0.0),
         "crank_speed_rad_per_s": Field(float, "crank speed for kind = constant_speed"),
+        "spring_model": Field(("massless", "chain"),
+                              "massless: one spring on the slider; chain: the coil's mass as "
+                              "spring_segments springs with lumped masses between "
+                              "(flex.dynamics.builder.spring_chain)"),
+        "spring_mass_kg": Field(doc="mass of the spring's active coils (spring_model = chain)",
+                                **_POS),
+        "spring_segments": Field(int, "spring_model = chain: segments of the coil (its "
+                                 "lumped masses: segments - 1 inside, half a segment's on "
+                                 "the slider)", minimum=1, maximum=256),
     },
     "simulation": {
         "end_time_s": Field(doc="simulated time span", **_POS),

@@ -77,6 +77,48 @@ class Mechanism:
     wing: dict[str, Any] = field(default_factory=dict)
     #: built by :mod:`flex.dynamics.planar` (2D bodies; joint loads read by its own rules)
     planar: bool = False
+    #: ``drive.spring_model = "chain"``: ``{"chain": SpringChain, "nodes": [inner nodes,
+    #: slider side first]}`` (collect reads their sensors ``spring_chain.<i>.<output>``)
+    spring_chain: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class SpringChain:
+    """The drive spring with its mass (``drive.spring_model = "chain"``): ``segments`` equal
+    springs in series on the slide line between the slider and the frame, each of rate
+    ``segments`` x k [N/m] (and damping ``segments`` x d [N s/m]), compressed by
+    preload / ``segments`` [m] at t = 0, so the chain's rate, damping and preload force are
+    the massless spring's. The coil's mass m_s [kg] is lumped at the segment ends: each
+    segment's half to each end, i.e. ``segments`` - 1 inner masses of m_s / segments and
+    m_s / (2 segments) moving with the slider (the frame's half-segment does not move).
+    Converges to the continuous coil as segments^-2 (docs/spring-mass.md).
+    """
+
+    segments: int
+    segment_stiffness_N_per_m: float
+    segment_damping_Ns_per_m: float
+    segment_preload_m: float
+    inner_mass_kg: float
+    slider_share_kg: float
+
+
+def spring_chain(scene: Scene) -> SpringChain | None:
+    """The scene's :class:`SpringChain`, or None for a massless spring or no spring."""
+    drive = scene["drive"]
+    if drive["kind"] != "spring" or drive["spring_model"] != "chain":
+        return None
+    segments, mass_kg = int(drive["spring_segments"]), drive["spring_mass_kg"]
+    return SpringChain(segments, segments * drive["spring_stiffness_N_per_m"],
+                       segments * drive["spring_damping_Ns_per_m"],
+                       drive["spring_preload_m"] / segments, mass_kg / segments,
+                       mass_kg / (2 * segments))
+
+
+def slider_mass_kg(scene: Scene) -> float:
+    """The slider's mass [kg] in the mechanism: its own, plus the spring's end share when the
+    spring is a chain (:class:`SpringChain`)."""
+    chain = spring_chain(scene)
+    return scene["slider"]["mass_kg"] + (chain.slider_share_kg if chain else 0.0)
 
 
 def _rotation_z(angle_rad: float) -> np.ndarray:
@@ -246,7 +288,7 @@ class _Builder:
     def add_slider(self) -> dict:
         """The slider: a rigid body at joint C, not turned (its prismatic joint holds it)."""
         slider, init = self.scene["slider"], self.init
-        return self.rigid_body("slider", slider["mass_kg"], slider["inertia_kgm2"],
+        return self.rigid_body("slider", slider_mass_kg(self.scene), slider["inertia_kgm2"],
                                init.joint_C_m, 0.0, init.joint_C_velocity_m_per_s, 0.0)
 
     def _add_flexible_crank(self, crank_reduction: Any) -> None:
@@ -365,6 +407,10 @@ class _Builder:
         if drive["kind"] == "spring":
             slider_x = mbs.AddMarker(eii.MarkerNodeCoordinate(
                 nodeNumber=self.slider_body["nodeNumber"], coordinate=0))
+            chain = spring_chain(self.scene)
+            if chain is not None:
+                self._add_spring_chain(chain, ground_coordinate, slider_x)
+                return
             # slider coordinate = displacement from t = 0; spring force k (q + preload) pushes -x
             mbs.AddObject(eii.ObjectConnectorCoordinateSpringDamper(
                 markerNumbers=[ground_coordinate, slider_x],
@@ -377,6 +423,32 @@ class _Builder:
         mbs.AddObject(eii.ObjectConnectorCoordinate(
             markerNumbers=[ground_coordinate, crank_rotation], velocityLevel=True,
             offset=drive["crank_speed_rad_per_s"]))
+
+    def _add_spring_chain(self, chain: SpringChain, ground_coordinate: int,
+                          slider_x: int) -> None:
+        """The spring as a chain (:class:`SpringChain`) from the slider's x coordinate
+        (marker ``slider_x``) to the frame's (``ground_coordinate``): inner point masses on
+        the slide line (1D nodes: their x displacement from t = 0, at rest) joined by
+        coordinate springs; each spring's frame side is its marker 0, as the massless one's."""
+        mbs, eii = self.mbs, self.eii
+        nodes = [mbs.AddNode(eii.Node1D(referenceCoordinates=[0.0]))
+                 for _ in range(chain.segments - 1)]
+        for node in nodes:
+            mbs.AddObject(eii.ObjectMass1D(mass=chain.inner_mass_kg, nodeNumber=node,
+                                           referencePosition=list(self.init.joint_C_m)))
+        ends = [slider_x, *(mbs.AddMarker(eii.MarkerNodeCoordinate(nodeNumber=node,
+                                                                   coordinate=0))
+                            for node in nodes), ground_coordinate]
+        for slider_side, frame_side in zip(ends[:-1], ends[1:], strict=True):
+            mbs.AddObject(eii.ObjectConnectorCoordinateSpringDamper(
+                markerNumbers=[frame_side, slider_side],
+                stiffness=chain.segment_stiffness_N_per_m,
+                damping=chain.segment_damping_Ns_per_m, offset=-chain.segment_preload_m))
+        for index, node in enumerate(nodes):
+            for output in ("Coordinates", "Coordinates_t"):
+                self.add(f"spring_chain.{index}.{output}",
+                         self.sensor("Node", output, nodeNumber=node))
+        self.mech.spring_chain = {"chain": chain, "nodes": nodes}
 
     def add(self, name: str, sensor) -> None:
         self.mech.sensors[name] = self.mbs.AddSensor(sensor)

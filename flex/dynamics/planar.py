@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from flex.data.scene import Scene
-from flex.dynamics.builder import Mechanism, _Builder
+from flex.dynamics.builder import Mechanism, _Builder, slider_mass_kg
 
 
 def is_planar(scene: Scene) -> bool:
@@ -69,13 +69,13 @@ class PlanarBuilder(_Builder):
         """The slider as a mass moving along x from joint C (its one coordinate: the x
         displacement, as the 3D slider node's first one, which the spring acts on)."""
         slider, init = self.scene["slider"], self.init
+        mass_kg = slider_mass_kg(self.scene)  # with a chain spring's end share
         node = self.mbs.AddNode(self.eii.Node1D(
             referenceCoordinates=[0.0], initialVelocities=[init.joint_C_velocity_m_per_s[0]]))
         body = self.mbs.AddObject(self.eii.ObjectMass1D(
-            name="slider", mass=slider["mass_kg"], nodeNumber=node,
+            name="slider", mass=mass_kg, nodeNumber=node,
             referencePosition=list(init.joint_C_m)))
-        self.mech.rigid_bodies["slider"] = (slider["mass_kg"],
-                                            np.eye(3) * slider["inertia_kgm2"])
+        self.mech.rigid_bodies["slider"] = (mass_kg, np.eye(3) * slider["inertia_kgm2"])
         return {"bodyNumber": body, "nodeNumber": node, "sliding": True}
 
     def body_marker(self, body: dict, global_point) -> int:

@@ -362,13 +362,40 @@ def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s:
     if mech.flexible_energy:
         out["energy/strain"] = Dataset(strain, "J", "elastic strain energy of the flexible links")
     drive = scene["drive"]
-    if drive["kind"] == "spring":
+    if mech.spring_chain:
+        chain_kinetic, potential = _spring_chain_energy(mech, slider_displacement_m)
+        kinetic += chain_kinetic
+        out["energy/kinetic"] = Dataset(kinetic, "J", "kinetic energy of all links and of "
+                                                      "the spring chain's inner masses")
+        out["energy/spring_potential"] = Dataset(potential, "J", "spring strain energy "
+                                                 "(sum over the chain's segments)")
+    elif drive["kind"] == "spring":
         compression = drive["spring_preload_m"] - slider_displacement_m
         potential = 0.5 * drive["spring_stiffness_N_per_m"] * compression**2
         out["energy/spring_potential"] = Dataset(potential, "J", "spring strain energy")
+    if drive["kind"] == "spring":
         out["energy/total"] = Dataset(kinetic + strain + potential, "J",
                                       "kinetic + strain + spring energy (constant if undamped)")
     return out
+
+
+def _spring_chain_energy(mech: Mechanism, slider_displacement_m: np.ndarray
+                         ) -> tuple[np.ndarray, np.ndarray]:
+    """Kinetic energy of a spring chain's inner masses and the strain energy of its
+    segments [J] (:class:`flex.dynamics.builder.SpringChain`; the slider's share of the coil
+    is in the slider's kinetic energy). Segment j's compression is the segment preload plus
+    the x displacement of its slider-side end minus its frame-side end's (x = -travel)."""
+    chain = mech.spring_chain["chain"]
+    inner = [_sensor(mech, f"spring_chain.{i}.Coordinates")[:, 1]
+             for i in range(chain.segments - 1)]
+    speeds = [_sensor(mech, f"spring_chain.{i}.Coordinates_t")[:, 1]
+              for i in range(chain.segments - 1)]
+    ends = np.array([-slider_displacement_m, *inner, np.zeros_like(slider_displacement_m)])
+    compression = chain.segment_preload_m + ends[:-1] - ends[1:]
+    potential = 0.5 * chain.segment_stiffness_N_per_m * np.sum(compression**2, axis=0)
+    kinetic = 0.5 * chain.inner_mass_kg * np.sum(np.square(speeds), axis=0) if speeds \
+        else np.zeros_like(slider_displacement_m)
+    return kinetic, potential
 
 
 def reduction_for_scene(scene: Scene, link: str = "coupler", *,

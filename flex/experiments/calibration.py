@@ -46,6 +46,7 @@ from flex.config.ffrf_rule import (
 )
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
+from flex.dynamics.solver import FFRF_DEFLECTION_LIMIT
 from flex.experiments.tradeoff import (
     REFERENCE_MARGIN,
     ReductionPool,
@@ -240,10 +241,19 @@ def robustly_within(table: Mapping[str, np.ndarray], bound: float) -> np.ndarray
     return out
 
 
+def within_linear_validity(case: CaseResult) -> bool:
+    """Whether the reference's peak deflection stays within the linear FFRF body's validity
+    (:data:`flex.dynamics.solver.FFRF_DEFLECTION_LIMIT` of the length): beyond it the
+    discretization of a model that no longer holds is not what the rule should follow."""
+    length = coupler_of(case)["length_m"]
+    return case.attrs["reference_peak_deflection_m"] <= FFRF_DEFLECTION_LIMIT * length
+
+
 def certifiable(case: CaseResult, level: float) -> bool:
-    """Whether the case's reference is accurate enough to certify ``level``: its accuracy at
-    most 1 / REFERENCE_MARGIN of it (:data:`flex.experiments.tradeoff.REFERENCE_MARGIN`)."""
-    return (case.status == "ok"
+    """Whether the case can certify ``level``: its reference within the linear FFRF validity
+    (:func:`within_linear_validity`) and accurate to at most 1 / REFERENCE_MARGIN of the
+    level (:data:`flex.experiments.tradeoff.REFERENCE_MARGIN`)."""
+    return (case.status == "ok" and within_linear_validity(case)
             and case.attrs["reference_accuracy"] * REFERENCE_MARGIN <= level)
 
 

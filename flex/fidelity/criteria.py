@@ -197,6 +197,35 @@ kfit sweep the cases at P / P_cr <= 0.2 follow the n-law, the 0.5 mm plate at 0.
 linear FFRF model (no stress stiffening) diverges at 3-10 x."""
 
 
+LINEAR_FFRF_ERROR_FLOOR = 0.01
+LINEAR_FFRF_ERROR_PER_LOAD = 3.0
+GEOMETRIC_FFRF_ERROR = 0.015
+"""The flexible rungs of an ``auto`` coupler, measured by ``make ladder`` (thesis
+deployment, steel plates 0.5-10 mm, peak elastic midpoint deflection against the nonlinear
+FE coupler's, docs/geometric-stiffness.md): the linear FFRF coupler's error relative to the
+peak stayed below ``LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD x`` (the rigid
+probe's compression / Euler load, :func:`euler_load_ratio`); the FFRF coupler with
+geometric stiffness below ``GEOMETRIC_FFRF_ERROR`` (to probe ratios of 0.33)."""
+
+
+def flexible_rung(predicted_deflection: float, load_ratio: float, tolerance: float
+                  ) -> tuple[str, float]:
+    """The lowest flexible rung of the coupler ladder whose predicted deflection error meets
+    ``tolerance``: ``"ffrf"`` (linear), ``"ffrf_geometric"`` (``coupler.geometric_stiffness``)
+    or ``"nonlinear_fe"``, and that rung's predicted error (NaN for the last).
+
+    ``predicted_deflection``: the predicted peak deflection / length, margin included (the
+    rigid model's predicted error); an FFRF rung's error is that times its measured relative
+    error (:data:`LINEAR_FFRF_ERROR_FLOOR`, ...); ``load_ratio``: the rigid probe's
+    compression / Euler load. All dimensionless.
+    """
+    linear = LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio
+    for rung, relative in (("ffrf", linear), ("ffrf_geometric", GEOMETRIC_FFRF_ERROR)):
+        if predicted_deflection * relative <= tolerance:
+            return rung, predicted_deflection * relative
+    return "nonlinear_fe", math.nan
+
+
 def euler_load_ratio(force_B_N: np.ndarray, force_C_N: np.ndarray,
                      coupler_angle_rad: np.ndarray, length_m: float, thickness_m: float,
                      width_m: float, youngs_modulus_Pa: float) -> float:
@@ -922,10 +951,33 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
                                float(coupler["damping_ratio"]))
     _decide_by_loads(decision, predict_deflection(probe, coupler).relative_error(
         coupler["length_m"]), tolerance)
+    if decision.model == "ffrf":
+        _climb(decision, coupler, ratio, tolerance)
     coupler["model"] = decision.model
     if decision.model == "ffrf":
         _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s)
     return decision, how
+
+
+def _climb(decision: FidelityDecision, coupler: dict[str, Any], load_ratio: float,
+           tolerance: float) -> None:
+    """Past rigid, the lowest flexible rung that meets ``tolerance`` (:func:`flexible_rung`;
+    in place: ``coupler.geometric_stiffness`` set for its rung, a true value given kept;
+    ``decision.model`` "nonlinear_fe" for the last rung, refused for a damped coupler)."""
+    bound = decision.predicted_rigid_error * PREDICTION_MARGIN
+    rung, predicted = flexible_rung(bound, load_ratio, tolerance)
+    linear = bound * (LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio)
+    decision.reason += (f"; ladder: {rung} (predicted deflection error {predicted:.3g}; "
+                        f"linear FFRF {linear:.3g}, with geometric stiffness "
+                        f"{bound * GEOMETRIC_FFRF_ERROR:.3g}: make ladder's measured errors)")
+    if rung == "ffrf_geometric":
+        coupler["geometric_stiffness"] = True
+    if rung == "nonlinear_fe":
+        if coupler["damping_ratio"] != 0:
+            raise SceneError(f'coupler.model = "auto": {decision.reason}; the nonlinear FE '
+                             f"coupler has no damping model: set coupler.damping_ratio = 0, "
+                             f"or a larger fidelity.tolerance")
+        decision.model = "nonlinear_fe"
 
 
 def _decide_by_loads(decision: FidelityDecision, predicted_rigid_error: float,
