@@ -10,7 +10,7 @@ over max(1.1 first bending periods, 5 ms). Stored per thickness under
 difference to the nonlinear FE peak, the wall times, and the coupler's largest compression
 over its Euler load. Where the runs failed (the FFRF with geometric stiffness beyond the
 Euler load: it buckles, and a linear-in-load model has nothing to hold it) the report says
-so. ~6 min on 2 cores, most of it the nonlinear FE runs.
+so. ~3 min on 2 cores, most of it the nonlinear FE runs.
 """
 
 from __future__ import annotations
@@ -40,9 +40,15 @@ DESCRIPTION = ("coupler plates 0.3-10 mm: linear FFRF, FFRF with geometric stiff
 OVERRIDES = pinned_overrides()
 #: thickness [mm] -> (mesh size [mm], step [s]): meshes as the stability study's (about 2 t,
 #: 2 ... 5 mm); steps of >= 40 per first bending period, at most 5e-5 s (the linear FFRF
-#: 0.3 mm plate fails at 1e-4 s)
-PLATES = {0.3: (2.0, 2.5e-5), 0.5: (2.0, 5e-5), 1.0: (2.0, 5e-5), 2.0: (2.0, 2.5e-5),
-          3.0: (3.0, 2.5e-5), 5.0: (5.0, 1e-5), 10.0: (5.0, 5e-6)}
+#: 0.3 mm plate fails at 1e-4 s), except 0.5 mm: at 1e-4 s, the only step tried at which its
+#: FFRF run with geometric stiffness converges (5e-5 ... 1e-5 s: Newton fails after ~3 ms;
+#: docs/geometric-stiffness.md); its nonlinear FE peak moves by 0.03 % from 1e-4 to 5e-5 s
+PLATES = {0.3: (2.0, 2.5e-5), 0.5: (2.0, 1e-4), 0.6: (2.0, 5e-5), 0.7: (2.0, 5e-5),
+          1.0: (2.0, 5e-5), 2.0: (2.0, 2.5e-5), 3.0: (3.0, 2.5e-5), 5.0: (5.0, 1e-5),
+          10.0: (5.0, 5e-6)}
+#: the 0.3 mm plate is loaded beyond its Euler load: the FFRF body with geometric stiffness
+#: buckles without bound and Newton fails (flex run ladder exits 0 when exactly this fails)
+EXPECTED_FAILURES = frozenset({"t0.3mm_ffrf_geometric"})
 
 
 def _label(thickness_mm: float) -> str:

@@ -241,10 +241,12 @@ class _GeometricForce:
 
     Without ``end_b_tension``: f = -N(q) K_G q, N the link's mean axial force (its stretch).
     With it (a callable of ``mbs`` giving the tension at ``end_b`` [N], e.g. a joint's
-    reaction): the axial force falls linearly from N_b at ``end_b`` to 2 N - N_b at
-    ``end_a`` (the same mean), f = -[N K_G + (N_b - N) (2 K_b - K_G)] q with K_b the x / L
-    weighted matrix. N_b is read at each call; its dependence on the joint reaction is left
-    out of the Jacobian (Newton converges without it: the term is small beside K and M).
+    reaction, :func:`joint_tension`): the axial force falls linearly from N_b at ``end_b``
+    to 2 N - N_b at ``end_a`` (the same mean), f = -[N K_G + (N_b - N) (2 K_b - K_G)] q with
+    K_b the x / L weighted matrix. N_b is read at every call, in step with the state (the
+    Newton iterate's Lagrange multiplier); its dependence on the multiplier is left out of
+    the Jacobian. (Read once per step instead, it lags the axial ringing by a step and the
+    0.5 mm plate diverged at every step tried.)
     """
 
     def __init__(self, stiffness: GeometricStiffness, end_b_tension=None) -> None:

@@ -184,9 +184,7 @@ def steps_per_first_period(level: Mapping[str, Any], n_load: float,
     times the first: the smallest of :data:`STEP_GRID` at or above both ``steps_coefficient
     x n_load^(-steps_exponent)`` and ``steps_per_top_period x top_ratio`` (every retained
     mode resolved); None beyond the grid's finest."""
-    # a level with a fixed count (no law) reads as coefficient N, exponent 0
-    coefficient = level.get("steps_coefficient", level.get("steps_per_first_period"))
-    wanted = max(coefficient * n_load ** (-level.get("steps_exponent", 0.0)),
+    wanted = max(level["steps_coefficient"] * n_load ** (-level["steps_exponent"]),
                  level.get("steps_per_top_period", 0.0) * top_ratio)
     return next((float(n) for n in STEP_GRID if n >= wanted * (1 - 1e-9)), None)
 

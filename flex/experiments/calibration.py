@@ -14,11 +14,13 @@ and materials, springs and drives) :func:`measure_scene` runs
   cache, median of ``repeats``) and measured against the reference (relative error of the
   peak midpoint deflection, crank angle and slider position).
 
-:func:`fit_levels` picks, per tolerance level, the pair with the least total time over the
-calibration scenes whose certified error (measured + reference accuracy) stays within
-:data:`MARGIN` x the level on every one of them; :func:`validate` applies the fitted rule
-to scenes outside the calibration and compares it with the fastest grid pair that meets
-the level (target: within the level, at most :data:`SLOWDOWN_LIMIT` x slower).
+:func:`fit_levels` fits, per damping class and tolerance level, the rule's constants
+(:mod:`flex.config.ffrf_rule`: mode cut-off ratio, steps law ``N = C n^-B``, steps per period of
+the highest retained mode) on the calibration scenes that can certify the level
+(:func:`certifiable`), each scene robustly within :data:`MARGIN` x the level
+(:func:`robustly_within`), the cheapest in summed run time; :func:`validate` applies the fitted
+rule to scenes outside the calibration and compares it with the fastest grid pair robustly
+within the level (target: within the level, at most :data:`SLOWDOWN_LIMIT` x slower).
 """
 
 from __future__ import annotations
@@ -159,23 +161,6 @@ def measure_case(name: str, scene: Scene, *, repeats: int = 3,
 
 
 measure_case.case_version = 2  # type: ignore[attr-defined]
-
-
-def measure_scenes(scenes: Mapping[str, Scene], repeats: int = 3,
-                   cache_dir: Path | None = None,
-                   progress: Callable[[str, int, int], None] | None = None
-                   ) -> dict[str, CaseResult]:
-    """:func:`measure_scene` for every scene, in order (progress: ``[done/total] text``)."""
-    out = {}
-    for done, (name, scene) in enumerate(scenes.items()):
-        def say(text: str, at: int = done) -> None:
-            if progress:
-                progress(text, at, len(scenes))
-        say(f"{name}: reference")
-        out[name] = measure_scene(name, scene, repeats, cache_dir, say)
-    if progress:
-        progress("done", len(scenes), len(scenes))
-    return out
 
 
 def _datasets(reference: Reference, rows: Sequence[tuple[int, float, Any]]
