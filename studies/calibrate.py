@@ -1,17 +1,11 @@
 """Study ``calibrate``: the FFRF settings rule fitted on a family of scenes, validated on others.
 
-Every scene has an FFRF coupler on a rigid crank (the thesis deployment, 0.03 s). Per scene a
-converged reference and a grid of in-plane modes x steps per first bending period on the
-rule's mesh (:mod:`flex.experiments.calibration`). The rule (:mod:`flex.config.ffrf_rule`)
-is fitted per tolerance level on ``CALIBRATION`` and validated on ``VALIDATION`` (scenes not
-used in the fit: target within the level, at most 3x slower than the fastest grid pair).
-Undamped thick plates ring in their higher modes for ~100 first-mode periods: their peak is
-the highest of many crests, which a reference cannot pin to 1 % at affordable steps; some
-scenes therefore carry 1 % of stiffness-proportional damping (steel structures: 0.5-2 %).
-
-Stored: one case per scene (``grid/*``, ``reference/*``); ``/summary/rule/toml`` (the
-constants ``make rule-install`` copies to flex/config/ffrf_rule.toml), ``levels/*``,
-``validation/*``. Figure: one work-precision panel per scene with the rule's picks.
+Per scene (FFRF coupler, rigid crank, thesis deployment) a converged reference and a grid of
+in-plane modes x steps per first period (:mod:`flex.experiments.calibration`); the rule
+(:mod:`flex.config.ffrf_rule`) is fitted per damping class and level on ``CALIBRATION`` and
+validated on ``VALIDATION``. Some scenes carry 1 % damping: an undamped thick plate's peak is
+the highest of many crests, which no affordable reference pins to 1 %. Stored: a case per
+scene, ``/summary/rule/toml`` (``make rule-install``), ``levels/*``, ``validation/*``.
 """
 
 from __future__ import annotations
