@@ -44,7 +44,7 @@ from importlib import resources
 from typing import Any
 
 from flex.base.physics import in_plane_fixed_interface_omegas, pinned_pinned_omega
-from flex.data.scene import plate_mass_properties
+from flex.data.scene import MESH_ASPECT_LIMIT, plate_mass_properties
 
 #: steps per first bending period the rule chooses from (make calibrate's grid)
 STEP_GRID = (4, 8, 16, 32, 64, 128)
@@ -85,11 +85,12 @@ def first_period_s(link: Mapping[str, Any]) -> float:
 
 def rule_mesh_size_m(link: Mapping[str, Any]) -> float:
     """Element size [m] the rule gives a plate link: ``min(MESH_PER_THICKNESS t, L /
-    MESH_PER_LENGTH)``, and at most 20 x the plate's smaller side (netgen aspect limit)."""
+    MESH_PER_LENGTH)``, and at most :data:`flex.data.scene.MESH_ASPECT_LIMIT` x the plate's
+    smaller side (the elements' aspect limit the scene checks)."""
     mesh = rule_constants()["mesh"]
     size = min(mesh["per_thickness"] * link["thickness_m"],
                link["length_m"] / mesh["per_length"])
-    return float(min(size, 20.0 * min(link["thickness_m"], link["width_m"])))
+    return float(min(size, MESH_ASPECT_LIMIT * min(link["thickness_m"], link["width_m"])))
 
 
 def outside_family(link: Mapping[str, Any], tolerance: float) -> str:
