@@ -300,7 +300,9 @@ def test_euler_load_ratio_of_a_compressed_link():
 
 def test_auto_crank_is_rigid_ffrf_or_refused_with_a_reason(reduction_cache):
     criterion = _synthetic_criterion()
-    scene = load_scene(None, ['crank.model="auto"', "simulation.step_s=1e-4"])
+    # with the wing the crank's n-law decides (without one its loads do: test_crank_predictor)
+    scene = load_scene(None, ['crank.model="auto"', "simulation.step_s=1e-4",
+                              "wing.enabled=true"])
     resolved, decisions = resolve_fidelity(scene, criterion, criterion,
                                            cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "rigid"
@@ -309,7 +311,7 @@ def test_auto_crank_is_rigid_ffrf_or_refused_with_a_reason(reduction_cache):
     with pytest.raises(SceneError, match='set crank.geometry = "plate"'):
         resolve_fidelity(scene, strict, strict, cache_dir=reduction_cache)  # lumped: no mesh
     plate = load_scene(None, ['crank.model="auto"', 'crank.geometry="plate"',
-                              "simulation.step_s=1e-4"])
+                              "simulation.step_s=1e-4", "wing.enabled=true"])
     resolved, decisions = resolve_fidelity(plate, strict, strict, cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "ffrf" and resolved["crank"]["modes"] >= 2
 

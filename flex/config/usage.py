@@ -64,6 +64,10 @@ def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset()) -> dic
             for key in _SPRING_CHAIN:
                 unused[f"drive.{key}"] = ('drive.spring_model = "massless": the spring has no '
                                           'mass; used with spring_model = "chain"')
+        elif drive["spring_model"] == AUTO:
+            unused["drive.spring_segments"] = ('drive.spring_model = "auto" chooses the '
+                                               'segments itself; used with spring_model = '
+                                               '"chain"')
     else:
         for key in _SPRING:
             unused[f"drive.{key}"] = ('drive.kind = "constant_speed": no spring; used with '
@@ -129,12 +133,13 @@ def _link_unused(link: str, scene: Scene) -> dict[str, str]:
 
 
 def _reads_tolerance(scene: Scene) -> bool:
-    """Whether ``fidelity.tolerance`` is read: by an ``auto`` link, or by ``"auto"`` solver
+    """Whether ``fidelity.tolerance`` is read: by an ``auto`` link or spring model (validated:
+    only with a spring drive), or by ``"auto"`` solver
     keys choosing the FFRF coupler's entry (:func:`flex.config.settings.choose_entry`)."""
     from flex.config.settings import has_auto
 
     crank, coupler = scene["crank"]["model"], scene["coupler"]["model"]
-    if AUTO in (crank, coupler):
+    if AUTO in (crank, coupler) or scene["drive"]["spring_model"] == AUTO:
         return True
     return has_auto(scene) and coupler == "ffrf" and crank == "rigid"
 

@@ -138,10 +138,13 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "spring_damping_Ns_per_m": Field(float, "viscous damper beside the spring",
                                          minimum=0.0),
         "crank_speed_rad_per_s": Field(float, "crank speed for kind = constant_speed"),
-        "spring_model": Field(("massless", "chain"),
+        "spring_model": Field(("massless", "chain", "auto"),
                               "massless: one spring on the slider; chain: the coil's mass as "
                               "spring_segments springs with lumped masses between "
-                              "(flex.dynamics.builder.spring_chain)"),
+                              "(flex.dynamics.builder.spring_chain); auto: massless or chain "
+                              "(and its segments) from the massless spring's error predicted "
+                              "by a rigid probe run and fidelity.tolerance "
+                              "(flex.fidelity.spring_choice)"),
         "spring_mass_kg": Field(doc="mass of the spring's active coils (spring_model = chain)",
                                 **_POS),
         "spring_segments": Field(int, "spring_model = chain: segments of the coil (its "
@@ -406,6 +409,10 @@ def _check_geometry(scene: Scene) -> None:
         raise SceneError('crank.model = "ffrf" needs drive.kind = "spring": the constant-speed '
                          "drive constrains the rotation coordinate of a rigid crank, which a "
                          'flexible crank\'s floating frame does not have; accepted: "rigid"')
+    if scene["drive"]["spring_model"] == "auto" and scene["drive"]["kind"] != "spring":
+        raise SceneError('drive.spring_model = "auto" needs drive.kind = "spring" (a '
+                         "constant-speed drive has no spring to choose a model for); "
+                         'accepted: "massless" or "chain"')
     coupler = scene["coupler"]
     if coupler["model"] == "nonlinear_fe" and coupler["damping_ratio"] != 0:
         raise SceneError(f"coupler.damping_ratio = {coupler['damping_ratio']:g}: "

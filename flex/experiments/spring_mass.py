@@ -18,7 +18,9 @@ model treats it as massless. ``drive.spring_model = "chain"``
   coupler midpoint deflection [m], the governing error against the finest chain [-];
 - :func:`sweep_cases` and :func:`error_law_lines`: the massless spring's governing error
   against the spring's n = delta_t f_surge over a sweep of coil and slider masses, and its
-  fitted law ``e = c n^-p`` (docs/spring-mass.md).
+  fitted law ``e = c n^-p`` (docs/spring-mass.md);
+- :func:`massless_predictions`: that error as ``drive.spring_model = "auto"`` predicts it
+  from each case's rigid probe (:mod:`flex.fidelity.spring_choice`), against the measured.
 """
 
 from __future__ import annotations
@@ -316,8 +318,10 @@ def summary(scenes: Mapping[str, Scene], results: Mapping[str, CaseResult]
     lines, law = error_law_lines(massless_errors(cases, table))
     datasets["error_law/coefficient"] = Dataset(law.coefficient, "1", "c of e = c n^-p")
     datasets["error_law/exponent"] = Dataset(law.exponent, "1", "p of e = c n^-p")
+    predictions = massless_predictions(cases, table)
+    datasets.update(prediction_datasets(predictions))
     report += ["  deployments (rigid: bundled links; ffrf: steel plate coupler, 1 mm thesis, "
-               "3 mm wing):", *format_table(table), *lines]
+               "3 mm wing):", *format_table(table), *lines, *prediction_lines(predictions)]
     return datasets, "\n".join(report)
 
 
@@ -399,3 +403,53 @@ def error_law_lines(points: Mapping[str, tuple[float, float]]) -> tuple[list[str
     lines += [f"    {name:34s} n = {value[0]:7.3f}  error {value[1]:.3e}"
               for name, value in sorted(points.items(), key=lambda item: item[1][0])]
     return lines, law
+
+
+# --- 4. The prediction drive.spring_model = "auto" decides by -------------------------------
+
+def massless_predictions(cases: Mapping[str, Scene], table: Mapping[str, Mapping[str, float]]
+                         ) -> dict[str, tuple[float, float, float]]:
+    """For every ``*_massless`` case of ``table`` (:func:`deployment_table`; ``cases`` their
+    scenes): ``(predicted, measured governing error, m_s / M_min)`` [-], the prediction
+    (:func:`flex.fidelity.spring_choice.predict_massless_spring_error`) from the case's
+    rigid probe (:func:`flex.fidelity.criteria.deployment_probe`: an FFRF coupler's rigid
+    twin), as ``drive.spring_model = "auto"`` makes it."""
+    from flex.fidelity.criteria import deployment_probe
+    from flex.fidelity.spring_choice import predict_massless_spring_error
+
+    out = {}
+    for name, values in table.items():
+        if name.endswith("_massless"):
+            _, _, probe = deployment_probe(cases[name])
+            prediction = predict_massless_spring_error(probe,
+                                                       cases[name]["drive"]["spring_mass_kg"])
+            out[name] = (prediction.error, values["governing_error"], prediction.mass_ratio)
+    return out
+
+
+def prediction_datasets(predictions: Mapping[str, tuple[float, float, float]]
+                        ) -> dict[str, Dataset]:
+    """:func:`massless_predictions` as ``prediction/case|predicted|measured|mass_ratio``."""
+    names = list(predictions)
+    columns = zip(*predictions.values(), strict=True) if names else ((), (), ())
+    predicted, measured, ratio = (np.array(c, dtype=float) for c in columns)
+    return {"prediction/case": Dataset(np.array(names, dtype=object), "1", "case"),
+            "prediction/predicted": Dataset(predicted, "1", "the massless spring's governing "
+                                            "error predicted from the rigid probe"),
+            "prediction/measured": Dataset(measured, "1", "its governing error against the "
+                                           "finest chain"),
+            "prediction/mass_ratio": Dataset(ratio, "1", "m_s / M_min, M_min the smallest "
+                                             "mass reduced to the slider")}
+
+
+def prediction_lines(predictions: Mapping[str, tuple[float, float, float]]) -> list[str]:
+    """Report lines: predicted against measured, case by case, and the ratio's range."""
+    ratios = [p / m for p, m, _ in predictions.values() if m > 0]
+    lines = ["  drive.spring_model = auto: the massless spring's governing error predicted "
+             "from the rigid probe (flex.fidelity.spring_choice) against measured"
+             + (f": predicted / measured {min(ratios):.3f} ... {max(ratios):.3f}"
+                if ratios else "")]
+    lines += [f"    {name:34s} m_s/M_min = {ratio:6.3f}  predicted {p:.3e}  measured {m:.3e}"
+              f"  ratio {p / m if m > 0 else math.nan:.3f}"
+              for name, (p, m, ratio) in predictions.items()]
+    return lines

@@ -31,16 +31,19 @@ from flex.fidelity.error_estimate import estimate_step_error
 def resolve_auto(scene: Scene, criterion: Criterion | None = None,
                  crank_criterion: Criterion | None = None, *, cache_dir: Path | None = None
                  ) -> tuple[Scene, list[FidelityDecision]]:
-    """Resolve ``model = "auto"`` links (:func:`flex.fidelity.criteria.resolve_fidelity`) and print
-    each choice and its reason to stderr. A scene without ``auto`` links is returned as it
-    is, with no decisions. ``cache_dir``: the reduction cache folder (module doc)."""
-    if scene["coupler"]["model"] != "auto" and scene["crank"]["model"] != "auto":
+    """Resolve ``model = "auto"`` links and ``drive.spring_model = "auto"``
+    (:func:`flex.fidelity.criteria.resolve_fidelity`) and print each choice and its reason to
+    stderr. A scene without them is returned as it is, with no decisions. ``cache_dir``: the
+    reduction cache folder (module doc)."""
+    if "auto" not in (scene["coupler"]["model"], scene["crank"]["model"],
+                      scene["drive"]["spring_model"]):
         return scene, []
     resolved, decisions = resolve_fidelity(scene, criterion, crank_criterion,
                                            cache_dir=cache_dir)
     for decision in decisions:
         modes = f" ({decision.modes} modes)" if decision.modes else ""
-        print(f"flex: fidelity: {decision.link}.model = auto -> {decision.model}{modes}: "
+        key = "drive.spring_model" if decision.link == "spring" else f"{decision.link}.model"
+        print(f"flex: fidelity: {key} = auto -> {decision.model}{modes}: "
               f"{decision.reason}", file=sys.stderr)
     return resolved, decisions
 
