@@ -40,7 +40,7 @@ from typing import Any
 from flex.config.settings import AUTO_OVERRIDES, pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, derived_scenes
-from flex.experiments.benchmark import BenchPlan, StepCostPlan, run_bench
+from flex.experiments.benchmark import BenchPlan, PlatesPlan, StepCostPlan, run_bench
 from flex.experiments.benchmark_report import bench_figures, bench_summary
 from flex.experiments.reference_plans import ReferencePlan
 from flex.experiments.tradeoff import Setting
@@ -113,6 +113,12 @@ PLAN = BenchPlan(
                        newton="modified", newton_relative_tolerance=1e-8),
     step_cost=StepCostPlan(meshes_m=(0.004, 0.002, 0.001), modes=(6, 12, 24), step_s=1e-5,
                            end_time_s=0.003),
+    # issue 15's plates: at 1 % within 0.3 s, at 0.1 % within 2 s (in process, warm)
+    plates=PlatesPlan({f"steel_{mm:g}mm": [f"coupler.thickness_m={mm / 1000!r}"]
+                       for mm in (2, 3, 5, 10)} | {"aluminium_2mm": [
+                           "coupler.thickness_m=0.002", "coupler.youngs_modulus_Pa=70e9",
+                           "coupler.density_kg_per_m3=2700.0", "coupler.poisson_ratio=0.33"]},
+                      tolerances=(0.01, 0.001), targets_s={0.01: 0.3, 0.001: 2.0}),
 )
 
 
@@ -121,7 +127,7 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
-    """Run the five parts in order; each part's failure is stored, the others still run."""
+    """Run the six parts in order; each part's failure is stored, the others still run."""
     return run_bench(scenes, PLAN, REPEATS, run.progress, run.notes, cache_dir=run.cache_dir,
                      make_all=run.environment.get("FLEX_BENCH_MAKE", "1") != "0",
                      nonlinear=run.environment.get("FLEX_BENCH_NONLINEAR", "1") != "0")

@@ -94,3 +94,17 @@ def test_no_estimate_when_switched_off():
     result = simulate(load_scene(overrides={"simulation.error_estimate": False,
                                             "simulation.end_time_s": 0.005}), cache_dir=None)
     assert not any(key.startswith("estimated_error") for key in result.attrs)
+
+
+def test_a_second_pair_guards_against_a_lucky_first_one():
+    """q(h) = q* + c h^2 exactly: both pairs give c h^2; a run whose 2h companion agrees with
+    it by luck still gets the (2h, 4h) pair's estimate scaled to h."""
+    from flex.fidelity.error_estimate import _estimate
+
+    exact, c, h = 1.0, 3.0e4, 1e-4
+    values = [exact + c * (k * h) ** 2 for k in (1, 2, 4)]
+    assert _estimate(values, [h, 2 * h, 4 * h], 2) == pytest.approx(c * h**2, rel=1e-9)
+    lucky = [values[1], values[1], values[2]]  # the run equals its 2h companion
+    assert _estimate(lucky, [h, 2 * h, 4 * h], 2) == pytest.approx(
+        abs(values[1] - values[2]) / 3.0 / 4.0, rel=1e-12)
+    assert _estimate(values[:2], [h, 2 * h], 2) == pytest.approx(c * h**2, rel=1e-9)

@@ -205,6 +205,24 @@ def test_the_fitted_law_covers_every_calibration_scene():
         assert robustly_within(table, MARGIN * 0.01)[row].all()
 
 
+def test_the_fit_s_time_model_recovers_a_noisy_grid_s_time_per_step():
+    """Times a x N (1 + 0.1 m) with every other pair timed 3x slow (a busy machine): the
+    modelled time is the median time per step with those modes times the steps."""
+    from flex.experiments.calibration import grid_table, modelled_time_s
+
+    def noisy(m, n, n_load):
+        return cost(m, n, n_load) * (3.0 if int(math.log2(n)) % 2 else 1.0)
+
+    table = grid_table(_case("noisy", 0.001, step_law_error, noisy))
+    modelled = modelled_time_s(table)
+    exact = np.array([cost(m, n, 0) for m, n in zip(table["modes"],
+                                                      table["steps_per_first_period"],
+                                                      strict=True)])
+    # 6 steps per mode count, 3 of them 3x slow: the median lies between, at sqrt(3)x
+    assert modelled == pytest.approx(exact * math.sqrt(3.0), rel=1e-9)
+    assert np.all(np.diff(modelled[table["modes"] == 1]) > 0)  # monotone in the steps
+
+
 def test_a_level_too_few_references_can_certify_is_not_fitted():
     levels = fit_levels({"a": _case("a", 0.001, step_law_error, cost,
                                     reference_accuracy=1e-2)}, [1e-3])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 
 import pytest
@@ -44,15 +45,16 @@ def test_rigid_links_get_the_rigid_entry():
 
 def _rule_step(thickness_m=0.001, tolerance=0.01):
     """The step the rule should give an 80 mm steel plate: T1 / N of the level (closed form
-    pinned-pinned period, independent of flex.config.ffrf_rule)."""
-    import math
-
+    pinned-pinned period, independent of flex.config.ffrf_rule), rounded down to the largest
+    step that divides the bundled end time into a whole number of 4 steps."""
     omega = (math.pi / 0.080) ** 2 * math.sqrt(200e9 * thickness_m**2 / 12 / 7850.0)
     level = level_for(tolerance)
     scene = load_scene(None, PLATE + [f"coupler.thickness_m={thickness_m}"])
     per = steps_per_first_period(level, load_time_scale_s(scene) * omega / (2 * math.pi),
                                  top_mode_ratio(level, scene["coupler"]))
-    return 2 * math.pi / omega / per, level
+    step = 2 * math.pi / omega / per
+    end = scene["simulation"]["end_time_s"]
+    return end / (4 * math.ceil(end / (4 * step))), level
 
 
 def test_an_ffrf_coupler_gets_the_rule_s_step_modes_and_mesh():
@@ -145,10 +147,10 @@ def test_solver_settings_report_the_resolved_values():
 
 def test_a_default_ffrf_run_uses_and_records_the_chosen_settings(reduction_cache):
     step = _rule_step()[0]
-    result = simulate(load_scene(None, PLATE + [f"simulation.end_time_s={10 * step!r}"]),
+    result = simulate(load_scene(None, PLATE + [f"simulation.end_time_s={12 * step!r}"]),
                       "default", cache_dir=reduction_cache)
     time_s = result.datasets["time"].data
-    assert len(time_s) == 11 and time_s[1] - time_s[0] == pytest.approx(step)
+    assert len(time_s) == 13 and time_s[1] - time_s[0] == pytest.approx(step)
     assert result.attrs["solver_defaults_entry"] == "ffrf_rule"
     assert f"step_s = {step!r}" in result.attrs["solver_defaults_keys"]
     assert f"step_s = {step!r}" in result.scene_toml and '"auto"' not in result.scene_toml
@@ -162,7 +164,7 @@ def test_inspect_shows_the_resolved_solver_keys_and_no_scene_change(tmp_path, ca
     from flex.data.scene import to_toml
 
     step = _rule_step()[0]
-    scene = load_scene(None, PLATE + [f"simulation.end_time_s={10 * step!r}"])
+    scene = load_scene(None, PLATE + [f"simulation.end_time_s={12 * step!r}"])
     case = simulate(scene, "default", cache_dir=reduction_cache)
     path = write_results(tmp_path / "auto.h5", "simulate", [case], to_toml(scene))
     assert main(["inspect", str(path)]) == 0

@@ -288,7 +288,14 @@ def _mid_set(positions: np.ndarray, length_m: float, mesh_size_m: float,
             weights = weights + correction
     except np.linalg.LinAlgError:
         pass
-    return nodes, weights
+    return nodes, unit_sum(weights)
+
+
+def unit_sum(weights: np.ndarray) -> np.ndarray:
+    """Marker weights scaled to sum to 1 (Exudyn warns, once per marker and run, when a
+    solve left their sum off 1 by round-off)."""
+    weights = np.asarray(weights, dtype=float)
+    return weights / math.fsum(weights)
 
 
 def _pinned_pinned_frequency_Hz(ffrf_interface, reduction_length_m: float,
@@ -523,9 +530,11 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
     return Reduction(
         fem=fem, **sizes, poisson_ratio=float(poisson_ratio), modes=int(modes),
         mode_selection=mode_selection,
-        nodes_end_a=np.asarray(end_a["NodeNumbers"]), weights_end_a=end_a["NodeWeights"],
-        nodes_end_b=np.asarray(end_b["NodeNumbers"]), weights_end_b=end_b["NodeWeights"],
-        nodes_mid=np.asarray(mid["NodeNumbers"]), weights_mid=mid["NodeWeights"],
+        nodes_end_a=np.asarray(end_a["NodeNumbers"]),
+        weights_end_a=unit_sum(end_a["NodeWeights"]),
+        nodes_end_b=np.asarray(end_b["NodeNumbers"]),
+        weights_end_b=unit_sum(end_b["NodeWeights"]),
+        nodes_mid=np.asarray(mid["NodeNumbers"]), weights_mid=unit_sum(mid["NodeWeights"]),
         centre_end_a=centre(end_a), centre_end_b=centre(end_b), centre_mid=centre(mid),
         fixed_interface_frequencies_Hz=np.sqrt(np.abs(np.asarray(fem.eigenValues))) / (2 * np.pi),
         pinned_pinned_frequency_Hz=float(meta["pinned_pinned_frequency_Hz"]),

@@ -83,11 +83,13 @@ def first_period_s(link: Mapping[str, Any]) -> float:
     return 2.0 * math.pi / omega
 
 
-def rule_mesh_size_m(link: Mapping[str, Any]) -> float:
+def rule_mesh_size_m(link: Mapping[str, Any], mesh: Mapping[str, float] | None = None
+                     ) -> float:
     """Element size [m] the rule gives a plate link: ``min(MESH_PER_THICKNESS t, L /
     MESH_PER_LENGTH)``, and at most :data:`flex.data.scene.MESH_ASPECT_LIMIT` x the plate's
-    smaller side (the elements' aspect limit the scene checks)."""
-    mesh = rule_constants()["mesh"]
+    smaller side (the elements' aspect limit the scene checks). ``mesh``: the constants
+    ``per_thickness`` and ``per_length`` (default: the installed ones)."""
+    mesh = rule_constants()["mesh"] if mesh is None else mesh
     size = min(mesh["per_thickness"] * link["thickness_m"],
                link["length_m"] / mesh["per_length"])
     return float(min(size, MESH_ASPECT_LIMIT * min(link["thickness_m"], link["width_m"])))

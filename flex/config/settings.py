@@ -129,6 +129,13 @@ def choose_entry(scene: Scene) -> tuple[str, str, RulePick | None]:
     return "ffrf_rule", reason, chosen
 
 
+def whole_steps_s(step_s: float, end_time_s: float, multiple: int) -> float:
+    """The largest step [s] at most ``step_s`` that divides ``end_time_s`` into a whole
+    number of ``multiple`` steps."""
+    groups = max(1, math.ceil(end_time_s / (multiple * step_s) - 1e-9))
+    return end_time_s / (multiple * groups)
+
+
 def resolve_solver_settings(scene: Scene) -> tuple[Scene, SolverChoice | None]:
     """``scene`` with its ``"auto"`` solver and link keys filled in (see module doc)."""
     if not (has_auto(scene) or has_auto_link_keys(scene)):
@@ -138,8 +145,12 @@ def resolve_solver_settings(scene: Scene) -> tuple[Scene, SolverChoice | None]:
     entry = solver_defaults()[name]
     values = dict(entry)
     accuracy = entry["accuracy"]
-    if chosen is not None:
-        values["step_s"], accuracy = chosen.step_s, chosen.level
+    if chosen is not None:  # the end time a whole number of 4 steps: the error estimate's
+        # companions at 2 and 4 steps then end on it (a half-step companion costs 2 runs)
+        values["step_s"], accuracy = whole_steps_s(
+            chosen.step_s, float(resolved["simulation"]["end_time_s"]), 4), chosen.level
+        reason += (f"; step rounded down to {values['step_s']:.6g} s, a whole number of 4 "
+                   f"steps in the end time")
     for key in AUTO_KEYS:
         if resolved["simulation"][key] == AUTO:
             resolved["simulation"][key] = filled[key] = values[key]

@@ -2,7 +2,7 @@
 
 Every number is measured by the run, on whatever else the machine is doing: wall times [s]
 are medians of ``repeats`` runs, and each comparison is a ratio of two times measured in the
-same run. :func:`run_bench` runs the five parts of a :class:`BenchPlan` in order, each into
+same run. :func:`run_bench` runs the six parts of a :class:`BenchPlan` in order, each into
 ``notes[<part>]`` (a part that raises :class:`~flex.base.errors.FlexError` is stored as
 ``notes["<part>_failed"]`` and a failed case ``<part>_failed``; the others still run):
 
@@ -18,6 +18,9 @@ same run. :func:`run_bench` runs the five parts of a :class:`BenchPlan` in order
 - ``step_cost`` (:func:`bench_step_cost`, when the plan has a :class:`StepCostPlan`): the cost
   of an FFRF step against mesh size and mode count, joint markers on every face node (before)
   and on the fewest nodes (now);
+- ``plates`` (:func:`bench_plates`, when the plan has a :class:`PlatesPlan`): plates of other
+  thicknesses and materials at flex's own settings per tolerance, against converged
+  references;
 - ``make_all`` (:func:`bench_make_all`): ``make all FORCE=1`` with an empty reduction cache and
   again with it filled (``make_all`` False, the bench study's ``FLEX_BENCH_MAKE=0``, skips
   it).
@@ -30,6 +33,7 @@ The run-time switches ``nonlinear`` and ``make_all`` and the reduction cache fol
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import statistics
@@ -81,6 +85,19 @@ class StepCostPlan:
 
 
 @dataclass(frozen=True)
+class PlatesPlan:
+    """Plates timed as a user runs them, at flex's own settings for each tolerance.
+
+    ``plates``: name -> ``--set`` overrides of the FFRF bench scene; ``tolerances``: the
+    ``fidelity.tolerance`` values (relative peak-deflection error); ``targets_s``: tolerance
+    -> the in-process time target [s] (build + integration + output, reduction in memory)."""
+
+    plates: Mapping[str, Sequence[str]]
+    tolerances: Sequence[float]
+    targets_s: Mapping[float, float]
+
+
+@dataclass(frozen=True)
 class BenchPlan:
     """What the benchmark measures.
 
@@ -107,6 +124,7 @@ class BenchPlan:
     nonlinear_fine: Setting
     nonlinear_coarse: Setting
     step_cost: StepCostPlan | None = None
+    plates: PlatesPlan | None = None
 
 
 def _g(value: float) -> str:
@@ -308,6 +326,49 @@ def bench_step_cost(scene: Scene, plan: StepCostPlan, repeats: int, pool: Reduct
     notes["step_cost"] = rows
 
 
+def bench_plates(scene: Scene, plan: PlatesPlan, repeats: int, pool: ReductionPool, say: Say,
+                 notes: dict[str, Any]) -> dict[str, CaseResult]:
+    """Per plate: the converged reference of :mod:`flex.experiments.calibration` (its
+    accuracy certifies a level only within a third of it), then per tolerance flex's own
+    choice (every solver and link key ``"auto"``: :mod:`flex.config.ffrf_rule`, or the
+    visible fallback) timed and measured against it. ``notes["plates"]``: one row each."""
+    from flex.config.settings import AUTO_OVERRIDES, resolve_solver_settings
+    from flex.data.scene import apply_overrides
+    from flex.experiments.calibration import scene_reference
+    from flex.experiments.tradeoff import REFERENCE_MARGIN
+
+    rows, out = [], {}
+    for name, overrides in plan.plates.items():
+        plate = apply_overrides(scene, list(overrides))
+        reference = scene_reference(plate, pool, say)
+        say(f"{name}: reference accuracy {reference.accuracy:.1e}")
+        for tolerance in plan.tolerances:
+            auto = Setting(f"flex defaults at {tolerance:g}", tuple(AUTO_OVERRIDES) + (
+                ("coupler.modes", "auto"), ("coupler.mesh_size_m", "auto"),
+                ("fidelity.tolerance", tolerance)))
+            resolved, choice = resolve_solver_settings(scene_for(plate, auto))
+            concrete = Setting(auto.label, auto.overrides + (
+                ("coupler.modes", resolved["coupler"]["modes"]),
+                ("coupler.mesh_size_m", resolved["coupler"]["mesh_size_m"])))
+            pool.for_scene(scene_for(plate, concrete))  # warm: the reduction is not timed
+            m = measure(plate, concrete, reference, repeats, pool)
+            label = f"plate_{name}_tol_{tolerance:g}"
+            out[label] = bench_case(label, plate, m, {"rule_entry": choice.entry if choice
+                                                      else "", "tolerance": tolerance})
+            rows.append({"plate": name, "tolerance": tolerance, "measurement": m,
+                         "entry": choice.entry if choice else "",
+                         "step_s": resolved["simulation"]["step_s"],
+                         "modes": resolved["coupler"]["modes"],
+                         "mesh_size_m": resolved["coupler"]["mesh_size_m"],
+                         "reference_accuracy": reference.accuracy,
+                         "certifiable": reference.accuracy * REFERENCE_MARGIN <= tolerance,
+                         "target_s": plan.targets_s.get(tolerance, math.nan)})
+            say(f"{name} at {tolerance:g}: {m.total_time_s:.3f} s, error "
+                f"{m.errors.get('peak_deflection_relative', math.nan):.2e}")
+    notes["plates"] = rows
+    return out
+
+
 def bench_reduction(scene: Scene, say: Say, notes: dict[str, Any]) -> None:
     """Build time [s] of the scene's coupler reduction: cold (empty cache, median of 2),
     loaded from cache (median of 6), and its first FFRF projection (median of 2)."""
@@ -368,7 +429,7 @@ def run_bench(scenes: Mapping[str, Scene], plan: BenchPlan, repeats: int,
               progress: Progress | None = None, notes: dict[str, Any] | None = None, *,
               cache_dir: Path | None = None, nonlinear: bool = True, make_all: bool = True
               ) -> dict[str, CaseResult]:
-    """Run the five parts in order on ``scenes["rigid"]`` and ``scenes["ffrf_1mm"]`` (see the
+    """Run the six parts in order on ``scenes["rigid"]`` and ``scenes["ffrf_1mm"]`` (see the
     module doc); each part's failure is stored, the others still run.
 
     ``cache_dir``: the reduction cache folder of the timed runs (None: reductions built in
@@ -386,6 +447,8 @@ def run_bench(scenes: Mapping[str, Scene], plan: BenchPlan, repeats: int,
         ("reduction", lambda say: bench_reduction(scenes["ffrf_1mm"], say, notes)),
         ("step_cost", lambda say: plan.step_cost and bench_step_cost(
             scenes["ffrf_1mm"], plan.step_cost, repeats, pool, say, notes)),
+        ("plates", lambda say: plan.plates and bench_plates(
+            scenes["ffrf_1mm"], plan.plates, repeats, pool, say, notes)),
         ("make_all", lambda say: bench_make_all(say, notes, make_all))]
     for index, (name, part) in enumerate(parts):
         if progress:

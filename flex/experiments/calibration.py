@@ -119,16 +119,19 @@ def scene_reference(scene: Scene, pool: ReductionPool, progress: Progress | None
                                pool, progress=progress)
 
 
-def grid_settings(scene: Scene) -> list[tuple[int, float, Setting]]:
-    """The grid's (modes, steps per first period, setting) on the rule's mesh."""
+def grid_settings(scene: Scene, mesh_rule: Mapping[str, float] | None = None
+                  ) -> list[tuple[int, float, Setting]]:
+    """The grid's (modes, steps per first period, setting) on the rule's mesh
+    (:func:`flex.config.ffrf_rule.rule_mesh_size_m` with the constants ``mesh_rule``)."""
     coupler = scene["coupler"]
-    period, mesh = first_period_s(coupler), rule_mesh_size_m(coupler)
+    period, mesh = first_period_s(coupler), rule_mesh_size_m(coupler, mesh_rule)
     return [(modes, per, _setting(f"modes={modes} T1/{per:g}", period / per, modes, mesh))
             for modes in GRID_MODES for per in GRID_STEPS_PER_PERIOD]
 
 
 def measure_scene(name: str, scene: Scene, repeats: int = 3, cache_dir: Path | None = None,
-                  progress: Progress | None = None) -> CaseResult:
+                  progress: Progress | None = None,
+                  mesh_rule: Mapping[str, float] | None = None) -> CaseResult:
     """Reference and grid of one scene, as a case (datasets ``grid/*``, ``reference/*``;
     attributes ``reference_accuracy``, ``first_period_s``, ``rule_mesh_size_m``)."""
     pool = ReductionPool(cache_dir)
@@ -138,7 +141,7 @@ def measure_scene(name: str, scene: Scene, repeats: int = 3, cache_dir: Path | N
         return CaseResult(name, to_toml(scene), status="failed",
                           message=f"reference failed: {exc}")
     rows = []
-    for modes, per, setting in grid_settings(scene):
+    for modes, per, setting in grid_settings(scene, mesh_rule):
         if progress:
             progress(f"{name}: {setting.label}")
         try:  # loaded before the clock starts: every timed run finds it in memory
@@ -151,16 +154,19 @@ def measure_scene(name: str, scene: Scene, repeats: int = 3, cache_dir: Path | N
         "reference_accuracy": reference.accuracy,
         "reference_peak_deflection_m": reference.peak_deflection_m,
         "first_period_s": first_period_s(scene["coupler"]),
-        "rule_mesh_size_m": rule_mesh_size_m(scene["coupler"])})
+        "rule_mesh_size_m": rule_mesh_size_m(scene["coupler"], mesh_rule)})
 
 
-def measure_case(name: str, scene: Scene, *, repeats: int = 3,
-                 cache_dir: Path | None = None) -> CaseResult:
-    """:func:`measure_scene` as a sweep case function (:func:`flex.sweep.run_sweep`)."""
-    return measure_scene(name, scene, repeats, cache_dir)
+def measure_case(name: str, scene: Scene, *, repeats: int = 3, cache_dir: Path | None = None,
+                 mesh_rule: Mapping[str, float] | None = None) -> CaseResult:
+    """:func:`measure_scene` as a sweep case function (:func:`flex.sweep.run_sweep`). Bind
+    ``mesh_rule`` (the rule's mesh constants) with the scene's solver keys pinned: the case's
+    identity then holds everything it depends on, and installing a refitted rule does not
+    make its cases stale."""
+    return measure_scene(name, scene, repeats, cache_dir, mesh_rule=mesh_rule)
 
 
-measure_case.case_version = 2  # type: ignore[attr-defined]
+measure_case.case_version = 3  # type: ignore[attr-defined]
 
 
 def _datasets(reference: Reference, rows: Sequence[tuple[int, float, Any]]
@@ -256,6 +262,22 @@ def n_load_of(case: CaseResult) -> float:
     return load_time_scale_s(scene) / first_period_s(scene["coupler"])
 
 
+def modelled_time_s(table: Mapping[str, np.ndarray]) -> np.ndarray:
+    """Per grid pair, the time [s] the fit compares laws by: the scene's time per step with
+    that many modes (median over the grid's steps of measured time / steps per first period)
+    times the pair's steps. Single timings of 0.02-0.5 s runs on a shared machine scatter by
+    2-5x between neighbouring grid pairs (this grid: 8 modes at T1/32 timed below 1 mode at
+    T1/32), which would let the noise choose the law; validation keeps the measured times."""
+    steps, time = table["steps_per_first_period"], table["total_time"]
+    out = np.full(len(steps), math.nan)
+    for modes in np.unique(table["modes"]):
+        rows = table["modes"] == modes
+        timed = rows & np.isfinite(time) & (time > 0)
+        if timed.any():
+            out[rows] = np.exp(np.median(np.log(time[timed] / steps[timed]))) * steps[rows]
+    return out
+
+
 def needed_steps(table: Mapping[str, np.ndarray], modes: int, bound: float) -> float:
     """The fewest grid steps per first period that keep ``modes`` robustly within ``bound``
     (inf if none)."""
@@ -292,8 +314,8 @@ def _fit_one(level: float,
     :func:`flex.config.ffrf_rule.level_modes`): each scene's fewest robust steps per period
     N_i within MARGIN x level at its n_i = t_load / T1; the law N = C n^-B with B the
     least-squares slope of log N_i on log n_i (clipped to [0, 1.5]) and C the smallest that
-    covers every scene; its picks (rounded up to the grid) timed over the scenes. The ratio
-    with the least total time wins."""
+    covers every scene; its picks (rounded up to the grid) timed over the scenes
+    (:func:`modelled_time_s`). The ratio with the least total time wins."""
     scenes = sorted(usable)
     if len(usable) < MIN_SCENES:
         return {"tolerance": level, "modes": None, "scenes": scenes,
@@ -315,7 +337,7 @@ def _fit_one(level: float,
         if None in picks:  # the law leaves the grid on some scene: not a usable fit
             continue
         rows = [_row(t, m, per) for t, m, per in zip(tables, modes, picks, strict=True)]
-        time = float(sum(t["total_time"][r] for t, r in zip(tables, rows, strict=True)))
+        time = float(sum(modelled_time_s(t)[r] for t, r in zip(tables, rows, strict=True)))
         if best is None or time < best["total_time_s"]:
             best = {"tolerance": level, "modes": max(modes), **cut, **law,
                     "total_time_s": time,
