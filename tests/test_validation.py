@@ -181,3 +181,54 @@ def test_figures_render_and_pass_the_house_style_review(tmp_path, monkeypatch):
     assert [p.name for p in paths] == ["validation-deflection.png", "validation-slider.png"]
     assert all(p.stat().st_size > 1000 for p in paths)
     assert not problems, problems
+
+
+def test_b_frame_strain_reverses_and_doubles_the_first_mode_geometric_stiffness():
+    # why flex's FFRF rod differs: linear strain in a frame tangent at B takes the frame's turn
+    # theta = v'(0) against the chord as free, so the chord grows by L theta^2 / 2 and a
+    # tension N does work on it: -N pi^2 / L per unit a^2 for v = a sin(pi x / L), against the
+    # true +N pi^2 / (2 L) of the strain u' + v'^2 / 2 (Timoshenko & Gere)
+    true, tangent = validation.first_mode_geometric_stiffness_per_N(BENCH)
+    length = BENCH.rod_length_m
+    assert true == pytest.approx(math.pi**2 / (2 * length), rel=1e-5)
+    assert tangent == pytest.approx(-math.pi**2 / length, rel=1e-5)  # finite difference
+
+
+def test_b_frame_membrane_force_is_the_gradient_of_its_strain_energy():
+    rod = ivp_crank.rod_matrices(BENCH, 2, axial_bubbles=4)
+    ea = BENCH.youngs_modulus_Pa * BENCH.area_m2
+
+    def extra_energy_J(q: np.ndarray) -> float:
+        # EA/2 int (u' + theta v' - theta^2/2)^2 - u'^2 dx (the linear part is in rod.stiffness)
+        axial, theta = rod.axial_slope.T @ q, rod.lateral_slope_at_B @ q
+        strain = axial + theta * (rod.lateral_slope.T @ q) - theta**2 / 2
+        return 0.5 * ea * rod.quadrature_weight_m @ (strain**2 - axial**2)
+
+    q = 1e-4 * np.random.default_rng(3).standard_normal(rod.mass.shape[0])
+    force = ivp_crank.tangent_frame_membrane_force(BENCH, rod, q)
+    step = 1e-9
+    gradient = [(extra_energy_J(q + step * e) - extra_energy_J(q - step * e)) / (2 * step)
+                for e in np.eye(q.size)]
+    np.testing.assert_allclose(force, gradient, rtol=1e-5, atol=1e-6 * np.abs(force).max())
+
+
+def test_ffrf_rod_chord_grows_by_the_turn_of_its_b_frame(reduction_cache):
+    # flex's FFRF rod (frame on the B face, 2 modes, 10 ms): the chord B-C is the frame-x
+    # stretch u_C plus the frame turn's w_C^2 / (2 L), w_C the frame-y displacement of C
+    # (measured: equal to 0.03 um over 0.1 s, the turn up to 107 um, u_C up to 33 um)
+    from flex.bodies.geometric_stiffness import face_mean_displacement
+    from flex.dynamics.solver import reduction_for_scene
+
+    scene = load_scene(overrides=validation.benchmark_overrides() + [
+        'coupler.model="ffrf"', "coupler.mesh_size_m=0.008", "coupler.modes=2",
+        "simulation.step_s=2e-5", "simulation.end_time_s=0.01"])
+    data = {k: v.data for k, v in simulate(scene, cache_dir=reduction_cache).datasets.items()}
+    reduction = reduction_for_scene(scene, cache_dir=reduction_cache)
+    stretch, turn = face_mean_displacement(reduction, "end_b")[:2] @ data[
+        "coupler/modal_coordinates"].T
+    length = reduction.length_m
+    chord = stretch + turn**2 / (2 * length)
+    measured = data["coupler/chord_change"]
+    np.testing.assert_allclose(measured, chord - chord[0], atol=1e-3 * np.abs(measured).max())
+    # the turn's growth, not the stretch, is most of it
+    assert (turn**2 / (2 * length)).max() > 0.5 * measured.max()

@@ -40,6 +40,13 @@ each a switch here:
   every term of ``v'^2``);
 - ``pi_as_published``: the test set's truncated ``PI = 3.1415927`` in the stiffness.
 
+Three more ``geometric_stiffening`` variants explain flex's FFRF rod (its frame is the B
+face, tangent to the rod at B; :func:`tangent_frame_membrane_force`): ``"lateral_only"``, the
+consistent cross term's force on the lateral coordinates only (a geometric stiffness of the
+axial force, no foreshortening pull on the axial coordinates); ``"tangent_frame"``, the
+strain linear in the tangent frame; ``"tangent_frame_geometric"``, that plus the geometric
+stiffness in that frame (flex's ``coupler.geometric_stiffness``).
+
 Units: SI throughout (m, kg, s, rad, N).
 """
 
@@ -53,7 +60,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 #: geometric stiffening variants (module doc)
-STIFFENING = ("none", "published", "consistent")
+STIFFENING = ("none", "published", "consistent", "lateral_only", "tangent_frame",
+              "tangent_frame_geometric")
 #: the test set's truncated pi (crank.f, ``PI = 3.1415927D0``)
 PUBLISHED_PI = 3.1415927
 
@@ -119,6 +127,10 @@ class RodMatrices:
     gyroscopic: np.ndarray
     stiffening: np.ndarray
     quartic: np.ndarray
+    axial_slope: np.ndarray
+    lateral_slope: np.ndarray
+    lateral_slope_at_B: np.ndarray
+    quadrature_weight_m: np.ndarray
 
 
 def rod_matrices(bench: CrankBenchmark, lateral_modes: int = 2, axial_mass_factor: float = 1.0,
@@ -175,7 +187,9 @@ def rod_matrices(bench: CrankBenchmark, lateral_modes: int = 2, axial_mass_facto
                        area * length * integral(shape_v),
                        area * length**2 * integral(shape_u, xi),
                        area * length**2 * integral(shape_v, xi), gyroscopic, stiffening,
-                       quartic)
+                       quartic, slope_u / length, slope_v / length,
+                       np.concatenate([np.pi * k[:, 0], np.zeros(n - lateral_modes)]) / length,
+                       w * length)
 
 
 class TwoModeCrank:
@@ -250,11 +264,17 @@ class TwoModeCrank:
         force = quadratic_velocity_force(dm, rates)
         q = p[3:]
         force[3:] -= self.rod.stiffness @ q
-        if self.stiffening != "none":
+        if self.stiffening in ("published", "consistent"):
             force[3:] -= self.rod.stiffening @ q @ q
         if self.stiffening == "consistent":
             lateral = q[:self.rod.quartic.shape[0]]
             force[3:3 + lateral.size] -= self.rod.quartic @ lateral @ lateral @ lateral
+        if self.stiffening == "lateral_only":
+            lateral_modes = self.rod.quartic.shape[0]
+            force[3:3 + lateral_modes] -= (self.rod.stiffening @ q @ q)[:lateral_modes]
+        if self.stiffening.startswith("tangent_frame"):
+            force[3:] -= tangent_frame_membrane_force(
+                self.bench, self.rod, q, self.stiffening == "tangent_frame_geometric")
         g, jac, velocity, gamma = self.constraints(t, p, rates)
         a = self.baumgarte
         system = np.block([[m, jac.T], [jac, np.zeros((3, 3))]])
@@ -266,6 +286,35 @@ class TwoModeCrank:
         """First-order right-hand side of the state ``(p, p')``."""
         p, rates = y[:self.n], y[self.n:]
         return np.concatenate([rates, self.accelerations(t, p, rates)[0]])
+
+
+def tangent_frame_membrane_force(bench: CrankBenchmark, rod: RodMatrices, q: np.ndarray,
+                                 frame_geometric: bool = False) -> np.ndarray:
+    """The membrane force [N per m of coordinate] of a rod that is linear elastic in a frame
+    tangent to it at B (flex's FFRF coupler: frame on the B face), beyond the linear axial
+    stiffness already in ``rod.stiffness``.
+
+    In that frame the linear strain of the axis is the chord-frame ``e = u' + theta v' -
+    theta^2 / 2`` with ``theta = v'(0)`` (the frame's turn against the chord), instead of the
+    true ``u' + v'^2 / 2``: the gradient of ``EA/2 int e^2 dx`` minus its linear part ``EA
+    int u' du'``. Exact to second order in the deflection for the axial force's work; the
+    turn's axial shift ``-theta v(x)`` needs axial bubbles to be represented
+    (:func:`rod_matrices`). ``frame_geometric``: add the geometric stiffness of the axial
+    force ``N = EA e`` on the deflection measured in that frame, ``w' = v' - theta``
+    (``int N w' dw'``, N held: no pull on the axial coordinates), as flex's
+    ``coupler.geometric_stiffness`` adds it to the FFRF rod."""
+    axial, lateral = rod.axial_slope.T @ q, rod.lateral_slope.T @ q
+    theta = rod.lateral_slope_at_B @ q
+    strain = axial + theta * lateral - theta**2 / 2
+    d_strain = (rod.axial_slope + theta * rod.lateral_slope
+                + np.outer(rod.lateral_slope_at_B, lateral - theta))
+    stretch = bench.youngs_modulus_Pa * bench.area_m2
+    force = stretch * (d_strain @ (rod.quadrature_weight_m * strain)
+                       - rod.axial_slope @ (rod.quadrature_weight_m * axial))
+    if frame_geometric:
+        d_slope = rod.lateral_slope - rod.lateral_slope_at_B[:, None]
+        force += stretch * d_slope @ (rod.quadrature_weight_m * strain * (lateral - theta))
+    return force
 
 
 def quadratic_velocity_force(dm: np.ndarray, rates: np.ndarray) -> np.ndarray:

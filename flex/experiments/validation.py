@@ -21,6 +21,14 @@ model started there too, against two references: the beam with consistent axial 
 consistent geometric stiffening (:data:`BEST_BEAM`) and flex's nonlinear FE rod (3-D solid,
 Green-Lagrange strain), which agree in-plane; the FE rod's slider position is not a
 reference here (its midpoint drifts out of the mechanism plane, docs/validation.md).
+
+Why flex's FFRF rod differs from both (report section 4, :func:`_ffrf_explained`): its
+floating frame is the B face, tangent to the rod at B, and its strain is linear in that
+frame, so the frame's turn against the chord lengthens the chord at no strain and the
+axial force's geometric stiffness comes out reversed and doubled
+(:func:`first_mode_geometric_stiffness_per_N`). Measured by the two-mode model with that
+strain, by the FFRF rod with ``coupler.geometric_stiffness`` and by the two-mode model with
+both (:data:`EXPLAINED`).
 Units: m, s, rad, Hz; deflections and positions in m (reports in um).
 """
 
@@ -78,19 +86,26 @@ def benchmark_overrides(bench: CrankBenchmark = BENCH) -> list[str]:
             f"simulation.output_step_s={OUTPUT_STEP_S!r}", "simulation.error_estimate=false"]
 
 
-def flex_cases(scene: Scene, runs: dict[str, tuple[str, float, int, float]]) -> dict[str, Scene]:
-    """One scene per flex run: name -> (coupler model, mesh size [m], modes, step [s])."""
+def flex_cases(scene: Scene, runs: dict[str, tuple[str, float, int, float, bool]]
+               ) -> dict[str, Scene]:
+    """One scene per flex run: name -> (coupler model, mesh size [m], modes, step [s],
+    ``coupler.geometric_stiffness``)."""
     return derived_scenes(scene, {
         name: [f'coupler.model="{model}"', f"coupler.mesh_size_m={mesh!r}",
-               f"coupler.modes={modes}", f"simulation.step_s={step!r}"]
-        for name, (model, mesh, modes, step) in runs.items()})
+               f"coupler.modes={modes}", f"simulation.step_s={step!r}",
+               f"coupler.geometric_stiffness={str(geometric).lower()}"]
+        for name, (model, mesh, modes, step, geometric) in runs.items()})
 
 
 #: the two-mode runs: name -> (lateral modes, axial bubbles, axial mass factor, geometric
 #: stiffening, initial state, pi of the stiffness) -- the published model, then one change
 #: at a time (``mass_fixed``: axial mass block / 15; ``cross``: the published nonlinear term
 #: alone; ``locked``: consistent stiffening on the published axial element; ``stiffened``:
-#: consistent stiffening with 4 axial bubbles, :mod:`flex.dynamics.ivp_crank`)
+#: consistent stiffening with 4 axial bubbles; ``lateral_only``: the stiffening force on
+#: the bending coordinates only, no foreshortening pull on the axial ones; ``tangent_frame``:
+#: the strain of a rod linear elastic in a frame tangent at B, as flex's FFRF rod;
+#: ``tangent_frame_geometric``: that plus the geometric stiffness in that frame, as flex's FFRF
+#: rod with ``coupler.geometric_stiffness``, :mod:`flex.dynamics.ivp_crank`)
 TWO_MODE_RUNS: dict[str, tuple[int, int, float, str, str, float]] = {
     "published": (2, 0, 15.0, "none", "published", PUBLISHED_PI),
     "published_mass_fixed": (2, 0, 1.0, "none", "published", math.pi),
@@ -102,9 +117,24 @@ TWO_MODE_RUNS: dict[str, tuple[int, int, float, str, str, float]] = {
     "rigid_start_cross": (2, 0, 1.0, "published", "rigid", math.pi),
     "rigid_start_locked": (2, 0, 1.0, "consistent", "rigid", math.pi),
     "rigid_start_stiffened": (2, 4, 1.0, "consistent", "rigid", math.pi),
+    "rigid_start_lateral_only": (2, 0, 1.0, "lateral_only", "rigid", math.pi),
+    "rigid_start_tangent_frame": (2, 4, 1.0, "tangent_frame", "rigid", math.pi),
+    "rigid_start_tangent_frame_geometric": (2, 4, 1.0, "tangent_frame_geometric", "rigid",
+                                            math.pi),
 }
 #: the best beam: consistent axial mass, consistent geometric stiffening, no locking
 BEST_BEAM = "two-mode rigid_start_stiffened"
+#: section 4, why flex's FFRF rod differs: the runs compared (flex's FFRF rod without and
+#: with ``coupler.geometric_stiffness``, the two-mode model with the FFRF's strain, the
+#: linear and the stiffening-on-the-bending-only two-mode models)
+FFRF_PLAIN, FFRF_GEOMETRIC = "ffrf_h1e-5", "ffrf_geometric_h1e-5"
+TANGENT_FRAME = "two-mode rigid_start_tangent_frame"
+TANGENT_GEOMETRIC = "two-mode rigid_start_tangent_frame_geometric"
+LATERAL_ONLY = "two-mode rigid_start_lateral_only"
+EXPLAINED = ("two-mode rigid_start_mass_fixed", BEST_BEAM, LATERAL_ONLY, TANGENT_FRAME,
+             FFRF_PLAIN, TANGENT_GEOMETRIC, FFRF_GEOMETRIC)
+#: window of the early / late comparison in section 4 [s]
+WINDOW_S = 0.01
 
 
 def two_mode_runs(runs: dict[str, tuple[int, int, float, str, str, float]] | None = None,
@@ -161,12 +191,13 @@ def analyse(scene: Scene, results: dict[str, CaseResult], solutions: dict[str, C
     """The study's datasets and report: the rigid limit, the published values against the
     independent model and one change at a time, every run from the rigid start at t = 0.1 s
     and over time against :data:`BEST_BEAM` and ``reference`` (a flex case, the nonlinear FE
-    rod)."""
+    rod), and why flex's FFRF rod differs (:data:`EXPLAINED`; skipped if one is missing)."""
     lines = ["validation: the IVP test set's flexible slider-crank (Simeon; Mazzia & "
              "Magherini, Test Set for IVP Solvers, Bari: problem crank, crank.f)"]
     datasets: dict[str, Dataset] = {}
     for part_lines, part_datasets in (_rigid_limit(results), _published(solutions),
-                                      _runs(results, solutions, reference)):
+                                      _runs(results, solutions, reference),
+                                      _ffrf_explained(results, solutions, reference)):
         lines += part_lines
         datasets.update(part_datasets)
     return datasets, "\n".join(lines)
@@ -261,9 +292,9 @@ def _runs(results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
               f"Hz; Euler buckling load {buckling:.0f} N; crank harmonics 8 and 9: "
               f"{8 * BENCH.crank_speed_rad_per_s / (2 * math.pi):.1f}, "
               f"{9 * BENCH.crank_speed_rad_per_s / (2 * math.pi):.1f} Hz",
-              f"   {'run':36s} {'q_mid(0.1)':>10s} {'x3(0.1)':>12s} {'peak':>6s} {'rms/beam':>8s} "
+              f"   {'run':44s} {'q_mid(0.1)':>10s} {'x3(0.1)':>12s} {'peak':>6s} {'rms/beam':>8s} "
               f"{'rms/fe':>6s} {'dx3/beam':>8s} {'dx3/fe':>7s} {'oop':>6s} {'wall':>5s}",
-              f"   {'':36s} {'[um]':>10s} {'[m]':>12s} {'[Hz]':>6s} {'[1]':>8s} {'[1]':>6s} "
+              f"   {'':44s} {'[um]':>10s} {'[m]':>12s} {'[Hz]':>6s} {'[1]':>8s} {'[1]':>6s} "
               f"{'[um]':>8s} {'[um]':>7s} {'[um]':>6s} {'[s]':>5s}"]
     rows = []
     for name, run in runs.items():
@@ -279,7 +310,7 @@ def _runs(results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
                beam["deflection_rms_rel"], fe["deflection_rms_rel"], beam["slider_max_diff_m"],
                fe["slider_max_diff_m"], out_of_plane, wall)
         rows.append(row)
-        lines.append(f"   {name:36s} {row[1] * 1e6:10.2f} {row[2]:12.9f} {row[3]:6.1f} "
+        lines.append(f"   {name:44s} {row[1] * 1e6:10.2f} {row[2]:12.9f} {row[3]:6.1f} "
                      f"{row[4]:8.3f} {row[5]:6.3f} {row[6] * 1e6:8.2f} {row[7] * 1e6:7.2f} "
                      f"{row[8] * 1e6:6.0f} {row[9]:5.1f}")
         key = name.replace(" ", "_")
@@ -310,6 +341,142 @@ def _runs(results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
     datasets["published/euler_bernoulli_frequency"] = Dataset(
         omega_eb / (2 * math.pi), "Hz", "pinned-pinned first bending, 8 mm steel, 0.3 m")
     return lines, datasets
+
+
+def first_mode_geometric_stiffness_per_N(bench: CrankBenchmark = BENCH,
+                                         amplitude_m: float = 1e-7) -> tuple[float, float]:
+    """Generalized stiffness [1/m] that 1 N of uniform axial tension adds to the first
+    pinned-pinned bending mode ``v = a sin(pi x / L)``: with the true strain of the axis
+    ``u' + v'^2 / 2`` (``pi^2 / (2 L)``) and with the strain of a rod linear elastic in a
+    frame tangent to it at B, flex's FFRF rod (``-pi^2 / L``, :func:`flex.dynamics.ivp_crank.
+    tangent_frame_membrane_force`). By finite difference at ``amplitude_m`` [m]."""
+    rod = ivp_crank.rod_matrices(bench, 2)
+    strain = 1e-6
+    length = bench.rod_length_m
+    q = np.array([amplitude_m, 0.0, strain * length / 2, strain * length])  # u = strain x
+    tension_N = bench.youngs_modulus_Pa * bench.area_m2 * strain
+    true = (rod.stiffening @ q @ q)[0] / amplitude_m / tension_N
+    tangent = ivp_crank.tangent_frame_membrane_force(bench, rod, q)[0] / amplitude_m / tension_N
+    return float(true), float(tangent)
+
+
+def windowed_rms(curves: dict[str, np.ndarray], reference: dict[str, np.ndarray],
+                 window_s: float = WINDOW_S) -> tuple[float, float]:
+    """RMS deflection difference from ``reference`` over the first and the last ``window_s``
+    [s] of the run, relative to the reference's largest |deflection| over the whole run."""
+    time, peak = reference["time"], np.abs(reference["deflection"]).max()
+    difference = curves["deflection"] - reference["deflection"]
+    first, last = time <= time[0] + window_s, time >= time[-1] - window_s
+    return (float(np.sqrt(np.mean(difference[first] ** 2)) / peak),
+            float(np.sqrt(np.mean(difference[last] ** 2)) / peak))
+
+
+def _explained_runs(results: dict[str, CaseResult], solutions: dict[str, CrankSolution]
+                    ) -> dict[str, Any] | None:
+    """The runs of :data:`EXPLAINED` by name, or None if one is missing or failed."""
+    runs: dict[str, Any] = {}
+    for name in EXPLAINED:
+        if name.startswith("two-mode "):
+            runs[name] = solutions.get(name.removeprefix("two-mode "))
+        elif name in results and results[name].status == "ok":
+            runs[name] = results[name]
+    complete = len(runs) == len(EXPLAINED) and all(run is not None for run in runs.values())
+    return runs if complete else None
+
+
+def _ffrf_explained(results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
+                    reference: str) -> tuple[list[str], dict[str, Dataset]]:
+    """Section 4: why flex's FFRF rod differs from the beam models, measured."""
+    runs = _explained_runs(results, solutions)
+    if runs is None:
+        return ["", f"4. (skipped: needs the runs {', '.join(EXPLAINED)})"], {}
+    true, tangent = first_mode_geometric_stiffness_per_N()
+    length = BENCH.rod_length_m
+    lines = ["", "4. Why flex's FFRF rod differs: it is linear elastic in a floating frame on "
+             "its B face, tangent to the rod at B",
+             "   first-mode geometric stiffness per N of axial tension [1/m]: true strain "
+             f"u' + v'^2/2: {true:+.3f} (pi^2/2L = {math.pi**2 / (2 * length):.3f}); strain "
+             "linear in the B frame, u' + theta v' - theta^2/2 with theta = v'(0): "
+             f"{tangent:+.3f} (-pi^2/L = {-math.pi**2 / length:.3f}); ratio {tangent / true:+.2f}",
+             "   (the frame turns by theta against the chord, which linear strain takes as "
+             "free: the chord grows by L theta^2/2, where the real rod's shortens by "
+             "int v'^2/2)"]
+    table, table_lines = _explained_table(runs, results[reference])
+    lines += table_lines + _explained_verdict(table)
+    datasets = {"ffrf_explained/first_mode_geometric_stiffness_true": Dataset(
+                    true, "1/m", "first bending mode, per N of tension, strain u' + v'^2/2"),
+                "ffrf_explained/first_mode_geometric_stiffness_tangent_frame": Dataset(
+                    tangent, "1/m", "the same with the strain linear in a frame tangent at B "
+                    "(flex's FFRF rod)")}
+    for column in _EXPLAINED_COLUMNS:
+        datasets[f"ffrf_explained/{column}"] = Dataset(
+            np.array([row[column] for row in table.values()]),
+            "m" if column == "chord_change_max" else "1", _EXPLAINED_COLUMNS[column])
+    datasets["ffrf_explained/run"] = Dataset(np.array(list(table), dtype=object), "1", "run")
+    return lines, datasets
+
+
+_EXPLAINED_COLUMNS = {
+    "rms_beam": f"RMS deflection difference from {BEST_BEAM} / its peak |deflection|",
+    "rms_fe": "RMS deflection difference from the nonlinear FE rod / its peak |deflection|",
+    "rms_ffrf": f"RMS deflection difference from {FFRF_PLAIN} / its peak |deflection|",
+    "rms_ffrf_geometric": f"RMS deflection difference from {FFRF_GEOMETRIC} / its peak "
+                          "|deflection|",
+    "first_window": f"as rms_beam over the first {WINDOW_S} s",
+    "last_window": f"as rms_beam over the last {WINDOW_S} s",
+    "chord_change_max": "largest change of the distance B-C"}
+
+
+def _explained_table(runs: dict[str, Any], fe: CaseResult
+                     ) -> tuple[dict[str, dict[str, float]], list[str]]:
+    """Per run of section 4: RMS against the beam, the FE rod and the plain FFRF rod, early
+    and late windows against the beam, largest chord change; and its report lines."""
+    beam, fe_curves = _curves(runs[BEST_BEAM]), _curves(fe)
+    ffrf, ffrf_geometric = _curves(runs[FFRF_PLAIN]), _curves(runs[FFRF_GEOMETRIC])
+    lines = [f"   {'run':44s} {'q_mid(0.1)':>10s} {'rms/beam':>8s} {'rms/fe':>6s} "
+             f"{'rms/ffrf':>8s} {'/ffrf+gs':>8s} {'first':>6s} {'last':>6s} {'chord':>6s}",
+             f"   {'':44s} {'[um]':>10s} {'[1]':>8s} {'[1]':>6s} {'[1]':>8s} {'[1]':>8s} "
+             f"{'10 ms':>6s} {'10 ms':>6s} {'[um]':>6s}"]
+    table = {}
+    for name, run in runs.items():
+        curves = _curves(run)
+        first, last = windowed_rms(curves, beam)
+        row = {"deflection": float(curves["deflection"][-1]),
+               "rms_beam": _against(curves, beam)["deflection_rms_rel"],
+               "rms_fe": _against(curves, fe_curves)["deflection_rms_rel"],
+               "rms_ffrf": _against(curves, ffrf)["deflection_rms_rel"],
+               "rms_ffrf_geometric": _against(curves, ffrf_geometric)["deflection_rms_rel"],
+               "first_window": first, "last_window": last,
+               "chord_change_max": float(np.abs(curves["chord"]).max())}
+        table[name] = row
+        lines.append(f"   {name:44s} {row['deflection'] * 1e6:10.2f} {row['rms_beam']:8.3f} "
+                     f"{row['rms_fe']:6.3f} {row['rms_ffrf']:8.3f} "
+                     f"{row['rms_ffrf_geometric']:8.3f} {first:6.3f} {last:6.3f} "
+                     f"{row['chord_change_max'] * 1e6:6.1f}")
+    return table, lines
+
+
+def _explained_verdict(table: dict[str, dict[str, float]]) -> list[str]:
+    """The section's conclusions, from its table."""
+    plain, geometric = table[FFRF_PLAIN], table[FFRF_GEOMETRIC]
+    tangent, tangent_geometric = table[TANGENT_FRAME], table[TANGENT_GEOMETRIC]
+    return [
+        f"   the two-mode model with the B-frame strain is {tangent['rms_ffrf']:.3f} RMS from "
+        f"the FFRF rod (the beam is {table[BEST_BEAM]['rms_ffrf']:.3f} from it): the FFRF "
+        "difference is the frame's linear strain, not the 3-D body, the modes or the step",
+        f"   flex's geometric stiffness (coupler.geometric_stiffness) takes the FFRF rod from "
+        f"{plain['rms_beam']:.3f} to {geometric['rms_beam']:.3f} RMS against the beam "
+        f"({geometric['rms_fe']:.3f} against the FE rod): {geometric['first_window']:.3f} over "
+        f"the first {WINDOW_S * 1e3:.0f} ms, {geometric['last_window']:.3f} over the last (a "
+        "drift); the two-mode B-frame model with it: "
+        f"{tangent_geometric['rms_beam']:.3f} from the beam, "
+        f"{tangent_geometric['rms_ffrf_geometric']:.3f} from that FFRF rod",
+        f"   what is left is the chord's growth L theta^2/2, which that stiffness does not "
+        "undo (largest chord change "
+        f"{geometric['chord_change_max'] * 1e6:.0f} um against the beam's "
+        f"{table[BEST_BEAM]['chord_change_max'] * 1e6:.0f} um): in the chord frame the same "
+        f"stiffness force, on the bending coordinates alone, is "
+        f"{table[LATERAL_ONLY]['rms_beam']:.3f} from the beam"]
 
 
 def draw_figures(summary_data: dict[str, Dataset], folder: Path,
