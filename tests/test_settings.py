@@ -46,34 +46,35 @@ def test_rigid_links_get_the_rigid_entry():
 def _rule_step(thickness_m=0.001, tolerance=0.01):
     """The step the rule should give an 80 mm steel plate: T1 / N of the level (closed form
     pinned-pinned period, independent of flex.config.ffrf_rule), rounded down to the largest
-    step that divides the bundled end time into a whole number of 4 steps."""
+    step that divides the bundled end time into a whole number of 4 steps; the level and
+    n = t_load / T1."""
     omega = (math.pi / 0.080) ** 2 * math.sqrt(200e9 * thickness_m**2 / 12 / 7850.0)
     level = level_for(tolerance)
     scene = load_scene(None, PLATE + [f"coupler.thickness_m={thickness_m}"])
-    per = steps_per_first_period(level, load_time_scale_s(scene) * omega / (2 * math.pi),
-                                 top_mode_ratio(level, scene["coupler"]))
+    n_load = load_time_scale_s(scene) * omega / (2 * math.pi)
+    per = steps_per_first_period(level, n_load, top_mode_ratio(level, scene["coupler"], n_load))
     step = 2 * math.pi / omega / per
     end = scene["simulation"]["end_time_s"]
-    return end / (4 * math.ceil(end / (4 * step))), level
+    return end / (4 * math.ceil(end / (4 * step))), level, n_load
 
 
 def test_an_ffrf_coupler_gets_the_rule_s_step_modes_and_mesh():
     scene, choice = resolve_solver_settings(load_scene(None, PLATE))
-    step, level = _rule_step()
+    step, level, n_load = _rule_step()
     assert choice.entry == "ffrf_rule" and choice.accuracy == level["tolerance"]
     assert scene["simulation"]["step_s"] == pytest.approx(step, rel=1e-9)
     assert scene["simulation"]["newton"] == "modified"
-    assert scene["coupler"]["modes"] == level_modes(level, scene["coupler"])
+    assert scene["coupler"]["modes"] == level_modes(level, scene["coupler"], n_load)
     assert scene["coupler"]["mesh_size_m"] == pytest.approx(0.002)  # min(2 t, L / 16)
     assert choice.keys["coupler.modes"] == scene["coupler"]["modes"]
     assert "T1 = 0.002796 s" in choice.reason  # 357.6 Hz: 1 mm steel, 80 mm pinned-pinned
 
 
-@pytest.mark.parametrize("thickness_m, mesh_m", [(0.003, 0.005), (0.01, 0.005)])
+@pytest.mark.parametrize("thickness_m, mesh_m", [(0.003, 0.005), (0.005, 0.005)])
 def test_the_rule_scales_with_the_plate(thickness_m, mesh_m):
     scene, choice = resolve_solver_settings(load_scene(None, PLATE + [
         f"coupler.thickness_m={thickness_m}"]))
-    step, _ = _rule_step(thickness_m)
+    step = _rule_step(thickness_m)[0]
     assert choice.entry == "ffrf_rule"
     assert scene["simulation"]["step_s"] == pytest.approx(step, rel=1e-9)
     assert scene["coupler"]["mesh_size_m"] == pytest.approx(mesh_m)  # L / 16 caps 2 t
@@ -83,6 +84,8 @@ def test_the_rule_scales_with_the_plate(thickness_m, mesh_m):
     # 0.2 mm: L / t = 400, beyond the calibrated slenderness
     ("coupler.thickness_m=0.0002", "outside the calibrated family (length_m / thickness_m"),
     ("fidelity.tolerance=1e-5", "finer than the finest calibrated level"),
+    # 10 mm undamped: n = t_load / T1 beyond the 1 % level's calibration scenes
+    ("coupler.thickness_m=0.01", "of level 0.01's calibration scenes"),
     ('coupler.model="nonlinear_fe"', 'no calibrated rule for coupler.model = "nonlinear_fe"'),
 ])
 def test_flexible_scenes_outside_the_rule_fall_back_visibly(change, why):

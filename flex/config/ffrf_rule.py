@@ -155,25 +155,38 @@ def load_time_scale_s(scene: Mapping[str, Mapping[str, Any]]) -> float:
     return 0.5 * math.pi * math.sqrt(mass / drive["spring_stiffness_N_per_m"])
 
 
-def level_modes(level: Mapping[str, Any], link: Mapping[str, Any]) -> int:
-    """The in-plane eigenmodes a level keeps for ``link``: every estimated in-plane
-    fixed-interface mode (:func:`flex.base.physics.in_plane_fixed_interface_omegas`) up to
-    ``mode_cutoff_ratio`` x the first, rounded up to :data:`MODE_GRID`. A thick plate's
-    axial and shear-softened modes crowd towards its first bending mode, so it keeps more.
-    (A level with a fixed ``modes`` count keeps that.)"""
+def mode_cutoff(level: Mapping[str, Any], n_load: float = math.inf) -> float:
+    """The level's mode cut-off over the first bending frequency for a link with ``n_load =
+    t_load / T1``: the larger of ``mode_cutoff_ratio`` and ``mode_cutoff_load / n_load``.
+    The second is a cut-off at ``mode_cutoff_load`` x ``2 pi / t_load``: the modes the
+    load's own time scale can excite, which for a slender, slowly loaded link (small n)
+    reach far above its first mode, and for a stiff one stay below it."""
+    return max(level["mode_cutoff_ratio"], level.get("mode_cutoff_load", 0.0) / n_load)
+
+
+def level_modes(level: Mapping[str, Any], link: Mapping[str, Any],
+                n_load: float = math.inf) -> int:
+    """The in-plane eigenmodes a level keeps for ``link`` (``n_load = t_load / T1``): every
+    estimated in-plane fixed-interface mode
+    (:func:`flex.base.physics.in_plane_fixed_interface_omegas`) up to :func:`mode_cutoff`
+    x the first, rounded up to :data:`MODE_GRID`. A thick plate's axial and shear-softened
+    modes crowd towards its first bending mode, so it keeps more. (A level with a fixed
+    ``modes`` count keeps that.)"""
     if "mode_cutoff_ratio" not in level:
         return int(level["modes"])
     omegas = in_plane_fixed_interface_omegas(
         link["length_m"], link["thickness_m"], link["width_m"], link["youngs_modulus_Pa"],
         link["density_kg_per_m3"], link.get("poisson_ratio", 0.3), MODE_GRID[-1] + 1)
-    below = sum(1 for omega in omegas if omega <= level["mode_cutoff_ratio"] * omegas[0])
+    cut = mode_cutoff(level, n_load)
+    below = sum(1 for omega in omegas if omega <= cut * omegas[0])
     return next((m for m in MODE_GRID if m >= below), MODE_GRID[-1])
 
 
-def top_mode_ratio(level: Mapping[str, Any], link: Mapping[str, Any]) -> float:
-    """Estimated frequency of the highest in-plane mode the level keeps for ``link`` over the
-    first's (1 for one mode)."""
-    modes = level_modes(level, link)
+def top_mode_ratio(level: Mapping[str, Any], link: Mapping[str, Any],
+                   n_load: float = math.inf) -> float:
+    """Estimated frequency of the highest in-plane mode the level keeps for ``link`` (with
+    ``n_load``, :func:`level_modes`) over the first's (1 for one mode)."""
+    modes = level_modes(level, link, n_load)
     omegas = in_plane_fixed_interface_omegas(
         link["length_m"], link["thickness_m"], link["width_m"], link["youngs_modulus_Pa"],
         link["density_kg_per_m3"], link.get("poisson_ratio", 0.3), modes)
@@ -204,10 +217,16 @@ def pick(scene: Mapping[str, Mapping[str, Any]], tolerance: float, link: str = "
         return RulePick(None, level_modes(levels[0], values), mesh, None,
                         f"outside the calibrated family ({outside})")
     level = level_for(tolerance, damping)
-    modes = level_modes(level, values)
     period = first_period_s(values)
     n_load = load_time_scale_s(scene) / period
-    per = steps_per_first_period(level, n_load, top_mode_ratio(level, values))
+    n_range = level.get("n_load_min", 0.0), level.get("n_load_max", math.inf)
+    if not n_range[0] * (1 - 1e-9) <= n_load <= n_range[1] * (1 + 1e-9):
+        return RulePick(None, level_modes(level, values, n_load), mesh, None, (
+            f"outside the calibrated family (n = t_load / T1 = {n_load:.3g} is outside the "
+            f"[{n_range[0]:.3g}, {n_range[1]:.3g}] of level {level['tolerance']:g}'s "
+            f"calibration scenes)"))
+    modes = level_modes(level, values, n_load)
+    per = steps_per_first_period(level, n_load, top_mode_ratio(level, values, n_load))
     if per is None:
         return RulePick(None, modes, mesh, None, (
             f"outside the calibrated family (n = t_load / T1 = {n_load:.3g} would need more "
@@ -218,7 +237,8 @@ def pick(scene: Mapping[str, Mapping[str, Any]], tolerance: float, link: str = "
         f"worst calibration error {level['worst_error']:.2g}): n = t_load / T1 = "
         f"{n_load:.3g} (load time scale {load_time_scale_s(scene):.3g} s), step T1 / {per:g} "
         f"= {step:.3g} s (first bending period T1 = {period:.4g} s), {modes} "
-        f"in-plane modes ({_modes_text(level)}), mesh {_mesh_text()} = {mesh * 1e3:.3g} mm"))
+        f"in-plane modes ({_modes_text(level, n_load)}), mesh {_mesh_text()} = "
+        f"{mesh * 1e3:.3g} mm"))
 
 
 def _mesh_text() -> str:
@@ -226,10 +246,14 @@ def _mesh_text() -> str:
     return f"min({mesh['per_thickness']:g} t, L / {mesh['per_length']:g})"
 
 
-def _modes_text(level: Mapping[str, Any]) -> str:
-    if "mode_cutoff_ratio" in level:
-        return f"every one up to {level['mode_cutoff_ratio']:g} x the first"
-    return "the level's count"
+def _modes_text(level: Mapping[str, Any], n_load: float) -> str:
+    if "mode_cutoff_ratio" not in level:
+        return "the level's count"
+    text = f"every one up to {mode_cutoff(level, n_load):.3g} x the first"
+    if level.get("mode_cutoff_load", 0.0) > 0:
+        text += (f": the larger of {level['mode_cutoff_ratio']:g} and "
+                 f"{level['mode_cutoff_load']:g} / n")
+    return text
 
 
 def fill_link_keys(scene: dict[str, dict[str, Any]], link: str, tolerance: float

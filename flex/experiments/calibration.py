@@ -74,6 +74,8 @@ DAMPING_CLASSES = ("undamped", "damped")
 DAMPED_RATIO_MIN = 0.01
 #: mode cut-off ratios tried (flex.config.ffrf_rule.level_modes)
 MODE_CUTOFF_RATIOS = (1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0)
+#: load-based mode cut-offs tried (x 2 pi / t_load; flex.config.ffrf_rule.mode_cutoff; 0: none)
+MODE_CUTOFF_LOADS = (0.0, 4.0, 8.0, 16.0, 32.0)
 #: steps per period of the highest retained mode tried (0: no such bound)
 STEPS_PER_TOP_PERIOD = (0.0, 4.0, 8.0)
 #: a level of a class is calibrated only if at least this many references can certify it
@@ -324,10 +326,11 @@ def _fit_one(level: float,
     best: dict[str, Any] | None = None
     tables = [table for table, _, _ in usable.values()]
     n_load = np.array([n for _, n, _ in usable.values()])
-    for ratio, per_top in itertools.product(MODE_CUTOFF_RATIOS, STEPS_PER_TOP_PERIOD):
-        cut = {"mode_cutoff_ratio": ratio}
-        modes = [level_modes(cut, c) for _, _, c in usable.values()]
-        top = np.array([top_mode_ratio(cut, c) for _, _, c in usable.values()])
+    for ratio, load, per_top in itertools.product(MODE_CUTOFF_RATIOS, MODE_CUTOFF_LOADS,
+                                                  STEPS_PER_TOP_PERIOD):
+        cut = {"mode_cutoff_ratio": ratio, "mode_cutoff_load": load}
+        modes = [level_modes(cut, c, n) for _, n, c in usable.values()]
+        top = np.array([top_mode_ratio(cut, c, n) for _, n, c in usable.values()])
         needed = np.array([needed_steps(t, m, MARGIN * level)
                            for t, m in zip(tables, modes, strict=True)])
         if not np.all(np.isfinite(needed)):
@@ -340,6 +343,7 @@ def _fit_one(level: float,
         time = float(sum(modelled_time_s(t)[r] for t, r in zip(tables, rows, strict=True)))
         if best is None or time < best["total_time_s"]:
             best = {"tolerance": level, "modes": max(modes), **cut, **law,
+                    "n_load_min": float(np.min(n_load)), "n_load_max": float(np.max(n_load)),
                     "total_time_s": time,
                     "worst_error": float(max(t["certified"][r]
                                              for t, r in zip(tables, rows, strict=True)))}
@@ -397,13 +401,20 @@ def validate(cases: Mapping[str, CaseResult], levels: Sequence[Mapping[str, Any]
         for level in levels:
             if level.get("modes") is None or level.get("damping", damping) != damping:
                 continue
-            per = steps_per_first_period(level, n_load, top_mode_ratio(level,
-                                                                       coupler_of(case)))
+            if not (level.get("n_load_min", 0.0) * (1 - 1e-9) <= n_load
+                    <= level.get("n_load_max", math.inf) * (1 + 1e-9)):
+                rows.append({"scene": name, "tolerance": level["tolerance"], "outside":
+                             f"n = {n_load:.3g} outside level {level['tolerance']:g}'s "
+                             f"calibrated [{level['n_load_min']:.3g}, "
+                             f"{level['n_load_max']:.3g}]"})
+                continue
+            per = steps_per_first_period(level, n_load, top_mode_ratio(
+                level, coupler_of(case), n_load))
             if per is None:
                 rows.append({"scene": name, "tolerance": level["tolerance"], "outside":
                              f"n = {n_load:.3g} needs more than {STEP_GRID[-1]} steps"})
                 continue
-            pair = (level_modes(level, coupler_of(case)), per)
+            pair = (level_modes(level, coupler_of(case), n_load), per)
             row = _validation_row(name, table, level["tolerance"], pair,
                                   certifiable(case, level["tolerance"]))
             rows.append({"damping": damping, "n_load": n_load, **row})
@@ -442,7 +453,10 @@ def rule_toml(levels: Sequence[Mapping[str, Any]], bounds: Mapping[str, float],
     import tomli_w
 
     fitted = [{"damping": level["damping"], "tolerance": level["tolerance"],
-               "mode_cutoff_ratio": level["mode_cutoff_ratio"], "modes_max": level["modes"],
+               "mode_cutoff_ratio": level["mode_cutoff_ratio"],
+               "mode_cutoff_load": level.get("mode_cutoff_load", 0.0),
+               "n_load_min": level["n_load_min"], "n_load_max": level["n_load_max"],
+               "modes_max": level["modes"],
                "steps_per_top_period": level["steps_per_top_period"],
                "steps_coefficient": level["steps_coefficient"],
                "steps_exponent": level["steps_exponent"],

@@ -65,6 +65,13 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
         datasets[f"{prefix}/mode_cutoff_ratio"] = Dataset(
             level.get("mode_cutoff_ratio", math.nan), "1",
             "in-plane modes kept up to this multiple of the first")
+        datasets[f"{prefix}/mode_cutoff_load"] = Dataset(
+            level.get("mode_cutoff_load", math.nan), "1",
+            "and up to this multiple of 2 pi / t_load (cut-off max(ratio, this / n))")
+        for end in ("min", "max"):
+            datasets[f"{prefix}/n_load_{end}"] = Dataset(
+                level.get(f"n_load_{end}", math.nan), "1",
+                f"{end}imum n = t_load / T1 of the level's calibration scenes")
         datasets[f"{prefix}/steps_coefficient"] = Dataset(
             level.get("steps_coefficient", math.nan), "1", "C of N = C n^-B")
         datasets[f"{prefix}/steps_exponent"] = Dataset(
@@ -111,9 +118,12 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
                          f"({level['reason']}; "
                          f"scenes: {', '.join(level['scenes']) or 'none'})")
             continue
-        lines.append(f"- {level['damping']}, {level['tolerance']:g}: in-plane modes up to "
-                     f"{level['mode_cutoff_ratio']:g} x the first (at most {level['modes']} "
-                     f"on these scenes), N = {level['steps_coefficient']:.3g} n^-"
+        lines.append(f"- {level['damping']}, {level['tolerance']:g}, for n = t_load / T1 in "
+                     f"[{level['n_load_min']:.3g}, {level['n_load_max']:.3g}]: in-plane modes "
+                     f"up to max({level['mode_cutoff_ratio']:g}, "
+                     f"{level['mode_cutoff_load']:g} / n) x the first (at most "
+                     f"{level['modes']} on these scenes), N = {level['steps_coefficient']:.3g} "
+                     f"n^-"
                      f"{level['steps_exponent']:.2f} steps per first period and at least "
                      f"{level['steps_per_top_period']:g} per period of the highest retained "
                      f"mode (rounded up to the grid); worst certified error "
@@ -180,10 +190,14 @@ def draw_calibration(results: Mapping[str, CaseResult], datasets: Mapping[str, D
                 rows, cols, size=(13.0, 1.6 + 2.6 * rows)) as (fig, axes):
         for ax, (name, case) in zip(axes, cases.items(), strict=False):
             coupler = coupler_of(case)
-            picks = {level["tolerance"]: (level_modes(level, coupler), steps_per_first_period(
-                level, n_load_of(case), top_mode_ratio(level, coupler)))
+            n_load = n_load_of(case)
+            picks = {level["tolerance"]: (level_modes(level, coupler, n_load),
+                                          steps_per_first_period(level, n_load, top_mode_ratio(
+                                              level, coupler, n_load)))
                      for level in levels
-                if level["damping"] == damping_of(case)}
+                     if level["damping"] == damping_of(case)
+                     and level.get("n_load_min", 0.0) * (1 - 1e-9) <= n_load
+                     <= level.get("n_load_max", math.inf) * (1 + 1e-9)}
             _panel(ax, name, grid_table(case), sorted({lv["tolerance"] for lv in levels}),
                    picks)
         for ax in axes[len(cases):]:
@@ -230,6 +244,9 @@ def fitted_levels(datasets: Mapping[str, Dataset]) -> list[dict[str, Any]]:
             out.append({"damping": str(value("damping")),
                         "tolerance": float(value("tolerance")), "modes": int(value("modes")),
                         "mode_cutoff_ratio": float(value("mode_cutoff_ratio")),
+                        **{key: float(value(key)) for key in (
+                            "mode_cutoff_load", "n_load_min", "n_load_max")
+                           if f"levels/{index}/{key}" in datasets},
                         "steps_per_top_period": float(value("steps_per_top_period")),
                         "steps_coefficient": float(value("steps_coefficient")),
                         "steps_exponent": float(value("steps_exponent"))})
