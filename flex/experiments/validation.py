@@ -222,7 +222,8 @@ def _rigid_limit(results: dict[str, CaseResult]) -> tuple[list[str], dict[str, D
               f"{exact.slider_velocity_m_per_s[-1]:.9f} m/s (max diff "
               f"{np.abs(velocity_error).max():.2e} m/s)",
               f"   rod angle: closed form {exact.coupler_angle_rad[-1]:.10f} rad; published "
-              f"(flexible) {PUBLISHED_AT_0P1S[1]:.10f} rad",
+              f"(flexible) {PUBLISHED_AT_0P1S[1]:.10f} rad (diff "
+              f"{PUBLISHED_AT_0P1S[1] - exact.coupler_angle_rad[-1]:.2e} rad)",
               f"   published flexible x3 - rigid x3 = "
               f"{(PUBLISHED_AT_0P1S[2] - exact.slider_position_m[-1]) * 1e6:.3f} um"]
     datasets.update({
@@ -258,6 +259,9 @@ def _published(solutions: dict[str, CrankSolution]) -> tuple[list[str], dict[str
                                          "flex.dynamics.ivp_crank, published settings"),
         "published/relative_difference": Dataset(relative, "1", "|independent - published| "
                                                  "/ |published|")})
+    consistent, published_mass = (first_axial_frequency_hz(f) for f in (1.0, 15.0))
+    lines.append(f"   first axial mode (rod pinned at B, slider at C): {consistent:.0f} Hz with "
+                 f"the consistent axial mass, {published_mass:.0f} Hz with the published one")
     lines.append("   one change at a time from the published model, same published start:")
     for name, label in (("published_mass_fixed", "axial mass block / 15 (consistent mass)"),
                         ("published_cross", "published nonlinear term (IPAR(1) = 1)"),
@@ -267,6 +271,57 @@ def _published(solutions: dict[str, CrankSolution]) -> tuple[list[str], dict[str
                      f"({(state[3] / PUBLISHED_AT_0P1S[3] - 1) * 100:+6.2f} %), x3 - published "
                      f"= {(state[2] - PUBLISHED_AT_0P1S[2]) * 1e6:+.3f} um")
     return lines, datasets
+
+
+def first_axial_frequency_hz(axial_mass_factor: float, bench: CrankBenchmark = BENCH) -> float:
+    """First axial eigenfrequency [Hz] of the published quadratic axial element, pinned at B,
+    with the slider's mass at C, its mass block times ``axial_mass_factor`` (15: as
+    published, 1: consistent)."""
+    rod = ivp_crank.rod_matrices(bench, 2, axial_mass_factor=axial_mass_factor)
+    mass, stiffness = rod.mass[2:, 2:].copy(), rod.stiffness[2:, 2:]
+    mass[1, 1] += bench.slider_mass_kg
+    omega_squared = np.linalg.eigvals(np.linalg.solve(mass, stiffness)).real.min()
+    return float(np.sqrt(omega_squared) / (2 * math.pi))
+
+
+def _axial_load_lines(buckling_N: float) -> list[str]:
+    """The slider's inertia force over a crank turn (rigid closed form) and the change of the
+    first bending frequency it makes, ``sqrt(1 + P / P_Euler)``, tension positive."""
+    turn = np.linspace(0.0, 2 * math.pi / BENCH.crank_speed_rad_per_s, 2001)
+    _, exact = constant_speed_motion(BENCH.crank_length_m, BENCH.rod_length_m, 0.0,
+                                     BENCH.crank_speed_rad_per_s, turn)
+    force = -BENCH.slider_mass_kg * exact.slider_acceleration_m_per_s2
+    shift = [(math.sqrt(1 + f / buckling_N) - 1) * 100 for f in (force.min(), force.max())]
+    return [f"   slider inertia force -m3 x3'' (rigid, tension +): {force.min():+.0f} .. "
+            f"{force.max():+.0f} N; first bending frequency x sqrt(1 + P/P_Euler): "
+            f"{shift[0]:+.1f} .. {shift[1]:+.1f} % (the rod's own inertia adds to it)"]
+
+
+#: section 3, one change at a time from the linear model from the rigid start: label, run
+RIGID_START_CHANGES = (("published axial mass (x15) and pi", "two-mode rigid_start"),
+                       ("8 lateral modes", "two-mode rigid_start_8_modes"),
+                       ("consistent stiffening (beam)", BEST_BEAM))
+
+
+def _change_lines(runs: dict[str, Any], published: CrankSolution) -> list[str]:
+    """Section 3: largest deflections, and one change at a time from the linear two-mode
+    model with consistent mass (RMS deflection difference over its peak, x3 at 0.1 s)."""
+    needed = ["two-mode rigid_start_mass_fixed", *(name for _, name in RIGID_START_CHANGES)]
+    if not all(name in runs for name in needed):
+        return []
+    linear = _curves(runs["two-mode rigid_start_mass_fixed"])
+    lines = [f"   largest |midpoint deflection|: two-mode from the published start (close to "
+             f"smooth motion) {np.abs(published.midpoint_deflection_m).max() * 1e6:.0f} um; "
+             f"beam from the rigid start "
+             f"{np.abs(_curves(runs[BEST_BEAM])['deflection']).max() * 1e6:.0f} um",
+             "   one change at a time from 'two-mode rigid_start_mass_fixed' (linear, "
+             "consistent mass), same rigid start:"]
+    for label, name in RIGID_START_CHANGES:
+        curves = _curves(runs[name])
+        rms = _against(curves, linear)["deflection_rms_rel"]
+        lines.append(f"   {label:42s} RMS deflection difference {rms:.3f}, x3(0.1) "
+                     f"{(curves['slider'][-1] - linear['slider'][-1]) * 1e6:+.2f} um")
+    return lines
 
 
 def _runs(results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
@@ -292,6 +347,7 @@ def _runs(results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
               f"Hz; Euler buckling load {buckling:.0f} N; crank harmonics 8 and 9: "
               f"{8 * BENCH.crank_speed_rad_per_s / (2 * math.pi):.1f}, "
               f"{9 * BENCH.crank_speed_rad_per_s / (2 * math.pi):.1f} Hz",
+              *_axial_load_lines(buckling),
               f"   {'run':44s} {'q_mid(0.1)':>10s} {'x3(0.1)':>12s} {'peak':>6s} {'rms/beam':>8s} "
               f"{'rms/fe':>6s} {'dx3/beam':>8s} {'dx3/fe':>7s} {'oop':>6s} {'wall':>5s}",
               f"   {'':44s} {'[um]':>10s} {'[m]':>12s} {'[Hz]':>6s} {'[1]':>8s} {'[1]':>6s} "
@@ -318,6 +374,7 @@ def _runs(results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
                                                               f"{name}: v(L2/2) from chord B-C")
         datasets[f"runs/{key}/slider_position"] = Dataset(curves["slider"], "m", name)
         datasets[f"runs/{key}/chord_change"] = Dataset(curves["chord"], "m", name)
+    lines += _change_lines(runs, solutions["published"])
     datasets["runs/time"] = Dataset(references["fe"]["time"], "s", "sample times of every run")
     datasets["table/run"] = Dataset(np.array([r[0] for r in rows], dtype=object), "1", "run")
     for column, (name, unit, what) in enumerate((
