@@ -11,6 +11,7 @@ rule's picks marked on the Pareto front of the grid.
 from __future__ import annotations
 
 import math
+import tomllib
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -173,6 +174,10 @@ def _target_lines(rows: Sequence[Mapping[str, Any]]) -> list[str]:
     return lines
 
 
+def _text(value: Any) -> str:
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
 def draw_calibration(results: Mapping[str, CaseResult], datasets: Mapping[str, Dataset],
                      folder: Path) -> list[Path]:
     """``calibrate-work-precision.png``: per scene, certified error against time of every
@@ -182,6 +187,8 @@ def draw_calibration(results: Mapping[str, CaseResult], datasets: Mapping[str, D
     if not cases:
         return []
     levels = fitted_levels(datasets)
+    family = tomllib.loads(_text(datasets["rule/toml"].data))["family"] \
+        if "rule/toml" in datasets else {}
     cols = 4
     rows = math.ceil(len(cases) / cols)
     path = folder / "calibrate-work-precision.png"
@@ -191,7 +198,10 @@ def draw_calibration(results: Mapping[str, CaseResult], datasets: Mapping[str, D
         for ax, (name, case) in zip(axes, cases.items(), strict=False):
             coupler = coupler_of(case)
             n_load = n_load_of(case)
-            picks = {level["tolerance"]: (level_modes(level, coupler, n_load),
+            slender = coupler["length_m"] / coupler["thickness_m"]
+            inside = family.get("slenderness_min", 0.0) <= slender <= family.get(
+                "slenderness_max", math.inf)
+            picks = {} if not inside else {level["tolerance"]: (level_modes(level, coupler, n_load),
                                           steps_per_first_period(level, n_load, top_mode_ratio(
                                               level, coupler, n_load)))
                      for level in levels
