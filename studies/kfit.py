@@ -1,9 +1,12 @@
 """Study ``kfit`` (thesis sec. 6.2, Eq. 64-65): fit the rigid-or-flexible threshold k.
 
 Each case is one steel-plate coupler scene run twice with the same integrator settings: as
-an FFRF body (6 static + 6 fixed-interface Craig-Bampton modes) and as its rigid twin (same
-mass and inertia). The error measures of :mod:`flex.fidelity.criteria` compare the two over the
-deployment (t <= delta_t_stop). Families of cases:
+an FFRF body with geometric stiffness (``coupler.geometric_stiffness = true``; 3 static + 6
+in-plane fixed-interface Craig-Bampton modes) and as its rigid twin (same mass and inertia).
+The reference has geometric stiffness because the linear FFRF body's response to its axial
+force has the wrong sign (docs/validation.md section 4, docs/geometric-stiffness.md). The
+error measures of :mod:`flex.fidelity.criteria` compare the two over the deployment
+(t <= delta_t_stop). Families of cases:
 
 - ``thk_*``: coupler thickness 0.5-12 mm (20 log-spaced values plus Table 5's 1, 3, 5,
   10 mm), thesis spring (1500 N/m, 22 mm preload);
@@ -13,12 +16,13 @@ deployment (t <= delta_t_stop). Families of cases:
   the Euler load), which reaches n ~ 1 without buckling;
 - ``pre_*``: preload 11, 16 and 33 mm at five thicknesses (the deployment time barely
   changes with the preload of a linear spring, the load amplitude does);
-- every case undamped (``z0``) and with 2 % modal damping (``z2``); stiffness cases whose
-  estimated compression exceeds 2 x the Euler load are left out (the linear FFRF model
-  diverges there: measured at 3.3 and 11 x);
+- every case undamped (``z0``) and with 2 % modal damping (``z2``); candidates whose
+  estimated compression exceeds ``EULER_LOAD_LIMIT`` (0.25) x the Euler load are not
+  generated (``auto`` refuses such scenes, and the reference failed Newton there: the 0.5 mm
+  plate at the thesis spring, 0.5 and 1 mm at the stiffer springs); the report names them;
 - ``val_*``: scenes not in the fit (other thicknesses, stiffnesses, link lengths) with
-  ``coupler.model = "auto"``, each against a full FFRF run (12 modes), using the law
-  just fitted.
+  ``coupler.model = "auto"``, each against a full FFRF run (12 modes, geometric
+  stiffness), using the law just fitted.
 
 Mesh, time step and end time per case: :func:`flex.experiments.couplerfit.tuned`. The pipeline (fit
 cases, laws, criterion, validation) is :mod:`flex.experiments.lawfit`'s, with the coupler's cases,
@@ -27,7 +31,7 @@ fit and summary from :mod:`flex.experiments.couplerfit` and its figures from
 
 Every case's file is ``<sweep folder>/cases/<case>.h5`` (default ``results/kfit-cases``);
 the sweep resumes from them. The fit (``results/kfit-criterion.toml``) is what
-``make kfit-criterion`` copies to ``flex/criteria_fit.toml`` for ``auto``. Executor:
+``make kfit-criterion`` copies to ``flex/fidelity/criteria_fit.toml`` for ``auto``. Executor:
 ``flex run kfit --scheduler ... --folder DIR --retry-failed`` (see :mod:`flex.sweep`).
 """
 
@@ -88,11 +92,15 @@ VALIDATION: dict[str, tuple[list[str], float]] = {
 }
 
 
+def _grid() -> tuple:
+    """The fit grid, as :func:`flex.experiments.couplerfit.fit_cases` takes it."""
+    return (DAMPING_RATIOS, THICKNESSES_M, (STIFFNESS_THICKNESSES_M, STIFFNESSES_N_PER_M),
+            FAST_CASES, (PRELOAD_THICKNESSES_M, PRELOADS_M))
+
+
 def cases(scene: Scene) -> dict[str, Scene]:
     """Fit cases, then validation cases (run after the fit, see :func:`simulate_cases`)."""
-    fit = couplerfit.fit_cases(scene, DAMPING_RATIOS, THICKNESSES_M,
-                               (STIFFNESS_THICKNESSES_M, STIFFNESSES_N_PER_M), FAST_CASES,
-                               (PRELOAD_THICKNESSES_M, PRELOADS_M))
+    fit = couplerfit.fit_cases(scene, *_grid())
     return {**fit, **couplerfit.validation_cases(scene, VALIDATION)}
 
 
@@ -115,7 +123,8 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               notes: dict[str, Any] | None = None) -> Summary:
-    return Summary(*couplerfit.summarize(results, notes or {}))
+    return Summary(*couplerfit.summarize(results, notes or {},
+                                         couplerfit.left_out_cases(scene, *_grid())))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:

@@ -3,18 +3,29 @@
 The link-specific half of the :mod:`flex.experiments.lawfit` pipeline for the coupler (thesis sec.
 6.2,
 Eq. 64-65). A fit case (:func:`fit_case`, run on a sweep worker) is one steel-plate coupler
-scene run twice with the same integrator settings, as an FFRF body and as its rigid twin
-(same mass and inertia); the error measures of :mod:`flex.fidelity.criteria` compare the two over
-the deployment (t <= delta_t_stop). A validation case (:func:`validation_case`) runs
+scene run twice with the same integrator settings, as an FFRF body with geometric stiffness
+(``coupler.geometric_stiffness = true``, :data:`REFERENCE`) and as its rigid twin (same mass
+and inertia); the error measures of :mod:`flex.fidelity.criteria` compare the two over the
+deployment (t <= delta_t_stop). A validation case (:func:`validation_case`) runs
 ``coupler.model = "auto"`` with the law just fitted against the full FFRF model
-(:data:`flex.experiments.lawfit.FULL_MODES` modes).
+(:data:`flex.experiments.lawfit.FULL_MODES` modes, geometric stiffness too).
+
+Why geometric stiffness: the linear FFRF body, its floating frame on the B face, puts the
+axial force's rigid-turn term through its bending with the wrong sign and twice the size
+(docs/validation.md section 4, docs/geometric-stiffness.md): compression stiffens it,
+tension softens it. Against it the rigid model's error read too low in compression and too
+high in tension; with geometric stiffness the FFRF coupler is within ~1 % of the nonlinear
+FE coupler (``make ladder``).
 
 Scenes (:func:`fit_cases`): each is :func:`tuned` (mesh maxh = 3 t within [2 mm, 5 mm],
 the first frequency within 0.3 % of the converged one; time step h = min(1e-4 s, T/40,
 delta_t/400) with T the period of the first pinned-pinned bending mode: T/h = 24 leaves 8 %
 on the 12 mm crank deviation, T/h = 48 0.5 %, T/h = 28 keeps the 1 mm peak within 0.3 %).
-Stiffness cases whose estimated compression exceeds :data:`SKIP_EULER_RATIO` x the Euler
-load are left out (the linear FFRF model diverges there: measured at 3.3 and 11 x).
+Cases whose estimated compression (:func:`estimated_euler_ratio`) exceeds
+:data:`flex.fidelity.criteria.EULER_LOAD_LIMIT` x the Euler load are not generated
+(:func:`left_out_cases` names them, the report lists them): ``auto`` refuses such scenes,
+and the FFRF reference with geometric stiffness, linear in the axial force, failed Newton
+there (the 0.5 mm plate at the thesis spring, 0.33 P_E; 1 mm at 15000 N/m, 0.49 P_E).
 
 Fit (:func:`analyse`): a law per damping ratio, delta_t definition and measure over the
 cases within the small-deformation model (:data:`VALIDITY_DEFLECTION`) and below
@@ -56,7 +67,7 @@ from flex.fidelity.criteria import (
     pinned_pinned_omega,
     quasi_static_stress,
 )
-from flex.fidelity.predictor import predict_deflection
+from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection
 
 #: thesis Table 5: coupler thickness [m] of models 0-3
 THESIS_MODELS = {"model0": 1e-3, "model1": 3e-3, "model2": 5e-3, "model3": 10e-3}
@@ -65,9 +76,12 @@ THESIS_MODELS = {"model0": 1e-3, "model1": 3e-3, "model2": 5e-3, "model3": 10e-3
 #: buckling: stored, shown, but not fitted
 VALIDITY_DEFLECTION = 0.05
 #: compressive coupler force / (spring rate x preload), measured on the thesis scene (the
-#: spring mostly accelerates the slider); used only to leave out cases that would diverge
+#: spring mostly accelerates the slider); used only to leave out cases beyond the Euler load
+#: limit before they run (at the thesis preload it gave 0.33, 0.41, 1.10, 1.37 where the
+#: rigid twins measured 0.33, 0.49, 1.09, 1.62 P_E)
 COMPRESSION_SHARE = 0.32
-SKIP_EULER_RATIO = 2.0
+#: the FFRF reference of every fit and validation case: with geometric stiffness
+REFERENCE = {"model": "ffrf", "geometric_stiffness": True}
 #: preload of the fast cases: this fraction of the Euler load, estimated with
 #: COMPRESSION_SHARE; fast springs load the coupler more (measured 1.7-2 x the estimate), so
 #: this keeps P < 0.25 P_euler
@@ -122,7 +136,8 @@ def _plate(scene: Scene, thickness_m: float, zeta: float, spring_N_per_m: float,
     case = tuned(apply_overrides(scene, [f"coupler.thickness_m={thickness_m!r}",
                                          f"coupler.damping_ratio={zeta!r}",
                                          f"drive.spring_stiffness_N_per_m={spring_N_per_m!r}",
-                                         f"drive.spring_preload_m={preload_m!r}"]))
+                                         f"drive.spring_preload_m={preload_m!r}",
+                                         "coupler.geometric_stiffness=true"]))
     validate(case)
     return case
 
@@ -132,35 +147,65 @@ def _euler_N(scene: Scene, thickness_m: float) -> float:
     return euler_buckling_load_N(c["length_m"], thickness_m, c["width_m"], c["youngs_modulus_Pa"])
 
 
+def estimated_euler_ratio(scene: Scene, thickness_m: float, spring_N_per_m: float,
+                          preload_m: float) -> float:
+    """The coupler's largest compression / its Euler load, estimated before the case runs:
+    :data:`COMPRESSION_SHARE` x spring rate [N/m] x preload [m] over pi^2 E I / L^2."""
+    return COMPRESSION_SHARE * spring_N_per_m * preload_m / _euler_N(scene, thickness_m)
+
+
+def _grid(scene: Scene, damping_ratios: tuple[float, ...], thicknesses: tuple[float, ...],
+          stiffness_grid: tuple[tuple[float, ...], tuple[float, ...]],
+          fast: tuple[tuple[float, float], ...],
+          preload_grid: tuple[tuple[float, ...], tuple[float, ...]]
+          ) -> dict[str, tuple[float, float, float, float]]:
+    """Every candidate fit case: name -> (thickness [m], damping ratio, spring rate [N/m],
+    preload [m])."""
+    out = {}
+    for zeta in damping_ratios:
+        z = f"z{round(zeta * 100)}"
+        for t in thicknesses:
+            out[f"thk_t{label(t, 1e3)}mm_{z}"] = (t, zeta, THESIS_SPRING_N_PER_M,
+                                                  THESIS_PRELOAD_M)
+        for t in stiffness_grid[0]:
+            for k in stiffness_grid[1]:
+                out[f"stf_t{label(t, 1e3)}mm_k{k:.0f}_{z}"] = (t, zeta, k, THESIS_PRELOAD_M)
+        for t, k in fast:
+            preload = min(THESIS_PRELOAD_M, round(FAST_EULER_RATIO * _euler_N(scene, t)
+                                                  / (COMPRESSION_SHARE * k), 4))
+            out[f"stf_t{label(t, 1e3)}mm_k{k:.0f}_{z}"] = (t, zeta, k, preload)
+        for t in preload_grid[0]:
+            for preload in preload_grid[1]:
+                out[f"pre_t{label(t, 1e3)}mm_p{label(preload, 1e3)}mm_{z}"] = (
+                    t, zeta, THESIS_SPRING_N_PER_M, preload)
+    return out
+
+
+def left_out_cases(scene: Scene, *grid: Any) -> dict[str, float]:
+    """The candidates of :func:`fit_cases` (same arguments after ``scene``) it does not
+    generate: name -> estimated compression / Euler load (:func:`estimated_euler_ratio`),
+    beyond :data:`flex.fidelity.criteria.EULER_LOAD_LIMIT` (``auto`` refuses such scenes)."""
+    out = {}
+    for name, (t, _, k, preload) in _grid(scene, *grid).items():
+        ratio = estimated_euler_ratio(scene, t, k, preload)
+        if ratio > EULER_LOAD_LIMIT:
+            out[name] = ratio
+    return out
+
+
 def fit_cases(scene: Scene, damping_ratios: tuple[float, ...], thicknesses: tuple[float, ...],
               stiffness_grid: tuple[tuple[float, ...], tuple[float, ...]],
               fast: tuple[tuple[float, float], ...],
               preload_grid: tuple[tuple[float, ...], tuple[float, ...]]) -> dict[str, Scene]:
     """The fit cases, per damping ratio: ``thk_*`` (each thickness [m], thesis spring),
-    ``stf_*`` (thicknesses x spring rates [N/m] of ``stiffness_grid``, thesis preload, those
-    beyond :data:`SKIP_EULER_RATIO` left out; then the ``fast`` (thickness, rate) pairs with
-    the preload of :data:`FAST_EULER_RATIO`), ``pre_*`` (thicknesses x preloads [m])."""
-    out: dict[str, Scene] = {}
-    for zeta in damping_ratios:
-        z = f"z{round(zeta * 100)}"
-        for t in thicknesses:
-            out[f"thk_t{label(t, 1e3)}mm_{z}"] = _plate(scene, t, zeta, THESIS_SPRING_N_PER_M,
-                                                        THESIS_PRELOAD_M)
-        for t in stiffness_grid[0]:
-            for k in stiffness_grid[1]:
-                compression_N = COMPRESSION_SHARE * k * THESIS_PRELOAD_M  # estimated
-                if compression_N <= SKIP_EULER_RATIO * _euler_N(scene, t):
-                    out[f"stf_t{label(t, 1e3)}mm_k{k:.0f}_{z}"] = _plate(scene, t, zeta, k,
-                                                                         THESIS_PRELOAD_M)
-        for t, k in fast:
-            preload = min(THESIS_PRELOAD_M, round(FAST_EULER_RATIO * _euler_N(scene, t)
-                                                  / (COMPRESSION_SHARE * k), 4))
-            out[f"stf_t{label(t, 1e3)}mm_k{k:.0f}_{z}"] = _plate(scene, t, zeta, k, preload)
-        for t in preload_grid[0]:
-            for preload in preload_grid[1]:
-                out[f"pre_t{label(t, 1e3)}mm_p{label(preload, 1e3)}mm_{z}"] = _plate(
-                    scene, t, zeta, THESIS_SPRING_N_PER_M, preload)
-    return out
+    ``stf_*`` (thicknesses x spring rates [N/m] of ``stiffness_grid``, thesis preload; then
+    the ``fast`` (thickness, rate) pairs with the preload of :data:`FAST_EULER_RATIO`),
+    ``pre_*`` (thicknesses x preloads [m]); every FFRF twin with geometric stiffness. Those
+    of :func:`left_out_cases` (estimated beyond the Euler load limit) are not generated."""
+    grid = (damping_ratios, thicknesses, stiffness_grid, fast, preload_grid)
+    skipped = left_out_cases(scene, *grid)
+    return {name: _plate(scene, *values) for name, values in _grid(scene, *grid).items()
+            if name not in skipped}
 
 
 def validation_cases(scene: Scene, validation: dict[str, tuple[list[str], float]]
@@ -216,8 +261,11 @@ def prepare_reduction(scene: Scene, *, cache_dir: Path | None = None) -> dict[st
 
 
 def full_scene(scene: Scene) -> Scene:
-    """The validation reference: the scene's coupler as FFRF with the full model's modes."""
-    return _with(scene, coupler__model="ffrf", coupler__modes=lawfit.FULL_MODES)
+    """The validation reference: the scene's coupler as FFRF (:data:`REFERENCE`: with
+    geometric stiffness) with the full model's modes."""
+    return _with(scene, coupler__model=REFERENCE["model"],
+                 coupler__geometric_stiffness=REFERENCE["geometric_stiffness"],
+                 coupler__modes=lawfit.FULL_MODES)
 
 
 def full_geometry_key(scene: Scene) -> tuple | None:
@@ -264,8 +312,9 @@ def _run_pair(scene: Scene, reduction: Any, cache_dir: Path | None
     step = scene["simulation"]["step_s"]
     end = min(rigid_scene["simulation"]["end_time_s"],
               step * math.ceil(1.02 * times["stop"] / step + 2))
-    ffrf = simulate(_with(scene, coupler__model="ffrf", simulation__end_time_s=end), "ffrf",
-                    reduction, cache_dir=cache_dir)
+    ffrf = simulate(_with(scene, coupler__model=REFERENCE["model"],
+                          coupler__geometric_stiffness=REFERENCE["geometric_stiffness"],
+                          simulation__end_time_s=end), "ffrf", reduction, cache_dir=cache_dir)
     walls = {"rigid": rigid.counters["wall_time_s"], "ffrf": ffrf.counters["wall_time_s"],
              "ffrf_steps": ffrf.counters["steps"], "rigid_steps": rigid.counters["steps"]}
     return rigid_data, case_data(ffrf), times, walls
@@ -383,8 +432,9 @@ def fit_case(name: str, scene: Scene, *, cache_dir: Path | None = None) -> CaseR
 
 
 #: bumped when what a fit case stores changes (the sweep reruns older case files): 2 adds
-#: the load-based predictor (the mesh rule is in the scene, so the scene hash follows it)
-fit_case.case_version = 2
+#: the load-based predictor, 3 the FFRF twin with geometric stiffness (also in the scene;
+#: the mesh rule is in the scene, so the scene hash follows it)
+fit_case.case_version = 3
 
 
 def validation_case(name: str, scene: Scene, criterion_toml: str | None = None, *,
@@ -435,8 +485,9 @@ def validation_case(name: str, scene: Scene, criterion_toml: str | None = None, 
 # ------------------------------------------------------------------------------------------
 # the pipeline on the sweep engine
 # ------------------------------------------------------------------------------------------
-#: 2: auto decides the coupler by the load-based prediction (older files are rerun)
-validation_case.case_version = 2
+#: 2: auto decides the coupler by the load-based prediction, 3: the full FFRF reference
+#: with geometric stiffness (older files are rerun)
+validation_case.case_version = 3
 
 
 def sweep_phases(cache_dir: Path | None = None) -> dict[str, lawfit.SweepPhase]:
@@ -527,7 +578,11 @@ def criterion_toml(analysis: dict[str, Any], provenance: bool = True) -> str:
     ``provenance=False`` leaves out the creation time and git commit."""
     fitted = int(np.sum(analysis["table"]["fitted"])) if len(analysis["table"]["name"]) else 0
     meta = {"source": "make kfit (studies/kfit.py); copy with make kfit-criterion",
+            "reference": "ffrf with coupler.geometric_stiffness = true",
             "cases_fitted": fitted, "euler_load_limit": EULER_LOAD_LIMIT}
+    margin = prediction_margin(analysis["table"]) if fitted else math.nan
+    if math.isfinite(margin):  # what flex.fidelity.predictor.PREDICTION_MARGIN must cover
+        meta["prediction_margin_measured"] = round(margin, 4)
     return lawfit.criterion_toml(analysis["fits"], HEADER, meta, provenance)
 
 
@@ -537,8 +592,9 @@ def criterion_toml(analysis: dict[str, Any], provenance: bool = True) -> str:
 def _table_datasets(data: dict[str, np.ndarray], results: dict[str, CaseResult]
                     ) -> dict[str, Dataset]:
     own = {"name": ("1", "case name"), "family": ("1", "thk, stf or pre"),
-           "fitted": ("1", "1 if used in the fits (deflection <= 5 % L2 and compression "
-                           "<= 0.25 Euler load)")}
+           "fitted": ("1", f"1 if used in the fits (deflection <= "
+                           f"{VALIDITY_DEFLECTION:.0%} L2 and compression <= "
+                           f"{EULER_LOAD_LIMIT:g} Euler load)")}
     out = {}
     for key, values in data.items():
         if key in own:
@@ -658,7 +714,8 @@ def _validation(results: dict[str, CaseResult], datasets: dict[str, Dataset]) ->
                                                         "auto choice")
     if not rows:
         return []
-    return lawfit.validation_lines(rows, "a full FFRF run, 12 modes; auto's times include "
+    return lawfit.validation_lines(rows, f"a full FFRF run with geometric stiffness, "
+                                         f"{lawfit.FULL_MODES} modes; auto's times include "
                                          "its rigid probe run, the full model's its reduction")
 
 
@@ -677,6 +734,50 @@ def _sweep_lines(sweep: dict[str, Any], datasets: dict[str, Dataset]) -> list[st
 
 #: the band the load-based predictor is held to (issue: predicted / true within [0.67, 2])
 PREDICTOR_BAND = (0.67, 2.0)
+#: the quantile of measured / predicted over the fitted cases that ``auto``'s margin on the
+#: load-based prediction is (:data:`flex.fidelity.predictor.PREDICTION_MARGIN`)
+MARGIN_QUANTILE = 0.95
+
+
+def prediction_margin(data: dict[str, np.ndarray]) -> float:
+    """The :data:`MARGIN_QUANTILE` quantile of measured / predicted deflection error over
+    the fitted rows of the fit table (NaN if none): what
+    :data:`flex.fidelity.predictor.PREDICTION_MARGIN` is taken from."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = data["measures/deflection"] / data["predictor/deflection"]
+    rows = np.isfinite(ratio) & data["fitted"]
+    return float(np.quantile(ratio[rows], MARGIN_QUANTILE)) if rows.any() else math.nan
+
+
+def exclusion_lines(data: dict[str, np.ndarray], left_out: dict[str, float],
+                    datasets: dict[str, Dataset]) -> list[str]:
+    """Report lines (and ``excluded/*`` datasets) naming every case not in the fit and why:
+    not generated (``left_out``: name -> estimated compression / Euler load), or run but
+    beyond :data:`VALIDITY_DEFLECTION` or :data:`flex.fidelity.criteria.EULER_LOAD_LIMIT`."""
+    lines = []
+    if left_out:
+        names = sorted(left_out)
+        datasets["excluded/not_generated/name"] = Dataset(np.array(names), "1", "candidate "
+                                                          "fit cases not run")
+        datasets["excluded/not_generated/estimated_euler_load_ratio"] = Dataset(
+            np.array([left_out[n] for n in names]), "1", "estimated compression / Euler load "
+            f"({COMPRESSION_SHARE:g} x spring rate x preload / pi^2 E I / L^2)")
+        lines.append(f"  not generated ({len(names)}): estimated compression beyond "
+                     f"{EULER_LOAD_LIMIT:g} x the Euler load, the limit auto refuses (the FFRF "
+                     f"reference with geometric stiffness fails Newton there): "
+                     + ", ".join(f"{n} ({left_out[n]:.2f})" for n in names))
+    if len(data["name"]):
+        deflection = data["measures/deflection"] > VALIDITY_DEFLECTION
+        load = data["measures/euler_load_ratio"] > EULER_LOAD_LIMIT
+        for mask, why in ((deflection, f"deflection > {VALIDITY_DEFLECTION:.0%} of L2"),
+                          (load & ~deflection, f"compression > {EULER_LOAD_LIMIT:g} x the "
+                                               "Euler load")):
+            if mask.any():
+                lines.append(f"  run, not fitted ({why}): " + ", ".join(
+                    f"{n} ({r:.2f} P_E)" for n, r in zip(
+                        data["name"][mask], data["measures/euler_load_ratio"][mask],
+                        strict=True)))
+    return lines
 
 
 def predictor_ratios(data: dict[str, np.ndarray], fits: dict[tuple, ErrorLaw]
@@ -704,7 +805,8 @@ def predictor_lines(data: dict[str, np.ndarray], fits: dict[tuple, ErrorLaw],
     names = {"n_law": "n-law (central fit, this run)",
              "loads": "from the rigid twin's loads (oscillator)",
              "load_factor": "from the loads, ramp load factor only"}
-    lines = [f"  predicted / measured deflection error of the rigid model (target "
+    lines = [f"  predicted / measured deflection error of the rigid model (measured: against "
+             f"the FFRF coupler with geometric stiffness; target "
              f"{PREDICTOR_BAND[0]:g}-{PREDICTOR_BAND[1]:g}):"]
     for key, ratio in ratios.items():
         datasets[f"predictors/{key}_ratio"] = Dataset(ratio, "1", f"{names[key]}: predicted "
@@ -718,19 +820,33 @@ def predictor_lines(data: dict[str, np.ndarray], fits: dict[tuple, ErrorLaw],
             lines.append(f"    {names[key]:42s} {label_text:6s} {int(rows.sum()):4d} cases: "
                          f"median {np.median(ratio[rows]):.3g}, {np.min(ratio[rows]):.3g}-"
                          f"{np.max(ratio[rows]):.3g}, {inside:.0%} inside")
+    margin = prediction_margin(data)
+    datasets["predictors/margin"] = Dataset(margin, "1", f"{MARGIN_QUANTILE:.0%} quantile of "
+                                            "measured / predicted (loads) over the fitted "
+                                            "cases")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        largest = np.nanmax(np.where(data["fitted"], 1.0 / ratios["loads"], np.nan))
+    lines.append(f"  auto's margin on the loads' prediction: this run's {MARGIN_QUANTILE:.0%} "
+                 f"quantile of measured / predicted (fitted cases) {margin:.3g}, largest "
+                 f"{largest:.3g}; installed flex.fidelity.predictor.PREDICTION_MARGIN "
+                 f"{PREDICTION_MARGIN:g}")
     return lines
 
 
-def summarize(results: dict[str, CaseResult], notes: dict[str, Any]) -> Any:
+def summarize(results: dict[str, CaseResult], notes: dict[str, Any],
+              left_out: dict[str, float] | None = None) -> Any:
     """The kfit summary (a :class:`flex.study.Summary`-shaped ``(datasets, report,
     figure_data)`` tuple): fit table, laws, k(tolerance), the thesis's k, the validation,
-    the sweep's figures. ``notes``: the run's (``analysis``, ``sweep``), else fitted again."""
+    the sweep's figures. ``notes``: the run's (``analysis``, ``sweep``), else fitted again;
+    ``left_out``: the candidates not generated (:func:`left_out_cases`)."""
     analysis = notes.get("analysis") or analyse(results)
     data, fits = analysis["table"], analysis["fits"]
     datasets = _table_datasets(data, results)
     lines = [f"kfit: rigid-or-flexible threshold from {len(data['name'])} FFRF/rigid pairs "
              f"({int(np.sum(data['fitted']))} fitted; "
-             f"{sum(c.status != 'ok' for c in results.values())} failed)"]
+             f"{sum(c.status != 'ok' for c in results.values())} failed); the FFRF coupler "
+             f"with geometric stiffness is the reference"]
+    lines += exclusion_lines(data, left_out or {}, datasets)
     if not fits:
         return datasets, "\n".join(lines + ["  no fit: too few successful cases"]), {}
     ks = _k_values(fits)

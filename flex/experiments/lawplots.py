@@ -73,8 +73,9 @@ def _predictors(analysis: dict[str, Any], path: Path) -> list[Path]:
         return []
     measured = data["measures/deflection"]
     ratios = predictor_ratios(data, analysis["fits"])
-    with figure(path, "Rigid model's deflection error: predicted against measured (FFRF), "
-                "per kfit case", "measured peak deflection / L2 [-] (log)",
+    with figure(path, "Rigid model's deflection error: predicted against measured (FFRF "
+                "with geometric stiffness), per kfit case",
+                "measured peak deflection / L2 [-] (log)",
                 "predicted peak deflection / L2 [-] (log)", size=(6.8, 6.0)) as ax:
         finite = measured[np.isfinite(measured) & (measured > 0)]
         line = np.array([finite.min() / 3, finite.max() * 3])

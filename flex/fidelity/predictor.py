@@ -55,9 +55,12 @@ from flex.base.physics import (
 #: a load that starts at no less than this fraction of its peak counts as a step (r = 0)
 STEP_FRACTION = 0.5
 #: what ``auto`` multiplies the prediction by before it compares it with the tolerance: the
-#: 95 % quantile of measured / predicted deflection error over the 106 fitted cases of make
-#: kfit (fresh clone, commit 62741ed; the kfit report shows the distribution every run)
-PREDICTION_MARGIN = 1.31
+#: largest measured / predicted deflection error measured, 1.12 both over make kfit's 106
+#: fitted cases (against FFRF with geometric stiffness; its 95 % quantile 1.06) and over the
+#: crank's 15 scenes (tests/test_crank_predictor.py), rounded up. The kfit report prints the
+#: run's quantile and largest ratio beside this value every run. (1.31 before, the quantile
+#: against the linear FFRF reference, whose geometric stiffening has the wrong sign.)
+PREDICTION_MARGIN = 1.15
 
 
 @dataclass(frozen=True)
