@@ -17,8 +17,8 @@ from flex.config.usage import unused_keys
 from flex.data.scene import load_scene
 from flex.dynamics.solver import integrate
 from flex.experiments.spring_mass import chain_matrices, governing_error
-from flex.fidelity.criteria import deployment_probe, resolve_fidelity
-from flex.fidelity.simulation import simulate
+from flex.fidelity.criteria import deployment_probe
+from flex.fidelity.simulation import resolve_auto, simulate
 from flex.fidelity.spring_choice import (
     CHAIN_ERROR_CONSTANT,
     SPRING_PREDICTION_MARGIN,
@@ -136,8 +136,8 @@ def test_predicted_massless_error_bounds_the_measured_one(coil_kg, slider_kg):
 
 def test_auto_picks_massless_at_a_loose_tolerance_and_a_chain_at_a_tight_one():
     def resolve(tolerance: float):
-        return resolve_fidelity(load_scene(overrides=['drive.spring_model="auto"',
-                                                      f"fidelity.tolerance={tolerance}"]))
+        return resolve_auto(load_scene(overrides=['drive.spring_model="auto"',
+                                                  f"fidelity.tolerance={tolerance}"]))
 
     loose, (decision,) = resolve(0.5)
     assert loose["drive"]["spring_model"] == "massless" and decision.segments == 0

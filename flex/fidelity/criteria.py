@@ -895,9 +895,9 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
     ``"ffrf"`` with its modes for a plate crank; a lumped crank the criterion calls flexible,
     or a flexible one with a constant-speed drive, is refused with a :class:`SceneError`. A
     coupler loaded beyond :data:`EULER_LOAD_LIMIT` of its
-    Euler load is refused too (outside the fit). ``drive.spring_model = "auto"`` is resolved
-    first, by its own probe (:func:`flex.fidelity.spring_choice.decide_spring`). Scenes
-    without ``auto`` are returned
+    Euler load is refused too (outside the fit). ``drive.spring_model = "auto"`` must be
+    resolved before (:func:`flex.fidelity.simulation.resolve_auto` does it first, with
+    :func:`flex.fidelity.spring_choice.decide_spring`). Scenes without ``auto`` are returned
     unchanged (a copy). ``cache_dir``: the reduction cache folder of the crank's frequency
     analysis (None: its reduction is built in memory, no disk cache).
     """
@@ -908,10 +908,6 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
     wants_coupler = coupler.get("model") == "auto"
     wants_crank = crank.get("model") == "auto"
     decisions: list[FidelityDecision] = []
-    if resolved["drive"].get("spring_model") == "auto":  # first: the links' probe uses it
-        from flex.fidelity.spring_choice import decide_spring
-
-        decisions.append(decide_spring(resolved))
     if not (wants_coupler or wants_crank):
         return resolved, decisions
     criterion = criterion or load_criterion()

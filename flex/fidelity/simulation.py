@@ -15,6 +15,7 @@ command line and :mod:`flex.api` pass the user's folder
 
 from __future__ import annotations
 
+import copy
 import sys
 from pathlib import Path
 from typing import Any
@@ -26,20 +27,28 @@ from flex.data.scene import Scene, to_toml
 from flex.dynamics.solver import integrate, scene_reductions, time_scales
 from flex.fidelity.criteria import Criterion, FidelityDecision, resolve_fidelity
 from flex.fidelity.error_estimate import estimate_step_error
+from flex.fidelity.spring_choice import decide_spring
 
 
 def resolve_auto(scene: Scene, criterion: Criterion | None = None,
                  crank_criterion: Criterion | None = None, *, cache_dir: Path | None = None
                  ) -> tuple[Scene, list[FidelityDecision]]:
-    """Resolve ``model = "auto"`` links and ``drive.spring_model = "auto"``
-    (:func:`flex.fidelity.criteria.resolve_fidelity`) and print each choice and its reason to
+    """Resolve ``drive.spring_model = "auto"`` first
+    (:func:`flex.fidelity.spring_choice.decide_spring`: the links' probe then runs with the
+    chosen spring), then ``model = "auto"`` links
+    (:func:`flex.fidelity.criteria.resolve_fidelity`), and print each choice and its reason to
     stderr. A scene without them is returned as it is, with no decisions. ``cache_dir``: the
     reduction cache folder (module doc)."""
     if "auto" not in (scene["coupler"]["model"], scene["crank"]["model"],
                       scene["drive"]["spring_model"]):
         return scene, []
+    spring: list[FidelityDecision] = []
+    if scene["drive"]["spring_model"] == "auto":
+        scene = copy.deepcopy(scene)
+        spring.append(decide_spring(scene))
     resolved, decisions = resolve_fidelity(scene, criterion, crank_criterion,
                                            cache_dir=cache_dir)
+    decisions = spring + decisions
     for decision in decisions:
         modes = f" ({decision.modes} modes)" if decision.modes else ""
         key = "drive.spring_model" if decision.link == "spring" else f"{decision.link}.model"

@@ -27,7 +27,7 @@ links and an FFRF coupler judged by its rigid twin's probe, coil masses 3-300 g 
 masses 26.4 and 100 g; m_s / M_min 0.017-3.1), predicted / measured 1.00-1.17 (the
 quasi-static part alone 0.87-1.00; the chain's deployment time within 1 %; docs/spring-mass.md).
 
-``auto`` (:func:`decide_spring`, hooked into :func:`flex.fidelity.criteria.resolve_fidelity`):
+``auto`` (:func:`decide_spring`, called first by :func:`flex.fidelity.simulation.resolve_auto`):
 ``"massless"`` when the prediction times :data:`SPRING_PREDICTION_MARGIN` meets
 ``fidelity.tolerance``; otherwise ``"chain"`` with the fewest segments N whose discretization
 error, :data:`CHAIN_ERROR_CONSTANT` x that bound / N^2, stays within
