@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from flex.base.errors import SceneError
-from flex.base.physics import TWO_PI, n_values
+from flex.base.physics import TWO_PI, n_values, spring_end_mass_wave_numbers
 from flex.base.thesis import (  # noqa: F401 - part of this module's face
     THESIS_ACTIVE_COILS,
     THESIS_ANGLE_MAX_TIME_S,
@@ -481,15 +481,13 @@ def surge_frequency_fixed_free_Hz(rate_N_per_m: float, active_mass_kg: float) ->
 def surge_frequency_fixed_end_mass_Hz(rate_N_per_m: float, active_mass_kg: float,
                                       end_mass_kg: float) -> float:
     """First frequency [Hz] of a spring (rate k, distributed mass m) fixed at one end and
-    carrying a point mass M at the other: ``beta tan(beta) = m / M``,
-    ``omega = beta sqrt(k / m)`` (a bar with a tip mass). M -> 0 gives the fixed-free value."""
-    from scipy.optimize import brentq
-
+    carrying a point mass M at the other: ``beta tan(beta) = m / M``
+    (:func:`flex.base.physics.spring_end_mass_wave_numbers`), ``omega = beta sqrt(k / m)``
+    (a bar with a tip mass). M -> 0 gives the fixed-free value."""
     k = _require_positive("rate_N_per_m", rate_N_per_m, "N/m")
     m = _require_positive("active_mass_kg", active_mass_kg, "kg")
     big_m = _require_positive("end_mass_kg", end_mass_kg, "kg")
-    ratio = m / big_m
-    beta = brentq(lambda b: b * math.tan(b) - ratio, 0.0, math.pi / 2 - 1e-12, xtol=1e-14)
+    beta = float(spring_end_mass_wave_numbers(m / big_m, 1)[0])
     return beta * math.sqrt(k / m) / (2.0 * math.pi)
 
 
