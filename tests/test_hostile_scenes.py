@@ -138,6 +138,7 @@ def test_malformed_overrides_are_refused(override, names):
     (['crank.model="ffrf"'], ["crank.geometry"]),
     (['crank.geometry="plate"', 'crank.model="ffrf"', 'drive.kind="constant_speed"'],
      ["crank.model", "drive.kind"]),
+    (['crank.model="auto"', 'drive.kind="constant_speed"'], ["crank.model", "drive.kind"]),
     (['coupler.geometry="plate"', 'coupler.model="nonlinear_fe"', "coupler.damping_ratio=0.1"],
      ["coupler.damping_ratio"]),
     (['simulation.integrator="explicit_penalty"', 'coupler.geometry="plate"',

@@ -409,6 +409,10 @@ def _check_geometry(scene: Scene) -> None:
         raise SceneError('crank.model = "ffrf" needs drive.kind = "spring": the constant-speed '
                          "drive constrains the rotation coordinate of a rigid crank, which a "
                          'flexible crank\'s floating frame does not have; accepted: "rigid"')
+    if scene["crank"]["model"] == "auto" and scene["drive"]["kind"] != "spring":
+        raise SceneError('crank.model = "auto" needs drive.kind = "spring": auto analyses the '
+                         "crank as a flexible plate in the mechanism, and a flexible crank needs "
+                         'the spring drive; accepted with a constant-speed drive: "rigid"')
     if scene["drive"]["spring_model"] == "auto" and scene["drive"]["kind"] != "spring":
         raise SceneError('drive.spring_model = "auto" needs drive.kind = "spring" (a '
                          "constant-speed drive has no spring to choose a model for); "
