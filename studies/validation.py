@@ -54,7 +54,7 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
     """flex's runs (reductions cached in ``run.cache_dir``), then the independent two-mode
     runs into ``run.notes``."""
     results = simulate_each(scenes, run)
-    run.notes["two_mode"] = validation.two_mode_runs()
+    run.notes["two_mode"] = validation.two_mode_runs(progress=run.progress)
     return results
 
 

@@ -35,6 +35,7 @@ Units: m, s, rad, Hz; deflections and positions in m (reports in um).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -138,14 +139,24 @@ WINDOW_S = 0.01
 
 
 def two_mode_runs(runs: dict[str, tuple[int, int, float, str, str, float]] | None = None,
-                  rtol: float = 1e-10) -> dict[str, CrankSolution]:
-    """The independent model's runs (:data:`TWO_MODE_RUNS` by default), 5-90 s each (axial
-    bubbles make the explicit integration stiff: ~0.9 M evaluations)."""
-    return {name: ivp_crank.solve(BENCH, modes, factor, stiffening, initial,
-                                  output_step_s=OUTPUT_STEP_S, rtol=rtol, atol=rtol * 1e-3,
-                                  pi_value=pi_value, axial_bubbles=bubbles)
-            for name, (modes, bubbles, factor, stiffening, initial, pi_value)
-            in (runs or TWO_MODE_RUNS).items()}
+                  rtol: float = 1e-10,
+                  progress: Callable[[str, int, int], None] | None = None
+                  ) -> dict[str, CrankSolution]:
+    """The independent model's runs (:data:`TWO_MODE_RUNS` by default), 5-140 s each (axial
+    bubbles make the explicit integration stiff: ~0.9 M evaluations); ``progress(name, done,
+    total)`` is told before each (a log shows which one is running)."""
+    chosen = runs or TWO_MODE_RUNS
+    out = {}
+    for index, (name, (modes, bubbles, factor, stiffening, initial, pi_value)) in enumerate(
+            chosen.items()):
+        if progress:
+            progress(f"two-mode model: {name}", index, len(chosen))
+        out[name] = ivp_crank.solve(BENCH, modes, factor, stiffening, initial,
+                                    output_step_s=OUTPUT_STEP_S, rtol=rtol, atol=rtol * 1e-3,
+                                    pi_value=pi_value, axial_bubbles=bubbles)
+    if progress:
+        progress("two-mode model: done", len(chosen), len(chosen))
+    return out
 
 
 def dominant_frequency_hz(time_s: np.ndarray, signal: np.ndarray,
