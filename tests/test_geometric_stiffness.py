@@ -208,7 +208,7 @@ def test_auto_switches_the_geometric_stiffness_on_for_a_tight_tolerance():
     # 1 mm plate: the rigid probe predicts ~0.2 % of the length, 0.05 of the Euler load;
     # at a tolerance of 1e-4 the linear FFRF's predicted error does not meet it, the
     # geometric rung's does; at 1e-3 linear FFRF is kept (at 1e-2 it is rigid)
-    from flex.fidelity.criteria import resolve_fidelity
+    from flex.fidelity.criteria import GEOMETRIC_RUNG_MODES, resolve_fidelity
 
     def scene(tolerance: float):
         return load_scene(overrides=['coupler.geometry="plate"', 'coupler.model="auto"',
@@ -217,6 +217,8 @@ def test_auto_switches_the_geometric_stiffness_on_for_a_tight_tolerance():
     tight, (decision,) = resolve_fidelity(scene(1e-4))
     assert tight["coupler"]["model"] == "ffrf" and tight["coupler"]["geometric_stiffness"]
     assert "ladder: ffrf_geometric" in decision.reason
+    # the geometric rung keeps the first mode (auto modes): the rule's 2 fail Newton there
+    assert tight["coupler"]["modes"] == decision.modes == GEOMETRIC_RUNG_MODES == 1
     loose, (decision,) = resolve_fidelity(scene(1e-3))
     assert loose["coupler"]["model"] == "ffrf" and not loose["coupler"]["geometric_stiffness"]
     assert "ladder: ffrf " in decision.reason
