@@ -24,3 +24,19 @@ def test_step_cost_measures_both_joint_marker_kinds(reduction_cache):
     # the same equations to the Newton tolerance: the same iteration counts, give or take one
     assert abs(row["fewest_newton_per_step"] - row["all_face_nodes_newton_per_step"]) <= 1
     assert said and "mesh 4 mm, 2 modes" in said[0]
+
+
+def test_newton_variants_report_their_iterations_per_step(reduction_cache):
+    """Full Newton at a looser tolerance takes fewer iterations per step than modified Newton
+    at flex's (a Jacobian every iteration against one kept while converging)."""
+    scene = apply_overrides(default_scene(), [
+        'coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.thickness_m=0.001"])
+    notes: dict = {}
+    plan = StepCostPlan((0.004,), (2,), 1e-5, 5e-4, {"modified 1e-8": ("modified", 1e-8),
+                                                     "full 1e-6": ("full", 1e-6)})
+    bench_step_cost(scene, plan, 1, ReductionPool(reduction_cache), lambda _: None, notes)
+    modified, full = notes["newton"]
+    assert (modified["label"], full["label"]) == ("modified 1e-8", "full 1e-6")
+    assert full["newton_per_step"] < modified["newton_per_step"]
+    assert all(math.isfinite(row["ms_per_step"]) and row["ms_per_step"] > 0
+               for row in (modified, full))

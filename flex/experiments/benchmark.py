@@ -41,7 +41,7 @@ import subprocess
 import tempfile
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -76,12 +76,15 @@ class StepCostPlan:
     """Per-step cost of the FFRF coupler: the thesis deployment's first ``end_time_s`` [s] at
     ``step_s`` [s] (modified Newton, relative tolerance 1e-8, spectral radius 0.9) on each mesh
     size [m] and mode count, with the joint markers on every face node (before) and on the
-    fewest nodes (now, :func:`flex.bodies.reduction.add_ffrf_link`)."""
+    fewest nodes (now, :func:`flex.bodies.reduction.add_ffrf_link`). ``newton``: label ->
+    (Newton variant, relative tolerance), each timed on the first mesh and the largest mode
+    count below the largest (iterations per step against the cost of a step)."""
 
     meshes_m: Sequence[float]
     modes: Sequence[int]
     step_s: float
     end_time_s: float
+    newton: Mapping[str, tuple[str, float]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -324,6 +327,37 @@ def bench_step_cost(scene: Scene, plan: StepCostPlan, repeats: int, pool: Reduct
                 f"{row['fewest_ms_per_step']:.3f} ms (all face nodes "
                 f"{row['all_face_nodes_ms_per_step']:.3f} ms)")
     notes["step_cost"] = rows
+    if plan.newton:
+        notes["newton"] = _newton_variants(scene, plan, repeats, pool, say)
+
+
+def _newton_variants(scene: Scene, plan: StepCostPlan, repeats: int, pool: ReductionPool,
+                     say: Say) -> list[dict[str, Any]]:
+    """Per Newton variant of the plan: median ms and Newton iterations per step."""
+    from flex.data.scene import apply_overrides
+    from flex.dynamics.mechanism import build_mechanism
+    from flex.dynamics.solver import run
+
+    modes = sorted(plan.modes)[-2] if len(plan.modes) > 1 else plan.modes[0]
+    rows = []
+    for label, (variant, tolerance) in plan.newton.items():
+        case = apply_overrides(scene, [
+            f"coupler.mesh_size_m={plan.meshes_m[0]}", f"coupler.modes={modes}",
+            f"simulation.step_s={plan.step_s}", f"simulation.end_time_s={plan.end_time_s}",
+            f'simulation.newton="{variant}"', f"simulation.newton_relative_tolerance={tolerance}",
+            "simulation.spectral_radius=0.9"])
+        reduction = pool.for_scene(case)
+        samples = []
+        for _ in range(repeats):
+            counters = run(build_mechanism(case, reduction))
+            samples.append((1e3 * counters["wall_time_s"] / counters["steps"],
+                            counters["newton_iterations"] / counters["steps"]))
+        rows.append({"label": label, "mesh_size_m": plan.meshes_m[0], "modes": modes,
+                     "ms_per_step": statistics.median(v[0] for v in samples),
+                     "newton_per_step": statistics.median(v[1] for v in samples)})
+        say(f"Newton {label}: {rows[-1]['ms_per_step']:.3f} ms, "
+            f"{rows[-1]['newton_per_step']:.2f} iterations per step")
+    return rows
 
 
 def bench_plates(scene: Scene, plan: PlatesPlan, repeats: int, pool: ReductionPool, say: Say,

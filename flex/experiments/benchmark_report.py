@@ -204,6 +204,21 @@ def _step_cost_rows(rows: list[Mapping[str, Any]], datasets: dict[str, Dataset])
             for r, ratio in zip(rows, speedup, strict=True)]
 
 
+def _newton_rows(rows: list[Mapping[str, Any]], datasets: dict[str, Dataset]) -> list[Row]:
+    """``newton/...`` columns (one entry per Newton variant) and a table row each."""
+    if not rows:
+        return []
+    for key, units, text in (("label", "1", "Newton variant and relative tolerance"),
+                             ("ms_per_step", "ms", "wall time per step, median"),
+                             ("newton_per_step", "1", "Newton iterations per step")):
+        _put(datasets, f"newton/{key}", np.array([r[key] for r in rows],
+                                                 dtype=object if key == "label" else float),
+             units, text)
+    return [(f"FFRF 1 mm step, Newton {r['label']}", f"{r['ms_per_step']:.3f} ms",
+             f"{r['newton_per_step']:.2f} iterations per step (mesh {r['mesh_size_m'] * 1e3:g} "
+             f"mm, {r['modes']} modes)") for r in rows]
+
+
 def _plates_rows(rows: list[Mapping[str, Any]], datasets: dict[str, Dataset]) -> list[Row]:
     """``plates/...`` columns (one entry per plate and tolerance) and a table row each: flex's
     own settings, their time against the target and their error against the reference."""
@@ -254,6 +269,7 @@ def bench_summary(notes: Mapping[str, Any], plan: BenchPlan) -> tuple[dict[str, 
         if notes.get(part):
             rows += _profile_rows(part, notes[part], datasets)
     rows += _step_cost_rows(notes.get("step_cost", []), datasets)
+    rows += _newton_rows(notes.get("newton", []), datasets)
     rows += _plates_rows(notes.get("plates", []), datasets)
     rows += _cache_rows(notes, datasets)
     rows += [(key, "failed", value[:150]) for key, value in notes.items()
