@@ -15,12 +15,13 @@ and materials, springs and drives) :func:`measure_scene` runs
   peak midpoint deflection, crank angle and slider position).
 
 :func:`fit_levels` fits, per damping class and tolerance level, the rule's constants
-(:mod:`flex.config.ffrf_rule`: mode cut-off ratio, steps law ``N = C n^-B``, steps per period of
-the highest retained mode) on the calibration scenes that can certify the level
-(:func:`certifiable`), each scene robustly within :data:`MARGIN` x the level
-(:func:`robustly_within`), the cheapest in summed run time; :func:`validate` applies the fitted
-rule to scenes outside the calibration and compares it with the fastest grid pair robustly
-within the level (target: within the level, at most :data:`SLOWDOWN_LIMIT` x slower).
+(:mod:`flex.config.ffrf_rule`: mode cut-off ratio and load cut-off, steps law ``N = C n^-B``,
+steps per period of the highest retained mode, and the range of ``n = t_load / T1`` it holds
+over) on the calibration scenes that can certify the level (:func:`certifiable`), each scene
+robustly within :data:`MARGIN` x the level (:func:`robustly_within`), the cheapest in summed
+modelled run time (:func:`modelled_time_s`); :func:`validate` applies the fitted rule to
+scenes outside the calibration and compares it with the fastest grid pair robustly within the
+level, by measured time (target: within the level, at most :data:`SLOWDOWN_LIMIT` x slower).
 """
 
 from __future__ import annotations
