@@ -66,7 +66,7 @@ def test_a_rigid_run_estimates_its_own_error_against_the_reference_dae():
 
     result = simulate(load_scene(), cache_dir=None)
     assert result.attrs["estimated_error_validity"].startswith("asymptotic")
-    assert "companion run at h = 2e-05 s" in result.attrs["estimated_error_method"]
+    assert "companion runs at h = 2e-05, 4e-05 s" in result.attrs["estimated_error_method"]
     time_s = np.asarray(result.datasets["time"].data)
     reference = solve_reference(load_scene(), time_s[[0, -1]], rtol=1e-12, atol=1e-14)
     true = abs(result.datasets["crank/angle"].data[-1] - reference.q[-1, 2])
@@ -108,3 +108,17 @@ def test_a_second_pair_guards_against_a_lucky_first_one():
     assert _estimate(lucky, [h, 2 * h, 4 * h], 2) == pytest.approx(
         abs(values[1] - values[2]) / 3.0 / 4.0, rel=1e-12)
     assert _estimate(values[:2], [h, 2 * h], 2) == pytest.approx(c * h**2, rel=1e-9)
+
+
+def test_the_observed_order_replaces_the_formal_one():
+    """q(h) = q* + c h exactly (first order, as under-resolved content converges): the three
+    runs show order 1 and the estimate is c h, where the formal order 2 would give c h / 3;
+    a third-order sequence is clipped to the formal 2."""
+    from flex.fidelity.error_estimate import _estimate, observed_order
+
+    exact, c, h = 1.0, 30.0, 1e-4
+    first = [exact + c * k * h for k in (1, 2, 4)]
+    assert observed_order(first, 2) == pytest.approx(1.0)
+    assert _estimate(first, [h, 2 * h, 4 * h], 2) == pytest.approx(c * h, rel=1e-9)
+    third = [exact + c * (k * h) ** 3 for k in (1, 2, 4)]
+    assert observed_order(third, 2) == 2.0
