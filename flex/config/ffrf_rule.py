@@ -164,6 +164,13 @@ def mode_cutoff(level: Mapping[str, Any], n_load: float = math.inf) -> float:
     return max(level["mode_cutoff_ratio"], level.get("mode_cutoff_load", 0.0) / n_load)
 
 
+def holds_at(level: Mapping[str, Any], n_load: float) -> bool:
+    """Whether ``n_load = t_load / T1`` lies within the range the level's calibration scenes
+    spanned (``n_load_min`` / ``n_load_max``; a level without them holds everywhere)."""
+    return (level.get("n_load_min", 0.0) * (1 - 1e-9) <= n_load
+            <= level.get("n_load_max", math.inf) * (1 + 1e-9))
+
+
 def level_modes(level: Mapping[str, Any], link: Mapping[str, Any],
                 n_load: float = math.inf) -> int:
     """The in-plane eigenmodes a level keeps for ``link`` (``n_load = t_load / T1``): every
@@ -219,12 +226,11 @@ def pick(scene: Mapping[str, Mapping[str, Any]], tolerance: float, link: str = "
     level = level_for(tolerance, damping)
     period = first_period_s(values)
     n_load = load_time_scale_s(scene) / period
-    n_range = level.get("n_load_min", 0.0), level.get("n_load_max", math.inf)
-    if not n_range[0] * (1 - 1e-9) <= n_load <= n_range[1] * (1 + 1e-9):
+    if not holds_at(level, n_load):
         return RulePick(None, level_modes(level, values, n_load), mesh, None, (
             f"outside the calibrated family (n = t_load / T1 = {n_load:.3g} is outside the "
-            f"[{n_range[0]:.3g}, {n_range[1]:.3g}] of level {level['tolerance']:g}'s "
-            f"calibration scenes)"))
+            f"[{level['n_load_min']:.3g}, {level['n_load_max']:.3g}] of level "
+            f"{level['tolerance']:g}'s calibration scenes)"))
     modes = level_modes(level, values, n_load)
     per = steps_per_first_period(level, n_load, top_mode_ratio(level, values, n_load))
     if per is None:

@@ -298,25 +298,19 @@ def bench_step_cost(scene: Scene, plan: StepCostPlan, repeats: int, pool: Reduct
     and Newton iterations per step of both joint-marker kinds (runs of the two kinds
     alternate, so a change in the machine's load touches both alike)."""
     from flex.bodies.reduction import JOINT_MARKERS
-    from flex.data.scene import apply_overrides
     from flex.dynamics.mechanism import build_mechanism
     from flex.dynamics.solver import run
 
     rows = []
     for mesh in plan.meshes_m:
         for modes in plan.modes:
-            case = apply_overrides(scene, [
-                f"coupler.mesh_size_m={mesh}", f"coupler.modes={modes}",
-                f"simulation.step_s={plan.step_s}", f"simulation.end_time_s={plan.end_time_s}",
-                'simulation.newton="modified"', "simulation.newton_relative_tolerance=1e-8",
-                "simulation.spectral_radius=0.9"])
+            case = _step_case(scene, plan, mesh, modes)
             reduction = pool.for_scene(case)
             samples: dict[str, list[tuple[float, float]]] = {kind: [] for kind in JOINT_MARKERS}
             for _ in range(repeats):
                 for kind in JOINT_MARKERS:
-                    counters = run(build_mechanism(case, reduction, ffrf_joint_markers=kind))
-                    samples[kind].append((1e3 * counters["wall_time_s"] / counters["steps"],
-                                          counters["newton_iterations"] / counters["steps"]))
+                    samples[kind].append(_per_step(run(build_mechanism(
+                        case, reduction, ffrf_joint_markers=kind))))
             row: dict[str, Any] = {"mesh_size_m": mesh, "modes": modes,
                                    "mesh_nodes": reduction.n_nodes}
             for kind, values in samples.items():
@@ -331,27 +325,36 @@ def bench_step_cost(scene: Scene, plan: StepCostPlan, repeats: int, pool: Reduct
         notes["newton"] = _newton_variants(scene, plan, repeats, pool, say)
 
 
+def _step_case(scene: Scene, plan: StepCostPlan, mesh_m: float, modes: int,
+               newton: str = "modified", tolerance: float = 1e-8) -> Scene:
+    """The plan's short run on ``mesh_m`` with ``modes``, Newton ``newton`` at ``tolerance``."""
+    from flex.data.scene import apply_overrides
+
+    return apply_overrides(scene, [
+        f"coupler.mesh_size_m={mesh_m}", f"coupler.modes={modes}",
+        f"simulation.step_s={plan.step_s}", f"simulation.end_time_s={plan.end_time_s}",
+        f'simulation.newton="{newton}"', f"simulation.newton_relative_tolerance={tolerance}",
+        "simulation.spectral_radius=0.9"])
+
+
+def _per_step(counters: Mapping[str, float]) -> tuple[float, float]:
+    """Wall time [ms] and Newton iterations per step of a run's counters."""
+    return (1e3 * counters["wall_time_s"] / counters["steps"],
+            counters["newton_iterations"] / counters["steps"])
+
+
 def _newton_variants(scene: Scene, plan: StepCostPlan, repeats: int, pool: ReductionPool,
                      say: Say) -> list[dict[str, Any]]:
     """Per Newton variant of the plan: median ms and Newton iterations per step."""
-    from flex.data.scene import apply_overrides
     from flex.dynamics.mechanism import build_mechanism
     from flex.dynamics.solver import run
 
     modes = sorted(plan.modes)[-2] if len(plan.modes) > 1 else plan.modes[0]
     rows = []
     for label, (variant, tolerance) in plan.newton.items():
-        case = apply_overrides(scene, [
-            f"coupler.mesh_size_m={plan.meshes_m[0]}", f"coupler.modes={modes}",
-            f"simulation.step_s={plan.step_s}", f"simulation.end_time_s={plan.end_time_s}",
-            f'simulation.newton="{variant}"', f"simulation.newton_relative_tolerance={tolerance}",
-            "simulation.spectral_radius=0.9"])
+        case = _step_case(scene, plan, plan.meshes_m[0], modes, variant, tolerance)
         reduction = pool.for_scene(case)
-        samples = []
-        for _ in range(repeats):
-            counters = run(build_mechanism(case, reduction))
-            samples.append((1e3 * counters["wall_time_s"] / counters["steps"],
-                            counters["newton_iterations"] / counters["steps"]))
+        samples = [_per_step(run(build_mechanism(case, reduction))) for _ in range(repeats)]
         rows.append({"label": label, "mesh_size_m": plan.meshes_m[0], "modes": modes,
                      "ms_per_step": statistics.median(v[0] for v in samples),
                      "newton_per_step": statistics.median(v[1] for v in samples)})
@@ -369,7 +372,7 @@ def bench_plates(scene: Scene, plan: PlatesPlan, repeats: int, pool: ReductionPo
     from flex.config.settings import AUTO_OVERRIDES, resolve_solver_settings
     from flex.data.scene import apply_overrides
     from flex.experiments.calibration import scene_reference
-    from flex.experiments.tradeoff import REFERENCE_MARGIN
+    from flex.experiments.tradeoff import certifies
 
     rows, out = [], {}
     for name, overrides in plan.plates.items():
@@ -395,7 +398,7 @@ def bench_plates(scene: Scene, plan: PlatesPlan, repeats: int, pool: ReductionPo
                          "modes": resolved["coupler"]["modes"],
                          "mesh_size_m": resolved["coupler"]["mesh_size_m"],
                          "reference_accuracy": reference.accuracy,
-                         "certifiable": reference.accuracy * REFERENCE_MARGIN <= tolerance,
+                         "certifiable": certifies(reference.accuracy, tolerance),
                          "target_s": plan.targets_s.get(tolerance, math.nan)})
             say(f"{name} at {tolerance:g}: {m.total_time_s:.3f} s, error "
                 f"{m.errors.get('peak_deflection_relative', math.nan):.2e}")

@@ -41,6 +41,7 @@ from flex.config.ffrf_rule import (
     MODE_GRID,
     STEP_GRID,
     first_period_s,
+    holds_at,
     level_modes,
     load_time_scale_s,
     rule_mesh_size_m,
@@ -51,10 +52,10 @@ from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
 from flex.dynamics.solver import FFRF_DEFLECTION_LIMIT
 from flex.experiments.tradeoff import (
-    REFERENCE_MARGIN,
     ReductionPool,
     Reference,
     Setting,
+    certifies,
     converged_reference,
     measure,
     scene_for,
@@ -248,7 +249,7 @@ def certifiable(case: CaseResult, level: float) -> bool:
     (:func:`within_linear_validity`) and accurate to at most 1 / REFERENCE_MARGIN of the
     level (:data:`flex.experiments.tradeoff.REFERENCE_MARGIN`)."""
     return (case.status == "ok" and within_linear_validity(case)
-            and case.attrs["reference_accuracy"] * REFERENCE_MARGIN <= level)
+            and certifies(case.attrs["reference_accuracy"], level))
 
 
 def damping_of(case: CaseResult) -> str:
@@ -402,8 +403,7 @@ def validate(cases: Mapping[str, CaseResult], levels: Sequence[Mapping[str, Any]
         for level in levels:
             if level.get("modes") is None or level.get("damping", damping) != damping:
                 continue
-            if not (level.get("n_load_min", 0.0) * (1 - 1e-9) <= n_load
-                    <= level.get("n_load_max", math.inf) * (1 + 1e-9)):
+            if not holds_at(level, n_load):
                 rows.append({"scene": name, "tolerance": level["tolerance"], "outside":
                              f"n = {n_load:.3g} outside level {level['tolerance']:g}'s "
                              f"calibrated [{level['n_load_min']:.3g}, "

@@ -20,6 +20,7 @@ import numpy as np
 
 from flex.base.plotting import legend_below, log_ticks, panels
 from flex.config.ffrf_rule import (
+    holds_at,
     level_modes,
     rule_constants,
     steps_per_first_period,
@@ -206,8 +207,7 @@ def draw_calibration(results: Mapping[str, CaseResult], datasets: Mapping[str, D
                                               level, coupler, n_load)))
                      for level in levels
                      if level["damping"] == damping_of(case)
-                     and level.get("n_load_min", 0.0) * (1 - 1e-9) <= n_load
-                     <= level.get("n_load_max", math.inf) * (1 + 1e-9)}
+                     and holds_at(level, n_load)}
             _panel(ax, name, grid_table(case), sorted({lv["tolerance"] for lv in levels}),
                    picks)
         for ax in axes[len(cases):]:

@@ -59,6 +59,13 @@ ACCURACY_LEVELS = (1e-2, 1e-3, 1e-4)
 #: a reference certifies an accuracy level only if the level is at least this many times the
 #: reference's estimated own error (:attr:`Reference.accuracy`)
 REFERENCE_MARGIN = 3.0
+
+
+def certifies(reference_accuracy: float, level: float) -> bool:
+    """Whether a reference accurate to ``reference_accuracy`` (relative) can certify the
+    accuracy ``level``: at least :data:`REFERENCE_MARGIN` times its own error."""
+    return reference_accuracy * REFERENCE_MARGIN <= level
+
 #: safety factor on a Richardson error estimate from three levels in the asymptotic range
 #: (Roache's grid convergence index for three grids)
 RICHARDSON_SAFETY = 1.25
@@ -684,7 +691,7 @@ def recommend(measurements: Iterable[Measurement], reference: Reference,
     candidates = [m for m in measurements if m.ok and (eligible is None or eligible(m))]
     out = []
     for level in levels:
-        if reference.accuracy * REFERENCE_MARGIN > level:
+        if not certifies(reference.accuracy, level):
             out.append(Recommendation(level, None, f"reference accurate to "
                                       f"{reference.accuracy:.1e} only: cannot certify "
                                       f"{level:.0e}"))
