@@ -15,10 +15,11 @@ run is a
 ``failed`` case with the step and time in its message and no data); per scene under
 ``/summary/<scene>/`` (:mod:`flex.experiments.workprecision_report`): ``runs/...`` (with
 ``on_pareto_front``), ``reference/...`` (with its convergence evidence), ``recommended/...``
-(per accuracy level 1 %, 0.1 %, 0.01 %) and ``default/...`` (whether the bundled "auto" solver
-keys are the measured pick, :mod:`flex.experiments.defaults_check`). Figures: one work-precision
-diagram
-(error against wall time, log-log, Pareto front marked) per scene.
+(per accuracy level 1 %, 0.1 %, 0.01 %), ``default/...`` (whether the bundled "auto" solver
+keys are the measured pick) and, FFRF scenes, ``rule/...`` (the settings flex's rule picks
+when asked for 1 % and 0.1 %, "flex rule (...)", and where they sit;
+:mod:`flex.experiments.defaults_check`). Figures: one work-precision diagram (error against
+wall time, log-log, Pareto front and rule picks marked) per scene.
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from typing import Any
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, derived_scenes
-from flex.experiments.defaults_check import default_setting
+from flex.experiments.defaults_check import default_setting, rule_settings
 from flex.experiments.reference_plans import scipy_setting
 from flex.experiments.tradeoff import Setting
 from flex.experiments.workprecision import nonlinear_available, run_work_precision
@@ -57,13 +58,14 @@ S = Setting.of
 ONE = "one knob: "  # the group of the one-knob-at-a-time sweeps
 
 
-def settings(scene_name: str, nonlinear: bool) -> list[Setting]:
-    """The knob settings measured for one scene: one knob at a time around the base, then
-    combinations, then the flex defaults (``nonlinear``: the nonlinear FE coupler is
-    installed)."""
+def settings(scene_name: str, nonlinear: bool, scene: Scene) -> list[Setting]:
+    """The knob settings measured for one scene (``scene``: its case scene): one knob at a
+    time around the base, then combinations, then the flex defaults and (FFRF) the rule's
+    picks at 1 % and 0.1 % (``nonlinear``: the nonlinear FE coupler is installed)."""
     if scene_name == "rigid":
         return _rigid_settings() + [default_setting()]
-    return _ffrf_settings(scene_name == "ffrf_1mm", nonlinear) + [default_setting()]
+    return (_ffrf_settings(scene_name == "ffrf_1mm", nonlinear) + [default_setting()]
+            + rule_settings(scene))
 
 
 def _rigid_settings() -> list[Setting]:
@@ -174,7 +176,8 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """References first, then every setting, per scene; returns one case per run."""
-    plans = {name: settings(name, nonlinear_available()) for name in scenes}
+    plans = {name: settings(name, nonlinear_available(), scene)
+             for name, scene in scenes.items()}
     return run_work_precision(scenes, plans, REPEATS, run.progress, run.notes,
                               cache_dir=run.cache_dir)
 
@@ -190,7 +193,8 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
     """Work-precision diagram per scene: every ok run (colour: sweep; marker: engine), the
-    Pareto front of all runs (solid) and of flex's own settings (dashed, labelled)."""
+    Pareto front of all runs (solid) and of flex's own settings (dashed, labelled), the
+    rule's picks (open stars)."""
     return work_precision_figures(summary.datasets, folder)
 
 

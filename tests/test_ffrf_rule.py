@@ -156,7 +156,8 @@ def test_the_highest_retained_mode_bounds_the_step():
 def test_only_auto_link_keys_are_filled():
     scene = _scene(0.001, 'coupler.modes="auto"', "coupler.mesh_size_m=0.003")
     filled = fill_link_keys(scene, "coupler", 0.01)
-    assert filled == {"modes": level_modes(level_for(0.01), scene["coupler"])}
+    n_load = load_time_scale_s(scene) / first_period_s(scene["coupler"])
+    assert filled == {"modes": level_modes(level_for(0.01), scene["coupler"], n_load)}
     assert scene["coupler"]["mesh_size_m"] == 0.003
 
 
@@ -255,6 +256,40 @@ def test_the_fit_s_time_model_recovers_a_noisy_grid_s_time_per_step():
     # 6 steps per mode count, 3 of them 3x slow: the median lies between, at sqrt(3)x
     assert modelled == pytest.approx(exact * math.sqrt(3.0), rel=1e-9)
     assert np.all(np.diff(modelled[table["modes"] == 1]) > 0)  # monotone in the steps
+
+
+def test_the_law_rounded_to_the_grid_gives_each_scene_what_it_needs_and_no_more():
+    """C is the smallest for which the law, rounded up as the rule rounds it, covers every
+    scene: at the fitted C each scene gets exactly its needed grid value, and 10 % less C
+    leaves one short."""
+    from flex.experiments.calibration import _step_law
+
+    needed, n_load = np.array([32.0, 16.0, 8.0]), np.array([2.0, 5.0, 30.0])
+    law = _step_law(needed, n_load, np.zeros(3), 0.5)
+    picks = [steps_per_first_period(law, n) for n in n_load]
+    assert picks == list(needed)
+    lower = {**law, "steps_coefficient": 0.9 * law["steps_coefficient"]}
+    assert any(steps_per_first_period(lower, n) < need for n, need in zip(n_load, needed,
+                                                                            strict=True))
+
+
+def test_a_level_rests_on_the_longest_run_of_scenes_the_grid_can_meet():
+    """Ordered by n: three scenes the grid meets, one it cannot (its errors never fall
+    within the level), one more it meets: the level keeps the first three, leaves out the
+    rest, and so holds only over their n."""
+    from flex.experiments.calibration import grid_table, reachable_run
+
+    def unreachable(m, n, n_load):
+        return 0.05
+
+    usable = {}
+    for index, t in enumerate((0.0008, 0.001, 0.0015, 0.002, 0.003)):
+        error = unreachable if index == 3 else step_law_error
+        case = _case(f"t{t}", t, error, cost)
+        usable[case.name] = (grid_table(case), float(index + 1), None)
+    kept, left = reachable_run(usable, 0.01)
+    assert sorted(kept) == ["t0.0008", "t0.001", "t0.0015"]
+    assert [text.split()[0] for text in left] == ["t0.002", "t0.003"]
 
 
 def test_a_level_too_few_references_can_certify_is_not_fitted():

@@ -219,13 +219,13 @@ def pick(scene: Mapping[str, Mapping[str, Any]], tolerance: float, link: str = "
     damping = damping_class(values)
     mesh = rule_mesh_size_m(values)
     outside = outside_family(values, tolerance)
-    if outside:
-        levels = _levels(damping) or _levels("undamped") or rule_constants()["levels"]
-        return RulePick(None, level_modes(levels[0], values), mesh, None,
-                        f"outside the calibrated family ({outside})")
-    level = level_for(tolerance, damping)
     period = first_period_s(values)
     n_load = load_time_scale_s(scene) / period
+    if outside:  # the modes of the class's first level at this load, not the ratio alone
+        levels = _levels(damping) or _levels("undamped") or rule_constants()["levels"]
+        return RulePick(None, level_modes(levels[0], values, n_load), mesh, None,
+                        f"outside the calibrated family ({outside})")
+    level = level_for(tolerance, damping)
     if not holds_at(level, n_load):
         return RulePick(None, level_modes(level, values, n_load), mesh, None, (
             f"outside the calibrated family (n = t_load / T1 = {n_load:.3g} is outside the "

@@ -80,6 +80,8 @@ MODE_CUTOFF_RATIOS = (1.0, 2.0, 3.0, 4.0, 6.0, 8.0, 12.0)
 MODE_CUTOFF_LOADS = (0.0, 4.0, 8.0, 16.0, 32.0)
 #: steps per period of the highest retained mode tried (0: no such bound)
 STEPS_PER_TOP_PERIOD = (0.0, 4.0, 8.0)
+#: exponents B of the steps law N = C n^-B tried
+STEPS_EXPONENTS = tuple(round(0.05 * k, 2) for k in range(31))
 #: a level of a class is calibrated only if at least this many references can certify it
 MIN_SCENES = 3
 #: validation target: the rule's pick at most this many times slower than the grid's fastest
@@ -302,8 +304,32 @@ def fit_levels(calibration: Mapping[str, CaseResult], levels: Sequence[float] = 
             usable = {name: (grid_table(case), n_load_of(case), coupler_of(case))
                       for name, case in calibration.items()
                       if certifiable(case, level) and damping_of(case) == damping}
-            out.append({"damping": damping, **_fit_one(level, usable)})
+            usable, beyond = reachable_run(usable, MARGIN * level)
+            out.append({"damping": damping, **_fit_one(level, usable),
+                        "beyond_grid": beyond})
     return out
+
+
+def reachable_run(usable: Mapping[str, tuple[Mapping[str, np.ndarray], float, Any]],
+                  bound: float) -> tuple[dict[str, Any], list[str]]:
+    """The scenes a level can rest on: ordered by n = t_load / T1, the longest run of
+    consecutive scenes with some grid pair robustly within ``bound``
+    (:func:`robustly_within`; the lower n on a tie). A scene no grid pair meets (it needs
+    more modes or steps than the grid has) cannot shape the law, and the level must not
+    claim the n around it: the level holds over its run's n only. Also returned: the scenes
+    left out, as "name (n = ...)"."""
+    order = sorted(usable, key=lambda name: usable[name][1])
+    reached = [bool(robustly_within(usable[name][0], bound).any()) for name in order]
+    best: tuple[int, int] = (0, 0)
+    start = 0
+    for index, ok in enumerate([*reached, False]):
+        if not ok:
+            if index - start > best[1] - best[0]:
+                best = (start, index)
+            start = index + 1
+    kept = order[best[0]:best[1]]
+    left = [f"{name} (n = {usable[name][1]:.3g})" for name in order if name not in kept]
+    return {name: usable[name] for name in kept}, left
 
 
 def coupler_of(case: CaseResult) -> dict[str, Any]:
@@ -314,60 +340,82 @@ def coupler_of(case: CaseResult) -> dict[str, Any]:
 def _fit_one(level: float,
              usable: Mapping[str, tuple[Mapping[str, np.ndarray], float, dict[str, Any]]]
              ) -> dict[str, Any]:
-    """Per mode cut-off ratio of :data:`MODE_CUTOFF_RATIOS` (each scene's modes:
-    :func:`flex.config.ffrf_rule.level_modes`): each scene's fewest robust steps per period
-    N_i within MARGIN x level at its n_i = t_load / T1; the law N = C n^-B with B the
-    least-squares slope of log N_i on log n_i (clipped to [0, 1.5]) and C the smallest that
-    covers every scene; its picks (rounded up to the grid) timed over the scenes
-    (:func:`modelled_time_s`). The ratio with the least total time wins."""
+    """Per mode cut-off (ratio :data:`MODE_CUTOFF_RATIOS`, load :data:`MODE_CUTOFF_LOADS`;
+    each scene's modes: :func:`flex.config.ffrf_rule.level_modes`), steps per period of the
+    top mode (:data:`STEPS_PER_TOP_PERIOD`) and law exponent B (:data:`STEPS_EXPONENTS`):
+    each scene's fewest robust steps per period N_i within MARGIN x level at its n_i = t_load
+    / T1, the smallest C for which the law N = C n^-B, rounded up to the grid as the rule
+    rounds it, gives every scene at least its N_i (:func:`_step_law`), and the law's picks
+    timed over the scenes (:func:`modelled_time_s`). The combination with the least total
+    time wins (ties: :func:`_middle_of_ties`)."""
     scenes = sorted(usable)
     if len(usable) < MIN_SCENES:
         return {"tolerance": level, "modes": None, "scenes": scenes,
                 "reason": f"{len(usable)} calibration references can certify it (at least "
                           f"{MIN_SCENES} needed)"}
-    best: dict[str, Any] | None = None
+    best: list[dict[str, Any]] = []
     tables = [table for table, _, _ in usable.values()]
+    times = [modelled_time_s(table) for table in tables]
     n_load = np.array([n for _, n, _ in usable.values()])
-    for ratio, load, per_top in itertools.product(MODE_CUTOFF_RATIOS, MODE_CUTOFF_LOADS,
-                                                  STEPS_PER_TOP_PERIOD):
+    needed_by_modes = [{m: needed_steps(t, m, MARGIN * level) for m in MODE_GRID}
+                       for t in tables]
+    for ratio, load in itertools.product(MODE_CUTOFF_RATIOS, MODE_CUTOFF_LOADS):
         cut = {"mode_cutoff_ratio": ratio, "mode_cutoff_load": load}
         modes = [level_modes(cut, c, n) for _, n, c in usable.values()]
         top = np.array([top_mode_ratio(cut, c, n) for _, n, c in usable.values()])
-        needed = np.array([needed_steps(t, m, MARGIN * level)
-                           for t, m in zip(tables, modes, strict=True)])
+        needed = np.array([by_modes[m] for by_modes, m in zip(needed_by_modes, modes,
+                                                              strict=True)])
         if not np.all(np.isfinite(needed)):
             continue
-        law = {"steps_per_top_period": per_top, **_step_law(needed, n_load, per_top * top)}
-        picks = [steps_per_first_period(law, n, r) for n, r in zip(n_load, top, strict=True)]
-        if None in picks:  # the law leaves the grid on some scene: not a usable fit
-            continue
-        rows = [_row(t, m, per) for t, m, per in zip(tables, modes, picks, strict=True)]
-        time = float(sum(modelled_time_s(t)[r] for t, r in zip(tables, rows, strict=True)))
-        if best is None or time < best["total_time_s"]:
-            best = {"tolerance": level, "modes": max(modes), **cut, **law,
-                    "n_load_min": float(np.min(n_load)), "n_load_max": float(np.max(n_load)),
-                    "total_time_s": time,
-                    "worst_error": float(max(t["certified"][r]
-                                             for t, r in zip(tables, rows, strict=True)))}
-    return {**(best or {"tolerance": level, "modes": None, "reason":
-                        f"no mode cut-off keeps every scene robustly within {MARGIN:g} x "
-                        f"{level:g} on the grid"}), "scenes": scenes}
+        for per_top, exponent in itertools.product(STEPS_PER_TOP_PERIOD, STEPS_EXPONENTS):
+            law = {"steps_per_top_period": per_top,
+                   **_step_law(needed, n_load, per_top * top, exponent)}
+            picks = [steps_per_first_period(law, n, r) for n, r in zip(n_load, top,
+                                                                         strict=True)]
+            if None in picks:  # the law leaves the grid on some scene: not a usable fit
+                continue
+            rows = [_row(t, m, per) for t, m, per in zip(tables, modes, picks, strict=True)]
+            time = float(sum(s[r] for s, r in zip(times, rows, strict=True)))
+            if best and time > best[0]["total_time_s"] * (1 + 1e-9):
+                continue
+            fit = {"tolerance": level, "modes": max(modes), **cut, **law,
+                   "n_load_min": float(np.min(n_load)), "n_load_max": float(np.max(n_load)),
+                   "total_time_s": time,
+                   "worst_error": float(max(t["certified"][r]
+                                            for t, r in zip(tables, rows, strict=True)))}
+            tied = best and time >= best[0]["total_time_s"] * (1 - 1e-9)
+            best = [*best, fit] if tied else [fit]
+    if not best:
+        return {"tolerance": level, "modes": None, "scenes": scenes, "reason":
+                f"no mode cut-off keeps every scene robustly within {MARGIN:g} x {level:g} "
+                f"on the grid"}
+    return {**_middle_of_ties(best), "scenes": scenes}
 
 
-def _step_law(needed: np.ndarray, n_load: np.ndarray, resolved: np.ndarray
+def _middle_of_ties(fits: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """Of laws equally fast on the calibration scenes (the same picks: exponents B whose
+    rounded laws agree there), the middle B of the first mode cut-off's: the calibration
+    leaves B anywhere in that range, and its middle strays least between the scenes."""
+    keys = ("mode_cutoff_ratio", "mode_cutoff_load", "steps_per_top_period")
+    same = [fit for fit in fits if all(fit[key] == fits[0][key] for key in keys)]
+    return same[(len(same) - 1) // 2]
+
+
+def _step_law(needed: np.ndarray, n_load: np.ndarray, resolved: np.ndarray, exponent: float
               ) -> dict[str, float]:
-    """``N = C n^-B`` through the scenes whose needed steps the top-mode resolution
-    (``resolved``, steps per first period) does not already give: B the least-squares slope
-    of log N on log n (clipped to [0, 1.5]; 0 with fewer than two such scenes), C the
-    smallest that covers them."""
-    open_ = needed > resolved * (1 + 1e-9)
+    """``N = C n^-B`` with ``B = exponent`` and C the smallest for which the law, rounded up
+    to :data:`flex.config.ffrf_rule.STEP_GRID` as the rule rounds it, gives every scene at
+    least its ``needed`` steps where the top-mode resolution (``resolved``, steps per first
+    period) does not already: the law needs only exceed the grid value below ``needed``
+    (a law through the needed values themselves, as fitted before, overshoots by up to
+    one grid step, 2x the run time)."""
+    below = np.array([max((g for g in STEP_GRID if g < x * (1 - 1e-9)), default=0.0)
+                      for x in needed])
+    open_ = (needed > resolved * (1 + 1e-9)) & (below > 0)
     if not open_.any():
         return {"steps_coefficient": float(STEP_GRID[0]), "steps_exponent": 0.0}
-    x, y = np.log(n_load[open_]), np.log(needed[open_])
-    slope = np.polyfit(x, y, 1)[0] if open_.sum() >= 2 and np.ptp(x) > 0 else 0.0
-    exponent = float(np.clip(-slope, 0.0, 1.5))
-    return {"steps_coefficient": float(np.max(needed[open_] * n_load[open_] ** exponent)),
-            "steps_exponent": exponent}
+    coefficient = float(np.max(below[open_] * n_load[open_] ** exponent)) * (1 + 1e-6)
+    return {"steps_coefficient": coefficient, "steps_exponent": float(exponent)}
 
 
 def _row(table: Mapping[str, np.ndarray], modes: int, per: float) -> int:

@@ -118,7 +118,8 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
         if level.get("modes") is None:
             lines.append(f"- {level['damping']}, {level['tolerance']:g}: not calibrated "
                          f"({level['reason']}; "
-                         f"scenes: {', '.join(level['scenes']) or 'none'})")
+                         f"scenes: {', '.join(level['scenes']) or 'none'})"
+                         + _beyond_text(level))
             continue
         lines.append(f"- {level['damping']}, {level['tolerance']:g}, for n = t_load / T1 in "
                      f"[{level['n_load_min']:.3g}, {level['n_load_max']:.3g}]: in-plane modes "
@@ -130,7 +131,8 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
                      f"{level['steps_per_top_period']:g} per period of the highest retained "
                      f"mode (rounded up to the grid); worst certified error "
                      f"{level['worst_error']:.2g} over "
-                     f"{len(level['scenes'])} scenes ({', '.join(level['scenes'])})")
+                     f"{len(level['scenes'])} scenes ({', '.join(level['scenes'])})"
+                     + _beyond_text(level))
     lines += ["", "## Validation (scenes not used in the fit)", "",
               "| scene | n = t_load / T1 | level | certifiable | rule pick | rule error | rule "
               "time [s] | fastest within [s] (pair) | slowdown | meets |",
@@ -173,6 +175,14 @@ def _target_lines(rows: Sequence[Mapping[str, Any]]) -> list[str]:
         lines.append(f"- {row['scene']} at {row['tolerance']:g}: {row['rule_time_s']:.3g} s "
                      f"({verdict}), certified error {row['rule_error']:.2g}")
     return lines
+
+
+def _beyond_text(level: Mapping[str, Any]) -> str:
+    """The level's certifiable scenes outside its n range (no grid pair meets one of them,
+    :func:`flex.experiments.calibration.reachable_run`)."""
+    beyond = level.get("beyond_grid") or []
+    return (f"; left out, the grid cannot meet the level on, or beyond, "
+            f"{', '.join(beyond)}" if beyond else "")
 
 
 def _text(value: Any) -> str:

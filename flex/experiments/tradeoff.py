@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import FlexError, SceneError
-from flex.config.settings import resolved_simulation
+from flex.config.settings import has_auto_link_keys, resolve_link_keys, resolved_simulation
 from flex.data.results import Dataset
 from flex.data.scene import Scene, apply_overrides, validate
 from flex.dynamics.reference import solve_reference
@@ -355,9 +355,13 @@ class ReductionPool:
 
     def for_scene(self, scene: Scene, order: int = 2) -> Any:
         """The scene's reduction (tetrahedra of ``order``) for an ``ffrf`` coupler, else
-        None."""
+        None. ``"auto"`` modes and mesh size are keyed by what the rule fills in at the
+        scene's ``fidelity.tolerance`` (:func:`flex.config.settings.resolve_link_keys`), as
+        the run resolves them."""
         if scene["coupler"]["model"] != "ffrf":
             return None
+        if has_auto_link_keys(scene):
+            scene, _ = resolve_link_keys(scene)
         from flex.dynamics.solver import reduction_for_scene
 
         c = scene["coupler"]

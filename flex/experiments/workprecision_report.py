@@ -5,11 +5,11 @@ the recommendations, the defaults check, and the work-precision diagram.
 run_work_precision` into datasets under ``<scene>/``: ``runs/...`` (the table of
 :func:`flex.experiments.tradeoff.measurements_table`, with ``on_pareto_front``), ``reference/...``
 (what it
-is and its convergence evidence), ``recommended/...`` (per accuracy level 1 %, 0.1 %, 0.01 %)
-and ``default/...`` (:mod:`flex.experiments.defaults_check`), and into the report text.
-:func:`work_precision_figures` draws, from those datasets, one diagram per scene: error
-against wall time (log-log), the Pareto fronts, the accuracy levels and the band the reference
-cannot resolve.
+is and its convergence evidence), ``recommended/...`` (per accuracy level 1 %, 0.1 %, 0.01 %),
+``default/...`` and ``rule/...`` (the flex rule's picks, :mod:`flex.experiments.defaults_check`),
+and into the report text. :func:`work_precision_figures` draws, from those datasets, one diagram
+per scene: error against wall time (log-log), the Pareto fronts, the rule's picks (open stars),
+the accuracy levels and the band the reference cannot resolve.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import numpy as np
 from flex.base.plotting import figure, legend_below
 from flex.data.results import Dataset
 from flex.data.scene import Scene
-from flex.experiments.defaults_check import ffrf_defaults_check, rigid_defaults_check
+from flex.experiments.defaults_check import ffrf_defaults_check, rigid_defaults_check, rule_check
 from flex.experiments.tradeoff import (
     ACCURACY_LEVELS,
     Measurement,
@@ -193,7 +193,8 @@ def summarize_work_precision(runs: Mapping[str, SceneRuns], scenes: Mapping[str,
         recommended, text = recommendations(scene_name, measurements, reference)
         datasets.update(recommended)
         lines += text + _front_lines(measurements, front)
-        checks = []
+        checks = [rule_check(scene_name, measurements, reference, front,
+                             scenes.get(scene_name))]
         if scene_name == ffrf_default_scene:
             checks.append(ffrf_defaults_check(scene_name, measurements, reference,
                                               scenes[scene_name]))
@@ -210,8 +211,35 @@ def summarize_work_precision(runs: Mapping[str, SceneRuns], scenes: Mapping[str,
     return datasets, "\n".join(lines)
 
 
-def _diagram(ax: Any, table: dict[str, np.ndarray], accuracy: float | None) -> None:
-    """One work-precision diagram on ``ax`` from a scene's run table."""
+#: colours of the rule's picks: inside its calibrated family, and its fallback
+RULE_COLOURS = {False: "crimson", True: "darkorange"}
+
+
+def _rule_picks(ax: Any, rule: Mapping[str, np.ndarray], walls: np.ndarray) -> None:
+    """The rule's picks (``<scene>/rule/...`` columns) as large open stars labelled ``rule 1
+    %`` (``(fallback)`` where so) on top of the fronts; ``walls`` [s]: every run's wall time
+    (a label near the slow end is set to the left of its star)."""
+    finite = walls[np.isfinite(walls) & (walls > 0)]
+    span = np.log(finite.max() / finite.min()) if finite.size > 1 else 0.0
+    for level, wall, error, fallback in zip(rule["level"], rule["wall_time"], rule["error"],
+                                            rule["fallback"], strict=True):
+        if not (math.isfinite(wall) and math.isfinite(error)):
+            continue
+        fallback = bool(fallback)
+        colour = RULE_COLOURS[fallback]
+        ax.loglog([wall], [error], "*", ms=20, mfc="none", mec=colour, mew=1.6, zorder=5,
+                  label="flex rule pick (fallback)" if fallback else "flex rule pick")
+        left = span > 0 and np.log(wall / finite.min()) > 0.75 * span
+        ax.annotate(f"rule {float(level) * 100:g} %{' (fallback)' if fallback else ''}",
+                    (wall, error), xytext=(-10 if left else 10, 7),
+                    textcoords="offset points", ha="right" if left else "left", fontsize=7,
+                    fontweight="bold", color=colour, zorder=6)
+
+
+def _diagram(ax: Any, table: dict[str, np.ndarray], accuracy: float | None,
+             rule: Mapping[str, np.ndarray] | None = None) -> None:
+    """One work-precision diagram on ``ax`` from a scene's run table (and the rule's picks,
+    ``<scene>/rule/...`` columns)."""
     import matplotlib
 
     colours = matplotlib.colormaps["tab20"]
@@ -236,6 +264,8 @@ def _diagram(ax: Any, table: dict[str, np.ndarray], accuracy: float | None) -> N
     for rank, i in enumerate(own_front):  # alternate sides: neighbours overlap
         ax.annotate(str(label[i]), (wall[i], error[i]), fontsize=6,
                     xytext=(4, -9 if rank % 2 == 0 else 4), textcoords="offset points")
+    if rule:
+        _rule_picks(ax, rule, wall)
     for level in ACCURACY_LEVELS:
         ax.axhline(level, color="grey", lw=0.6, ls=":")
     ax.plot([], [], color="grey", lw=0.6, ls=":",
@@ -253,19 +283,21 @@ def _diagram(ax: Any, table: dict[str, np.ndarray], accuracy: float | None) -> N
 def work_precision_figures(datasets: Mapping[str, Dataset], folder: Path) -> list[Path]:
     """``tradeoff-<scene>.png`` per scene with a run table: every ok run (colour: sweep;
     marker: engine), the Pareto front of all runs (solid) and of flex's own settings (dashed,
-    labelled)."""
+    labelled), and the flex rule's picks (open stars, ``<scene>/rule/...``)."""
     paths = []
     for scene_name in dict.fromkeys(key.split("/runs/")[0] for key in datasets
                                     if "/runs/" in key):
         table = {key.split("/runs/")[1]: value.data for key, value in datasets.items()
                  if key.startswith(f"{scene_name}/runs/")}
         accuracy = datasets.get(f"{scene_name}/reference/accuracy")
+        rule = {key.split("/rule/")[1]: np.asarray(value.data)
+                for key, value in datasets.items() if key.startswith(f"{scene_name}/rule/")}
         path = folder / f"tradeoff-{scene_name}.png"
         with figure(path, f"Work-precision diagram, scene {scene_name} (0.03 s deployment): "
                     "error against integration time of every setting",
                     "wall time of the integration [s] (median of repeats)",
                     "largest relative error against the reference [-]",
                     size=(9.0, 7.5)) as ax:
-            _diagram(ax, table, None if accuracy is None else float(accuracy.data))
+            _diagram(ax, table, None if accuracy is None else float(accuracy.data), rule)
         paths.append(path)
     return paths
