@@ -230,6 +230,13 @@ def _panel(ax: Any, name: str, table: Mapping[str, np.ndarray], levels: Sequence
            picks: Mapping[float, tuple[int, float | None]]) -> None:
     time, error = table["total_time"], table["certified"]
     ok = np.isfinite(time) & np.isfinite(error) & (error > 0)
+    ax.set_title(name, fontsize="small")
+    if not ok.any():  # every grid run failed (a deflection beyond the linear FFRF body's)
+        ax.text(0.5, 0.5, "no grid run finished", ha="center", va="center",
+                transform=ax.transAxes, fontsize="small")
+        ax.set_xticks([])
+        ax.set_yticks([])
+        return
     for modes, marker in zip((1, 2, 4, 8), "o^sD", strict=False):
         chosen = ok & (table["modes"] == modes)
         ax.plot(time[chosen], error[chosen], marker, ms=3, ls="none", label=f"{modes} modes")
@@ -247,7 +254,6 @@ def _panel(ax: Any, name: str, table: Mapping[str, np.ndarray], levels: Sequence
     ax.set_yscale("log")
     log_ticks(ax, "x")
     log_ticks(ax, "y")
-    ax.set_title(name, fontsize="small")
     ax.set_xlabel("run time [s]")
     ax.set_ylabel("certified error [1]")
 
