@@ -298,6 +298,27 @@ def test_a_level_rests_on_the_longest_run_of_scenes_the_grid_can_meet():
     assert [text.split()[0] for text in left] == ["t0.002", "t0.003"]
 
 
+def test_cross_validation_judges_each_scene_by_a_fit_without_it():
+    """Four scenes follow one law, a fifth needs 4x the steps: in the fit it is covered
+    (the law bends to it), left out it is not: the leave-one-out row says so. A scene at
+    either end of n, left out, lies outside the others' range."""
+    from flex.experiments.calibration import cross_validate
+
+    def hard(m, n, n_load):
+        return 16.0 * step_law_error(m, n, n_load)
+
+    cases = {f"t{t}": _case(f"t{t}", t, step_law_error, cost)
+             for t in (0.001, 0.0015, 0.002, 0.003)}
+    cases["hard"] = _case("hard", 0.0025, hard, cost)
+    assert all(row["rule_error"] <= 0.01 for row in validate(cases, fit_levels(cases, [0.01]))
+               if "rule_error" in row)
+    rows = {row["scene"]: row for row in cross_validate(cases, [0.01])}
+    assert set(rows) == set(cases)
+    assert rows["hard"]["rule_error"] > 0.01 and not rows["hard"]["meets"]
+    # the thinnest and thickest left out lie beyond the others' n: judged outside the level
+    assert "outside" in rows["t0.001"] and "outside" in rows["t0.003"]
+
+
 def test_a_level_too_few_references_can_certify_is_not_fitted():
     levels = fit_levels({"a": _case("a", 0.001, step_law_error, cost,
                                     reference_accuracy=1e-2)}, [1e-3])

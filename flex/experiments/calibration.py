@@ -19,7 +19,8 @@ and materials, springs and drives) :func:`measure_scene` runs
 steps per period of the highest retained mode, and the range of ``n = t_load / T1`` it holds
 over) on the calibration scenes that can certify the level (:func:`certifiable`), each scene
 robustly within :data:`MARGIN` x the level (:func:`robustly_within`), the cheapest in summed
-modelled run time (:func:`modelled_time_s`); :func:`validate` applies the fitted rule to
+modelled run time (:func:`modelled_time_s`); :func:`cross_validate` refits with each
+calibration scene left out and judges the fit on it; :func:`validate` applies the fitted rule to
 scenes outside the calibration and compares it with the fastest grid pair robustly within the
 level, by measured time (target: within the level, at most :data:`SLOWDOWN_LIMIT` x slower).
 """
@@ -481,6 +482,19 @@ def validate(cases: Mapping[str, CaseResult], levels: Sequence[Mapping[str, Any]
             row = _validation_row(name, table, level["tolerance"], pair,
                                   certifiable(case, level["tolerance"]))
             rows.append({"damping": damping, "n_load": n_load, **row})
+    return rows
+
+
+def cross_validate(calibration: Mapping[str, CaseResult],
+                   levels: Sequence[float] = LEVELS) -> list[dict[str, Any]]:
+    """Leave-one-out on the calibration scenes: each scene in turn is left out of the fit
+    (:func:`fit_levels` on the others) and the rule so fitted is judged on it
+    (:func:`validate`). The fit's own evidence of how it generalizes, without spending the
+    held-out validation scenes on choosing between fit designs. Rows as :func:`validate`'s."""
+    rows: list[dict[str, Any]] = []
+    for name, case in calibration.items():
+        others = {other: c for other, c in calibration.items() if other != name}
+        rows += validate({name: case}, fit_levels(others, levels))
     return rows
 
 

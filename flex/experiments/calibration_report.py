@@ -32,6 +32,7 @@ from flex.experiments.calibration import (
     MARGIN,
     SLOWDOWN_LIMIT,
     coupler_of,
+    cross_validate,
     damping_of,
     family_bounds,
     fit_levels,
@@ -52,6 +53,8 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
                     bounds)
     in_sample = validate({name: results[name] for name in calibration if name in results},
                          fitted)
+    left_out = cross_validate({name: results[name] for name in calibration
+                               if name in results})
     toml = rule_toml(fitted, bounds, rule_constants()["mesh"])
     datasets = {"rule/toml": Dataset(toml, "1", "the rule's constants (make rule-install)")}
     for index, level in enumerate(fitted):
@@ -80,25 +83,32 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
             level.get("steps_exponent", math.nan), "1", "B of N = C n^-B")
         datasets[f"{prefix}/worst_error"] = Dataset(level.get("worst_error", math.nan), "1",
                                                     "largest certified calibration error")
+    datasets.update(_row_datasets("validation", rows))
+    datasets.update(_row_datasets("cross_validation", left_out))
+    return datasets, _report(results, fitted, rows, toml, in_sample, left_out)
+
+
+def _row_datasets(group: str, rows: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]:
+    """The judged rows of :func:`flex.experiments.calibration.validate` as ``group/*``."""
     judged = [row for row in rows if "failed" not in row and "outside" not in row]
-    for key, units, text in (("rule_error", "1", "certified error of the rule's pick"),
-                             ("rule_time_s", "s", "time of the rule's pick"),
-                             ("best_time_s", "s", "fastest grid pair within the level"),
-                             ("slowdown", "1", "rule / fastest")):
-        datasets[f"validation/{key}"] = Dataset(np.array([row[key] for row in judged]),
-                                                units, text)
-    datasets["validation/scene"] = Dataset(np.array([row["scene"] for row in judged],
-                                                    dtype=object), "1", "scene")
-    datasets["validation/tolerance"] = Dataset(np.array([row["tolerance"] for row in judged]),
-                                               "1", "level")
-    datasets["validation/meets"] = Dataset(np.array([row["meets"] for row in judged]), "1",
-                                           "within the level and the slowdown limit")
-    return datasets, _report(results, fitted, rows, toml, in_sample)
+    out = {f"{group}/{key}": Dataset(np.array([row[key] for row in judged]), units, text)
+           for key, units, text in (
+               ("rule_error", "1", "certified error of the rule's pick"),
+               ("rule_time_s", "s", "time of the rule's pick"),
+               ("best_time_s", "s", "fastest grid pair within the level"),
+               ("slowdown", "1", "rule / fastest"),
+               ("tolerance", "1", "level"),
+               ("certifiable", "1", "the scene's reference can certify the level"),
+               ("meets", "1", "within the level and the slowdown limit"))}
+    out[f"{group}/scene"] = Dataset(np.array([row["scene"] for row in judged], dtype=object),
+                                    "1", "scene")
+    return out
 
 
 def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any]],
             rows: Sequence[Mapping[str, Any]], toml: str,
-            in_sample: Sequence[Mapping[str, Any]] = ()) -> str:
+            in_sample: Sequence[Mapping[str, Any]] = (),
+            left_out: Sequence[Mapping[str, Any]] = ()) -> str:
     lines = ["# FFRF settings rule: calibration and validation", "",
              "Error: relative error of the peak elastic midpoint deflection against each "
              "scene's converged reference, plus the reference's own accuracy (certified). "
@@ -153,9 +163,33 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
               and row["certifiable"]]
     met = sum(row["meets"] for row in judged)
     lines += ["", f"Validation: {met} of {len(judged)} certifiable (scene, level) pairs meet "
-              f"their level at most {SLOWDOWN_LIMIT:g}x slower than the fastest grid pair.",
+              f"their level at most {SLOWDOWN_LIMIT:g}x slower than the fastest grid pair; "
+              + _within_text(judged) + ".", *_cross_lines(left_out),
               "", "## Rule constants (make rule-install)", "", "```toml", toml.strip(), "```"]
     return "\n".join(lines)
+
+
+def _within_text(judged: Sequence[Mapping[str, Any]]) -> str:
+    within = [row for row in judged if row["rule_error"] <= row["tolerance"]]
+    worst = max((row["rule_error"] / row["tolerance"] for row in judged), default=math.nan)
+    return (f"{len(within)} of {len(judged)} within their level (worst {worst:.2g} x the "
+            f"level)")
+
+
+def _cross_lines(rows: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The leave-one-out cross-validation in a few lines: counts and the misses."""
+    judged = [row for row in rows if "failed" not in row and "outside" not in row
+              and row["certifiable"]]
+    if not judged:
+        return []
+    met = sum(row["meets"] for row in judged)
+    misses = [f"{row['scene']} at {row['tolerance']:g}: {row['rule_pair']}, error "
+              f"{row['rule_error'] / row['tolerance']:.2g} x the level, {row['slowdown']:.2g}x "
+              f"slower" for row in judged if not row["meets"]]
+    return ["", "## Cross-validation (each calibration scene left out of the fit in turn)", "",
+            f"{met} of {len(judged)} certifiable (scene, level) pairs meet their level at most "
+            f"{SLOWDOWN_LIMIT:g}x slower than the fastest grid pair; " + _within_text(judged)
+            + ". The misses:", "", *(f"- {miss}" for miss in misses)]
 
 
 #: issue 15's time targets for the rule's picks [s] per level (in process, warm reduction)
