@@ -122,3 +122,40 @@ def test_the_observed_order_replaces_the_formal_one():
     assert _estimate(first, [h, 2 * h, 4 * h], 2) == pytest.approx(c * h, rel=1e-9)
     third = [exact + c * (k * h) ** 3 for k in (1, 2, 4)]
     assert observed_order(third, 2) == 2.0
+
+
+def _datasets(time_s, values):
+    from flex.data.results import Dataset
+
+    return {"time": Dataset(time_s, "s"), "coupler/midpoint_deflection": Dataset(values, "m")}
+
+
+def test_a_crest_that_only_moves_in_time_keeps_its_height():
+    """The other run is the same crest shifted by a fraction of a sample: the peak may
+    move by the sampling, not by the shift's pointwise difference."""
+    from flex.fidelity.error_estimate import peak_difference
+
+    time_s = np.arange(0.0, 0.02, 1e-5)
+    crest = np.sin(2 * np.pi * 100 * time_s) * np.exp(-((time_s - 0.0025) / 0.004) ** 2)
+    later = np.sin(2 * np.pi * 100 * (time_s - 3e-6)) * np.exp(
+        -((time_s - 3e-6 - 0.0025) / 0.004) ** 2)
+    pointwise = np.max(np.abs(crest - later))
+    moved = peak_difference(_datasets(time_s, crest), _datasets(time_s, later),
+                            "coupler/midpoint_deflection")
+    assert moved < 0.05 * pointwise
+
+
+def test_faster_content_at_another_phase_on_the_crest_is_caught():
+    """Two runs whose peaks agree by luck: the same slow crest, a small 4 kHz ripple at
+    opposite phases that happens to leave both maxima equal. The estimate sees the ripple's
+    change (2 x its amplitude, within 20 %), not the peaks' zero difference."""
+    from flex.fidelity.error_estimate import peak_difference
+
+    time_s = np.arange(0.0, 0.005, 1e-6)
+    slow = np.sin(2 * np.pi * 100 * time_s)
+    ripple = 1e-3 * np.sin(2 * np.pi * 4000 * time_s)
+    a, b = slow + ripple, slow - ripple
+    b *= np.max(np.abs(a)) / np.max(np.abs(b))  # the peaks agree exactly
+    moved = peak_difference(_datasets(time_s, a), _datasets(time_s, b),
+                            "coupler/midpoint_deflection")
+    assert moved == pytest.approx(2e-3, rel=0.2)
