@@ -277,7 +277,7 @@ def _diagram(ax: Any, table: dict[str, np.ndarray], accuracy: float | None,
     legend_below(ax.figure, [
         ("o: Exudyn, implicit generalized-alpha (colour: sweep)", {"marker": "o"}),
         ("s: scipy DAE (reference solver)", {"marker": "s"}),
-        ("^: Exudyn, explicit Runge-Kutta + joint springs", {"marker": "^"})], ncol=3)
+        ("^: Exudyn, explicit Runge-Kutta + joint springs", {"marker": "^"})], ncol=2)
 
 
 def work_precision_figures(datasets: Mapping[str, Dataset], folder: Path) -> list[Path]:
