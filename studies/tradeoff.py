@@ -3,23 +3,18 @@
 Three scenes of the thesis deployment (22 mm preload, 0.03 s): the rigid Table 1 model
 (``rigid``) and a steel-plate FFRF coupler 1 mm and 10 mm thick (``ffrf_1mm``, ``ffrf_10mm``).
 For each, a converged reference is run and shown converged
-(:mod:`flex.experiments.reference_plans`), then
-the knobs are varied one at a time around a base setting and in combination (:func:`settings`):
-time step, generalized-alpha spectral radius, index-3 versus index-2 (Newmark) constraints,
-full versus modified Newton and its tolerance, explicit Runge-Kutta with penalty joints
-(rigid), number of modes, mesh size and element order, the fully nonlinear FE coupler instead
-of the FFRF reduction, and the independent scipy reference DAE (rigid) at several tolerances.
+(:mod:`flex.experiments.reference_plans`), then the knobs are varied one at a time around a base
+setting and in combination (:func:`settings`): time step, generalized-alpha spectral radius,
+index-3 versus index-2 (Newmark) constraints, full versus modified Newton and its tolerance,
+explicit Runge-Kutta with penalty joints (rigid), number of modes, mesh size and element order,
+the fully nonlinear FE coupler instead of the FFRF reduction, and the independent scipy
+reference DAE (rigid) at several tolerances.
 
-Stored (:mod:`flex.experiments.workprecision`): per run a case ``<scene>__<setting>`` (a diverged
-run is a
-``failed`` case with the step and time in its message and no data); per scene under
-``/summary/<scene>/`` (:mod:`flex.experiments.workprecision_report`): ``runs/...`` (with
-``on_pareto_front``), ``reference/...`` (with its convergence evidence), ``recommended/...``
-(per accuracy level 1 %, 0.1 %, 0.01 %), ``default/...`` (whether the bundled "auto" solver
-keys are the measured pick) and, FFRF scenes, ``rule/...`` (the settings flex's rule picks
-when asked for 1 % and 0.1 %, "flex rule (...)", and where they sit;
-:mod:`flex.experiments.defaults_check`). Figures: one work-precision diagram (error against
-wall time, log-log, Pareto front and rule picks marked) per scene.
+Stored (:mod:`flex.experiments.workprecision`): a case ``<scene>__<setting>`` per run (a diverged
+run: a ``failed`` case); under ``/summary/<scene>/`` (:mod:`flex.experiments.workprecision_report`)
+``runs/...``, ``reference/...``, ``recommended/...`` (1 %, 0.1 %, 0.01 %), ``default/...`` and
+(FFRF) ``rule/...``: the bundled "auto" keys and the rule's picks at 1 % and 0.1 % against the
+runs (:mod:`flex.experiments.defaults_check`). Figures: a work-precision diagram per scene.
 """
 
 from __future__ import annotations
