@@ -347,20 +347,22 @@ def _fit_one(level: float,
     each scene's fewest robust steps per period N_i within MARGIN x level at its n_i = t_load
     / T1, the smallest C for which the law N = C n^-B reaches every scene's N_i
     (:func:`_step_law`), and the law's picks (rounded up to the grid) timed over the scenes
-    (:func:`modelled_time_s`). The combination with the least total
-    time wins (ties: :func:`_closest_of_ties`)."""
+    (:func:`modelled_time_s`). The combination with the least total time wins; of exponents
+    equally fast (the same picks: the calibration leaves B anywhere in that range), the one
+    nearest the slope the scenes' needed steps show (:func:`_slope`)."""
     scenes = sorted(usable)
     if len(usable) < MIN_SCENES:
         return {"tolerance": level, "modes": None, "scenes": scenes,
                 "reason": f"{len(usable)} calibration references can certify it (at least "
                           f"{MIN_SCENES} needed)"}
-    best: list[dict[str, Any]] = []
+    best: dict[str, Any] | None = None
     tables = [table for table, _, _ in usable.values()]
     times = [modelled_time_s(table) for table in tables]
     n_load = np.array([n for _, n, _ in usable.values()])
     needed_by_modes = [{m: needed_steps(t, m, MARGIN * level) for m in MODE_GRID}
                        for t in tables]
-    for ratio, load in itertools.product(MODE_CUTOFF_RATIOS, MODE_CUTOFF_LOADS):
+    for ratio, load, per_top in itertools.product(MODE_CUTOFF_RATIOS, MODE_CUTOFF_LOADS,
+                                                  STEPS_PER_TOP_PERIOD):
         cut = {"mode_cutoff_ratio": ratio, "mode_cutoff_load": load}
         modes = [level_modes(cut, c, n) for _, n, c in usable.values()]
         top = np.array([top_mode_ratio(cut, c, n) for _, n, c in usable.values()])
@@ -368,42 +370,27 @@ def _fit_one(level: float,
                                                               strict=True)])
         if not np.all(np.isfinite(needed)):
             continue
-        for per_top, exponent in itertools.product(STEPS_PER_TOP_PERIOD, STEPS_EXPONENTS):
+        # nearest the slope the scenes show first: of exponents with the same picks (the
+        # same time), the first found stays
+        slope = _slope(needed, n_load, per_top * top)
+        for exponent in sorted(STEPS_EXPONENTS, key=lambda b: abs(b - slope)):
             law = {"steps_per_top_period": per_top,
-                   **_step_law(needed, n_load, per_top * top, exponent),
-                   "data_exponent": _slope(needed, n_load, per_top * top)}
+                   **_step_law(needed, n_load, per_top * top, exponent)}
             picks = [steps_per_first_period(law, n, r) for n, r in zip(n_load, top,
                                                                          strict=True)]
             if None in picks:  # the law leaves the grid on some scene: not a usable fit
                 continue
             rows = [_row(t, m, per) for t, m, per in zip(tables, modes, picks, strict=True)]
             time = float(sum(s[r] for s, r in zip(times, rows, strict=True)))
-            if best and time > best[0]["total_time_s"] * (1 + 1e-9):
-                continue
-            fit = {"tolerance": level, "modes": max(modes), **cut, **law,
-                   "n_load_min": float(np.min(n_load)), "n_load_max": float(np.max(n_load)),
-                   "total_time_s": time,
-                   "worst_error": float(max(t["certified"][r]
-                                            for t, r in zip(tables, rows, strict=True)))}
-            tied = best and time >= best[0]["total_time_s"] * (1 - 1e-9)
-            best = [*best, fit] if tied else [fit]
-    if not best:
-        return {"tolerance": level, "modes": None, "scenes": scenes, "reason":
-                f"no mode cut-off keeps every scene robustly within {MARGIN:g} x {level:g} "
-                f"on the grid"}
-    chosen = _closest_of_ties(best)
-    chosen.pop("data_exponent")
-    return {**chosen, "scenes": scenes}
-
-
-def _closest_of_ties(fits: Sequence[dict[str, Any]]) -> dict[str, Any]:
-    """Of laws equally fast on the calibration scenes (the same picks: exponents B whose
-    rounded laws agree there), with the first mode cut-off's, the B closest to the slope the
-    scenes' needed steps show (``data_exponent``, :func:`_slope`): the picks leave B
-    anywhere in that range, the data say where in it."""
-    keys = ("mode_cutoff_ratio", "mode_cutoff_load", "steps_per_top_period")
-    same = [fit for fit in fits if all(fit[key] == fits[0][key] for key in keys)]
-    return dict(min(same, key=lambda fit: abs(fit["steps_exponent"] - fit["data_exponent"])))
+            if best is None or time < best["total_time_s"] * (1 - 1e-9):
+                best = {"tolerance": level, "modes": max(modes), **cut, **law,
+                        "n_load_min": float(np.min(n_load)),
+                        "n_load_max": float(np.max(n_load)), "total_time_s": time,
+                        "worst_error": float(max(t["certified"][r]
+                                                 for t, r in zip(tables, rows, strict=True)))}
+    return {**(best or {"tolerance": level, "modes": None, "reason":
+                        f"no mode cut-off keeps every scene robustly within {MARGIN:g} x "
+                        f"{level:g} on the grid"}), "scenes": scenes}
 
 
 def _slope(needed: np.ndarray, n_load: np.ndarray, resolved: np.ndarray) -> float:

@@ -159,37 +159,39 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
                      f"{row['slowdown']:.2g} | {row['meets']} |")
     lines += _target_lines([*rows, *({**row, "scene": f"{row['scene']} (calibration)"}
                                      for row in in_sample)])
-    judged = [row for row in rows if "failed" not in row and "outside" not in row
-              and row["certifiable"]]
-    met = sum(row["meets"] for row in judged)
-    lines += ["", f"Validation: {met} of {len(judged)} certifiable (scene, level) pairs meet "
-              f"their level at most {SLOWDOWN_LIMIT:g}x slower than the fastest grid pair; "
-              + _within_text(judged) + ".", *_cross_lines(left_out),
+    lines += ["", f"Validation: {_tally(_certifiable_rows(rows))}.",
+              *_cross_lines(left_out),
               "", "## Rule constants (make rule-install)", "", "```toml", toml.strip(), "```"]
     return "\n".join(lines)
 
 
-def _within_text(judged: Sequence[Mapping[str, Any]]) -> str:
+def _certifiable_rows(rows: Sequence[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
+    """The judged rows of :func:`flex.experiments.calibration.validate` whose reference can
+    certify their level."""
+    return [row for row in rows if "failed" not in row and "outside" not in row
+            and row["certifiable"]]
+
+
+def _tally(judged: Sequence[Mapping[str, Any]]) -> str:
+    """How many certifiable pairs meet the target, and how many are within their level."""
     within = [row for row in judged if row["rule_error"] <= row["tolerance"]]
     worst = max((row["rule_error"] / row["tolerance"] for row in judged), default=math.nan)
-    return (f"{len(within)} of {len(judged)} within their level (worst {worst:.2g} x the "
-            f"level)")
+    return (f"{sum(row['meets'] for row in judged)} of {len(judged)} certifiable (scene, "
+            f"level) pairs meet their level at most {SLOWDOWN_LIMIT:g}x slower than the "
+            f"fastest grid pair; {len(within)} of {len(judged)} within their level (worst "
+            f"{worst:.2g} x the level)")
 
 
 def _cross_lines(rows: Sequence[Mapping[str, Any]]) -> list[str]:
     """The leave-one-out cross-validation in a few lines: counts and the misses."""
-    judged = [row for row in rows if "failed" not in row and "outside" not in row
-              and row["certifiable"]]
+    judged = _certifiable_rows(rows)
     if not judged:
         return []
-    met = sum(row["meets"] for row in judged)
     misses = [f"{row['scene']} at {row['tolerance']:g}: {row['rule_pair']}, error "
               f"{row['rule_error'] / row['tolerance']:.2g} x the level, {row['slowdown']:.2g}x "
               f"slower" for row in judged if not row["meets"]]
     return ["", "## Cross-validation (each calibration scene left out of the fit in turn)", "",
-            f"{met} of {len(judged)} certifiable (scene, level) pairs meet their level at most "
-            f"{SLOWDOWN_LIMIT:g}x slower than the fastest grid pair; " + _within_text(judged)
-            + ". The misses:", "", *(f"- {miss}" for miss in misses)]
+            f"{_tally(judged)}. The misses:", "", *(f"- {miss}" for miss in misses)]
 
 
 #: issue 15's time targets for the rule's picks [s] per level (in process, warm reduction)
