@@ -319,6 +319,63 @@ def test_cross_validation_judges_each_scene_by_a_fit_without_it():
     assert "outside" in rows["t0.001"] and "outside" in rows["t0.003"]
 
 
+def test_the_local_design_picks_the_cheapest_pair_robust_on_the_nearest_scenes():
+    """Left out, the 1 mm scene takes, with one neighbour, the cheapest pair robust on the
+    nearest scene (1.2 mm); with two, a pair robust on the far one too, which needs 16x the
+    error's steps squared: the pick moves to more steps."""
+    from flex.experiments.calibration import grid_table, modelled_time_s
+    from flex.experiments.rule_designs import neighbour_pick
+
+    def hard(m, n, n_load):
+        return 16.0 * step_law_error(m, n, n_load)
+
+    held = _case("t0.001", 0.001, step_law_error, cost)
+    near = _case("t0.0012", 0.0012, step_law_error, cost)
+    far = _case("far", 0.005, hard, cost)
+    others = {"t0.0012": near, "far": far}
+    table = grid_table(near)
+    ok = robustly_within(table, 0.01)
+    cheapest = int(np.flatnonzero(ok)[np.argmin(modelled_time_s(table)[ok])])
+    assert neighbour_pick(held, others, 0.01, 1, 1.0) == cheapest
+    both = neighbour_pick(held, others, 0.01, 2, 1.0)
+    assert robustly_within(grid_table(far), 0.01)[both] and ok[both]
+    assert table["steps_per_first_period"][both] > table["steps_per_first_period"][cheapest]
+    assert neighbour_pick(held, others, 0.01, 3, 1.0) is None  # only two scenes to ask
+
+
+def test_every_rule_design_is_judged_on_the_installed_design_s_pairs():
+    from flex.experiments.calibration import cross_validate
+    from flex.experiments.rule_designs import INSTALLED, design_frontier
+
+    cases = {f"t{t}": _case(f"t{t}", t, step_law_error, cost)
+             for t in (0.001, 0.0012, 0.0015, 0.002, 0.003)}
+    designs = design_frontier(cases, [0.01])
+    judged = [row for row in cross_validate(cases, [0.01])
+              if "rule_pair" in row and row["certifiable"]]
+    assert designs[0]["design"] == INSTALLED and designs[0]["judged"] == len(judged) > 0
+    assert designs[0]["meets"] == sum(row["meets"] for row in judged)
+    for row in designs:
+        assert row["judged"] == len(judged)
+        assert row["no_pick"] + row["not_robust"] + row["slower"] + row["meets"] \
+            == row["judged"]
+
+
+def test_the_calibration_summary_stores_and_reports_the_designs_compared():
+    from flex.experiments.calibration_report import calibration_summary
+    from flex.experiments.rule_designs import NEIGHBOUR_MARGINS, NEIGHBOURS
+
+    thicknesses = {f"t{t}": t for t in (0.001, 0.0012, 0.0015, 0.002, 0.003)}
+    results = {name: _case(name, t, step_law_error, cost) for name, t in thicknesses.items()}
+    scenes = {name: _scene(t) for name, t in thicknesses.items()}
+    for name, case in results.items():  # what the report's references table reads
+        case.attrs["first_period_s"] = first_period_s(scenes[name]["coupler"])
+    datasets, report = calibration_summary(results, {k: scenes[k] for k in list(scenes)[:4]},
+                                           {"t0.003": scenes["t0.003"]})
+    designs = 1 + len(NEIGHBOURS) * len(NEIGHBOUR_MARGINS)
+    assert len(datasets["design_frontier/meets"].data) == designs
+    assert "## Rule designs compared" in report
+
+
 def test_a_level_too_few_references_can_certify_is_not_fitted():
     levels = fit_levels({"a": _case("a", 0.001, step_law_error, cost,
                                     reference_accuracy=1e-2)}, [1e-3])

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from functools import cache
 from typing import Any
 
 import numpy as np
@@ -109,6 +110,11 @@ def euler_bernoulli_beta_l(end_condition: str, mode_count: int) -> list[float]:
     if end_condition not in BEAM_END_CONDITIONS:
         raise ValueError(f"end_condition = {end_condition!r}: must be one of "
                          f"{', '.join(BEAM_END_CONDITIONS)}")
+    return list(_beta_l_roots(end_condition, mode_count))
+
+
+@cache  # a constant table: make calibrate's fit asks for the same roots ~10^4 times
+def _beta_l_roots(end_condition: str, mode_count: int) -> tuple[float, ...]:
     roots: list[float] = []
     for n in range(1, mode_count + 1):
         if end_condition == "pinned-pinned":
@@ -125,7 +131,7 @@ def euler_bernoulli_beta_l(end_condition: str, mode_count: int) -> list[float]:
             guess = (n + 0.25) * math.pi
             roots.append(_bisect(lambda x: math.sin(x) - math.cos(x) * math.tanh(x),
                                  guess - 0.3, guess + 0.3))
-    return roots
+    return tuple(roots)
 
 
 def euler_bernoulli_omega(beta_l: Any, length_m: float, height_m: float,

@@ -361,6 +361,8 @@ def _fit_one(level: float,
     n_load = np.array([n for _, n, _ in usable.values()])
     needed_by_modes = [{m: needed_steps(t, m, MARGIN * level) for m in MODE_GRID}
                        for t in tables]
+    indices = [{(int(m), round(per)): row for row, (m, per) in enumerate(
+        zip(t["modes"], t["steps_per_first_period"], strict=True))} for t in tables]
     for ratio, load, per_top in itertools.product(MODE_CUTOFF_RATIOS, MODE_CUTOFF_LOADS,
                                                   STEPS_PER_TOP_PERIOD):
         cut = {"mode_cutoff_ratio": ratio, "mode_cutoff_load": load}
@@ -380,7 +382,8 @@ def _fit_one(level: float,
                                                                          strict=True)]
             if None in picks:  # the law leaves the grid on some scene: not a usable fit
                 continue
-            rows = [_row(t, m, per) for t, m, per in zip(tables, modes, picks, strict=True)]
+            rows = [index[(m, round(per))] for index, m, per in zip(indices, modes, picks,
+                                                                       strict=True)]
             time = float(sum(s[r] for s, r in zip(times, rows, strict=True)))
             if best is None or time < best["total_time_s"] * (1 - 1e-9):
                 best = {"tolerance": level, "modes": max(modes), **cut, **law,
@@ -466,7 +469,7 @@ def validate(cases: Mapping[str, CaseResult], levels: Sequence[Mapping[str, Any]
                              f"n = {n_load:.3g} needs more than {STEP_GRID[-1]} steps"})
                 continue
             pair = (level_modes(level, coupler_of(case), n_load), per)
-            row = _validation_row(name, table, level["tolerance"], pair,
+            row = validation_row(name, table, level["tolerance"], pair,
                                   certifiable(case, level["tolerance"]))
             rows.append({"damping": damping, "n_load": n_load, **row})
     return rows
@@ -485,8 +488,11 @@ def cross_validate(calibration: Mapping[str, CaseResult],
     return rows
 
 
-def _validation_row(name: str, table: Mapping[str, np.ndarray], tol: float,
-                    pair: tuple[int, float], can_certify: bool) -> dict[str, Any]:
+def validation_row(name: str, table: Mapping[str, np.ndarray], tol: float,
+                   pair: tuple[int, float], can_certify: bool) -> dict[str, Any]:
+    """The grid ``pair`` (modes, steps per first period) of a scene judged at ``tol``
+    against the fastest grid pair robustly within it (row keys: :func:`validate`'s, and
+    ``robust``: the pair robustly within ``tol``)."""
     rule = _row(table, *pair)
     within = np.flatnonzero(robustly_within(table, tol))
     best = int(within[np.argmin(table["total_time"][within])]) if within.size else None
@@ -498,8 +504,8 @@ def _validation_row(name: str, table: Mapping[str, np.ndarray], tol: float,
            "best_pair": "" if best is None else
            f"{int(table['modes'][best])} modes, T1/{table['steps_per_first_period'][best]:g}"}
     row["slowdown"] = row["rule_time_s"] / row["best_time_s"]
-    row["meets"] = bool(can_certify and robustly_within(table, tol)[rule]
-                        and row["slowdown"] <= SLOWDOWN_LIMIT)
+    row["robust"] = bool(robustly_within(table, tol)[rule])
+    row["meets"] = bool(can_certify and row["robust"] and row["slowdown"] <= SLOWDOWN_LIMIT)
     return row
 
 

@@ -41,6 +41,7 @@ from flex.experiments.calibration import (
     rule_toml,
     validate,
 )
+from flex.experiments.rule_designs import design_frontier
 from flex.experiments.tradeoff import pareto_front
 
 
@@ -55,6 +56,7 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
                          fitted)
     left_out = cross_validate({name: results[name] for name in calibration
                                if name in results})
+    designs = design_frontier(_within_family(results, {**calibration, **validation}, bounds))
     toml = rule_toml(fitted, bounds, rule_constants()["mesh"])
     datasets = {"rule/toml": Dataset(toml, "1", "the rule's constants (make rule-install)")}
     for index, level in enumerate(fitted):
@@ -85,7 +87,74 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
                                                     "largest certified calibration error")
     datasets.update(_row_datasets("validation", rows))
     datasets.update(_row_datasets("cross_validation", left_out))
-    return datasets, _report(results, fitted, rows, toml, in_sample, left_out)
+    datasets.update(_design_datasets(designs))
+    return datasets, _report(results, fitted, rows, toml, in_sample, left_out, designs)
+
+
+def _within_family(results: Mapping[str, CaseResult], scenes: Mapping[str, Scene],
+                   bounds: Mapping[str, float]) -> dict[str, CaseResult]:
+    """The measured cases of ``scenes`` whose coupler's slenderness lies within ``bounds``."""
+    def inside(scene: Scene) -> bool:
+        slenderness = scene["coupler"]["length_m"] / scene["coupler"]["thickness_m"]
+        return bounds["slenderness_min"] <= slenderness <= bounds["slenderness_max"]
+
+    return {name: results[name] for name, scene in scenes.items()
+            if name in results and inside(scene)}
+
+
+#: the columns of the rule designs' comparison (flex.experiments.rule_designs)
+DESIGN_COLUMNS = (("judged", "pairs"), ("no_pick", "no pick"),
+                  ("over_level", "over the level"), ("not_robust", "not robustly within"),
+                  ("slower", f"robust, > {SLOWDOWN_LIMIT:g}x slower"),
+                  ("meets", "meet the target"))
+
+
+def _design_datasets(designs: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]:
+    """:func:`flex.experiments.rule_designs.design_frontier`'s tallies as
+    ``design_frontier/*``."""
+    out = {f"design_frontier/{key}": Dataset(np.array([row[key] for row in designs]), "1",
+                                             f"(scene, level) pairs: {text}")
+           for key, text in DESIGN_COLUMNS}
+    out["design_frontier/design"] = Dataset(np.array([row["design"] for row in designs],
+                                                     dtype=object), "1", "rule design")
+    out["design_frontier/worst_ratio"] = Dataset(
+        np.array([row["worst_ratio"] for row in designs]), "1",
+        "largest certified error of a pick / its level")
+    return out
+
+
+def _design_lines(designs: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The rule designs' comparison: a table and what it shows."""
+    if not designs:
+        return []
+    scenes = {row["scene"] for row in designs[0]["rows"]}
+    lines = ["", "## Rule designs compared (leave-one-out over every measured scene)", "",
+             "Each calibration and validation scene in turn is left out, and each design, "
+             "built from the others, picks its settings (`flex.experiments.rule_designs`). "
+             f"Every design is judged on the same {len(designs[0]['rows'])} (scene, level) "
+             f"pairs, from {len(scenes)} scenes. The validation scenes are spent here only "
+             "for comparing designs, not for choosing the installed one. A design with no "
+             "pick falls back, visibly.", "",
+             "| design | " + " | ".join(text for _, text in DESIGN_COLUMNS)
+             + " | worst error / level |",
+             "|---|" + "---|" * (len(DESIGN_COLUMNS) + 1)]
+    for row in designs:
+        lines.append(f"| {row['design']} | "
+                     + " | ".join(str(row[key]) for key, _ in DESIGN_COLUMNS)
+                     + f" | {row['worst_ratio']:.2g} |")
+    safe = [row for row in designs if row["over_level"] == 0]
+    fastest = max(designs, key=lambda row: row["meets"])
+    if safe:
+        best_safe = max(safe, key=lambda row: row["meets"])
+        lines += ["", f"Of the designs whose every pick keeps its left-out pair within the "
+                  f"level, the best meets the target on {best_safe['meets']} of "
+                  f"{best_safe['judged']} pairs ({best_safe['design']})."]
+    else:
+        lines += ["", "Every design puts some left-out pair over its level."]
+    lines.append(f"The most pairs meeting the target: {fastest['meets']} of "
+                 f"{fastest['judged']} ({fastest['design']}), with {fastest['over_level']} "
+                 f"over the level (worst {fastest['worst_ratio']:.2g} x).")
+    return lines
 
 
 def _row_datasets(group: str, rows: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]:
@@ -108,7 +177,8 @@ def _row_datasets(group: str, rows: Sequence[Mapping[str, Any]]) -> dict[str, Da
 def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any]],
             rows: Sequence[Mapping[str, Any]], toml: str,
             in_sample: Sequence[Mapping[str, Any]] = (),
-            left_out: Sequence[Mapping[str, Any]] = ()) -> str:
+            left_out: Sequence[Mapping[str, Any]] = (),
+            designs: Sequence[Mapping[str, Any]] = ()) -> str:
     lines = ["# FFRF settings rule: calibration and validation", "",
              "Error: relative error of the peak elastic midpoint deflection against each "
              "scene's converged reference, plus the reference's own accuracy (certified). "
@@ -160,7 +230,7 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
     lines += _target_lines([*rows, *({**row, "scene": f"{row['scene']} (calibration)"}
                                      for row in in_sample)])
     lines += ["", f"Validation: {_tally(_certifiable_rows(rows))}.",
-              *_cross_lines(left_out),
+              *_cross_lines(left_out), *_design_lines(designs),
               "", "## Rule constants (make rule-install)", "", "```toml", toml.strip(), "```"]
     return "\n".join(lines)
 
