@@ -360,6 +360,24 @@ def test_every_rule_design_is_judged_on_the_installed_design_s_pairs():
             == row["judged"]
 
 
+def test_near_twins_one_setting_cannot_serve_fast_are_found():
+    """Two plates 5 % apart in thickness, one needing 4x the steps of the other (16x the
+    error): the pair robust on both is the harder one's, 4x slower on the easier one. A plate
+    3x thicker is nobody's twin."""
+    from flex.experiments.rule_designs import near_twins
+
+    def hard(m, n, n_load):
+        return 16.0 * step_law_error(m, n, n_load)
+
+    cases = {"a": _case("a", 0.001, step_law_error, cost),
+             "b": _case("b", 0.00105, hard, cost),
+             "far": _case("far", 0.003, step_law_error, cost)}
+    (row,) = near_twins(cases, 0.01)
+    assert row["scenes"] == ("a", "b")
+    assert row["slowdown"] == pytest.approx(4.0)
+    assert row["shared_pair"].startswith("1 modes")
+
+
 def test_the_calibration_summary_stores_and_reports_the_designs_compared():
     from flex.experiments.calibration_report import calibration_summary
     from flex.experiments.rule_designs import NEIGHBOUR_MARGINS, NEIGHBOURS
@@ -373,7 +391,8 @@ def test_the_calibration_summary_stores_and_reports_the_designs_compared():
                                            {"t0.003": scenes["t0.003"]})
     designs = 1 + len(NEIGHBOURS) * len(NEIGHBOUR_MARGINS)
     assert len(datasets["design_frontier/meets"].data) == designs
-    assert "## Rule designs compared" in report
+    assert "## Rule designs compared" in report and "Near twins" in report
+    assert "near_twins/slowdown" in datasets
 
 
 def test_a_level_too_few_references_can_certify_is_not_fitted():

@@ -29,6 +29,7 @@ from flex.config.ffrf_rule import (
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.experiments.calibration import (
+    LEVELS,
     MARGIN,
     SLOWDOWN_LIMIT,
     coupler_of,
@@ -41,7 +42,7 @@ from flex.experiments.calibration import (
     rule_toml,
     validate,
 )
-from flex.experiments.rule_designs import design_frontier
+from flex.experiments.rule_designs import TWIN_CLOSENESS, design_frontier, near_twins
 from flex.experiments.tradeoff import pareto_front
 
 
@@ -56,7 +57,9 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
                          fitted)
     left_out = cross_validate({name: results[name] for name in calibration
                                if name in results})
-    designs = design_frontier(_within_family(results, {**calibration, **validation}, bounds))
+    family = _within_family(results, {**calibration, **validation}, bounds)
+    designs = design_frontier(family)
+    twins = [{**row, "tolerance": level} for level in LEVELS for row in near_twins(family, level)]
     toml = rule_toml(fitted, bounds, rule_constants()["mesh"])
     datasets = {"rule/toml": Dataset(toml, "1", "the rule's constants (make rule-install)")}
     for index, level in enumerate(fitted):
@@ -88,7 +91,9 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
     datasets.update(_row_datasets("validation", rows))
     datasets.update(_row_datasets("cross_validation", left_out))
     datasets.update(_design_datasets(designs))
-    return datasets, _report(results, fitted, rows, toml, in_sample, left_out, designs)
+    datasets.update(_twin_datasets(twins))
+    return datasets, _report(results, fitted, rows, toml, in_sample, left_out,
+                             [*_design_lines(designs), *_twin_lines(twins)])
 
 
 def _within_family(results: Mapping[str, CaseResult], scenes: Mapping[str, Scene],
@@ -121,6 +126,39 @@ def _design_datasets(designs: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]
         np.array([row["worst_ratio"] for row in designs]), "1",
         "largest certified error of a pick / its level")
     return out
+
+
+def _twin_datasets(twins: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]:
+    """:func:`flex.experiments.rule_designs.near_twins`' rows as ``near_twins/*``."""
+    return {
+        "near_twins/scene_a": Dataset(np.array([row["scenes"][0] for row in twins],
+                                               dtype=object), "1", "first scene of the pair"),
+        "near_twins/scene_b": Dataset(np.array([row["scenes"][1] for row in twins],
+                                               dtype=object), "1", "second scene"),
+        "near_twins/tolerance": Dataset(np.array([row["tolerance"] for row in twins]), "1",
+                                        "level"),
+        "near_twins/slowdown": Dataset(np.array([row["slowdown"] for row in twins]), "1",
+                                       "least worse-of-the-two modelled slowdown of a grid "
+                                       "pair robust on both (inf: none)")}
+
+
+def _twin_lines(twins: Sequence[Mapping[str, Any]]) -> list[str]:
+    """The near twins in a few lines: how many, and those one setting cannot serve within
+    the slowdown limit."""
+    apart = [row for row in twins if row["slowdown"] > SLOWDOWN_LIMIT]
+    lines = ["", f"Near twins (same damping class, n and L / t within "
+             f"{TWIN_CLOSENESS:.0%} of each other, where a rule of (n, L / t) gives nearly "
+             f"the same settings): {len(twins)} (scene, scene, level) triples; "
+             f"{len(apart)} of them no grid pair serves both within their level at most "
+             f"{SLOWDOWN_LIMIT:g}x slower than each one's fastest (modelled times)"
+             + (":" if apart else ".")]
+    if apart:
+        lines.append("")
+    for row in apart:
+        lines.append(f"- {row['scenes'][0]} and {row['scenes'][1]} at {row['tolerance']:g}: "
+                     f"{row['shared_pair'] or 'no shared pair'}, {row['slowdown']:.2g}x "
+                     f"slower on one of them")
+    return lines
 
 
 def _design_lines(designs: Sequence[Mapping[str, Any]]) -> list[str]:
@@ -177,8 +215,8 @@ def _row_datasets(group: str, rows: Sequence[Mapping[str, Any]]) -> dict[str, Da
 def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any]],
             rows: Sequence[Mapping[str, Any]], toml: str,
             in_sample: Sequence[Mapping[str, Any]] = (),
-            left_out: Sequence[Mapping[str, Any]] = (),
-            designs: Sequence[Mapping[str, Any]] = ()) -> str:
+            left_out: Sequence[Mapping[str, Any]] = (), comparison: Sequence[str] = ()
+            ) -> str:
     lines = ["# FFRF settings rule: calibration and validation", "",
              "Error: relative error of the peak elastic midpoint deflection against each "
              "scene's converged reference, plus the reference's own accuracy (certified). "
@@ -230,7 +268,7 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
     lines += _target_lines([*rows, *({**row, "scene": f"{row['scene']} (calibration)"}
                                      for row in in_sample)])
     lines += ["", f"Validation: {_tally(_certifiable_rows(rows))}.",
-              *_cross_lines(left_out), *_design_lines(designs),
+              *_cross_lines(left_out), *comparison,
               "", "## Rule constants (make rule-install)", "", "```toml", toml.strip(), "```"]
     return "\n".join(lines)
 

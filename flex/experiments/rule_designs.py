@@ -19,6 +19,11 @@ leave-one-out judges with a reference that can certify the level. Per design: pa
 level (what a user would see), picks not robustly within it, picks robustly within it but more
 than the slowdown limit slower, and picks that meet the target.
 
+:func:`near_twins` shows why no rule of these inputs can be fast everywhere: pairs of scenes of
+one damping class whose n and L / t lie within :data:`TWIN_CLOSENESS` of each other (a rule of
+(n, L / t) gives them nearly the same settings), with the grid pair robust on both that is
+least slow on the slower of the two.
+
 Contract: pure functions of the stored cases; nothing is run.
 """
 
@@ -49,6 +54,8 @@ from flex.experiments.calibration import (
 NEIGHBOURS = (1, 2, 3)
 #: the local design keeps its pick robustly within this fraction of the level on the neighbours
 NEIGHBOUR_MARGINS = (1.0, 0.5)
+#: near twins: n and L / t within this relative distance of each other
+TWIN_CLOSENESS = 0.15
 #: the installed design's name in the rows
 INSTALLED = "installed: one law per class"
 
@@ -132,3 +139,37 @@ def _tally(design: str, rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
             "meets": sum(row["meets"] for row in picked),
             "worst_ratio": max((row["rule_error"] / row["tolerance"] for row in picked),
                                default=math.nan), "rows": list(rows)}
+
+
+def near_twins(cases: Mapping[str, CaseResult], level: float,
+               closeness: float = TWIN_CLOSENESS) -> list[dict[str, Any]]:
+    """Pairs of ``cases`` of one damping class, both able to certify ``level`` and some grid
+    pair robustly within it, whose n and L / t differ by at most ``closeness`` (relative).
+    Row keys: ``scenes`` (the two names), ``shared_pair`` ("" if none), ``slowdown``: the
+    least, over grid pairs robustly within the level on both, of the larger of the two
+    scenes' modelled slowdowns against their own fastest robust pair (inf if none)."""
+    usable = {}
+    for name, case in cases.items():
+        if not certifiable(case, level):
+            continue
+        table = grid_table(case)
+        ok = robustly_within(table, level)
+        if ok.any():
+            time = modelled_time_s(table)
+            usable[name] = (case, table, ok, time / np.min(time[ok]))
+    rows = []
+    names = sorted(usable)
+    limit = math.log1p(closeness)
+    for index, first in enumerate(names):
+        for second in names[index + 1:]:
+            (a, table, ok_a, slow_a), (b, _, ok_b, slow_b) = usable[first], usable[second]
+            gaps = np.abs(np.subtract(scene_features(a), scene_features(b)))
+            if damping_of(a) != damping_of(b) or np.any(gaps > limit):
+                continue
+            worst = np.where(ok_a & ok_b, np.maximum(slow_a, slow_b), np.inf)
+            best = int(np.argmin(worst))
+            rows.append({"scenes": (first, second), "slowdown": float(worst[best]),
+                         "shared_pair": "" if math.isinf(worst[best]) else
+                         f"{int(table['modes'][best])} modes, "
+                         f"T1/{table['steps_per_first_period'][best]:g}"})
+    return rows
