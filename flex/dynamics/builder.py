@@ -130,6 +130,25 @@ def _rotation_z(angle_rad: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+def _turned_marker(mbs: Any, marker: int, rotation: np.ndarray) -> int:
+    """A copy of ``marker`` with its frame turned by ``rotation`` (3x3, in the marker's frame)
+    through its ``localHT``: a joint's frame as Exudyn takes it since 1.12.244 deprecated the
+    joints' ``rotationMarker0/1``. A copy, so that the marker's own sensors (the frame of B's
+    force in collect among them) read as before. Rigid markers only (``BodyRigid``,
+    ``NodeRigid``, ``SuperElementRigid``: each has a ``localHT``)."""
+    data = mbs.GetMarker(marker)
+    if "localHT" not in data:
+        raise TypeError(f"marker {marker} ({data['markerType']}) has no frame (localHT) to turn")
+    turn = np.eye(4)
+    turn[:3, :3] = rotation
+    # names are unique (Exudyn names the copy); localPosition / offset is the localHT's
+    # translation, which the copy keeps
+    copy = {key: value for key, value in data.items()
+            if key not in ("name", "localPosition", "offset")}
+    copy["localHT"] = np.asarray(data["localHT"]) @ turn
+    return mbs.AddMarker(copy)
+
+
 #: damping of the penalty joints, as a fraction of critical for the lightest link's mass
 PENALTY_DAMPING_RATIO = 0.2
 
@@ -284,10 +303,12 @@ class _Builder:
         """Weld the wing's root marker to the crank's marker at A (a rigid-body marker, or
         the joint face of a flexible crank); return the joint. Its reaction torque is the
         wing root bending moment in the mechanism plane."""
+        # both markers turned back by the crank angle: the weld frame is global at t = 0
         crank_rotation = _rotation_z(self.init.crank_angle_rad)
+        markers = [_turned_marker(self.mbs, marker, crank_rotation.T)
+                   for marker in (crank_root, wing_root)]
         return self.mbs.AddObject(self.eii.ObjectJointGeneric(
-            markerNumbers=[crank_root, wing_root], constrainedAxes=[1, 1, 1, 1, 1, 1],
-            rotationMarker0=crank_rotation.T, rotationMarker1=crank_rotation.T))
+            markerNumbers=markers, constrainedAxes=[1, 1, 1, 1, 1, 1]))
 
     def add_slider(self) -> dict:
         """The slider: a rigid body at joint C, not turned (its prismatic joint holds it)."""
@@ -384,19 +405,20 @@ class _Builder:
         coupler_ref = _rotation_z(self.init.coupler_angle_rad)
         # joint frames coincide with the global axes at t = 0; force outputs are in the frame
         # of marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where
-        # it can
+        # it can; the links' markers are turned by copies (_turned_marker)
         self.joints = {
             "A": mbs.AddObject(eii.ObjectJointRevoluteZ(
-                markerNumbers=[m["ground_A"], m["crank_A"]], rotationMarker1=crank_ref.T)),
+                markerNumbers=[m["ground_A"], _turned_marker(mbs, m["crank_A"], crank_ref.T)])),
             "B": mbs.AddObject(eii.ObjectJointRevoluteZ(
-                markerNumbers=[m["crank_B"], m["coupler_B"]], rotationMarker0=crank_ref.T,
-                rotationMarker1=coupler_ref.T)),
+                markerNumbers=[_turned_marker(mbs, m["crank_B"], crank_ref.T),
+                               _turned_marker(mbs, m["coupler_B"], coupler_ref.T)])),
             "C": mbs.AddObject(eii.ObjectJointSpherical(
                 markerNumbers=[m["slider_C"], m["coupler_C"]], constrainedAxes=[1, 1, 0])),
             "P": mbs.AddObject(eii.ObjectJointPrismaticX(
                 markerNumbers=[m["ground_C"], m["slider_C"]]))}
         # B's force is reported in the frame of the crank's marker at B (its joint face when
-        # the crank is flexible): collect turns it with that marker's rotation
+        # the crank is flexible), turned back by the initial crank angle: collect turns it
+        # with that marker's rotation since t = 0
         self.mech.joint_frames = {"A": None, "B": "marker_crank_B", "C": None, "P": None}
         coupler = scene["coupler"]
         if coupler["model"] == "ffrf" and coupler["geometric_stiffness"]:
