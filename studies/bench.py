@@ -114,7 +114,8 @@ PLAN = BenchPlan(
     step_cost=StepCostPlan(meshes_m=(0.004, 0.002, 0.001), modes=(6, 12, 24), step_s=1e-5,
                            end_time_s=0.003, newton={  # issue 15: at most 2 iterations?
                                "modified 1e-8 (flex)": ("modified", 1e-8),
-                               "full 1e-8": ("full", 1e-8), "full 1e-6": ("full", 1e-6)}),
+                               "full 1e-8": ("full", 1e-8), "full 1e-6": ("full", 1e-6),
+                               "Jacobian per step 1e-5": ("jacobian_per_step", 1e-5)}),
     # issue 15's plates: at 1 % within 0.3 s, at 0.1 % within 2 s (in process, warm)
     plates=PlatesPlan({f"steel_{mm:g}mm": [f"coupler.thickness_m={mm / 1000!r}"]
                        for mm in (2, 3, 5, 10)} | {"aluminium_2mm": [

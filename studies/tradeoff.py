@@ -14,7 +14,7 @@ Stored (:mod:`flex.experiments.workprecision`): a case ``<scene>__<setting>`` pe
 run: a ``failed`` case); under ``/summary/<scene>/`` (:mod:`flex.experiments.workprecision_report`)
 ``runs/...``, ``reference/...``, ``recommended/...`` (1 %, 0.1 %, 0.01 %), ``default/...`` and
 (FFRF) ``rule/...``: the bundled "auto" keys and the rule's picks at 1 % and 0.1 % against the
-runs (:mod:`flex.experiments.defaults_check`). Figures: a work-precision diagram per scene.
+runs (:mod:`~flex.experiments.defaults_check`, :mod:`~flex.experiments.rule_check`); figures.
 """
 
 from __future__ import annotations
@@ -25,8 +25,9 @@ from typing import Any
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, derived_scenes
-from flex.experiments.defaults_check import default_setting, rule_settings
+from flex.experiments.defaults_check import default_setting
 from flex.experiments.reference_plans import scipy_setting
+from flex.experiments.rule_check import rule_settings
 from flex.experiments.tradeoff import Setting
 from flex.experiments.workprecision import nonlinear_available, run_work_precision
 from flex.experiments.workprecision_report import summarize_work_precision, work_precision_figures

@@ -335,3 +335,27 @@ def test_coupler_compression_is_the_joint_C_force_toward_B():
     coupler = dict(length_m=0.08, thickness_m=0.001, width_m=0.01, youngs_modulus_Pa=200e9)
     assert coupler_euler_load_N(coupler) == pytest.approx(
         np.pi ** 2 * 200e9 * 0.01 * 0.001 ** 3 / 12 / 0.08 ** 2, rel=1e-12)  # 257 N
+
+
+def test_a_jacobian_per_step_converges_like_full_newton_with_one_jacobian_per_step(
+        reduction_cache):
+    """``newton = "jacobian_per_step"``: one Jacobian update per step, reused within it (as
+    many iterations as full Newton from the same start, fewer than modified Newton's), and the
+    same deflection as full Newton to the Newton tolerance."""
+    runs = {}
+    for newton in ("full", "modified", "jacobian_per_step"):
+        scene = load_scene(None, ['coupler.geometry="plate"', 'coupler.model="ffrf"',
+                                  "coupler.thickness_m=0.001", "coupler.modes=2",
+                                  "coupler.mesh_size_m=0.004", "simulation.step_s=1e-5",
+                                  "simulation.end_time_s=0.001",
+                                  "simulation.error_estimate=false",
+                                  f'simulation.newton="{newton}"',
+                                  "simulation.newton_relative_tolerance=1e-6"])
+        runs[newton] = simulate(scene, newton, cache_dir=reduction_cache)
+    per_step = runs["jacobian_per_step"].counters
+    assert per_step["jacobian_updates"] <= per_step["steps"] < 2 * per_step["jacobian_updates"]
+    assert per_step["newton_iterations"] < runs["modified"].counters["newton_iterations"]
+    deflection = {name: run.datasets["coupler/midpoint_deflection"].data
+                  for name, run in runs.items()}
+    scale = np.max(np.abs(deflection["full"]))
+    assert np.max(np.abs(deflection["jacobian_per_step"] - deflection["full"])) < 1e-4 * scale

@@ -15,7 +15,7 @@ from flex.config.ffrf_rule import pick
 from flex.config.settings import resolve_solver_settings
 from flex.data.results import Dataset
 from flex.data.scene import Scene, load_scene
-from flex.experiments.defaults_check import (
+from flex.experiments.rule_check import (
     RULE_GROUP,
     RULE_LEVELS,
     rule_level,

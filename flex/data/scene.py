@@ -167,8 +167,9 @@ SCHEMA: dict[str, dict[str, Field]] = {
                              "generalized_alpha: position-level constraints (index 3), or "
                              "velocity-level constraints (index 2, Newmark with the same "
                              "spectral_radius)"),
-        "newton": Field(("full", "modified"),
-                        "Newton iteration: Jacobian every iteration, or reused while it converges",
+        "newton": Field(("full", "modified", "jacobian_per_step"),
+                        "Newton iteration: Jacobian every iteration, reused while it converges "
+                        "(modified), or computed once per step and reused within it",
                         auto=True),
         "error_estimate": Field(bool, "estimate the run's own step error on its headline "
                                       "quantities with a companion run at twice (or half) the "

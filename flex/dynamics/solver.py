@@ -19,10 +19,10 @@
 
 The integrator follows the scene's ``[simulation]`` knobs (:func:`solver_settings`): Exudyn's
 implicit generalized-alpha (index 3; or Newmark with index-2 constraints), full or modified
-Newton, or an explicit Runge-Kutta method with penalty joints; always at a fixed step (a
-Newton failure is reported, not retried with a smaller step). Step N covers
-t = (N - 1) h ... N h: a Newton failure names the step and its start time, a non-finite or
-exploding output the step that produced it and its end time.
+Newton (or a Jacobian once per step), or an explicit Runge-Kutta method with penalty joints;
+always at a fixed step (a Newton failure is reported, not retried with a smaller step). Step
+N covers t = (N - 1) h ... N h: a Newton failure names the step and its start time, a
+non-finite or exploding output the step that produced it and its end time.
 """
 
 from __future__ import annotations
@@ -81,9 +81,11 @@ def solver_settings(scene: Scene) -> dict[str, Any]:
         "spectral_radius": sim["spectral_radius"],
         "newton_relative_tolerance": sim["newton_relative_tolerance"],
         "newton_absolute_tolerance": 1e-2 * sim["newton_relative_tolerance"],
-        "modified_newton": sim["newton"] == "modified",
+        "modified_newton": sim["newton"] in ("modified", "jacobian_per_step"),
         "adaptive_step": False,  # fixed step: a Newton failure is a divergence, not a retry
     }
+    if sim["newton"] == "jacobian_per_step":  # only then: other runs' stored settings stay
+        settings["jacobian_per_step"] = True
     settings.update(_integrator_settings(sim))
     if scene["coupler"]["model"] == "nonlinear_fe":
         settings.update(NONLINEAR_FE_SOLVER)
@@ -136,6 +138,7 @@ def _exudyn_settings(settings: dict[str, Any]):
     ti.newton.relativeTolerance = settings["newton_relative_tolerance"]
     ti.newton.absoluteTolerance = settings["newton_absolute_tolerance"]
     ti.newton.useModifiedNewton = settings["modified_newton"]
+    ti.newton.modifiedNewtonJacUpdatePerStep = settings.get("jacobian_per_step", False)
     if "linear_solver" in settings:
         s.linearSolver.solverType = getattr(exu.LinearSolverType, settings["linear_solver"])
     ti.verboseMode = 0

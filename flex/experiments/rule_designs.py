@@ -53,7 +53,7 @@ from flex.experiments.calibration import (
 #: neighbour counts k of the local design
 NEIGHBOURS = (1, 2, 3)
 #: the local design keeps its pick robustly within this fraction of the level on the neighbours
-NEIGHBOUR_MARGINS = (1.0, 0.5)
+NEIGHBOUR_MARGINS = (1.0, 0.7, 0.5)
 #: near twins: n and L / t within this relative distance of each other
 TWIN_CLOSENESS = 0.15
 #: the installed design's name in the rows

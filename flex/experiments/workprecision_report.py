@@ -6,7 +6,7 @@ run_work_precision` into datasets under ``<scene>/``: ``runs/...`` (the table of
 :func:`flex.experiments.tradeoff.measurements_table`, with ``on_pareto_front``), ``reference/...``
 (what it
 is and its convergence evidence), ``recommended/...`` (per accuracy level 1 %, 0.1 %, 0.01 %),
-``default/...`` and ``rule/...`` (the flex rule's picks, :mod:`flex.experiments.defaults_check`),
+``default/...`` and ``rule/...`` (the flex rule's picks, :mod:`flex.experiments.rule_check`),
 and into the report text. :func:`work_precision_figures` draws, from those datasets, one diagram
 per scene: error against wall time (log-log), the Pareto fronts, the rule's picks (open stars),
 the accuracy levels and the band the reference cannot resolve.
@@ -24,7 +24,8 @@ import numpy as np
 from flex.base.plotting import figure, legend_below
 from flex.data.results import Dataset
 from flex.data.scene import Scene
-from flex.experiments.defaults_check import ffrf_defaults_check, rigid_defaults_check, rule_check
+from flex.experiments.defaults_check import ffrf_defaults_check, rigid_defaults_check
+from flex.experiments.rule_check import rule_check
 from flex.experiments.tradeoff import (
     ACCURACY_LEVELS,
     Measurement,
