@@ -83,15 +83,14 @@ def neighbour_pick(held: CaseResult, others: Mapping[str, CaseResult], level: fl
         ok = robustly_within(table, margin * level)
         if ok.any():
             distance = float(np.linalg.norm(np.array(scene_features(case)) - x))
-            candidates.append((distance, table, ok))
+            candidates.append((distance, modelled_time_s(table), ok))
     if len(candidates) < k:
         return None
     nearest = sorted(candidates, key=lambda item: item[0])[:k]
     shared = np.all([ok for _, _, ok in nearest], axis=0)
     if not shared.any():
         return None
-    slowdown = np.max([modelled_time_s(table) / np.min(modelled_time_s(table)[ok])
-                       for _, table, ok in nearest], axis=0)
+    slowdown = np.max([time / np.min(time[ok]) for _, time, ok in nearest], axis=0)
     slowdown[~shared] = np.inf
     return int(np.argmin(slowdown))
 
@@ -101,9 +100,8 @@ def design_frontier(cases: Mapping[str, CaseResult], levels: Sequence[float] = L
     """Leave-one-out over ``cases`` for the installed design and the local ones (see the
     module doc). Rows: ``design``, ``judged``, ``no_pick`` (the neighbours share no pair),
     ``over_level``, ``not_robust``, ``slower`` (robustly within, more than the slowdown
-    limit slower), ``meets``, ``worst_ratio``
-    (largest certified error / level), ``rows`` (the per-pair rows of
-    :func:`flex.experiments.calibration.validate`)."""
+    limit slower), ``meets``, ``worst_ratio`` (largest certified error / level), ``rows``
+    (the per-pair rows of :func:`flex.experiments.calibration.validate`)."""
     installed = [row for row in cross_validate(cases, levels)
                  if "rule_pair" in row and row["certifiable"]]
     out = [_tally(INSTALLED, installed)]
