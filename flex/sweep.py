@@ -263,6 +263,16 @@ def make_executor(scheduler: str | None = None, workers: int | None = None) -> E
 # ------------------------------------------------------------------------------------------
 # case files
 # ------------------------------------------------------------------------------------------
+def _physics_versions() -> str:
+    """What a flexible link's physics depends on beyond the scene: the reduction's basis
+    (chord frame since version 2) and its geometric stiffness (a changed body must not
+    resume stale cases)."""
+    from flex.bodies.geometric_stiffness import GEOMETRIC_FORMAT_VERSION
+    from flex.bodies.reduction import CACHE_FORMAT_VERSION
+
+    return f"#reduction{CACHE_FORMAT_VERSION}#geometric{GEOMETRIC_FORMAT_VERSION}"
+
+
 def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
     """Identity of a case: its resolved scene and the case function's qualified name and
     ``case_version`` attribute (bumped when what the function stores changes: stale case
@@ -288,6 +298,7 @@ def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
     version = getattr(function, "case_version", None)
     if version is not None:
         extra += f"@{version}"
+    extra += _physics_versions()
     label = f"{function.__module__}.{function.__qualname__}{extra}"
     return hashlib.sha256((label + "\n" + to_toml(scene)).encode()).hexdigest()[:24]
 

@@ -28,7 +28,7 @@ def test_every_reference_has_geometric_stiffness_and_auto_keeps_the_default(stud
     assert all(s["coupler"]["geometric_stiffness"] is True for s in fit.values())
     assert all(s["coupler"]["model"] == "ffrf" for s in fit.values())
     for s in validation.values():  # auto is validated as a user gets it (key at default)
-        assert s["coupler"]["model"] == "auto" and s["coupler"]["geometric_stiffness"] is False
+        assert s["coupler"]["model"] == "auto" and s["coupler"]["geometric_stiffness"] is True
         full = couplerfit.full_scene(s)
         assert full["coupler"]["model"] == "ffrf"
         assert full["coupler"]["geometric_stiffness"] is True

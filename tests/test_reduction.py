@@ -361,14 +361,18 @@ def test_thesis_plates_pinned_pinned_frequency(thickness, mesh_size, low, high, 
 # joint markers: as cheap as the basis allows, the same motion as on every face node
 # ------------------------------------------------------------------------------------------
 def test_joint_markers_use_the_frame_node_and_four_corners_of_the_rigid_face(reduction):
-    from flex.bodies.reduction import _face_corners, _moves_rigidly
+    from flex.bodies.reduction import _face_corners, _rigid_face_motions
 
     basis = reduction.fem.modeBasis["matrix"]
     basis = basis.reshape(-1, 3, basis.shape[1])
     positions = reduction.fem.GetNodePositionsAsArray()
-    assert not np.any(basis[reduction.nodes_end_a])  # the frame is the joint-B face
+    # chord frame: end_a only turns about z about its centre (the frame's origin), so a pin
+    # at B may use the frame node; end_b moves rigidly (along x, turning about z)
+    end_a = np.asarray(reduction.nodes_end_a)
+    turns = _rigid_face_motions(positions[end_a], basis[end_a], reduction.centre_end_a)
+    assert turns is not None and not np.any(turns[:, :5]) and np.any(turns[:, 5])
     end_b = np.asarray(reduction.nodes_end_b)
-    assert _moves_rigidly(positions[end_b], basis[end_b])
+    assert _rigid_face_motions(positions[end_b], basis[end_b]) is not None
     corners = _face_corners(positions, end_b)
     yz = positions[corners][:, 1:]
     assert len(corners) == 4
@@ -377,7 +381,7 @@ def test_joint_markers_use_the_frame_node_and_four_corners_of_the_rigid_face(red
     # a bent face is not rigid: the check must say so
     bent = basis[end_b].copy()
     bent[:, 0, -1] += positions[end_b][:, 1] ** 2
-    assert not _moves_rigidly(positions[end_b], bent)
+    assert _rigid_face_motions(positions[end_b], bent) is None
 
 
 @pytest.mark.parametrize("link", ["coupler", "crank"])

@@ -11,7 +11,6 @@ to stay put (0 deg: unstable equilibrium, 180 deg: stable), near it the crank cr
 from __future__ import annotations
 
 import math
-import re
 
 import h5py
 import numpy as np
@@ -123,24 +122,23 @@ def test_start_near_a_dead_centre_matches_the_reference(angle_deg, bound_rad):
         assert swing > 10 * abs(math.radians(angle_deg))
 
 
-def test_thin_ffrf_plate_with_a_large_step_fails_cleanly_and_runs_with_a_small_one(
+def test_a_coupler_beyond_its_euler_load_runs_and_says_the_result_is_not_valid(
         reduction_cache):
-    # a 0.3 mm plate (first bending mode ~107 Hz, deflection ~4x its thickness) cannot take
-    # a 0.1 ms step: Newton fails within the first steps (measured: step 4 with all modes,
-    # 6 with the in-plane ones); at 0.01 ms it runs
+    # a 0.3 mm plate (Euler load 6.9 N) pushed by the ~33 N spring: the chord-frame FFRF body
+    # runs at 0.1 ms and 0.01 ms steps alike (the linear body in the end_a face frame failed
+    # Newton within 6 steps at 0.1 ms), but its geometric stiffness is linear in the load:
+    # the buckled plate grows without bound, and the result says it is not valid
     plate = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.thickness_m=0.0003",
              "coupler.mesh_size_m=0.006", "coupler.modes=6", "simulation.end_time_s=0.001",
              "simulation.newton_relative_tolerance=1e-8"]
-    failed = simulate_case(load_scene(overrides=plate + ["simulation.step_s=1e-4"]), "large",
-                           cache_dir=reduction_cache)
-    assert failed.status == "failed" and not failed.datasets
-    match = re.search(r"diverged at step (\d+) \(t = ([0-9.e-]+) s", failed.message)
-    assert "Newton failed" in failed.message and match
-    assert int(match[1]) <= 10 and float(match[2]) == pytest.approx((int(match[1]) - 1) * 1e-4)
-    small = simulate_case(load_scene(overrides=plate + ["simulation.step_s=1e-5"]), "small",
-                          cache_dir=reduction_cache)
-    assert small.status == "ok"
-    assert np.isfinite(small.datasets["coupler/midpoint_deflection"].data).all()
+    peaks = []
+    for step_s in (1e-4, 1e-5):
+        case = simulate_case(load_scene(overrides=plate + [f"simulation.step_s={step_s}"]),
+                             "thin", cache_dir=reduction_cache)
+        assert case.status == "ok"
+        assert "x its Euler load" in case.attrs["validity_warning"]
+        peaks.append(np.abs(case.datasets["coupler/midpoint_deflection"].data).max())
+    assert peaks[0] == pytest.approx(peaks[1], rel=0.02)  # measured 0.7 %
 
 
 @pytest.mark.slow

@@ -1,62 +1,55 @@
-"""Geometric stiffness of an FFRF plate link: the stress-stiffening of its reduced modes under
-the link's axial force.
+"""Geometric stiffness of an FFRF plate link: the softening of its bending modes under its own
+axial force.
 
 A floating-frame body is linear elastic in its own frame: a compressed link keeps its bending
 stiffness, so a thin coupler near its Euler load bends far less in the linear FFRF model than
-in the fully nonlinear FE one (docs/stability.md). The missing term is the initial-stress
-(geometric) stiffness of the axial force N (tension positive) [N]::
+in the fully nonlinear FE one (docs/geometric-stiffness.md). The missing term is the
+initial-stress (geometric) stiffness of the axial force N (tension positive) [N]::
 
     K_sigma(N) = N / A * integral over the plate of  du/dx . dv/dx  dV      (A = t w)
 
-the second-order work of a uniform axial stress N / A through the rotations of the material
-lines (the 1/2 (du_y/dx)^2 + 1/2 (du_z/dx)^2 part of the Green strain the linear body drops).
-Projected on the reduction's mode basis Phi once per reduction, ``K_G = Phi^T K_sigma(1 N)
-Phi`` [1/m], and its part weighted by x / L, ``K_b`` (a tension at ``end_b`` falling
-linearly to zero at ``end_a``). The body gets the generalized force on its modal coordinates
-q (:class:`_GeometricForce`)::
+the second-order work of the axial stress through the rotations of the material lines (the
+1/2 (du_y/dx)^2 + 1/2 (du_z/dx)^2 part of the Green strain the linear body drops). Projected
+on the reduction's mode basis Phi once per reduction, ``K_G = Phi^T K_sigma(1 N) Phi`` [1/m].
+The body gets the generalized force on its modal coordinates q (:class:`_GeometricForce`)::
 
-    f(q) = -[N K_G + (N_C - N) (2 K_b - K_G)] q
+    f(q) = -N(q) K_G q,        N(q) = k_N . q
 
-an axial force varying linearly along the link with mean N and value N_C at ``end_b``:
+with N the link's axial force from its own stretch: the elastic force of the ``end_b`` axial
+static mode (``k_N`` its row of the reduced stiffness matrix). f depends on q alone, so its
+Jacobian is exact (``N K_G + (K_G q) k_N^T``) and Newton converges as for the linear body,
+whatever the modes and the step.
 
-- N(q) = k_N . q, the link's mean axial force from its own stretch: the elastic force of the
-  ``end_b`` axial static mode (``k_N`` its row of the reduced stiffness matrix), ringing
-  included;
-- N_C, the tension at joint C: its reaction along the body's x axis, read at each call
-  (:func:`joint_tension`; None: uniform, N_C = N).
+Why this is the whole correction: the reduction's floating frame is the chord B-C
+(:mod:`flex.bodies.reduction`), so the joint forces' axial part acts along the frame's x axis
+and the linear FFRF body is blind to it; the geometric potential of the axial force is then
+exactly -N/2 integral(w'^2) over the elastic field w measured from the chord, q^T K_G q / 2
+over the whole basis (static modes included). :func:`pinned_pinned_eigen` checks it against
+the Euler load and f(P) = f0 sqrt(1 - P / P_E).
 
-Why the variation matters: the coupler's own axial inertia makes its compression differ
-between B and C (measured 14 against 18 N on the 0.5 mm plate, 20 %), and with the frame at
-``end_a`` the elastic rotations w' of a pinned bending mode vanish at B and are largest at
-C, so the end C compression weighs most. With the mean alone the 0.5 mm plate's peak was
-7.5 % below the nonlinear FE one, with the linear variation 1.1 % (docs/geometric-stiffness.md).
+What was measured and dropped (docs/geometric-stiffness.md): with the frame on the joint-B
+face (Exudyn's default), the chord turns against the frame and the linear body puts the axial
+force through that turn (compression stiffened it); its correction needed the tension at C
+read from joint C's Lagrange multiplier, which is not in the Jacobian, and failed Newton with
+2 to 24 modes on loaded scenes. A conservative form (the energy 1/2 k_N (stretch + 1/2 q^T
+K_G q)^2, bending feeding back on the stretch) ran but overshot the nonlinear FE coupler by
+up to 3.4 % in a narrow band of thickness (0.60-0.61 mm) where the reduced model's axial and
+bending frequencies meet; the form above stays within 0.35 % from 0.5 to 10 mm.
 
-Why the full K_G and nothing subtracted: the floating frame is the ``end_a`` face. A bent
-pinned link's chord is turned against that frame by delta_C / L (delta_C: the frame-y
-displacement of ``end_b``), and the FFRF model, whose frame rotation is exact, already puts
-the axial force through that rigid turn (the chord's length grows by delta_C^2 / 2L). The
-complete second-order potential of the axial force, -N/2 integral((theta + w')^2) with the
-frame angle theta = -delta_C / L against the chord, splits into that rigid part
-(+N delta_C^2 / 2L) and -N/2 integral(w'^2) over the elastic field w measured in the frame,
-which is exactly q^T K_G q / 2 with K_G over the whole basis (static modes included).
-:func:`pinned_pinned_eigen` checks the sum against the Euler load and against
-f(P) = f0 sqrt(1 - P / P_E).
-
-Validity (``make ladder``, docs/geometric-stiffness.md): within 1 % of the nonlinear FE
-coupler's peak deflection from 0.7 mm up, 1.1 % at 0.5-0.6 mm (compression up to 0.56 of the
-Euler load); at 0.5 mm only at a coarse step (1e-4 s: Newton fails at finer ones, the axial
-ringing modulating every bending mode through the single axial static mode); beyond the
-Euler load the body buckles without bound (linear in N) and the run fails.
+Validity: below the Euler load. The model is linear in N: beyond it the body buckles without
+bound and the run fails, where only the nonlinear FE coupler holds.
 
 Cached beside the reduction (``<key>.geometric.hdf5`` in the reduction's cache folder, keyed
-by the reduction's key and a digest of its mode basis); a reduction without a cache file
-computes it afresh (a mesh and one bilinear form: about as long as meshing the plate).
+by the reduction's key and a digest of its mode basis, its content checked on load by a
+digest of its arrays); a reduction without a cache file computes it afresh (a mesh and one
+bilinear form: about as long as meshing the plate).
 """
 
 from __future__ import annotations
 
 import hashlib
 import os
+import sys
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -65,7 +58,7 @@ from typing import Any
 import numpy as np
 
 #: bump when the content or layout of a cache entry changes (old entries are then rebuilt)
-GEOMETRIC_FORMAT_VERSION = 2
+GEOMETRIC_FORMAT_VERSION = 3
 _SUFFIX = ".geometric.hdf5"
 
 
@@ -74,14 +67,12 @@ class GeometricStiffness:
     """The reduced geometric stiffness of one :class:`flex.bodies.reduction.Reduction`.
 
     ``matrix_per_N`` (K_G, m x m over the modal coordinates, [1/m]: generalized stiffness
-    per newton of uniform axial tension); ``matrix_end_b_per_N`` (K_b [1/m]: the same for a
-    tension of 1 N at ``end_b`` falling linearly to 0 at ``end_a``); ``axial_force_row_N_per_m``
-    (k_N: the link's mean axial force N = k_N . q [N], tension positive); ``axial_mode``
-    (column of the ``end_b`` axial static mode); ``from_cache``.
+    per newton of uniform axial tension); ``axial_force_row_N_per_m`` (k_N: the link's axial
+    force N = k_N . q [N], tension positive); ``axial_mode`` (column of the ``end_b`` axial
+    static mode); ``from_cache``.
     """
 
     matrix_per_N: np.ndarray
-    matrix_end_b_per_N: np.ndarray
     axial_force_row_N_per_m: np.ndarray
     axial_mode: int
     from_cache: bool = False
@@ -115,11 +106,11 @@ def _axial_mode(reduction: Any) -> int:
     return mode
 
 
-def _unit_axial_stress_matrices(reduction: Any) -> tuple[Any, Any]:
+def unit_axial_stress_matrices(reduction: Any, rising: bool = False) -> Any:
     """K_sigma for 1 N of axial tension over the plate's mesh, Exudyn coordinate order
-    (x, y, z per node), scipy CSR [1/m]: (1 / A) integral du/dx . dv/dx dV; and the same
-    weighted by x / L (the share of a tension at ``end_b`` that falls linearly to zero at
-    ``end_a``).
+    (x, y, z per node), scipy CSR [1/m]: (1 / A) integral du/dx . dv/dx dV; with ``rising``
+    the same weighted by x / L (a tension of 1 N at ``end_b`` falling linearly to zero at
+    ``end_a``: a distributed axial load).
 
     The mesh is remade with the reduction's arguments (the same mesh and node numbering, as
     :mod:`flex.bodies.nonlinear` relies on); the node positions are checked against the
@@ -143,39 +134,44 @@ def _unit_axial_stress_matrices(reduction: Any) -> tuple[Any, Any]:
     n_nodes = len(positions)
     coordinate = np.arange(3 * n_nodes)
     ngsolve_index = (coordinate % 3) * n_nodes + coordinate // 3  # of Exudyn 3 i + c
-    matrices = []
-    for weight in (1.0, ngs.x / r.length_m):
-        form = ngs.BilinearForm(space)
-        form += (weight / (r.thickness_m * r.width_m)) * ngs.InnerProduct(
-            ngs.Grad(u) * along, ngs.Grad(v) * along) * ngs.dx
-        form.Assemble()
-        values, columns, pointers = form.mat.CSR()
-        matrix = csr_matrix((np.asarray(values), np.asarray(columns).astype(np.int64),
-                             np.asarray(pointers).astype(np.int64)),
-                            shape=(space.ndof, space.ndof))
-        matrices.append(matrix[ngsolve_index][:, ngsolve_index])
-    return matrices[0], matrices[1]
+    weight = ngs.x / r.length_m if rising else 1.0
+    form = ngs.BilinearForm(space)
+    form += (weight / (r.thickness_m * r.width_m)) * ngs.InnerProduct(
+        ngs.Grad(u) * along, ngs.Grad(v) * along) * ngs.dx
+    form.Assemble()
+    values, columns, pointers = form.mat.CSR()
+    matrix = csr_matrix((np.asarray(values), np.asarray(columns).astype(np.int64),
+                         np.asarray(pointers).astype(np.int64)), shape=(space.ndof, space.ndof))
+    return matrix[ngsolve_index][:, ngsolve_index]
+
+
+def projected(reduction: Any, matrix: Any) -> np.ndarray:
+    """``Phi^T matrix Phi`` on the reduction's mode basis, symmetrized."""
+    basis = reduction.fem.modeBasis["matrix"]
+    reduced = basis.T @ (matrix @ basis)
+    return 0.5 * (reduced + reduced.T)
 
 
 def compute_geometric_stiffness(reduction: Any) -> GeometricStiffness:
     """K_G and k_N of ``reduction`` (see the module doc), computed on its mesh."""
     basis = reduction.fem.modeBasis["matrix"]
-    uniform, rising = (basis.T @ (matrix @ basis)
-                       for matrix in _unit_axial_stress_matrices(reduction))
     stiffness = basis.T @ (reduction.fem.stiffnessMatrix @ basis)
     mode = _axial_mode(reduction)
-    return GeometricStiffness(matrix_per_N=0.5 * (uniform + uniform.T),
-                              matrix_end_b_per_N=0.5 * (rising + rising.T),
-                              axial_force_row_N_per_m=np.asarray(stiffness[mode]).ravel(),
-                              axial_mode=mode)
+    return GeometricStiffness(
+        matrix_per_N=projected(reduction, unit_axial_stress_matrices(reduction)),
+        axial_force_row_N_per_m=np.asarray(stiffness[mode]).ravel(), axial_mode=mode)
 
 
 # ------------------------------------------------------------------------------------------
 # cache
 # ------------------------------------------------------------------------------------------
-def _basis_digest(reduction: Any) -> str:
-    basis = np.ascontiguousarray(reduction.fem.modeBasis["matrix"])
-    return hashlib.sha256(str(basis.shape).encode() + basis.tobytes()).hexdigest()[:24]
+def _digest(*arrays: np.ndarray) -> str:
+    digest = hashlib.sha256()
+    for array in arrays:
+        array = np.ascontiguousarray(array)
+        digest.update(str(array.dtype).encode() + str(array.shape).encode())
+        digest.update(array.tobytes())
+    return digest.hexdigest()[:24]
 
 
 def _cache_path(reduction: Any) -> Path | None:
@@ -185,24 +181,29 @@ def _cache_path(reduction: Any) -> Path | None:
     return Path(cache_file).with_name(f"{reduction.key}{_SUFFIX}")
 
 
-def _load(path: Path, digest: str) -> GeometricStiffness | None:
-    """The entry at ``path`` if whole and made for this basis, else None."""
+def _load(path: Path, basis_digest: str) -> GeometricStiffness | None:
+    """The entry at ``path`` if whole, made for this basis and unchanged since it was
+    written (its content digest), else None."""
     import h5py
 
     try:
         with h5py.File(path, "r") as h5:
             if (h5.attrs["format_version"] != GEOMETRIC_FORMAT_VERSION
-                    or h5.attrs["basis_digest"] != digest):
+                    or h5.attrs["basis_digest"] != basis_digest):
                 return None
-            return GeometricStiffness(matrix_per_N=h5["matrix_per_N"][()],
-                                      matrix_end_b_per_N=h5["matrix_end_b_per_N"][()],
-                                      axial_force_row_N_per_m=h5["axial_force_row_N_per_m"][()],
+            matrix = h5["matrix_per_N"][()]
+            row = h5["axial_force_row_N_per_m"][()]
+            if h5.attrs["content_digest"] != _digest(matrix, row):
+                print(f"flex: reduction cache: {path} does not match its content digest "
+                      f"(damaged or edited); rebuilding it", file=sys.stderr, flush=True)
+                return None
+            return GeometricStiffness(matrix_per_N=matrix, axial_force_row_N_per_m=row,
                                       axial_mode=int(h5.attrs["axial_mode"]), from_cache=True)
     except Exception:  # missing, truncated or foreign: rebuilt by the caller
         return None
 
 
-def _save(path: Path, stiffness: GeometricStiffness, digest: str) -> None:
+def _save(path: Path, stiffness: GeometricStiffness, basis_digest: str) -> None:
     """Write atomically (a temporary file renamed): readers never see half an entry."""
     import h5py
 
@@ -213,10 +214,11 @@ def _save(path: Path, stiffness: GeometricStiffness, digest: str) -> None:
     try:
         with h5py.File(temporary, "w") as h5:
             h5["matrix_per_N"] = stiffness.matrix_per_N
-            h5["matrix_end_b_per_N"] = stiffness.matrix_end_b_per_N
             h5["axial_force_row_N_per_m"] = stiffness.axial_force_row_N_per_m
-            h5.attrs.update(format_version=GEOMETRIC_FORMAT_VERSION, basis_digest=digest,
-                            axial_mode=stiffness.axial_mode)
+            h5.attrs.update(format_version=GEOMETRIC_FORMAT_VERSION, basis_digest=basis_digest,
+                            axial_mode=stiffness.axial_mode,
+                            content_digest=_digest(stiffness.matrix_per_N,
+                                                   stiffness.axial_force_row_N_per_m))
         os.replace(temporary, path)
     except BaseException:
         Path(temporary).unlink(missing_ok=True)
@@ -225,16 +227,17 @@ def _save(path: Path, stiffness: GeometricStiffness, digest: str) -> None:
 
 def geometric_stiffness(reduction: Any) -> GeometricStiffness:
     """The reduction's :class:`GeometricStiffness`: loaded from beside its cache file when
-    there is a whole entry for its basis, else computed (and stored there, if it has one)."""
+    there is a whole, unchanged entry for its basis, else computed (and stored there, if it
+    has one)."""
     path = _cache_path(reduction)
-    digest = _basis_digest(reduction)
+    basis_digest = _digest(reduction.fem.modeBasis["matrix"])
     if path is not None and path.is_file():
-        cached = _load(path, digest)
+        cached = _load(path, basis_digest)
         if cached is not None:
             return cached
     stiffness = compute_geometric_stiffness(reduction)
     if path is not None:
-        _save(path, stiffness, digest)
+        _save(path, stiffness, basis_digest)
     return stiffness
 
 
@@ -242,76 +245,38 @@ def geometric_stiffness(reduction: Any) -> GeometricStiffness:
 # Exudyn
 # ------------------------------------------------------------------------------------------
 class _GeometricForce:
-    """The generalized force on the modal coordinates and its Jacobian, as the user functions
-    of an Exudyn ``ObjectGenericODE2`` on the modal node.
+    """f(q) = -N(q) K_G q, N(q) = k_N . q, and its exact Jacobian, as the user functions of an
+    Exudyn ``ObjectGenericODE2`` on the modal node."""
 
-    Without ``end_b_tension``: f = -N(q) K_G q, N the link's mean axial force (its stretch).
-    With it (a callable of ``mbs`` giving the tension at ``end_b`` [N], e.g. a joint's
-    reaction, :func:`joint_tension`): the axial force falls linearly from N_b at ``end_b``
-    to 2 N - N_b at ``end_a`` (the same mean), f = -[N K_G + (N_b - N) (2 K_b - K_G)] q with
-    K_b the x / L weighted matrix. N_b is read at every call, in step with the state (the
-    Newton iterate's Lagrange multiplier); its dependence on the multiplier is left out of
-    the Jacobian. (Read once per step instead, it lags the axial ringing by a step and the
-    0.5 mm plate diverged at every step tried.)
-    """
-
-    def __init__(self, stiffness: GeometricStiffness, end_b_tension=None) -> None:
+    def __init__(self, stiffness: GeometricStiffness) -> None:
         self.matrix = np.asarray(stiffness.matrix_per_N, dtype=float)
-        self.gradient = 2.0 * np.asarray(stiffness.matrix_end_b_per_N) - self.matrix
         self.row = np.asarray(stiffness.axial_force_row_N_per_m, dtype=float)
-        self.end_b_tension = end_b_tension
-
-    def _parts(self, mbs, q: np.ndarray) -> tuple[float, float]:
-        mean = float(self.row @ q)
-        excess = 0.0 if self.end_b_tension is None else self.end_b_tension(mbs) - mean
-        return mean, excess
 
     def force(self, mbs, t, item_index, q, q_t) -> np.ndarray:
-        """-[N K_G + (N_b - N)(2 K_b - K_G)] q [N per modal coordinate]."""
+        """-N(q) K_G q [N per modal coordinate]."""
         q = np.asarray(q)
-        mean, excess = self._parts(mbs, q)
-        return -(mean * (self.matrix @ q) + excess * (self.gradient @ q))
+        return -float(self.row @ q) * (self.matrix @ q)
 
     def jacobian(self, mbs, t, item_index, q, q_t, f_ode2, f_ode2_t):
-        """``f_ode2`` times the derivative of minus :meth:`force` in q (Exudyn's sign), N_b
-        held."""
+        """``f_ode2`` times the derivative of minus :meth:`force` in q (Exudyn's sign)."""
         import exudyn as exu
 
         q = np.asarray(q)
-        mean, excess = self._parts(mbs, q)
-        tangent = (mean * self.matrix + excess * self.gradient
-                   + np.outer((self.matrix - self.gradient) @ q, self.row))
+        tangent = float(self.row @ q) * self.matrix + np.outer(self.matrix @ q, self.row)
         container = exu.MatrixContainer()
         container.SetWithDenseMatrix(float(f_ode2) * tangent, useDenseMatrix=True)
         return container
 
 
-def joint_tension(joint: int, frame_node: int):
-    """A callable of ``mbs`` giving the tension [N] a joint puts on its second body along
-    the x axis of the FFRF body whose floating frame is ``frame_node``: minus the joint's
-    global ``Force`` output (Exudyn reports the force on the first body) dotted with that
-    axis. For :func:`add_geometric_stiffness`'s ``end_b_tension`` (a joint at ``end_b``)."""
-    import exudyn as exu
-
-    def tension(mbs) -> float:
-        force = np.asarray(mbs.GetObjectOutput(joint, exu.OutputVariableType.Force))
-        rotation = np.asarray(mbs.GetNodeOutput(frame_node,
-                                                exu.OutputVariableType.RotationMatrix))
-        return float(-force @ rotation.reshape(3, 3)[:, 0])
-
-    return tension
-
-
 def add_geometric_stiffness(mbs, node_modal: int, stiffness: GeometricStiffness,
-                            name: str = "coupler", end_b_tension=None) -> int:
+                            name: str = "coupler") -> int:
     """Add the geometric stiffness force to the FFRF body whose modal coordinates are the
     node ``node_modal`` (``add_ffrf_link``'s ``node_modal``): an ``ObjectGenericODE2`` with
-    no mass acting on that node alone (:class:`_GeometricForce`; ``end_b_tension``: None
-    for a uniform axial force, or e.g. :func:`joint_tension` of the joint at ``end_b``).
-    Returns its ObjectIndex; call ``mbs.Assemble()`` afterwards."""
+    no mass acting on that node alone (:class:`_GeometricForce`). Returns its ObjectIndex;
+    call ``mbs.Assemble()`` afterwards."""
     import exudyn.itemInterface as eii
 
-    force = _GeometricForce(stiffness, end_b_tension)
+    force = _GeometricForce(stiffness)
     size = len(force.row)
     zero = np.zeros((size, size))
     return mbs.AddObject(eii.ObjectGenericODE2(
@@ -330,60 +295,21 @@ def pinned_pinned_eigen(reduction: Any, stiffness: GeometricStiffness, compressi
 
     ``rising`` False: ``compression_N`` [N] uniform along the link (end loads along the
     chord); True: growing linearly from 0 at ``end_a`` to ``compression_N`` at ``end_b``
-    (a distributed axial load, e.g. the link's own axial inertia). The coordinates are the
-    modal ones and a small rigid turn theta of the frame about z at ``end_a`` (the FFRF
-    frame's rotation against the chord); ``end_b``'s y displacement is held
-    (theta L + delta_C(q) = 0), its x free. The turn's mass terms come from the mesh's mass
-    matrix, its geometric terms are closed-form (a rigid turn: du_y/dx = theta), the elastic
-    ones K_G (or its x / L weighted part): together the whole second-order potential of the
-    axial force, as the FFRF model's exact frame rotation plus :class:`_GeometricForce`
-    make it. Undamped; solved on the constraint's null space.
+    (a distributed axial load, e.g. the link's own axial inertia). In the chord frame the
+    pinned link is the modal coordinates alone (the frame is held by the two pins, ``end_b``
+    free along x): (K - P K_G) v = omega^2 M v. Undamped.
     """
-    from scipy.linalg import eigh, null_space
+    from scipy.linalg import eigh
 
     fem = reduction.fem
     basis = fem.modeBasis["matrix"]
-    positions = fem.GetNodePositionsAsArray()
-    turn = np.zeros_like(positions)  # rigid turn about z at end_a: (-y, x, 0)
-    turn[:, 0], turn[:, 1] = -positions[:, 1], positions[:, 0]
-    full = np.column_stack([turn.ravel(), basis])
-    mass = full.T @ (fem.massMatrix @ full)
-    elastic = np.zeros_like(mass)
-    elastic[1:, 1:] = basis.T @ (fem.stiffnessMatrix @ basis)
-    end_b_y = face_mean_displacement(reduction, "end_b")[1]
-    geometric = _turn_geometric(reduction, stiffness, end_b_y, rising)
-    held = null_space(np.concatenate([[reduction.length_m], end_b_y])[None, :])
-    mass_h, elastic_h, geometric_h = (held.T @ m @ held for m in (mass, elastic, geometric))
-    omega2 = eigh(elastic_h - compression_N * geometric_h, mass_h, eigvals_only=True)
+    mass = basis.T @ (fem.massMatrix @ basis)
+    elastic = basis.T @ (fem.stiffnessMatrix @ basis)
+    geometric = (projected(reduction, unit_axial_stress_matrices(reduction, rising=True))
+                 if rising else stiffness.matrix_per_N)
+    omega2 = eigh(elastic - compression_N * geometric, mass, eigvals_only=True)
     # buckling: the largest mu of G v = mu K v gives the lowest positive load 1 / mu
-    mu = eigh(geometric_h, elastic_h, eigvals_only=True)
+    mu = eigh(geometric, elastic, eigvals_only=True)
     buckling_N = 1.0 / mu[-1] if mu[-1] > 0 else float("inf")
     frequency = float(np.sqrt(omega2[0]) / (2 * np.pi)) if omega2[0] > 0 else 0.0
     return frequency, float(buckling_N)
-
-
-def _turn_geometric(reduction: Any, stiffness: GeometricStiffness, end_b_y: np.ndarray,
-                    rising: bool) -> np.ndarray:
-    """The geometric matrix per newton [1/m] over (turn, modes) for a uniform (``rising``
-    False) or linearly rising (0 at ``end_a``, 1 N at ``end_b``) axial tension.
-
-    Turn terms (1 / A) integral w(x) du_turn/dx . dv/dx dV with du_turn/dx = (0, 1, 0):
-    turn-turn L mean(w); turn-mode integral(w phi_y') dx = phi_y(end_b) (w = 1) or
-    phi_y(end_b) - mean of phi_y over the volume (w = x / L, by parts)."""
-    size = len(end_b_y) + 1
-    geometric = np.zeros((size, size))
-    if not rising:
-        geometric[0, 0] = reduction.length_m
-        geometric[0, 1:] = geometric[1:, 0] = end_b_y
-        geometric[1:, 1:] = stiffness.matrix_per_N
-        return geometric
-    fem = reduction.fem
-    basis = fem.modeBasis["matrix"]
-    along_y = np.zeros(basis.shape[0])
-    along_y[1::3] = 1.0
-    volume_m3 = reduction.length_m * reduction.thickness_m * reduction.width_m
-    mean_y = (along_y @ (fem.massMatrix @ basis)) / (reduction.density_kg_per_m3 * volume_m3)
-    geometric[0, 0] = reduction.length_m / 2
-    geometric[0, 1:] = geometric[1:, 0] = end_b_y - mean_y
-    geometric[1:, 1:] = stiffness.matrix_end_b_per_N
-    return geometric

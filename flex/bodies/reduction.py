@@ -14,13 +14,27 @@ Body coordinates (metres) are the mesh's: x along the link from the centre of ``
 (x = 0, joint B) to the centre of ``end_b`` (x = length, joint C), y across the thickness
 (in the mechanism plane, the bending height), z across the width (out of plane).
 
-Mode basis: the static modes of ``end_b`` (its rigid-face translations and rotations) followed
-by ``modes`` fixed-interface eigenmodes (both end faces clamped). ``end_a`` gets no static
-modes: its nodes move rigidly with the floating frame, so the frame *is* the joint-B face.
-Both end faces stay rigid (RBE2-like), as a pin through a stiff eye would keep them. By
-default only the in-plane modes are kept (3 static: x, y, rotation about z; the lowest
-``modes`` eigenmodes symmetric about the mechanism plane): a planar mechanism loads its links
-in plane, and torsion and out-of-plane bending are decoupled from that load by symmetry.
+Mode basis (a chord frame): static modes and ``modes`` fixed-interface eigenmodes (both end
+faces clamped). The static modes are ``end_b``'s axial translation and rotations and
+``end_a``'s rotations about the transverse axes, each a rigid motion of its face carried into
+the plate by static condensation; no mode moves the centre of ``end_a`` or moves the centre
+of ``end_b`` off the x axis. The floating frame therefore has its origin at joint B and its x
+axis on the chord B-C, whatever the link's bending: a rigid-body motion of the frame *is*
+the chord's. Both end faces stay rigid (RBE2-like), as a pin through a stiff eye would keep
+them. By default only the in-plane modes are kept (3 static: ``end_b`` along x, ``end_a`` and
+``end_b`` turned about z; the lowest ``modes`` eigenmodes symmetric about the mechanism
+plane): a planar mechanism loads its links in plane, and torsion and out-of-plane bending
+are decoupled from that load by symmetry.
+
+Why the chord frame and not Exudyn's default (the frame on the ``end_a`` face, ``end_b``
+translating across it): the axial force of a pinned link acts along its chord. With the frame
+on the face, a bent link's chord is turned against the frame and the linear body puts the
+axial force through that turn: compression *stiffens* it (the wrong sign), and the
+geometric stiffness that corrects it must cancel large frame-rotation terms, which made it
+fail Newton with more than one mode. In the chord frame the axial force is along the frame's
+x axis: the linear body is blind to it (no stiffening, no softening) and
+:mod:`flex.bodies.geometric_stiffness` adds exactly the missing softening
+(docs/geometric-stiffness.md).
 """
 
 from __future__ import annotations
@@ -44,7 +58,7 @@ from flex.base.errors import SceneError
 from flex.bodies.plate import PlateLink, plate_mesh
 
 #: Bump when the content or layout of a cache file changes; old entries are then rebuilt.
-CACHE_FORMAT_VERSION = 1
+CACHE_FORMAT_VERSION = 2  # 2: the chord frame (end_a rotation static modes)
 
 END_A = "end_a"  #: mesh boundary name of the joint-B face (x = 0)
 END_B = "end_b"  #: mesh boundary name of the joint-C face (x = length)
@@ -357,10 +371,14 @@ def _ngsolve_thread_count(threads: int | None) -> Iterator[None]:
 
 def _craig_bampton_basis(fem, mass_form, stiffness_form, interfaces: list[np.ndarray],
                          modes: int, selection: str) -> int:
-    """Put the Hurty-Craig-Bampton basis in ``fem`` (``modeBasis``, ``eigenValues``): the
-    static modes of ``end_b`` and ``modes`` fixed-interface eigenmodes, all of them or the
-    in-plane ones (``selection``, see :func:`build_reduction`). ``end_a`` goes first: it gets
-    no static modes and becomes the floating frame. Returns the number of static modes.
+    """Put the chord-frame Craig-Bampton basis in ``fem`` (``modeBasis``, ``eigenValues``):
+    static modes and ``modes`` fixed-interface eigenmodes, all of them or the in-plane ones
+    (``selection``, see :func:`build_reduction`). Returns the number of static modes.
+
+    Exudyn's Hurty-Craig-Bampton modes make ``end_a`` the floating frame (it gets no static
+    modes) and give ``end_b`` its six rigid-face modes; :func:`_chord_frame` then trades
+    ``end_b``'s transverse translations for rotations of ``end_a``, so the frame's x axis runs
+    through both face centres (see the module doc for why).
 
     In-plane eigenmodes: more eigenmodes are computed than asked (about half of a thin
     plate's lowest modes are torsion and out-of-plane bending), their in-plane subspace is
@@ -370,20 +388,65 @@ def _craig_bampton_basis(fem, mass_form, stiffness_form, interfaces: list[np.nda
     while True:
         fem.ComputeHurtyCraigBamptonModesNGsolve(mass_form, stiffness_form, interfaces,
                                                  computed)
-        if selection == "all":
-            return _STATIC_MODES
         basis = fem.modeBasis["matrix"]
+        if selection == "all":
+            static = np.arange(_STATIC_MODES)
+            eigenmodes, eigenvalues = basis[:, _STATIC_MODES:], np.asarray(fem.eigenValues)
+            break
         positions = fem.GetNodePositionsAsArray()
         found = _in_plane_eigenmodes(fem, positions, basis[:, _STATIC_MODES:], modes)
         if found is not None:
+            static = np.flatnonzero(
+                _mirror_antisymmetry(positions, basis[:, :_STATIC_MODES]) < 0.5)
+            eigenmodes, eigenvalues = found
             break
         computed = int(1.5 * computed) + 4
-    static = np.flatnonzero(_mirror_antisymmetry(positions, basis[:, :_STATIC_MODES]) < 0.5)
-    eigenmodes, eigenvalues = found
-    fem.modeBasis["matrix"] = np.ascontiguousarray(
-        np.column_stack([basis[:, static], eigenmodes]))
+    static_modes = _chord_frame(fem, basis[:, static], interfaces)
+    fem.modeBasis["matrix"] = np.ascontiguousarray(np.column_stack([static_modes, eigenmodes]))
     fem.eigenValues = eigenvalues
-    return len(static)
+    return static_modes.shape[1]
+
+
+def _face_mean(fem, nodes: np.ndarray, columns: np.ndarray) -> np.ndarray:
+    """Area-weighted mean displacement (3, m) of the face ``nodes`` in each column."""
+    weights = np.asarray(fem.GetNodeWeightsFromSurfaceAreas(nodes))
+    return np.einsum("n,ncm->cm", weights / weights.sum(),
+                     columns.reshape(-1, 3, columns.shape[1])[nodes])
+
+
+def _chord_frame(fem, static_modes: np.ndarray, interfaces: list[np.ndarray]) -> np.ndarray:
+    """``end_b``'s static modes (columns) with each transverse translation (y, and z when
+    kept) replaced by the static mode of a unit rotation of ``end_a`` about the other
+    transverse axis (z, and y) through its centre, ``end_b`` clamped: no mode then moves the
+    centre of ``end_b`` off the frame's x axis, nor the centre of ``end_a`` off its origin.
+
+    Each new mode is the rigid turn of ``end_a`` [1 rad] carried into the interior by the
+    static condensation (K_ii u_i = -K_ib u_b, one sparse factorization for both)."""
+    from scipy.sparse.linalg import splu
+
+    end_a, end_b = (np.asarray(nodes) for nodes in interfaces)
+    translation = _face_mean(fem, end_b, static_modes)
+    positions = fem.GetNodePositionsAsArray()
+    centre_a = _face_mean(fem, end_a, positions.reshape(-1, 1))[:, 0]
+    size = 3 * len(positions)
+    fixed = np.zeros(size, dtype=bool)
+    for nodes in (end_a, end_b):
+        fixed[(3 * nodes[:, None] + np.arange(3)).ravel()] = True
+    stiffness = fem.stiffnessMatrix.tocsc()
+    interior = splu(stiffness[~fixed][:, ~fixed].tocsc())
+    out = static_modes.copy()
+    # (translation replaced, rotation axis of end_a): y <-> z axis, z <-> y axis
+    for component, axis in ((1, np.array([0.0, 0.0, 1.0])), (2, np.array([0.0, 1.0, 0.0]))):
+        column = np.flatnonzero(np.isclose(translation[component], 1.0, atol=1e-6))
+        if len(column) == 0:
+            continue
+        boundary = np.zeros(size)
+        turn = np.cross(axis, positions[end_a] - centre_a)  # small rigid turn, 1 rad
+        boundary[(3 * end_a[:, None] + np.arange(3)).ravel()] = turn.ravel()
+        mode = boundary.copy()
+        mode[~fixed] = interior.solve(-(stiffness[~fixed][:, fixed] @ boundary[fixed]))
+        out[:, column[0]] = mode
+    return out
 
 
 def _mirror_parts(positions: np.ndarray, basis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -622,7 +685,8 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
                   initial_velocity_B_m_per_s: Sequence[float] = (0.0, 0.0, 0.0),
                   initial_angular_velocity_rad_per_s: float = 0.0,
                   name: str = "coupler", joint_markers: str = "fewest",
-                  end_b_rotation: bool = True) -> dict[str, Any]:
+                  end_b_rotation: bool = True, end_a_rotation: bool = True
+                  ) -> dict[str, Any]:
     """Add the reduced plate to ``mbs`` as an ``ObjectFFRFreducedOrder`` between B and C.
 
     Written for the coupler (``end_a`` at B, ``end_b`` at C); the crank uses it with
@@ -638,6 +702,8 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
         four corner nodes of a rigid ``end_b``), ``"all_face_nodes"`` puts a
         ``MarkerSuperElementRigid`` on every face node (area weights; the same results to
         the Newton tolerance, several times the cost: kept to measure that);
+        ``end_a_rotation = False`` (a joint at B free about z, a revolute pin) lets ``marker_B``
+        be the frame node itself (its turn about z is then the chord's, not the face's);
         ``end_b_rotation = False`` (a joint at C that constrains only the position, the
         coupler's pin at C) makes ``marker_C`` a position marker, cheaper still; ``marker_mid``
         is a ``MarkerSuperElementPosition`` on the mid-length slab
@@ -688,7 +754,7 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
         **add_plate_markers(mbs, body, reduction, position_B, rotation, name,
                             joint_markers=None if joint_markers == "all_face_nodes" else
                             _ffrf_joint_markers(mbs, body, added["nRigidBody"], reduction,
-                                                name, end_b_rotation)),
+                                                name, end_b_rotation, end_a_rotation)),
         "stiffness_proportional_damping_s": beta,
     }
 
@@ -715,18 +781,21 @@ RIGID_FACE_TOLERANCE = 1e-9
 
 
 def _ffrf_joint_markers(mbs, body, frame_node, reduction: Reduction, name: str,
-                        end_b_rotation: bool = True) -> dict[str, Any]:
+                        end_b_rotation: bool = True, end_a_rotation: bool = True
+                        ) -> dict[str, Any]:
     """The joint markers at ``end_a`` (B) and ``end_b`` (C) of an FFRF body, as cheap as the
     reduced basis allows.
 
     Why: a ``MarkerSuperElementRigid`` costs time per face node and mode at every residual
     and Jacobian evaluation (Exudyn's CMarkerSuperElementRigid), and the joints were most of
-    an FFRF step, growing with the mesh (33, 39, 63 face nodes for 4, 2, 1 mm meshes).
-    Hurty-Craig-Bampton with RBE2-like interfaces leaves ``end_a`` out of every mode (the
-    floating frame *is* that face) and moves ``end_b`` rigidly in every mode, so:
+    an FFRF step, growing with the mesh (33, 39, 63 face nodes for 4, 2, 1 mm meshes). In
+    the chord-frame basis both end faces move rigidly in every mode, and no mode moves the
+    centre of ``end_a`` (the frame's origin), so:
 
-    - a face no mode moves, centred on the frame's origin, gets a ``MarkerNodeRigid`` on the
-      frame node (as Exudyn's CMS examples attach joints);
+    - ``end_a`` without ``end_a_rotation`` (its joint ignores the face's turn about z, as a
+      revolute pin about z does) gets a ``MarkerNodeRigid`` on the frame node, when no mode
+      turns the face about x or y (the in-plane basis): the frame node then has the face's
+      position and its orientation but for that turn;
     - a face every mode moves rigidly gets a ``MarkerSuperElementRigid`` on its four corner
       nodes, equal weights (any three or more non-collinear nodes centred on the face centre
       give the same position and rotation of a rigid face);
@@ -743,21 +812,23 @@ def _ffrf_joint_markers(mbs, body, frame_node, reduction: Reduction, name: str,
     basis = reduction.fem.modeBasis["matrix"]
     basis = basis.reshape(-1, 3, basis.shape[1])
     markers = {}
-    for face, label in ((END_A, "B"), (END_B, "C")):
+    for face, label, rotation in ((END_A, "B", end_a_rotation), (END_B, "C", end_b_rotation)):
         nodes = np.asarray(getattr(reduction, f"nodes_{face}"))
         weights = getattr(reduction, f"weights_{face}")
         centre = getattr(reduction, f"centre_{face}")
-        if not np.any(basis[nodes]) and np.allclose(centre, 0.0, rtol=0,
-                                                    atol=1e-9 * reduction.length_m):
+        motions = _rigid_face_motions(positions[nodes], basis[nodes], centre)
+        if (face == END_A and not rotation and motions is not None
+                and not np.any(motions[:, :5])
+                and np.allclose(centre, 0.0, rtol=0, atol=1e-9 * reduction.length_m)):
             markers[f"marker_{label}"] = mbs.AddMarker(eii.MarkerNodeRigid(
                 name=f"{name}:{label}", nodeNumber=frame_node))
             continue
         corners = _face_corners(positions, nodes)
-        if (len(corners) == 4 and _moves_rigidly(positions[nodes], basis[nodes])
+        if (len(corners) == 4 and motions is not None
                 and np.allclose(positions[corners].mean(axis=0), centre, rtol=0,
                                 atol=1e-9 * reduction.length_m)):
             nodes, weights = corners, np.full(4, 0.25)
-        kind = (eii.MarkerSuperElementPosition if face == END_B and not end_b_rotation
+        kind = (eii.MarkerSuperElementPosition if face == END_B and not rotation
                 else eii.MarkerSuperElementRigid)
         markers[f"marker_{label}"] = mbs.AddMarker(kind(
             name=f"{name}:{label}", bodyNumber=body, meshNodeNumbers=nodes,
@@ -775,23 +846,31 @@ def _face_corners(positions: np.ndarray, nodes: np.ndarray) -> np.ndarray:
     return np.array(sorted(picks))
 
 
-def _moves_rigidly(face_positions: np.ndarray, face_modes: np.ndarray) -> bool:
-    """Whether every mode's displacement of the face nodes is a (linearized) rigid motion,
-    u = t + w x r, to :data:`RIGID_FACE_TOLERANCE` (least squares over the face nodes)."""
-    r = face_positions - face_positions.mean(axis=0)
+def _rigid_face_motions(face_positions: np.ndarray, face_modes: np.ndarray,
+                        origin: np.ndarray | None = None) -> np.ndarray | None:
+    """Per mode, the face's (linearized) rigid motion u = t + w x r about ``origin`` [m]
+    (None: the face nodes' centroid),
+    rows (t_x, t_y, t_z, w_x, w_y, w_z) with entries below :data:`RIGID_FACE_TOLERANCE` of
+    the mode's face displacement set to 0; None if some mode does not move the face rigidly
+    to that tolerance (least squares over the face nodes)."""
+    r = face_positions - (face_positions.mean(axis=0) if origin is None else origin)
     fit = np.zeros((3 * len(r), 6))
     for i, (x, y, z) in enumerate(r):
         fit[3 * i:3 * i + 3, :3] = np.eye(3)
         fit[3 * i:3 * i + 3, 3:] = [[0.0, z, -y], [-z, 0.0, x], [y, -x, 0.0]]  # -[r]x
+    motions = []
     for mode in np.moveaxis(face_modes, 2, 0):
         u = mode.ravel()
         size = np.linalg.norm(u)
-        if size == 0:
-            continue
-        parameters, *_ = np.linalg.lstsq(fit, u, rcond=None)
-        if np.linalg.norm(fit @ parameters - u) > RIGID_FACE_TOLERANCE * size:
-            return False
-    return True
+        parameters = np.zeros(6)
+        if size > 0:
+            parameters, *_ = np.linalg.lstsq(fit, u, rcond=None)
+            if np.linalg.norm(fit @ parameters - u) > RIGID_FACE_TOLERANCE * size:
+                return None
+            scale = np.concatenate([np.ones(3), np.full(3, np.abs(r).max())])
+            parameters[np.abs(parameters) * scale < RIGID_FACE_TOLERANCE * size] = 0.0
+        motions.append(parameters)
+    return np.array(motions).reshape(-1, 6)
 
 
 def add_plate_markers(mbs, body, plate, position_B: np.ndarray, rotation: np.ndarray,

@@ -124,9 +124,9 @@ def _link_unused(link: str, scene: Scene) -> dict[str, str]:
             mark(("thickness_m",), f'{link}.model = "auto" with geometry = "lumped" analyses '
                                    f"the plate of the {link}'s mass_kg (its thickness follows "
                                    f'from it); used with geometry = "plate"')
-    if link == "coupler" and model not in ("ffrf", AUTO):
+    if model not in ("ffrf", AUTO):
         mark(("geometric_stiffness",),
-             f'coupler.model = "{model}": only an FFRF body takes the geometric stiffness of '
+             f'{link}.model = "{model}": only an FFRF body takes the geometric stiffness of '
              f'its axial force (the nonlinear FE body has it exactly); used with model = '
              f'"ffrf" or "auto"')
     return unused

@@ -89,6 +89,10 @@ def _plate_fields(link: str) -> dict[str, Field]:
         "mesh_size_m": Field(doc="netgen maximum element size (auto: min(2 t, L / 16), "
                              "flex.config.ffrf_rule)", auto=True, **_POS),
         "damping_ratio": Field(float, "modal damping ratio", minimum=0.0, below=1.0),
+        "geometric_stiffness": Field(bool, "model = ffrf: soften the bending modes under the "
+                                     "link's own axial force (flex.bodies.geometric_stiffness; "
+                                     "false: the linear FFRF body, for comparison)",
+                                     default=True),
     }
 
 
@@ -114,9 +118,6 @@ SCHEMA: dict[str, dict[str, Field]] = {
                        "(accuracy reference, ~50x slower per step); auto: rigid or "
                        "ffrf (and modes) from the fitted criterion and fidelity.tolerance"),
         **_plate_fields("coupler"),
-        "geometric_stiffness": Field(bool, "model = ffrf: add the geometric stiffness of the "
-                                     "link's axial force to its modes (stress-stiffening; "
-                                     "flex.bodies.geometric_stiffness)", default=False),
     },
     "wing": {
         "enabled": Field(bool, "weld a wing plate to the crank at A (sec. 6.4 application)"),

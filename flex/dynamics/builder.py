@@ -327,7 +327,8 @@ class _Builder:
             self.mbs, crank_reduction, [0.0, 0.0, 0.0], self.init.crank_angle_rad,
             damping_ratio=self.scene["crank"]["damping_ratio"],
             initial_angular_velocity_rad_per_s=self.init.crank_speed_rad_per_s, name="crank",
-            joint_markers=self.ffrf_joint_markers)
+            joint_markers=self.ffrf_joint_markers,
+            end_a_rotation=bool(self.scene["wing"]["enabled"]))  # the weld turns with A
         self.markers["crank_A"] = flexible_crank["marker_B"]
         self.markers["crank_B"] = flexible_crank["marker_C"]
         self.mech.crank = dict(flexible_crank, reduction=crank_reduction)
@@ -345,6 +346,7 @@ class _Builder:
                 initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
                 initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s,
                 joint_markers=self.ffrf_joint_markers,
+                end_a_rotation=False,  # the pin at B is free about z
                 end_b_rotation=False)  # the pin at C constrains x and y only
             self.mech.coupler = dict(self.coupler, reduction=reduction)
         elif model == "nonlinear_fe":
@@ -370,19 +372,19 @@ class _Builder:
         self.markers["coupler_C"] = self.coupler["marker_C"]
 
     def _add_geometric_stiffness(self) -> None:
-        """The stress-stiffening of the FFRF coupler's modes under its axial force
-        (``coupler.geometric_stiffness``; :mod:`flex.bodies.geometric_stiffness`): the mean
-        from the coupler's stretch, the value at C from joint C's reaction."""
+        """The softening of each FFRF link's bending modes under its own axial force
+        (``<link>.geometric_stiffness``, true by default;
+        :mod:`flex.bodies.geometric_stiffness`)."""
         from flex.bodies.geometric_stiffness import (
             add_geometric_stiffness,
             geometric_stiffness,
-            joint_tension,
         )
 
-        stiffness = geometric_stiffness(self.mech.coupler["reduction"])
-        self.coupler["geometric_stiffness"] = add_geometric_stiffness(
-            self.mbs, self.coupler["node_modal"], stiffness,
-            end_b_tension=joint_tension(self.joints["C"], self.coupler["node_frame"]))
+        for name, link in (("coupler", self.mech.coupler), ("crank", self.mech.crank)):
+            values = self.scene[name]
+            if values["model"] == "ffrf" and values["geometric_stiffness"]:
+                link["geometric_stiffness"] = add_geometric_stiffness(
+                    self.mbs, link["node_modal"], geometric_stiffness(link["reduction"]), name)
 
     def add_joints(self) -> None:
         """Revolute A and B, the in-plane pin C, the prismatic slide (or penalty springs for
@@ -420,9 +422,7 @@ class _Builder:
         # the crank is flexible), turned back by the initial crank angle: collect turns it
         # with that marker's rotation since t = 0
         self.mech.joint_frames = {"A": None, "B": "marker_crank_B", "C": None, "P": None}
-        coupler = scene["coupler"]
-        if coupler["model"] == "ffrf" and coupler["geometric_stiffness"]:
-            self._add_geometric_stiffness()
+        self._add_geometric_stiffness()
 
     def add_drive(self) -> None:
         """The preloaded spring on the slider, or the crank held at constant speed."""

@@ -653,11 +653,33 @@ VALIDITY_WARNING = "validity_warning"
 FFRF_DEFLECTION_LIMIT = 0.01
 
 
+def _buckling_warnings(scene: Scene, datasets: dict[str, Dataset]) -> list[str]:
+    """An FFRF coupler compressed beyond its Euler load pi^2 E I / L^2: its geometric
+    stiffness is linear in the load and holds no buckled shape."""
+    from flex.base.kinematics import chord_components
+    from flex.base.physics import euler_buckling_load_N
+
+    coupler = scene["coupler"]
+    if coupler["model"] != "ffrf" or "joints/C/force_on_coupler" not in datasets:
+        return []
+    axial, _ = chord_components(datasets["joints/C/force_on_coupler"].data,
+                                datasets["coupler/angle"].data)
+    ratio = float(np.max(-axial, initial=0.0)) / euler_buckling_load_N(
+        coupler["length_m"], coupler["thickness_m"], coupler["width_m"],
+        coupler["youngs_modulus_Pa"])
+    if ratio <= 1.0:
+        return []
+    return [f"coupler: compressed to {ratio:.3g} x its Euler load (pi^2 E I / L^2): the FFRF "
+            f"body's geometric stiffness is linear in the load and holds no buckled shape; "
+            f'use coupler.model = "nonlinear_fe" or a thicker coupler']
+
+
 def validity_warning(scene: Scene, datasets: dict[str, Dataset]) -> str:
     """Why the results of a finished run may not be valid ("" if nothing is known against
-    them): an FFRF link whose peak elastic midpoint deflection exceeds
-    :data:`FFRF_DEFLECTION_LIMIT` of its length (linear FFRF validity)."""
-    warnings = []
+    them): an FFRF coupler compressed beyond its Euler load; an FFRF link whose peak
+    elastic midpoint deflection exceeds :data:`FFRF_DEFLECTION_LIMIT` of its length (linear
+    FFRF validity)."""
+    warnings = _buckling_warnings(scene, datasets)
     for link in ("crank", "coupler"):
         name = f"{link}/midpoint_deflection"
         if scene[link]["model"] != "ffrf" or name not in datasets:

@@ -201,37 +201,30 @@ undamped) and 0.49 (1 mm, 15000 N/m, undamped) and beyond the Euler load; the fi
 reach 0.24 (the kfit report lists what is left out)."""
 
 
-LINEAR_FFRF_ERROR_FLOOR = 0.01
-LINEAR_FFRF_ERROR_PER_LOAD = 3.0
-GEOMETRIC_FFRF_ERROR = 0.015
-"""The flexible rungs of an ``auto`` coupler, measured by ``make ladder`` (thesis
-deployment, steel plates 0.5-10 mm, peak elastic midpoint deflection against the nonlinear
-FE coupler's, docs/geometric-stiffness.md): the linear FFRF coupler's error relative to the
-peak stayed below ``LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD x`` (x the rigid
-probe's compression / Euler load, :func:`euler_load_ratio`; measured 0.36 % at x = 1e-4,
-2.0 % at 0.0076, 11.5 % at 0.049, 34 % at 0.13, 40 % at 0.20, 46 % at 0.33: the closest
-is 0.87 of the bound); the FFRF coupler with geometric stiffness stayed below
-``GEOMETRIC_FFRF_ERROR`` (largest 1.11 %, x up to 0.20, and 0.33 at a step of 1e-4 s), so
-within :data:`EULER_LOAD_LIMIT` the ladder never needs the nonlinear FE coupler unless the
-tolerance is below 1.5 % of the predicted deflection."""
+LINEAR_FFRF_ERROR_FLOOR = 0.005
+LINEAR_FFRF_ERROR_PER_LOAD = 1.0
+GEOMETRIC_FFRF_ERROR = 0.005
+"""The FFRF rungs' model errors relative to the quantity, measured by ``make ladder``
+(thesis deployment, steel plates 0.5-10 mm, peak elastic midpoint deflection against the
+nonlinear FE coupler's, docs/geometric-stiffness.md): the FFRF coupler (chord frame, with
+the geometric stiffness of its axial force, flex's default) stayed within 0.35 % (largest at
+0.5-0.7 mm and at 10 mm, where both FFRF bodies differ alike from the nonlinear FE one: the
+rigid end faces), bounded by ``GEOMETRIC_FFRF_ERROR``; the linear FFRF coupler
+(``geometric_stiffness = false``) below ``LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD
+x`` (x the rigid probe's compression / Euler load, :func:`euler_load_ratio`; measured 0.32 %
+at x = 1e-4, 0.53 % at 0.0076, 3.2 % at 0.049, 13 % at 0.13, 16 % at 0.20, 18 % at 0.33)."""
 
 
-def flexible_rung(predicted_deflection: float, load_ratio: float, tolerance: float
+def flexible_rung(load_ratio: float, tolerance: float, geometric_stiffness: bool = True
                   ) -> tuple[str, float]:
-    """The lowest flexible rung of the coupler ladder whose predicted deflection error meets
-    ``tolerance``: ``"ffrf"`` (linear), ``"ffrf_geometric"`` (``coupler.geometric_stiffness``)
-    or ``"nonlinear_fe"``, and that rung's predicted error (NaN for the last).
-
-    ``predicted_deflection``: the predicted peak deflection / length, margin included (the
-    rigid model's predicted error); an FFRF rung's error is that times its measured relative
-    error (:data:`LINEAR_FFRF_ERROR_FLOOR`, ...); ``load_ratio``: the rigid probe's
-    compression / Euler load. All dimensionless.
-    """
-    linear = LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio
-    for rung, relative in (("ffrf", linear), ("ffrf_geometric", GEOMETRIC_FFRF_ERROR)):
-        if predicted_deflection * relative <= tolerance:
-            return rung, predicted_deflection * relative
-    return "nonlinear_fe", math.nan
+    """The coupler's flexible rung for ``tolerance`` (relative to the quantity: the peak
+    deflection or stress the rung computes): ``"ffrf"`` when its measured model error meets
+    it (:data:`GEOMETRIC_FFRF_ERROR`, or the linear body's bound at ``load_ratio``, the rigid
+    probe's compression / Euler load, without ``geometric_stiffness``), else
+    ``"nonlinear_fe"``; and the FFRF rung's relative model error. All dimensionless."""
+    relative = (GEOMETRIC_FFRF_ERROR if geometric_stiffness
+                else LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio)
+    return ("ffrf" if relative <= tolerance else "nonlinear_fe"), relative
 
 
 def euler_load_ratio(force_B_N: np.ndarray, force_C_N: np.ndarray,
@@ -923,15 +916,6 @@ def resolve_fidelity(scene: Mapping[str, Mapping[str, Any]],
     return resolved, decisions
 
 
-#: in-plane modes the geometric-stiffness rung keeps when the coupler's modes are "auto": its
-#: K_G is checked against the first mode's Euler load (f = f0 sqrt(1 - P / P_E),
-#: flex.bodies.geometric_stiffness). With the rule's 2 modes (and with 3 or 6) four of make
-#: design's thesis-angle scenes (1 mm plates, 3000-12000 N/m springs, compression up to
-#: 0.19 P_E) fail Newton at h = 1e-5 and 5e-5 s, the axial ringing feeding K_G; with 1 mode
-#: (and 4) all four run, and their peak deflections with 1 and 4 modes agree within 0.15 %.
-GEOMETRIC_RUNG_MODES = 1
-
-
 def _mode_cut(decision: FidelityDecision, resolved: dict[str, dict[str, Any]], link: str,
               k_phys: float, delta_t_s: float) -> None:
     """An ``ffrf`` decision keeps every estimated mode below omega_cut = k / delta_t; a link
@@ -943,10 +927,6 @@ def _mode_cut(decision: FidelityDecision, resolved: dict[str, dict[str, Any]], l
         decision.modes = fill_link_keys(resolved, link, decision.tolerance)["modes"]
         decision.reason += (f"; modes = {decision.modes}: the tolerance rule's "
                             f"(flex.config.ffrf_rule)")
-        if resolved[link].get("geometric_stiffness") and decision.modes > GEOMETRIC_RUNG_MODES:
-            decision.modes = resolved[link]["modes"] = GEOMETRIC_RUNG_MODES
-            decision.reason += (f", {GEOMETRIC_RUNG_MODES} on the geometric-stiffness rung "
-                                f"(flex.fidelity.criteria.GEOMETRIC_RUNG_MODES)")
         return
     omega_cut = k_phys * TWO_PI / delta_t_s
     decision.modes = modes_for_cutoff(resolved, omega_cut, link)
@@ -989,17 +969,15 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
 
 def _climb(decision: FidelityDecision, coupler: dict[str, Any], load_ratio: float,
            tolerance: float) -> None:
-    """Past rigid, the lowest flexible rung that meets ``tolerance`` (:func:`flexible_rung`;
-    in place: ``coupler.geometric_stiffness`` set for its rung, a true value given kept;
-    ``decision.model`` "nonlinear_fe" for the last rung, refused for a damped coupler)."""
-    bound = decision.predicted_rigid_error * PREDICTION_MARGIN
-    rung, predicted = flexible_rung(bound, load_ratio, tolerance)
-    linear = bound * (LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio)
-    decision.reason += (f"; ladder: {rung} (predicted deflection error {predicted:.3g}; "
-                        f"linear FFRF {linear:.3g}, with geometric stiffness "
-                        f"{bound * GEOMETRIC_FFRF_ERROR:.3g}: make ladder's measured errors)")
-    if rung == "ffrf_geometric":
-        coupler["geometric_stiffness"] = True
+    """Past rigid, the FFRF coupler when its measured model error relative to the deflection
+    meets ``tolerance`` (:func:`flexible_rung`), else the nonlinear FE coupler (in place:
+    ``decision.model``; refused for a damped coupler)."""
+    geometric = bool(coupler.get("geometric_stiffness", True))
+    rung, relative = flexible_rung(load_ratio, tolerance, geometric)
+    body = "FFRF" if geometric else "linear FFRF (geometric_stiffness = false)"
+    decision.reason += (f"; ladder: {rung} ({body} model error {relative:.3g} of the "
+                        f"deflection, make ladder's measured bound, "
+                        f"{'<=' if rung == 'ffrf' else '>'} tolerance {tolerance:g})")
     if rung == "nonlinear_fe":
         if coupler["damping_ratio"] != 0:
             raise SceneError(f'coupler.model = "auto": {decision.reason}; the nonlinear FE '
