@@ -1,26 +1,22 @@
-"""Study ``flexible`` (thesis sec. 6.2, figs. 35-50): FFRF couplers of four thicknesses.
+"""Study ``flexible`` (thesis sec. 6.2, figs. 35-50): coupler plates of four thicknesses.
 
 The coupler becomes a steel plate 0.08 x 0.01 x t (Table 5, models 0-3: t = 1, 3, 5, 10 mm)
-modelled twice in the same mechanism: as a floating-frame-of-reference body (NGsolve mesh,
-Hurty-Craig-Bampton reduction with the joint faces as interfaces) and as its rigid twin, a
-rigid body with the plate's own mass and inertia, so the pair differs only by elasticity
-(:mod:`flex.experiments.twins`). The spring deployment is the thesis scene (22 mm preload reading,
-undamped).
+modelled in the same mechanism as flex's default flexible body (``<model>_ffrf``: FFRF on
+the chord frame with the geometric stiffness of its axial force), as the linear FFRF body
+(``<model>_linear``), as its rigid twin (``<model>_rigid``: the plate's own mass and
+inertia) and as the fully nonlinear FE coupler, the reference, over ``REFERENCE_SPANS_S``
+(``<model>_nonlinear_fe``; :mod:`flex.experiments.twins`). The spring deployment is the thesis
+scene (22 mm preload reading, undamped).
 
 Stored per case: the rigid-body quantities, ``coupler/midpoint_deflection`` (elastic,
 relative to the chord B-C), ``coupler/chord_change``, ``coupler/midpoint_acceleration``,
-``coupler/modal_coordinates``, ``coupler/peak_bending_stress``; per model under
-``/summary/models/<model>``: the reduction's frequencies, mesh statistics and the
-deviations of the FFRF run from its rigid twin, and n = delta_t / T in both period
-conventions (thesis: T = 1/omega; physical: T = 2 pi / omega).
-
-Accuracy reference: the thinnest model also runs with the fully nonlinear FE coupler
-(:mod:`flex.bodies.nonlinear`: the same mesh, Green-Lagrange strain, no reduction) over
-``NONLINEAR_END_TIME_S`` (default: the whole deployment); ``/summary/nonlinear_reference/
-<model>`` holds its first and largest deflection peaks against the FFRF run's over the same
-span, the largest difference of the two curves, the axial load of the link against its
-Euler load (the geometric softening the linear FFRF body leaves out) and both wall times
-(:mod:`flex.fidelity.softening`).
+``coupler/modal_coordinates``, ``coupler/peak_bending_stress``; the default FFRF and rigid
+runs their error budgets (``estimated_error_*``). Per plate under ``/summary/models/<model>``:
+the reduction's frequencies, mesh statistics, the FFRF run's deviations from its rigid
+twin, its peaks with their estimated errors, and n = delta_t / T in both period
+conventions; under ``/summary/reference/<model>``: each model's first and largest
+deflection peaks over the reference's span and their errors against it, the curves'
+largest difference, the compression over the Euler load (:mod:`flex.fidelity.softening`).
 """
 
 from __future__ import annotations
@@ -36,8 +32,8 @@ from flex.experiments.twins import simulate_twins, summarize_twins, twin_cases, 
 from flex.study import StudyRun, Summary
 
 NAME = "flexible"
-DESCRIPTION = ("FFRF coupler plates t = 1, 3, 5, 10 mm against their rigid twins; nonlinear FE "
-               "reference for t = 1 mm")
+DESCRIPTION = ("coupler plates t = 1, 3, 5, 10 mm as FFRF (flex's default), linear FFRF and "
+               "rigid twins against the nonlinear FE coupler")
 OVERRIDES = pinned_overrides() + ['coupler.geometry="plate"']
 # keys the study reads itself (its plates and their rigid twins), beside its cases
 READS = ("coupler.length_m", "coupler.thickness_m", "coupler.width_m",
@@ -49,16 +45,17 @@ READS = ("coupler.length_m", "coupler.thickness_m", "coupler.width_m",
 MODELS = {"model0_t1mm": (0.001, 0.002), "model1_t3mm": (0.003, 0.003),
           "model2_t5mm": (0.005, 0.005), "model3_t10mm": (0.010, 0.005)}
 THESIS_DEPLOYMENT_TIME_S = THESIS_DELTA_T_S  # thesis sec. 6.2, Table 5 note
-# the nonlinear FE reference: the thinnest plate (largest deflection, lowest Euler load)
-# over the whole deployment (None: the scene's end time; 0.002 covers the first peak). It
-# costs ~0.1 s per step against ~2 ms for the FFRF body: 4.6 min of CPU, 7.4 min wall on the
-# shared 2-core machine, most of the study's time
-NONLINEAR_MODEL = "model0_t1mm"
-NONLINEAR_END_TIME_S: float | None = None
+# the nonlinear FE reference of each plate, run to this end time [s] (None: the scene's): the
+# first two deflection crests of the 1 mm plate (1.8 first bending periods), 2.7-9 periods
+# of the others. Per step it costs ~0.1 s (1 mm plate) to ~0.02 s (5-10 mm) against
+# ~0.5 ms for the FFRF body: most of the study's time
+REFERENCE_SPANS_S: dict[str, float | None] = {
+    "model0_t1mm": 0.005, "model1_t3mm": 0.0025, "model2_t5mm": 0.0025,
+    "model3_t10mm": 0.0025}
 
 
 def cases(scene: Scene) -> dict[str, Scene]:
-    return twin_cases(scene, MODELS, NONLINEAR_MODEL, NONLINEAR_END_TIME_S)
+    return twin_cases(scene, MODELS, REFERENCE_SPANS_S)
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
@@ -68,12 +65,12 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               notes: dict[str, Any] | None = None) -> Summary:
-    return Summary(*summarize_twins(scene, results, notes or {}, MODELS, NONLINEAR_MODEL,
+    return Summary(*summarize_twins(scene, results, notes or {}, MODELS,
                                     THESIS_DEPLOYMENT_TIME_S))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    return twin_figures(results, summary.datasets, folder, list(MODELS), NONLINEAR_MODEL)
+    return twin_figures(results, summary.datasets, folder, list(MODELS))
 
 if __name__ == "__main__":
     from flex.cli import main

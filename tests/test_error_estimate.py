@@ -84,8 +84,10 @@ def test_inspect_prints_the_estimated_error(tmp_path):
     case = simulate(load_scene(overrides={"simulation.end_time_s": 0.005}), cache_dir=None)
     path = write_results(tmp_path / "one.h5", "simulate", [case], to_toml(load_scene()))
     text = format_description(describe(path))
-    assert "estimated error: crank angle at the end time" in text
-    assert "method: step doubling" in text and "validity: asymptotic" in text
+    assert "estimated error (total = the sum of the terms):" in text
+    assert "crank angle at the end time: " in text and " = step " in text
+    assert "method: step: step doubling" in text and "validity: asymptotic" in text
+    assert "leaves out: " in text and "the elasticity of the rigid crank and coupler" in text
 
 
 def test_no_estimate_when_switched_off():
@@ -159,3 +161,53 @@ def test_faster_content_at_another_phase_on_the_crest_is_caught():
     moved = peak_difference(_datasets(time_s, a), _datasets(time_s, b),
                             "coupler/midpoint_deflection")
     assert moved == pytest.approx(2e-3, rel=0.2)
+
+
+def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
+    """A coarse 5 mm plate over 3 ms: every headline quantity has its four terms, the total
+    is their sum, the relative error is the total over the quantity; the deflection's model
+    term is the ladder's bound times the whole deflection (its rigid twin has none)."""
+    from flex.api import load_scene
+    from flex.fidelity.criteria import GEOMETRIC_FFRF_ERROR
+    from flex.fidelity.error_budget import TERMS, budget_rows
+    from flex.fidelity.simulation import simulate
+
+    scene = load_scene(overrides=['coupler.geometry="plate"', 'coupler.model="ffrf"',
+                                  "coupler.thickness_m=0.005", "coupler.mesh_size_m=0.005",
+                                  "coupler.modes=2", "simulation.end_time_s=0.003",
+                                  "simulation.step_s=2.5e-5"])
+    result = simulate(scene, cache_dir=reduction_cache)
+    rows = {row.quantity: row for row in budget_rows(result.attrs)}
+    assert {"crank_angle_end_rad", "slider_position_end_m", "coupler_peak_deflection_m",
+            "coupler_peak_bending_stress_Pa", "joint_C_peak_force_N"} <= set(rows)
+    for row in rows.values():
+        assert set(row.terms) == set(TERMS)
+        assert row.total == pytest.approx(sum(row.terms.values()), rel=1e-12)
+        assert row.relative == pytest.approx(row.total / abs(row.value), rel=1e-12)
+    deflection = rows["coupler_peak_deflection_m"]
+    assert deflection.value == pytest.approx(
+        np.abs(result.datasets["coupler/midpoint_deflection"].data).max(), rel=1e-12)
+    assert deflection.terms["model"] == pytest.approx(GEOMETRIC_FFRF_ERROR * deflection.value,
+                                                      rel=1e-9)
+    assert deflection.terms["modes"] > 0 and deflection.terms["mesh"] > 0
+    method = result.attrs["estimated_error_method"]
+    assert "coupler 2 -> 4" in method and "coupler 0.005 -> 0.01 m" in method
+
+
+def test_a_linear_ffrf_run_counts_its_distance_to_the_default_body(reduction_cache):
+    """geometric_stiffness = false: the model term adds the difference to the default body,
+    so it exceeds the default body's own bound on the deflection."""
+    from flex.api import load_scene
+    from flex.fidelity.criteria import GEOMETRIC_FFRF_ERROR
+    from flex.fidelity.error_budget import budget_rows
+    from flex.fidelity.simulation import simulate
+
+    scene = load_scene(overrides=['coupler.geometry="plate"', 'coupler.model="ffrf"',
+                                  "coupler.thickness_m=0.001", "coupler.mesh_size_m=0.004",
+                                  "coupler.modes=1", "simulation.end_time_s=0.002",
+                                  "simulation.step_s=2.5e-5",
+                                  "coupler.geometric_stiffness=false"])
+    rows = {row.quantity: row for row in budget_rows(
+        simulate(scene, cache_dir=reduction_cache).attrs)}
+    deflection = rows["coupler_peak_deflection_m"]
+    assert deflection.terms["model"] > 2 * GEOMETRIC_FFRF_ERROR * deflection.value

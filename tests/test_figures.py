@@ -166,11 +166,13 @@ def test_flexible_figures_synthetic(tmp_path, reviewed):
                                          coupler__midpoint_acceleration=acceleration)
         data[f"models/{model}/peak_midpoint_deflection"] = amplitude
         data[f"models/{model}/thickness_m"] = thickness
-    model = flexible.NONLINEAR_MODEL
-    results[f"{model}_nonlinear_fe"] = case(
-        f"{model}_nonlinear_fe", time=TIME[:100],
-        coupler__midpoint_deflection=results[f"{model}_ffrf"].datasets[
-            "coupler/midpoint_deflection"].data[:100] * 1.05)
+    for model in list(flexible.MODELS)[:2]:  # two plates with a reference
+        ffrf = results[f"{model}_ffrf"].datasets["coupler/midpoint_deflection"].data
+        results[f"{model}_linear"] = case(f"{model}_linear", time=TIME,
+                                          coupler__midpoint_deflection=ffrf * 0.97)
+        results[f"{model}_nonlinear_fe"] = case(
+            f"{model}_nonlinear_fe", time=TIME[:100],
+            coupler__midpoint_deflection=ffrf[:100] * 1.05)
     paths = flexible.figures(results, summary(**data), tmp_path)
     check_pngs(paths, tmp_path, {"flexible-midpoint-deflection.png",
                                  "flexible-nonlinear-reference.png",

@@ -293,20 +293,28 @@ def test_ffrf_coupler_with_a_constant_speed_crank_follows_the_closed_form():
 # ------------------------------------------------------------------------------------------
 # flex.experiments.twins and flex.fidelity.softening
 # ------------------------------------------------------------------------------------------
-def test_twin_cases_pair_each_plate_and_add_the_nonlinear_reference_when_undamped():
+def test_twin_cases_model_each_plate_every_way_and_add_references_when_undamped():
     from flex.experiments.twins import twin_cases
 
     plates = {"a_t3mm": (0.003, 0.003), "b_t5mm": (0.005, 0.005)}
     base = load_scene(None, [*pinned_overrides(), 'coupler.geometry="plate"'])
-    scenes = twin_cases(base, plates, "a_t3mm", 0.002)
-    assert list(scenes) == ["a_t3mm_ffrf", "a_t3mm_rigid", "b_t5mm_ffrf", "b_t5mm_rigid",
-                            "a_t3mm_nonlinear_fe"]
+    scenes = twin_cases(base, plates, {"a_t3mm": 0.002})
+    assert list(scenes) == ["a_t3mm_ffrf", "a_t3mm_linear", "a_t3mm_rigid",
+                            "a_t3mm_nonlinear_fe", "b_t5mm_ffrf", "b_t5mm_linear",
+                            "b_t5mm_rigid"]
     assert scenes["b_t5mm_rigid"]["coupler"]["thickness_m"] == 0.005
     assert scenes["b_t5mm_rigid"]["coupler"]["model"] == "rigid"
-    assert scenes["a_t3mm_nonlinear_fe"]["simulation"]["end_time_s"] == 0.002
+    assert scenes["a_t3mm_ffrf"]["coupler"]["geometric_stiffness"] is True
+    assert scenes["a_t3mm_ffrf"]["simulation"]["error_estimate"] is True
+    linear, reference = scenes["a_t3mm_linear"], scenes["a_t3mm_nonlinear_fe"]
+    assert linear["coupler"]["geometric_stiffness"] is False
+    # the comparisons carry no estimate of their own: their error is what is measured
+    assert not linear["simulation"]["error_estimate"]
+    assert not reference["simulation"]["error_estimate"]
+    assert reference["simulation"]["end_time_s"] == 0.002
     damped = load_scene(None, [*pinned_overrides(), 'coupler.geometry="plate"',
                                "coupler.damping_ratio=0.01"])
-    assert "a_t3mm_nonlinear_fe" not in twin_cases(damped, plates, "a_t3mm")
+    assert "a_t3mm_nonlinear_fe" not in twin_cases(damped, plates, {"a_t3mm": None})
 
 
 def test_first_peak_is_the_first_lobe_not_the_ripple_or_the_largest_swing():

@@ -525,8 +525,8 @@ def _elastic_datasets(mech: Mechanism, link: str, start_marker: str, end_marker:
     if "reduction" not in body:  # nonlinear FE: nodal coordinates, no modes, no stress yet
         return out
     modal = _sensor(mech, f"{link}.modal_coordinates")[:, 1:]
-    out[f"{link}/modal_coordinates"] = Dataset(modal, "1",
-                                               "elastic coordinates: 6 static + eigenmodes")
+    out[f"{link}/modal_coordinates"] = Dataset(
+        modal, "1", "elastic coordinates: the static modes, then the fixed-interface eigenmodes")
     reduction = body["reduction"]
     if reduction.has_stress_modes:
         out[f"{link}/peak_bending_stress"] = Dataset(

@@ -1,8 +1,8 @@
-"""The model ladder of a plate coupler: linear FFRF, FFRF with geometric stiffness, nonlinear FE.
+"""The model ladder of a plate coupler: linear FFRF, FFRF (flex's default), nonlinear FE.
 
 For one plate thickness, the thesis deployment (spring release) is run three times on the same
-mesh, step and samples: the linear FFRF coupler, the FFRF coupler with the geometric stiffness
-of its axial force (``coupler.geometric_stiffness = true``,
+mesh, step and samples: the linear FFRF coupler (``coupler.geometric_stiffness = false``),
+flex's default FFRF coupler (chord frame, the geometric stiffness of its axial force,
 :mod:`flex.bodies.geometric_stiffness`) and the fully nonlinear FE coupler
 (:mod:`flex.bodies.nonlinear`), the reference. :func:`ladder_rung` returns each model's peak
 elastic midpoint deflection over the span, its relative difference to the nonlinear FE
@@ -26,8 +26,8 @@ from flex.fidelity.softening import coupler_compression_N, coupler_euler_load_N
 
 #: the three models, cheapest first: name -> coupler overrides
 MODELS = {
-    "ffrf": ('coupler.model="ffrf"', "coupler.geometric_stiffness=false"),
-    "ffrf_geometric": ('coupler.model="ffrf"', "coupler.geometric_stiffness=true"),
+    "linear": ('coupler.model="ffrf"', "coupler.geometric_stiffness=false"),
+    "ffrf": ('coupler.model="ffrf"', "coupler.geometric_stiffness=true"),
     "nonlinear_fe": ('coupler.model="nonlinear_fe"', "coupler.geometric_stiffness=false"),
 }
 REFERENCE = "nonlinear_fe"
@@ -40,7 +40,9 @@ KEEP = ("time", "crank/angle", "coupler/midpoint_deflection", "coupler/angle",
 class Rung:
     """One thickness: per model, the peak |midpoint deflection| [m], its relative difference
     to the nonlinear FE peak (dimensionless), the wall time [s] (NaN for a failed run, whose
-    message is in ``failures``), and the plate's largest compression over its Euler load."""
+    message is in ``failures``; a run that finished but may not be valid has its
+    ``validity_warning`` in ``warnings``), and the plate's largest compression over its
+    Euler load."""
 
     thickness_m: float
     step_s: float
@@ -50,6 +52,7 @@ class Rung:
     wall_time_s: dict[str, float] = field(default_factory=dict)
     compression_over_euler_load: float = math.nan
     failures: dict[str, str] = field(default_factory=dict)
+    warnings: dict[str, str] = field(default_factory=dict)
 
 
 def first_period_s(scene: Scene) -> float:
@@ -96,9 +99,11 @@ def rung_from_cases(cases: dict[str, CaseResult], scene: Scene) -> Rung:
             rung.peak_deflection_m[name] = rung.wall_time_s[name] = math.nan
             continue
         data = {k: v.data for k, v in case.datasets.items()}
+        if case.attrs.get("validity_warning"):
+            rung.warnings[name] = str(case.attrs["validity_warning"])
         rung.peak_deflection_m[name] = float(np.abs(data["coupler/midpoint_deflection"]).max())
         rung.wall_time_s[name] = float(case.counters["wall_time_s"])
-        if name == "ffrf":
+        if name == "linear":
             rung.compression_over_euler_load = float(
                 coupler_compression_N(data).max() / coupler_euler_load_N(scene["coupler"]))
     reference = rung.peak_deflection_m.get(REFERENCE, math.nan)
@@ -125,6 +130,9 @@ def rung_datasets(rung: Rung, prefix: str) -> dict[str, Dataset]:
     out = {f"{prefix}/compression_over_euler_load": Dataset(
         rung.compression_over_euler_load, "1", "largest compression of the linear FFRF "
         "coupler (joint C along B-C) / pinned-pinned Euler load")}
+    for name, warning in rung.warnings.items():
+        out[f"{prefix}/validity_warning_{name}"] = Dataset(warning, "", f"{name}: why its "
+                                                           "result may not be valid")
     for name in MODELS:
         out[f"{prefix}/peak_deflection_{name}"] = Dataset(
             rung.peak_deflection_m[name], "m", f"max |midpoint deflection|, {name}")
@@ -141,17 +149,19 @@ def ladder_table(rungs: list[Rung]) -> str:
     """A Markdown table of the rungs: thickness, P/P_E, step, each model's peak [um] and
     relative difference to the nonlinear FE peak [%], and wall times [s]."""
     lines = ["| t [mm] | max P/P_E | step [s] | span [ms] | nonlinear FE peak [um] | "
-             "linear FFRF | FFRF + K_G | wall FFRF / FFRF+K_G / FE [s] |",
+             "linear FFRF | FFRF (default) | wall linear / FFRF / FE [s] |",
              "|---|---|---|---|---|---|---|---|"]
     for r in rungs:
         peak, diff, wall = r.peak_deflection_m, r.difference_to_reference, r.wall_time_s
         lines.append(
             f"| {r.thickness_m * 1e3:g} | {r.compression_over_euler_load:.3g} | {r.step_s:g} | "
             f"{r.end_time_s * 1e3:.3g} | {peak[REFERENCE] * 1e6:.4g} | "
+            f"{peak['linear'] * 1e6:.4g} ({diff['linear']:+.2%}) | "
             f"{peak['ffrf'] * 1e6:.4g} ({diff['ffrf']:+.2%}) | "
-            f"{peak['ffrf_geometric'] * 1e6:.4g} ({diff['ffrf_geometric']:+.2%}) | "
-            f"{wall['ffrf']:.2g} / {wall['ffrf_geometric']:.2g} / {wall[REFERENCE]:.3g} |")
+            f"{wall['linear']:.2g} / {wall['ffrf']:.2g} / {wall[REFERENCE]:.3g} |")
     for r in rungs:
         for name, message in r.failures.items():
             lines.append(f"\n{r.thickness_m * 1e3:g} mm {name} failed: {message}")
+        for name, message in r.warnings.items():
+            lines.append(f"\n{r.thickness_m * 1e3:g} mm {name} is not valid: {message}")
     return "\n".join(lines)

@@ -1,16 +1,21 @@
-"""FFRF plate couplers beside their rigid twins, with a nonlinear FE reference.
+"""Plate couplers as every model of flex's ladder, against a nonlinear FE reference.
 
-A *twin pair* models one steel plate coupler twice in the same mechanism: as a
-floating-frame-of-reference body (NGsolve mesh, Hurty-Craig-Bampton reduction) and as its
-rigid twin, a rigid body with the plate's own mass and inertia, so the pair differs only by
-elasticity. :func:`twin_cases` builds the pairs of a table of plates (``{model:
-(thickness [m], mesh size [m])}``) and, for an undamped scene, the fully nonlinear FE coupler
-(:mod:`flex.bodies.nonlinear`) of one of them; :func:`simulate_twins` runs them, each reduction
-built (or loaded from the cache) once, its facts kept in the run's notes;
-:func:`summarize_twins` tabulates, per plate, the reduction's frequencies and mesh, the
-thesis's n = delta_t / T in both period conventions and the FFRF run's deviations from its
-twin, and compares the nonlinear FE run with its FFRF twin
-(:func:`flex.fidelity.softening.compare_with_nonlinear_fe`); :func:`twin_figures` draws them.
+One steel plate coupler is modelled several times in the same mechanism: as flex's default
+flexible body (``ffrf``: floating frame on the chord, NGsolve mesh, Hurty-Craig-Bampton
+reduction, the geometric stiffness of its axial force), as the linear FFRF body (``linear``:
+``geometric_stiffness = false``), as its rigid twin (``rigid``: a rigid body with the plate's
+own mass and inertia, so it differs from the others only by elasticity) and, for an undamped
+scene, as the fully nonlinear FE coupler (``nonlinear_fe``, :mod:`flex.bodies.nonlinear`: the
+reference, over a span of its own). :func:`twin_cases` builds them for a table of plates
+(``{model: (thickness [m], mesh size [m])}``); :func:`simulate_twins` runs them, each
+reduction built (or loaded from the cache) once, its facts kept in the run's notes; the
+default FFRF and rigid runs carry their error budgets (:mod:`flex.fidelity.error_budget`),
+the linear comparison and the reference none (their error is what the comparison
+measures; a reference needs no estimate). :func:`summarize_twins` tabulates, per plate, the
+reduction's frequencies and mesh, the thesis's n = delta_t / T in both period conventions,
+the FFRF run's deviations from its twin and its stated accuracy, and each model against the
+reference (:func:`flex.fidelity.softening.compare_with_reference`); :func:`twin_figures`
+draws them.
 """
 
 from __future__ import annotations
@@ -27,8 +32,9 @@ from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, validate
 from flex.dynamics.solver import reduction_for_scene
 from flex.fidelity.caseloop import Progress, run_each
+from flex.fidelity.error_budget import budget_rows
 from flex.fidelity.simulation import simulate_case
-from flex.fidelity.softening import compare_with_nonlinear_fe, coupler_euler_load_N
+from flex.fidelity.softening import compare_with_reference, coupler_euler_load_N
 
 Plates = dict[str, tuple[float, float]]  # model -> (thickness [m], mesh size [m])
 #: what the summary reports of each FFRF case's reduction (``notes["reductions"][case]``)
@@ -36,29 +42,38 @@ REDUCTION_FACTS = ("pinned_pinned_frequency_Hz", "fixed_interface_frequencies_Hz
                    "n_elements", "n_dof", "mass_kg")
 
 
-def _plate_case(scene: Scene, thickness_m: float, mesh_m: float, model: str,
-                *more: str) -> Scene:
-    """``scene`` with a plate coupler ``thickness_m`` thick meshed at ``mesh_m`` [m], modelled
-    as ``model``, and the overrides ``more``; validated."""
+def _plate_case(scene: Scene, thickness_m: float, mesh_m: float, *more: str) -> Scene:
+    """``scene`` with a plate coupler ``thickness_m`` thick meshed at ``mesh_m`` [m] and the
+    overrides ``more`` (its model among them); validated."""
     case = apply_overrides(scene, [f"coupler.thickness_m={thickness_m}",
-                                   f"coupler.mesh_size_m={mesh_m}", f'coupler.model="{model}"',
-                                   *more])
+                                   f"coupler.mesh_size_m={mesh_m}", *more])
     validate(case)
     return case
 
 
-def twin_cases(scene: Scene, plates: Plates, nonlinear_model: str,
-               nonlinear_end_time_s: float | None = None) -> dict[str, Scene]:
-    """``<model>_ffrf`` and ``<model>_rigid`` per plate; ``<nonlinear_model>_nonlinear_fe``
-    too when the scene is undamped (the nonlinear FE body has no damping), run to
-    ``nonlinear_end_time_s`` [s] (None: the scene's end time)."""
-    out = {f"{model}_{kind}": _plate_case(scene, thickness_m, mesh_m, kind)
-           for model, (thickness_m, mesh_m) in plates.items() for kind in ("ffrf", "rigid")}
-    if scene["coupler"]["damping_ratio"] == 0:
-        end_time = ([] if nonlinear_end_time_s is None
-                    else [f"simulation.end_time_s={nonlinear_end_time_s}"])
-        out[f"{nonlinear_model}_nonlinear_fe"] = _plate_case(
-            scene, *plates[nonlinear_model], "nonlinear_fe", *end_time)
+#: the models of each plate (case name suffix -> overrides)
+KINDS = {"ffrf": ['coupler.model="ffrf"'],
+         "linear": ['coupler.model="ffrf"', "coupler.geometric_stiffness=false",
+                    "simulation.error_estimate=false"],
+         "rigid": ['coupler.model="rigid"'],
+         "nonlinear_fe": ['coupler.model="nonlinear_fe"', "simulation.error_estimate=false"]}
+
+
+def twin_cases(scene: Scene, plates: Plates, reference_spans_s: dict[str, float | None]
+               ) -> dict[str, Scene]:
+    """``<model>_ffrf``, ``<model>_linear`` and ``<model>_rigid`` per plate; when the scene
+    is undamped (the nonlinear FE body has no damping) ``<model>_nonlinear_fe`` too, for each
+    plate in ``reference_spans_s``, run to that end time [s] (None: the scene's)."""
+    out = {}
+    for model, (thickness_m, mesh_m) in plates.items():
+        kinds = [kind for kind in KINDS if kind != "nonlinear_fe"]
+        if scene["coupler"]["damping_ratio"] == 0 and model in reference_spans_s:
+            kinds.append("nonlinear_fe")
+        for kind in kinds:
+            span = reference_spans_s.get(model) if kind == "nonlinear_fe" else None
+            out[f"{model}_{kind}"] = _plate_case(
+                scene, thickness_m, mesh_m, *KINDS[kind],
+                *([] if span is None else [f"simulation.end_time_s={span!r}"]))
     return out
 
 
@@ -97,8 +112,17 @@ def simulate_twins(scenes: dict[str, Scene], progress: Progress | None,
 
 
 HEADER = (f"  {'model':14s} {'t [mm]':>6s} {'f_pp [Hz]':>10s} {'n thesis':>9s} "
-          f"{'n 2pi/w':>8s} {'peak defl [um]':>15s} {'defl/L2':>9s} "
-          f"{'d crank [rad]':>13s} {'sigma [MPa]':>11s} {'wall [s]':>8s}")
+          f"{'n 2pi/w':>8s} {'peak defl [um]':>15s} {'+- est. [um]':>12s} {'defl/L2':>9s} "
+          f"{'d crank [rad]':>13s} {'sigma [MPa]':>11s} {'+- est.':>8s} {'wall [s]':>8s}")
+
+
+def _budget(case: CaseResult, quantity: str) -> tuple[float, float]:
+    """The stored estimated error of ``quantity`` [its units] and its relative value (NaN
+    where the case has none)."""
+    for row in budget_rows(case.attrs):
+        if row.quantity == quantity:
+            return row.total, row.relative
+    return float("nan"), float("nan")
 
 
 def _pair_values(thickness_m: float, facts: dict[str, Any], flex_case: CaseResult,
@@ -109,6 +133,8 @@ def _pair_values(thickness_m: float, facts: dict[str, Any], flex_case: CaseResul
     rigid_data = {k: v.data for k, v in rigid_case.datasets.items()}
     n = n_values(deployment_time_s, 2 * np.pi * facts["pinned_pinned_frequency_Hz"])
     peak = np.abs(flex_data["coupler/midpoint_deflection"]).max()
+    deflection_error, deflection_relative = _budget(flex_case, "coupler_peak_deflection_m")
+    stress_error, stress_relative = _budget(flex_case, "coupler_peak_bending_stress_Pa")
     return {
         "thickness_m": (thickness_m, "m", "plate thickness (in-plane bending height)"),
         "pinned_pinned_frequency_Hz": (facts["pinned_pinned_frequency_Hz"], "Hz",
@@ -121,7 +147,11 @@ def _pair_values(thickness_m: float, facts: dict[str, Any], flex_case: CaseResul
         "plate_mass": (facts["mass_kg"], "kg", "plate mass (also the rigid twin's)"),
         "n_thesis_convention": (n["thesis"], "1", "delta_t * omega (thesis: T = 1/omega)"),
         "n_physical": (n["physical"], "1", "delta_t / (2 pi / omega)"),
-        "peak_midpoint_deflection": (peak, "m", "max |elastic midpoint deflection|"),
+        "peak_midpoint_deflection": (peak, "m", "max |elastic midpoint deflection|, FFRF"),
+        "peak_midpoint_deflection_estimated_error": (
+            deflection_error, "m", "its estimated error (step + modes + mesh + model)"),
+        "peak_midpoint_deflection_estimated_relative_error": (
+            deflection_relative, "1", "that over the peak"),
         "peak_deflection_over_length": (peak / length_m, "1", "peak deflection / L2"),
         "max_crank_angle_deviation": (
             np.abs(flex_data["crank/angle"] - rigid_data["crank/angle"]).max(), "rad",
@@ -132,6 +162,10 @@ def _pair_values(thickness_m: float, facts: dict[str, Any], flex_case: CaseResul
         "peak_bending_stress": (
             flex_data.get("coupler/peak_bending_stress", np.array([np.nan])).max(), "Pa",
             "FFRF peak |sigma_xx|"),
+        "peak_bending_stress_estimated_error": (
+            stress_error, "Pa", "its estimated error (step + modes + mesh + model)"),
+        "peak_bending_stress_estimated_relative_error": (stress_relative, "1",
+                                                         "that over the peak stress"),
         "ffrf_wall_time": (flex_case.counters["wall_time_s"], "s", "FFRF simulation wall time"),
         "rigid_wall_time": (rigid_case.counters["wall_time_s"], "s",
                             "rigid twin simulation wall time"),
@@ -142,36 +176,47 @@ def _row(model: str, v: dict[str, Any]) -> str:
     """One plate's line of the report table (``v``: values by key, without units)."""
     return (f"  {model:14s} {v['thickness_m'] * 1e3:6.0f} "
             f"{v['pinned_pinned_frequency_Hz']:10.1f} {v['n_thesis_convention']:9.1f} "
-            f"{v['n_physical']:8.2f} {v['peak_midpoint_deflection'] * 1e6:15.3f} "
+            f"{v['n_physical']:8.2f} {v['peak_midpoint_deflection'] * 1e6:15.4g} "
+            f"{v['peak_midpoint_deflection_estimated_error'] * 1e6:12.2g} "
             f"{v['peak_deflection_over_length']:9.2e} "
-            f"{v['max_crank_angle_deviation']:13.2e} {v['peak_bending_stress'] / 1e6:11.2f} "
+            f"{v['max_crank_angle_deviation']:13.2e} {v['peak_bending_stress'] / 1e6:11.4g} "
+            f"{v['peak_bending_stress_estimated_relative_error']:8.1%} "
             f"{v['ffrf_wall_time']:8.2f}")
 
 
-def _nonlinear_lines(scene: Scene, results: dict[str, CaseResult], plates: Plates,
-                     model: str, datasets: dict[str, Dataset]) -> list[str]:
-    """Compare the nonlinear FE run with its FFRF twin (``nonlinear_reference/<model>/...``
-    added to ``datasets``); the report lines."""
-    if f"{model}_nonlinear_fe" not in results:
-        return [f"nonlinear FE reference {model}: not run (coupler.damping_ratio > 0; the "
-                f"nonlinear FE body has no damping model)"]
-    euler_load_N = coupler_euler_load_N({**scene["coupler"], "thickness_m": plates[model][0]})
-    found, lines = compare_with_nonlinear_fe(model, results[f"{model}_ffrf"],
-                                             results[f"{model}_nonlinear_fe"], euler_load_N,
-                                             f"nonlinear_reference/{model}")
-    datasets.update(found)
+def _reference_lines(scene: Scene, results: dict[str, CaseResult], plates: Plates,
+                     datasets: dict[str, Dataset]) -> list[str]:
+    """Each plate with a nonlinear FE run: every other model of it against that reference
+    (``reference/<model>/...`` added to ``datasets``); the report lines."""
+    lines = []
+    for model, (thickness_m, _) in plates.items():
+        reference = results.get(f"{model}_nonlinear_fe")
+        if reference is None:
+            continue
+        euler_load_N = coupler_euler_load_N({**scene["coupler"], "thickness_m": thickness_m})
+        runs = {kind: results[f"{model}_{kind}"] for kind in KINDS
+                if kind != "nonlinear_fe" and f"{model}_{kind}" in results}
+        found, more = compare_with_reference(model, runs, reference, euler_load_N,
+                                             f"reference/{model}")
+        datasets.update(found)
+        lines += more
+    if not lines and scene["coupler"]["damping_ratio"] != 0:
+        lines.append("nonlinear FE reference: not run (coupler.damping_ratio > 0; the "
+                     "nonlinear FE body has no damping model)")
     return lines
 
 
 def summarize_twins(scene: Scene, results: dict[str, CaseResult], notes: dict[str, Any],
-                    plates: Plates, nonlinear_model: str, deployment_time_s: float
+                    plates: Plates, deployment_time_s: float
                     ) -> tuple[dict[str, Dataset], str]:
     """The summary datasets and report: ``models/<model>/...`` per plate (see
-    :func:`_pair_values`), the nonlinear reference (``nonlinear_reference/<model>/...``) and
-    the report table. ``notes``: the run's, with the reductions' facts
-    (:func:`simulate_twins`); ``deployment_time_s``: delta_t of n [s]."""
+    :func:`_pair_values`), each plate's models against its nonlinear FE reference
+    (``reference/<model>/...``) and the report table. ``notes``: the run's, with the
+    reductions' facts (:func:`simulate_twins`); ``deployment_time_s``: delta_t of n [s]."""
     datasets: dict[str, Dataset] = {}
-    lines = ["flexible: FFRF coupler plates against their rigid twins (22 mm preload)", HEADER]
+    lines = ["flexible: FFRF coupler plates (flex's default body) against their rigid twins "
+             "(22 mm preload); +- est.: the stored estimated error of the peak (step, modes, "
+             "mesh, model)", HEADER]
     for model, (thickness_m, _) in plates.items():
         flex_case, rigid_case = results[f"{model}_ffrf"], results[f"{model}_rigid"]
         if flex_case.status != "ok" or rigid_case.status != "ok":
@@ -189,7 +234,7 @@ def summarize_twins(scene: Scene, results: dict[str, CaseResult], notes: dict[st
     lines.append("  n thesis = delta_t * omega (thesis Table 5 takes T = 1/omega); "
                  f"n 2pi/w = delta_t / T with the physical period; delta_t = "
                  f"{deployment_time_s:g} s")
-    lines += _nonlinear_lines(scene, results, plates, nonlinear_model, datasets)
+    lines += _reference_lines(scene, results, plates, datasets)
     return datasets, "\n".join(lines)
 
 
@@ -244,18 +289,29 @@ def _acceleration_pair(model: str, flex_data: dict[str, np.ndarray],
     return path
 
 
-def _nonlinear_figure(model: str, flex_data: dict[str, np.ndarray],
-                      nonlinear_data: dict[str, np.ndarray], folder: Path) -> Path:
-    """Midpoint deflection of the FFRF run against the nonlinear FE run over its span."""
+def _reference_figure(ok: dict[str, dict[str, np.ndarray]], models: list[str],
+                      folder: Path) -> Path:
+    """One panel per plate with a nonlinear FE run: the midpoint deflection of each model
+    over the reference's span (own scale each)."""
     path = folder / "flexible-nonlinear-reference.png"
-    samples = len(nonlinear_data["time"])
-    with figure(path, f"Midpoint deflection, {model_label(model)}: FFRF (linear elastic "
-                "body) against the nonlinear FE body", "time [s]",
-                f"midpoint deflection [{UM}]") as ax:
-        ax.plot(flex_data["time"][:samples],
-                flex_data["coupler/midpoint_deflection"][:samples] * 1e6, label="FFRF")
-        ax.plot(nonlinear_data["time"], nonlinear_data["coupler/midpoint_deflection"] * 1e6,
-                "k--", label="nonlinear FE (reference)")
+    styles = {"ffrf": ("C0", "-", "FFRF (flex's default)"),
+              "linear": ("C1", "-.", "linear FFRF"),
+              "nonlinear_fe": ("k", "--", "nonlinear FE (reference)")}
+    with panels(path, "Midpoint deflection of each coupler model against the nonlinear FE "
+                "reference, one panel per plate (own scale each)", rows=len(models),
+                size=(7.5, 1.6 + 2.0 * len(models)), sharex=True) as (fig, axes):
+        for ax, model in zip(axes, models, strict=True):
+            samples = len(ok[f"{model}_nonlinear_fe"]["time"])
+            for kind, (color, style, label) in styles.items():
+                data = ok.get(f"{model}_{kind}")
+                if data is not None:
+                    ax.plot(data["time"][:samples],
+                            np.asarray(data["coupler/midpoint_deflection"][:samples]) * 1e6,
+                            color=color, ls=style, lw=1.0, label=label)
+            ax.set_title(model_label(model), fontsize="small")
+            ax.set_ylabel(f"deflection [{UM}]")
+        axes[-1].set_xlabel("time [s]")
+        legend_below(fig)
     return path
 
 
@@ -278,19 +334,19 @@ def _peak_figure(thickness: list[float], peak: list[float], folder: Path) -> Pat
 
 
 def twin_figures(results: dict[str, CaseResult], summary: dict[str, Dataset], folder: Path,
-                 models: list[str], nonlinear_model: str) -> list[Path]:
-    """The deflection panels, each plate's accelerations against its twin, the nonlinear
-    reference and the peak deflection against thickness (whichever have their runs);
-    ``summary``: the summary datasets."""
+                 models: list[str]) -> list[Path]:
+    """The deflection panels, each plate's accelerations against its twin, the models
+    against the nonlinear FE reference and the peak deflection against thickness (whichever
+    have their runs); ``summary``: the summary datasets."""
     ok = {n: {k: v.data for k, v in c.datasets.items()} for n, c in results.items()
           if c.status == "ok"}
     drawn = [model for model in models if f"{model}_ffrf" in ok]
     paths = [_deflection_panels(ok, drawn, folder)] if drawn else []
     paths += [_acceleration_pair(model, ok[f"{model}_ffrf"], ok[f"{model}_rigid"], folder)
               for model in models if f"{model}_ffrf" in ok and f"{model}_rigid" in ok]
-    if f"{nonlinear_model}_ffrf" in ok and f"{nonlinear_model}_nonlinear_fe" in ok:
-        paths.append(_nonlinear_figure(nonlinear_model, ok[f"{nonlinear_model}_ffrf"],
-                                       ok[f"{nonlinear_model}_nonlinear_fe"], folder))
+    referenced = [model for model in models if f"{model}_nonlinear_fe" in ok]
+    if referenced:
+        paths.append(_reference_figure(ok, referenced, folder))
     found = [model for model in models
              if f"models/{model}/peak_midpoint_deflection" in summary]
     if found:

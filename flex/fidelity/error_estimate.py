@@ -66,19 +66,66 @@ def _peak(path: str) -> Callable[[dict[str, Any]], float | None]:
     return read
 
 
+def _deployment_time(datasets: dict[str, Any]) -> float | None:
+    """Time of the first maximum of the crank angle [s] (delta_t, docs/criterion.md); None
+    when the crank angle has no maximum within the run (a deployment not reached, a
+    constant-speed crank): missing, not the end time."""
+    if "crank/angle" not in datasets:
+        return None
+    angle = np.asarray(datasets["crank/angle"].data, dtype=float)
+    falling = np.flatnonzero(np.diff(angle) < 0)
+    if len(angle) < 3 or len(falling) == 0 or falling[0] == 0:
+        return None
+    top = int(falling[0])
+    time_s = np.asarray(datasets["time"].data, dtype=float)
+    # the parabola through the top sample and its neighbours: the maximum between samples
+    # (a sample time alone is off by up to half a step, more than the run's own error)
+    left, middle, right = angle[top - 1:top + 2]
+    curvature = left - 2.0 * middle + right
+    offset = 0.5 * (left - right) / curvature if curvature < 0 else 0.0
+    return float(time_s[top] + np.clip(offset, -0.5, 0.5) * (time_s[top + 1] - time_s[top]))
+
+
 #: the peak headline quantities and the series they are the peak of
 PEAK_PATHS = {"coupler_peak_deflection_m": "coupler/midpoint_deflection",
-              "crank_peak_deflection_m": "crank/midpoint_deflection"}
+              "crank_peak_deflection_m": "crank/midpoint_deflection",
+              "coupler_peak_bending_stress_Pa": "coupler/peak_bending_stress",
+              "crank_peak_bending_stress_Pa": "crank/peak_bending_stress",
+              **{f"joint_{joint}_peak_force_N": f"joints/{joint}/force_modulus"
+                 for joint in "ABC"}}
+_PEAK_WHAT = {"coupler_peak_deflection_m": ("m", "peak elastic midpoint deflection of the "
+                                                  "coupler"),
+              "crank_peak_deflection_m": ("m", "peak elastic midpoint deflection of the crank"),
+              "coupler_peak_bending_stress_Pa": ("Pa", "peak bending stress of the coupler"),
+              "crank_peak_bending_stress_Pa": ("Pa", "peak bending stress of the crank"),
+              **{f"joint_{joint}_peak_force_N": ("N", f"peak force of joint {joint}")
+                 for joint in "ABC"}}
 #: headline quantity -> (units, what, reader of a result's datasets; None: not in this run)
 HEADLINES: dict[str, tuple[str, str, Callable[[dict[str, Any]], float | None]]] = {
     "crank_angle_end_rad": ("rad", "crank angle at the end time", _final("crank/angle")),
     "slider_position_end_m": ("m", "slider position at the end time",
                               _final("slider/position")),
-    "coupler_peak_deflection_m": ("m", "peak elastic midpoint deflection of the coupler",
-                                  _peak("coupler/midpoint_deflection")),
-    "crank_peak_deflection_m": ("m", "peak elastic midpoint deflection of the crank",
-                                _peak("crank/midpoint_deflection")),
+    "deployment_time_s": ("s", "deployment time (first maximum of the crank angle)",
+                          _deployment_time),
+    **{name: (*_PEAK_WHAT[name], _peak(path)) for name, path in PEAK_PATHS.items()},
 }
+
+
+def headline_difference(name: str, run: dict[str, Any], other: dict[str, Any]) -> float | None:
+    """How far two runs' values of headline quantity ``name`` lie apart [its units]: a peak's
+    by :func:`peak_difference` (a missing series counts as zero: a rigid twin has no
+    deflection), any other's as the difference of the values; None if the run has no value
+    or the other run none for a non-peak quantity."""
+    read = HEADLINES[name][2]
+    if read(run) is None:
+        return None
+    if name in PEAK_PATHS:
+        path = PEAK_PATHS[name]
+        if path not in other:
+            return read(run)
+        return peak_difference(run, other, path)
+    value = read(other)
+    return None if value is None else abs(read(run) - value)
 
 
 @dataclass
@@ -163,7 +210,7 @@ def estimate_step_error(scene: Scene, result: CaseResult,
               f"at h = {at} s (the run: {step:g} s), Richardson extrapolation with the "
               f"integrator's order "
               f"{order}{'; the larger of the two pairs, scaled to h' if len(steps) > 2 else ''}"
-              f"; step error only (modes and mesh not estimated)")
+              f".")
     start = time.perf_counter()
     runs = [result.datasets]
     for companion_step in steps[1:]:

@@ -26,7 +26,7 @@ from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
 from flex.dynamics.solver import integrate, scene_reductions, time_scales
 from flex.fidelity.criteria import Criterion, FidelityDecision, resolve_fidelity
-from flex.fidelity.error_estimate import estimate_step_error
+from flex.fidelity.error_budget import error_budget
 from flex.fidelity.spring_choice import decide_spring
 
 
@@ -72,10 +72,11 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     of ``ffrf`` links (None: built, or loaded from ``cache_dir``). ``cache_dir``: the
     reduction cache folder (None: reductions are built in memory, no disk cache).
 
-    With ``simulation.error_estimate`` (the default), a companion run at twice (or half) the
-    step estimates the run's own step error on its headline quantities
-    (:mod:`flex.fidelity.error_estimate`): case attributes ``estimated_error_*``. A failed
-    companion leaves the run as it is and says why in ``estimated_error_validity``.
+    With ``simulation.error_estimate`` (the default), companion runs estimate the run's error
+    budget on its headline quantities, term by term (step, modes, mesh, model;
+    :mod:`flex.fidelity.error_budget`): case attributes ``estimated_error_*``. A failed
+    companion leaves the run as it is, its term out, and says why in
+    ``estimated_error_leaves_out``.
     """
     check_runnable(scene)  # before anything is built or probed
     scene, decisions = resolve_auto(scene, criterion, crank_criterion, cache_dir=cache_dir)
@@ -92,11 +93,18 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
         reductions = {link: built for link, built in (("coupler", reduction),
                                                        ("crank", crank_reduction))
                       if built is not None and resolved[link]["model"] == "ffrf"}
-        estimate = estimate_step_error(
-            resolved, result, lambda companion: integrate(
-                companion, f"{name}_companion", reduction, crank_reduction,
-                cache_dir=cache_dir), time_scales(resolved, reductions))
-        result.attrs.update(estimate.attrs())
+
+        def run_companion(companion: Scene) -> CaseResult:
+            # the run's reductions serve a companion whose links are meshed and reduced alike
+            same = all(companion[link][key] == resolved[link][key] for link in ("coupler",
+                                                                              "crank")
+                       for key in ("model", "modes", "mesh_size_m"))
+            return integrate(companion, f"{name}_companion", reduction if same else None,
+                             crank_reduction if same else None, cache_dir=cache_dir)
+
+        budget = error_budget(resolved, result, run_companion,
+                              time_scales(resolved, reductions))
+        result.attrs.update(budget.attrs())
     return result
 
 

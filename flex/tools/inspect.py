@@ -239,18 +239,20 @@ def format_description(info: dict[str, Any]) -> str:
 
 
 def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
-    """The case's ``estimated_error_*`` attributes (:mod:`flex.fidelity.error_estimate`) as
-    ``estimated error`` lines: the values with units, how they were made, their validity."""
-    from flex.fidelity.error_estimate import HEADLINES, PREFIX
+    """The case's error budget (:mod:`flex.fidelity.error_budget`): each headline quantity
+    with its value, total estimated error (absolute and relative) and terms; how the terms
+    were made, what the budget leaves out, the step estimate's validity."""
+    from flex.fidelity.error_budget import budget_rows
+    from flex.fidelity.error_estimate import PREFIX
 
-    values = [f"{what} {attrs[PREFIX + name]:.2g} {units}"
-              for name, (units, what, _) in HEADLINES.items() if PREFIX + name in attrs]
-    if not values and f"{PREFIX}validity" not in attrs:
+    rows = budget_rows(attrs)
+    if not rows and f"{PREFIX}validity" not in attrs:
         return []
-    lines = [f"  estimated error: {'; '.join(values) or 'none'}"]
-    for key in ("method", "validity"):
+    lines = ["  estimated error (total = the sum of the terms):"]
+    lines += [f"    {row.text()}" for row in rows] or ["    none"]
+    for key in ("method", "leaves_out", "validity"):
         if attrs.get(PREFIX + key):
-            lines.append(f"    {key}: {attrs[PREFIX + key]}")
+            lines.append(f"    {key.replace('_', ' ')}: {attrs[PREFIX + key]}")
     return lines
 
 

@@ -23,6 +23,7 @@ as they are. A study run writes ``reports/<stem>.md`` beside its result file
 
 from __future__ import annotations
 
+import math
 import os
 import re
 from collections import Counter
@@ -301,7 +302,36 @@ def _cases_section(cases: list[dict[str, Any]]) -> list[str]:
                      *(attrs.get(f"counter_{key}", "-") for key in counters),
                      "<br>".join(_case_notes(attrs))])
     lines += _table(header, rows)
-    return lines + _case_attributes(cases)
+    return lines + _budget_section(cases) + _case_attributes(cases)
+
+
+def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
+    """Each case's error budget: a row per headline quantity (value, total estimated error,
+    relative, terms), then how the terms were made and what they leave out."""
+    from flex.fidelity.error_budget import TERMS, budget_rows
+    from flex.fidelity.error_estimate import PREFIX
+
+    rows, notes = [], {}
+    for case in cases:
+        for row in budget_rows(case["attrs"]):
+            rows.append([_code(case["name"]), row.what, f"{row.value:.6g} {row.units}",
+                         f"{row.total:.2g} {row.units}",
+                         f"{100 * row.relative:.2g} %" if math.isfinite(row.relative) else "-",
+                         *(f"{row.terms[t]:.2g}" if t in row.terms else "-" for t in TERMS)])
+        for key in ("method", "leaves_out", "validity"):
+            if case["attrs"].get(PREFIX + key):
+                notes.setdefault(key, {}).setdefault(case["attrs"][PREFIX + key], []).append(
+                    case["name"])
+    if not rows:
+        return []
+    lines = ["Estimated error of each headline quantity (total = the sum of the terms, in "
+             "the quantity's unit):", ""]
+    lines += _table(["case", "quantity", "value", "estimated error", "relative", *TERMS], rows)
+    for key, texts in notes.items():
+        for text, names in texts.items():
+            who = "every case" if len(names) == len(cases) else ", ".join(map(_code, names))
+            lines.append(f"- {key.replace('_', ' ')} ({who}): {text}")
+    return lines + [""]
 
 
 def _counter_keys(cases: list[dict[str, Any]]) -> list[str]:
@@ -339,7 +369,8 @@ def _case_notes(attrs: dict[str, Any]) -> list[str]:
 
 
 def _shown_in_notes(key: str, attrs: dict[str, Any]) -> bool:
-    if key in CASE_KNOWN or key.startswith("counter_") or key.startswith("solver_defaults_"):
+    if key in CASE_KNOWN or key.startswith(("counter_", "solver_defaults_", "estimated_error_",
+                                            "headline_")):
         return True
     return any(key.startswith(f"fidelity_{link}_") for link in _fidelity_links(attrs))
 
