@@ -68,7 +68,9 @@ def _peak(path: str) -> Callable[[dict[str, Any]], float | None]:
 
 #: the peak headline quantities and the series they are the peak of
 PEAK_PATHS = {"coupler_peak_deflection_m": "coupler/midpoint_deflection",
-              "crank_peak_deflection_m": "crank/midpoint_deflection"}
+              "crank_peak_deflection_m": "crank/midpoint_deflection",
+              "coupler_peak_von_mises_Pa": "coupler/peak_von_mises_stress",
+              "crank_peak_von_mises_Pa": "crank/peak_von_mises_stress"}
 #: headline quantity -> (units, what, reader of a result's datasets; None: not in this run)
 HEADLINES: dict[str, tuple[str, str, Callable[[dict[str, Any]], float | None]]] = {
     "crank_angle_end_rad": ("rad", "crank angle at the end time", _final("crank/angle")),
@@ -78,6 +80,10 @@ HEADLINES: dict[str, tuple[str, str, Callable[[dict[str, Any]], float | None]]] 
                                   _peak("coupler/midpoint_deflection")),
     "crank_peak_deflection_m": ("m", "peak elastic midpoint deflection of the crank",
                                 _peak("crank/midpoint_deflection")),
+    "coupler_peak_von_mises_Pa": ("Pa", "peak von Mises stress of the coupler (away from "
+                                  "the joint faces)", _peak("coupler/peak_von_mises_stress")),
+    "crank_peak_von_mises_Pa": ("Pa", "peak von Mises stress of the crank (away from the "
+                                "joint faces)", _peak("crank/peak_von_mises_stress")),
 }
 
 
