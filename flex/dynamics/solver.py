@@ -653,11 +653,14 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     if scene["coupler"]["model"] == "nonlinear_fe" and reduction is None:
         _announce_mesh("coupler", scene["coupler"], "nonlinear FE body")
     mech = build_mechanism(scene, reduction, crank_reduction)
+    recorder = _nodal_recorder(mech)
     counters = run(mech)
     with np.errstate(all="ignore"):  # a diverged run overflows; _check_finite reports it
         datasets = collect(mech)
     settings = solver_settings(scene)
     _check_finite(datasets, settings, scene, _reductions(mech))
+    if recorder is not None:  # its own time: after the check of the sampled datasets
+        datasets.update(recorder.datasets())
     import tomli_w
 
     result = CaseResult(name, to_toml(scene), datasets, counters=counters,
@@ -669,6 +672,17 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     if warning:
         result.attrs[VALIDITY_WARNING] = warning
     return result
+
+
+def _nodal_recorder(mech: Mechanism):
+    """A :class:`flex.bodies.nonlinear.NodalRecorder` for a nonlinear FE coupler, else None."""
+    if mech.scene["coupler"]["model"] != "nonlinear_fe":
+        return None
+    from flex.bodies.nonlinear import NodalRecorder
+
+    settings = solver_settings(mech.scene)
+    return NodalRecorder(mech.mbs, mech.coupler["nodes"], settings["step_s"],
+                         settings["output_step_s"], settings["end_time_s"])
 
 
 # ------------------------------------------------------------------------------------------
