@@ -61,7 +61,6 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.data.results import Dataset
 from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction import (
     END_A,
@@ -71,6 +70,7 @@ from flex.bodies.reduction import (
     add_plate_markers,
     as_vector3,
 )
+from flex.data.results import Dataset
 
 _MESH_ORDER = 2  # as the reduction: linear tets lock in bending
 #: wall-time seconds between two progress lines of an integration (see the module doc)
