@@ -120,7 +120,10 @@ def _view_tools(commands) -> None:
     animate.add_argument("case", nargs="?", metavar="CASE",
                          help="case name (may be omitted when the file has one case)")
     animate.add_argument("--out", required=True, metavar="FILE",
-                         help="animation file, .mp4 or .gif")
+                         help="animation file, .mp4 or .gif; .png: one frame (--time)")
+    animate.add_argument("--time", type=float, metavar="S", dest="at_time_s",
+                         help="for a .png: the frame nearest this time (default: the time "
+                              "of the peak von Mises stress)")
     animate.add_argument("--frames", type=int, default=200, metavar="N",
                          help="at most N frames, evenly spaced in the stored samples "
                               "(default 200)")
@@ -291,8 +294,10 @@ def _view_tool(args: argparse.Namespace) -> int:
     from flex.tools.animate import animate_case
 
     done = animate_case(args.file, args.case, args.out, frames=args.frames, fps=args.fps,
-                        magnification=args.magnification, cache_dir=cache_dir)
-    _print(f"wrote {done.path} ({done.frames} frames, {done.width}x{done.height} px, "
+                        magnification=args.magnification, cache_dir=cache_dir,
+                        at_time_s=args.at_time_s)
+    _print(f"wrote {done.path} ({done.frames} frame{'s' if done.frames != 1 else ''}, "
+           f"{done.width}x{done.height} px, "
            f"deformation x {done.magnification:g})")
     return EXIT_OK
 

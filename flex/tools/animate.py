@@ -14,7 +14,8 @@ frames is drawn as 1/20 of the link length, the factor rounded down to 1, 2 or 5
 Output: mp4 (H.264, yuv420p) through the ffmpeg binary of the ``imageio-ffmpeg`` package
 when it is installed, else an animated gif through Pillow (an ``.mp4`` asked for is then
 written as ``.gif``, and stderr says so). Frames are 960 x 540 pixels. The file is written
-under a temporary name and renamed when complete.
+under a temporary name and renamed when complete. A ``.png`` output is one frame (by
+default at the peak stress), e.g. for a document.
 """
 
 from __future__ import annotations
@@ -149,16 +150,18 @@ def _default_magnification(motion: CaseMotion, frames: list[_Frame]) -> float:
 
 def animate_case(source: str | Path, case: str | None, out: str | Path, *, frames: int = 200,
                  fps: int = 25, magnification: float | None = None,
-                 cache_dir: Path | None = None,
+                 cache_dir: Path | None = None, at_time_s: float | None = None,
                  progress: Callable[[str], None] | None = None) -> Animation:
     """Animate ``case`` of result file ``source`` into ``out`` (``.mp4`` or ``.gif``; see the
-    module doc). ``frames``: at most this many, evenly spaced over the stored samples;
-    ``magnification``: the deformation scale (None: the default of the module doc).
-    Refusals (:class:`FlexError`): those of :func:`flex.tools.motion.case_motion`, a bad
-    suffix, frame count, rate or magnification."""
+    module doc; ``.png``: the one frame nearest ``at_time_s`` [s], by default the time of
+    the first flexible link's peak von Mises stress). ``frames``: at most this many, evenly
+    spaced over the stored samples; ``magnification``: the deformation scale (None: the
+    default of the module doc, from those frames). Refusals (:class:`FlexError`): those of
+    :func:`flex.tools.motion.case_motion`, a bad suffix, frame count, rate, time or
+    magnification."""
     out = Path(out)
-    if out.suffix.lower() not in (".mp4", ".gif"):
-        raise FlexError(f"--out {out}: must end in .mp4 or .gif")
+    if out.suffix.lower() not in (".mp4", ".gif", ".png"):
+        raise FlexError(f"--out {out}: must end in .mp4, .gif or .png (one frame)")
     if isinstance(fps, bool) or not isinstance(fps, int) or not 1 <= fps <= 120:
         raise FlexError(f"--fps {fps!r}: must be an integer in 1..120")
     if magnification is not None and not (math.isfinite(magnification) and magnification > 0):
@@ -172,6 +175,8 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
     drawn = _frames(motion, indices)
     factor = magnification if magnification is not None else _default_magnification(motion,
                                                                                      drawn)
+    if out.suffix.lower() == ".png":
+        drawn = _frames(motion, [_nearest(motion, at_time_s)])
     out.parent.mkdir(parents=True, exist_ok=True)
     part = out.with_name(f".{out.stem}.{os.getpid()}.part{out.suffix}")
     try:
@@ -182,6 +187,21 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
     if progress:
         progress(f"flex animate: wrote {out}")
     return Animation(out, len(drawn), SIZE_PX[0], SIZE_PX[1], fps, factor)
+
+
+def _nearest(motion: CaseMotion, at_time_s: float | None) -> int:
+    """The motion sample nearest ``at_time_s``; None: that of the first flexible link's
+    peak von Mises stress (else the middle sample)."""
+    if at_time_s is None:
+        at_time_s = next((float(motion.attrs[f"{b.name}_peak_von_mises_time_s"])
+                          for b in motion.flexible
+                          if f"{b.name}_peak_von_mises_time_s" in motion.attrs),
+                         float(motion.time_s[len(motion.time_s) // 2]))
+    if not (math.isfinite(at_time_s)
+            and motion.time_s[0] <= at_time_s <= motion.time_s[-1]):
+        raise FlexError(f"--time {at_time_s!r}: must lie in the stored times "
+                        f"{motion.time_s[0]:g} .. {motion.time_s[-1]:g} s")
+    return int(np.argmin(np.abs(motion.time_s - at_time_s)))
 
 
 def _render(motion: CaseMotion, frames: list[_Frame], magnification: float):
@@ -269,6 +289,9 @@ def _write(path: Path, frames, fps: int) -> None:
         return
     from PIL import Image
 
+    if path.suffix.lower() == ".png":
+        Image.fromarray(next(iter(frames))).save(path, format="PNG", optimize=True)
+        return
     images = [Image.fromarray(frame).quantize(colors=255) for frame in frames]
     images[0].save(path, format="GIF", save_all=True, append_images=images[1:],
                    duration=round(1000 / fps), loop=0)
