@@ -4,7 +4,9 @@
   principal stresses (``numpy.linalg.eigvalsh`` of each nodal tensor), and ``von_mises``
   against closed forms (uniaxial, pure shear, hydrostatic).
 - The exported files read back with **meshio's XDMF time-series reader**
-  (``meshio.xdmf.TimeSeriesReader``; ParaView's own reader does not install from PyPI here):
+  (``meshio.xdmf.TimeSeriesReader``; and, where the ``vtk`` wheel is installed, with
+  ParaView's "XDMF Reader", VTK's ``vtkXdmfReader``: passed here with vtk 9.7 installed by
+  hand, skipped without it):
   the reduction's mesh (nodes at the placed reference positions, quadratic tetrahedra), the
   number of times, the units. The exported midpoint deflection equals the stored
   ``coupler/midpoint_deflection`` when rebuilt by its definition (the mid-length slab's
@@ -326,3 +328,24 @@ def test_run_simulate_animate_writes_beside_the_figures(tmp_path, capsys):
     assert status == 0
     animation = tmp_path / "figures" / "s-case.mp4"
     assert animation.exists() and f"wrote {animation}" in out
+
+
+def test_vtk_xdmf_reader_reads_the_export(ffrf_file, reduction, tmp_path, capsys):
+    """ParaView's "XDMF Reader" is VTK's vtkXdmfReader: run only where the vtk wheel is
+    installed (not a dependency; ``pip install vtk``)."""
+    xdmf2 = pytest.importorskip("vtkmodules.vtkIOXdmf2")
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline
+
+    assert run_cli(capsys, "export", ffrf_file, "--out", tmp_path, "--every", "5")[0] == 0
+    reader = xdmf2.vtkXdmfReader()
+    reader.SetFileName(str(tmp_path / "plate-case.xdmf"))
+    reader.UpdateInformation()
+    times = reader.GetOutputInformation(0).Get(vtkStreamingDemandDrivenPipeline.TIME_STEPS())
+    assert len(times) == len(range(0, SAMPLES, 5))
+    reader.UpdateTimeStep(times[2])
+    grid = reader.GetOutputDataObject(0)
+    assert grid.GetCellType(0) == 24  # VTK_QUADRATIC_TETRA
+    assert grid.GetNumberOfCells() == reduction.n_elements + 2 * 5
+    stress = vtk_to_numpy(grid.GetPointData().GetArray("von_mises_stress_Pa"))
+    assert np.nanmax(stress) > 0
