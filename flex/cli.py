@@ -407,7 +407,8 @@ def _dispatch(argv: list[str] | None) -> int:
     args, extra = parser.parse_known_args(argv)
     if args.command is None:
         parser.error(f"unrecognized arguments: {' '.join(extra)}" if extra else
-                     "a COMMAND is required: run, scene, design, inspect, plot, compare or report")
+                     "a COMMAND is required: run, scene, design, inspect, plot, compare, report, "
+                     "export or animate")
     if extra:  # PATHs after options (compare A B --rtol 1e-6 PATH): argparse leaves them over
         if args.command in ("plot", "compare") and not any(e.startswith("-") for e in extra):
             args.paths += extra

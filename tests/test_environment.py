@@ -19,6 +19,7 @@ EDGES = {
     ("cli.py", "main"): "FLEX_DEBUG: show the traceback of an internal error",
     ("cli.py", "_run"): "flex run: the reduction cache folder and the study's variables",
     ("cli.py", "_design"): "flex design: the reduction cache folder",
+    ("cli.py", "_view_tool"): "flex export / animate: the reduction cache folder",
     ("api.py", "_cache_dir"): "flex.simulate / flex.run_study: the user's cache folder",
     ("api.py", "run_study"): "flex.run_study: the study's declared variables",
     # configures Exudyn itself (no user settings file) before it is imported

@@ -7,7 +7,8 @@ when the end time is a whole number of doubled steps, else one at half the step 
 returns an :class:`ErrorEstimate`:
 
 - ``values``: for each headline quantity (:data:`HEADLINES`: the crank angle and the slider
-  position at the end time, the peak elastic midpoint deflection of each flexible link), the
+  position at the end time, the peak elastic midpoint deflection of each flexible link, the
+  peak von Mises stress of each FFRF link away from its joint faces), the
   estimated error of the run's value [the quantity's units], by Richardson extrapolation.
   With the runs at h, 2h and 4h: the larger of ``|q_h - q_2h| / (2^p - 1)`` and the pair
   (2h, 4h)'s, scaled to h by ``2^-p``, with p the order the three runs show
