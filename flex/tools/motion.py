@@ -88,6 +88,10 @@ class CaseMotion:
             self.time_s = np.asarray(case_time, dtype=float)
             self.sample = np.arange(len(case_time))
 
+    def link_model(self, link: str) -> Any:
+        """The reduction (FFRF) or the meshed plate (nonlinear FE) of a flexible ``link``."""
+        return self._extra[link]
+
     @property
     def flexible(self) -> list[Body]:
         """The flexible bodies."""
