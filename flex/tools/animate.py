@@ -170,6 +170,7 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
         out = out.with_suffix(".gif")
         print(f"flex animate: no mp4 encoder (install imageio-ffmpeg): writing {out}",
               file=sys.stderr)
+    frame_indices(2, frames)  # a bad --frames is refused before anything is read
     motion = case_motion(source, case, cache_dir=cache_dir)
     indices = frame_indices(len(motion.time_s), frames)
     drawn = _frames(motion, indices)

@@ -94,6 +94,7 @@ def export_case(source: str | Path, case: str | None, out_dir: str | Path, every
     reduction cache folder. Refusals (:class:`FlexError`, one line): those of
     :func:`flex.tools.motion.case_motion`, a bad ``every``, an output folder that cannot be
     made. ``progress``: where progress lines go (None: nowhere)."""
+    sample_indices(1, every)  # a bad --every is refused before anything is read
     motion = case_motion(source, case, cache_dir=cache_dir)
     indices = sample_indices(len(motion.time_s), every)
     out = Path(out_dir)
