@@ -82,9 +82,55 @@ def _parser() -> argparse.ArgumentParser:
                      help="sweeps: rerun the cases that failed last time (default: keep them)")
     scene = commands.add_parser("scene", help="print the fully resolved scene as TOML")
     scene_options(scene)
+    run.add_argument("--animate", action="store_true",
+                     help="also animate each case with a flexible link (flex animate): "
+                          "figures/<file stem>-<case>.mp4 (or .gif) beside the result file")
     _result_tools(commands)
+    _view_tools(commands)
     _design_command(commands)
     return parser
+
+
+def _view_tools(commands) -> None:
+    """The ``export`` and ``animate`` subcommands (a case's bodies and fields)."""
+    export = commands.add_parser(
+        "export", help="write a case's meshes and nodal fields as XDMF + HDF5 (ParaView)",
+        description="Write each body of a case as one mesh (flexible links: the plate mesh "
+                    "of their reduction or nonlinear FE body; rigid links and the slider: "
+                    "boxes) with, at each stored time (or every N-th), the nodal displacement "
+                    "in the mechanism's and the link's frame and the recovered von Mises and "
+                    "axial stress, as OUT/<file stem>-<case>.xdmf + .h5 (ParaView, meshio). "
+                    "Refused (exit 2) when the reduction rebuilt today is not the mode basis "
+                    "the case was computed with.",
+        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    export.add_argument("file", metavar="FILE.h5")
+    export.add_argument("case", nargs="?", metavar="CASE",
+                        help="case name (may be omitted when the file has one case)")
+    export.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    export.add_argument("--every", type=int, default=1, metavar="N",
+                        help="export every N-th stored time (and the last; default 1)")
+    animate = commands.add_parser(
+        "animate", help="animate a case: the mechanism with its flexible links deformed",
+        description="Draw the mechanism in its plane at the stored times, each flexible link "
+                    "deformed (magnified, the factor printed on each frame) and coloured by "
+                    "von Mises stress, with the time and the crank angle; mp4 (H.264) when "
+                    "an ffmpeg encoder is available (the imageio-ffmpeg package), else gif.",
+        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter)
+    animate.add_argument("file", metavar="FILE.h5")
+    animate.add_argument("case", nargs="?", metavar="CASE",
+                         help="case name (may be omitted when the file has one case)")
+    animate.add_argument("--out", required=True, metavar="FILE",
+                         help="animation file, .mp4 or .gif; .png: one frame (--time)")
+    animate.add_argument("--time", type=float, metavar="S", dest="at_time_s",
+                         help="for a .png: the frame nearest this time (default: the time "
+                              "of the peak von Mises stress)")
+    animate.add_argument("--frames", type=int, default=200, metavar="N",
+                         help="at most N frames, evenly spaced in the stored samples "
+                              "(default 200)")
+    animate.add_argument("--fps", type=int, default=25, help="frames per second (default 25)")
+    animate.add_argument("--magnification", type=float, metavar="X",
+                         help="deformation scale (default: the peak deflection drawn as "
+                              "1/20 of the link length, rounded to 1, 2 or 5 x 10^k)")
 
 
 def _design_command(commands) -> None:
@@ -209,6 +255,8 @@ def _result_tool(args: argparse.Namespace) -> int:
 
         _print(f"wrote {write_report(args.file, args.out)}")
         return EXIT_OK
+    if args.command in ("export", "animate"):
+        return _view_tool(args)
     if args.command == "inspect":
         from flex.tools.inspect import describe, format_description
 
@@ -229,6 +277,29 @@ def _result_tool(args: argparse.Namespace) -> int:
     _print(json.dumps(report.as_dict(), indent=2) if args.json
            else report.format(args.limit))
     return EXIT_OK if report.passed else EXIT_FAILED
+
+
+def _view_tool(args: argparse.Namespace) -> int:
+    """Run ``export`` or ``animate``; the reduction cache folder is read here, once."""
+    from flex.bodies.reduction import reduction_cache_dir
+
+    cache_dir = reduction_cache_dir(os.environ)
+    if args.command == "export":
+        from flex.tools.export import export_case
+
+        done = export_case(args.file, args.case, args.out, args.every, cache_dir=cache_dir)
+        _print(f"wrote {done.xdmf} and {done.hdf5.name} ({done.times} times, {done.nodes} "
+               f"nodes, {done.bytes_written / 1e6:.1f} MB)")
+        return EXIT_OK
+    from flex.tools.animate import animate_case
+
+    done = animate_case(args.file, args.case, args.out, frames=args.frames, fps=args.fps,
+                        magnification=args.magnification, cache_dir=cache_dir,
+                        at_time_s=args.at_time_s)
+    _print(f"wrote {done.path} ({done.frames} frame{'s' if done.frames != 1 else ''}, "
+           f"{done.width}x{done.height} px, "
+           f"deformation x {done.magnification:g})")
+    return EXIT_OK
 
 
 def _print(text: str, end: str = "\n") -> None:
@@ -336,7 +407,8 @@ def _dispatch(argv: list[str] | None) -> int:
     args, extra = parser.parse_known_args(argv)
     if args.command is None:
         parser.error(f"unrecognized arguments: {' '.join(extra)}" if extra else
-                     "a COMMAND is required: run, scene, design, inspect, plot, compare or report")
+                     "a COMMAND is required: run, scene, design, inspect, plot, compare, report, "
+                     "export or animate")
     if extra:  # PATHs after options (compare A B --rtol 1e-6 PATH): argparse leaves them over
         if args.command in ("plot", "compare") and not any(e.startswith("-") for e in extra):
             args.paths += extra
@@ -395,4 +467,11 @@ def _run(args: argparse.Namespace) -> int:
     output = run_study(args.study, args.scene, args.overrides, args.out,
                        figures=not args.no_figures, quiet=args.quiet, sweep=sweep,
                        **from_environment(args.study, os.environ))
+    if args.animate and output.as_expected and output.path is not None:
+        from flex.tools.animate import animate_results
+
+        cache_dir = from_environment(args.study, os.environ)["cache_dir"]
+        for done in animate_results(output.path, cache_dir=cache_dir):
+            if not args.quiet:
+                _print(f"wrote {done.path} ({done.frames} frames)")
     return EXIT_OK if output.as_expected else EXIT_FAILED

@@ -19,6 +19,7 @@ EDGES = {
     ("cli.py", "main"): "FLEX_DEBUG: show the traceback of an internal error",
     ("cli.py", "_run"): "flex run: the reduction cache folder and the study's variables",
     ("cli.py", "_design"): "flex design: the reduction cache folder",
+    ("cli.py", "_view_tool"): "flex export / animate: the reduction cache folder",
     ("api.py", "_cache_dir"): "flex.simulate / flex.run_study: the user's cache folder",
     ("api.py", "run_study"): "flex.run_study: the study's declared variables",
     # configures Exudyn itself (no user settings file) before it is imported
@@ -127,12 +128,12 @@ def test_the_api_reads_the_cache_folder_and_a_study_run_passes_it_on(tmp_path, m
 
     monkeypatch.setenv("FLEX_CACHE_DIR", str(tmp_path))
     assert flex.simulate(flex.load_scene(overrides=COARSE_FFRF)).status == "ok"
-    # the API's default: the user's (the reduction and its geometric stiffness beside it)
-    (entry,) = [path for path in (tmp_path / "reductions").glob("*.hdf5")
-                if not path.name.endswith(".geometric.hdf5")]
+    # the API's default: the user's (the run's reduction, its geometric stiffness beside it,
+    # and those of the error budget's companions: more modes, a coarser mesh)
+    entries = sorted(path.name for path in (tmp_path / "reductions").glob("*.hdf5"))
+    assert len(entries) == 6
     monkeypatch.delenv("FLEX_CACHE_DIR")
     module, given = load_study("simulate"), tmp_path / "given"
     output = execute(module, study_scene(module, None, COARSE_FFRF), cache_dir=given)
     assert output.as_expected
-    assert sorted(path.name for path in given.glob("*.hdf5")) == [
-        entry.name.replace(".hdf5", ".geometric.hdf5"), entry.name]
+    assert sorted(path.name for path in given.glob("*.hdf5")) == entries

@@ -408,6 +408,8 @@ def test_fewest_joint_markers_give_the_motion_of_all_face_nodes(reduction, cache
     for key, full in curves["all_face_nodes"].items():
         if full.dtype.kind != "f" or not full.size or key == "constraint_norm":
             continue
+        if np.max(np.abs(full)) < 1e-15:  # round-off of a zero (a crank frame's origin at A)
+            continue
         scale = max(np.ptp(full), np.max(np.abs(full)) * 1e-12, 1e-300)
         assert np.max(np.abs(curves["fewest"][key] - full)) <= 1e-5 * scale, key
 

@@ -70,6 +70,7 @@ from flex.bodies.reduction import (
     add_plate_markers,
     as_vector3,
 )
+from flex.data.results import Dataset
 
 _MESH_ORDER = 2  # as the reduction: linear tets lock in bending
 #: wall-time seconds between two progress lines of an integration (see the module doc)
@@ -369,6 +370,59 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
         "n_dof": plate.n_dof,
         "elastic_forces": elastic,
     }
+
+
+#: the nonlinear FE coupler's nodal positions are stored at most this many times plus one
+#: (:class:`NodalRecorder`)
+NODAL_SNAPSHOTS = 300
+
+
+class NodalRecorder:
+    """The nonlinear FE body's global nodal positions [m] during an integration, for
+    ``flex export`` and ``flex animate`` (its nodes carry the whole field; no modes).
+
+    Recorded at t = 0 and then every ``k``-th output sample, ``k`` the smallest integer that
+    keeps the count within :data:`NODAL_SNAPSHOTS` + 1 (the flexible study's 3000 samples:
+    every 10th, 1e-4 s apart, ~28 per first bending period of the 1 mm plate), by an Exudyn
+    post-step function that copies the body's coordinates (an array copy per recorded step;
+    nothing else is computed). Stored as ``coupler/nodal/time`` [s] and
+    ``coupler/nodal/position`` [m] (snapshots, nodes, 3), gzip-compressed. Make it after
+    ``mbs.Assemble()`` (it reads the coordinates' indices).
+    """
+
+    def __init__(self, mbs, nodes: Sequence[int], step_s: float, output_step_s: float,
+                 end_time_s: float) -> None:
+        import exudyn as exu
+
+        samples = max(1, round(end_time_s / output_step_s))
+        self.step_s = float(step_s)
+        self.steps_between = round(output_step_s / step_s) * math.ceil(samples / NODAL_SNAPSHOTS)
+        self.reference = np.array([mbs.GetNode(n)["referenceCoordinates"] for n in nodes],
+                                  dtype=float)
+        first = np.array([mbs.GetNodeODE2Index(n) for n in nodes], dtype=np.int64)
+        self.indices = (first[:, None] + np.arange(3)).ravel()
+        self.times = [0.0]
+        self.positions = [self._positions(mbs.systemData.GetODE2Coordinates(
+            configuration=exu.ConfigurationType.Initial))]
+        mbs.SetPostStepUserFunction(self)
+
+    def _positions(self, coordinates) -> np.ndarray:
+        return self.reference + np.asarray(coordinates)[self.indices].reshape(-1, 3)
+
+    def __call__(self, mbs, t: float) -> bool:
+        step = round(t / self.step_s)  # Exudyn also calls it once at t = 0: skip that
+        if step % self.steps_between == 0 and t > self.times[-1] + 0.5 * self.step_s:
+            self.times.append(float(t))
+            self.positions.append(self._positions(mbs.systemData.GetODE2Coordinates()))
+        return True
+
+    def datasets(self, link: str = "coupler") -> dict[str, Dataset]:
+        """``<link>/nodal/time`` and ``<link>/nodal/position``."""
+        return {f"{link}/nodal/time": Dataset(np.array(self.times), "s",
+                                              "times of the nodal snapshots"),
+                f"{link}/nodal/position": Dataset(
+                    np.array(self.positions), "m", "node positions, mechanism frame (mesh "
+                    "node order)", compress=True)}
 
 
 def nonlinear_plate_for_scene(scene: dict[str, dict[str, Any]]) -> NonlinearPlate:

@@ -52,6 +52,7 @@ class Dataset:
     data: Any
     units: str
     description: str = ""
+    compress: bool = False  #: gzip (with shuffle) in the file: large fields (nodal snapshots)
 
 
 @dataclass
@@ -196,6 +197,9 @@ def _write_dataset(group, path: str, dataset: Dataset) -> None:
     if data.dtype.kind in "US":
         data = data.astype(object)
         created = group.create_dataset(path, data=data, dtype=_string_dtype())
+    elif dataset.compress:
+        created = group.create_dataset(path, data=data, compression="gzip",
+                                       compression_opts=4, shuffle=True)
     else:
         created = group.create_dataset(path, data=data)
     created.attrs["units"] = dataset.units

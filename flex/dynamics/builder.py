@@ -554,6 +554,9 @@ class _Builder:
                 continue
             self.add(f"{name}.modal_coordinates",
                      self.sensor("Node", "Coordinates", nodeNumber=link["node_modal"]))
+            for output in ("Position", "Rotation"):  # the floating frame (flex.tools.export)
+                self.add(f"{name}.frame_{output}",
+                         self.sensor("Node", output, nodeNumber=link["node_frame"]))
             # Exudyn's FFRF body reports its kinetic (rigid + elastic motion) and strain energy
             sensors = [self.mbs.AddSensor(self.sensor("Body", kind, bodyNumber=link["object"]))
                        for kind in ("KineticEnergy", "PotentialEnergy")]

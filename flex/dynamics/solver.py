@@ -502,6 +502,7 @@ def _elastic_datasets(mech: Mechanism, link: str, start_marker: str, end_marker:
     marker; an FFRF link adds its modal coordinates and bending stress.
     """
     from flex.bodies.reduction import bending_stress_history, midpoint_deflection
+    from flex.bodies.stress import peak_datasets
 
     position_start = _sensor(mech, f"{start_marker}.Position")[:, 1:4]
     position_end = _sensor(mech, f"{end_marker}.Position")[:, 1:4]
@@ -532,6 +533,35 @@ def _elastic_datasets(mech: Mechanism, link: str, start_marker: str, end_marker:
         out[f"{link}/peak_bending_stress"] = Dataset(
             bending_stress_history(reduction, modal), "Pa",
             "largest |sigma_xx| away from the end faces (bending + membrane)")
+        out.update(peak_datasets(link, reduction, modal))
+    out.update(_frame_datasets(mech, link))
+    return out
+
+
+def _frame_datasets(mech: Mechanism, link: str) -> dict[str, Dataset]:
+    """The pose of an FFRF link's floating frame (what :mod:`flex.tools.export` places the
+    nodal field with): origin x, y [m] and angle about z [rad]."""
+    origin = _sensor(mech, f"{link}.frame_Position")[:, 1:3]
+    angle = np.unwrap(_sensor(mech, f"{link}.frame_Rotation")[:, 3])
+    return {f"{link}/frame_position": Dataset(origin, "m", "floating frame origin x, y"),
+            f"{link}/frame_angle": Dataset(angle, "rad", "floating frame angle from +x")}
+
+
+def flexible_link_attrs(scene: Scene, datasets: dict[str, Dataset],
+                        reductions: dict[str, Any]) -> dict[str, Any]:
+    """Case attributes of each FFRF link: the identity of its mode basis (what its stored
+    modal coordinates mean) and its peak von Mises stresses, where and when
+    (:mod:`flex.bodies.stress`)."""
+    from flex.bodies.stress import basis_identity, peak_attrs
+
+    out: dict[str, Any] = {}
+    for link, reduction in reductions.items():
+        if scene[link]["model"] != "ffrf" or f"{link}/modal_coordinates" not in datasets:
+            continue
+        out.update(basis_identity(link, reduction))
+        if reduction.has_stress_modes:
+            out.update(peak_attrs(link, reduction, datasets[f"{link}/modal_coordinates"].data,
+                                  datasets["time"].data))
     return out
 
 
@@ -623,21 +653,36 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     if scene["coupler"]["model"] == "nonlinear_fe" and reduction is None:
         _announce_mesh("coupler", scene["coupler"], "nonlinear FE body")
     mech = build_mechanism(scene, reduction, crank_reduction)
+    recorder = _nodal_recorder(mech)
     counters = run(mech)
     with np.errstate(all="ignore"):  # a diverged run overflows; _check_finite reports it
         datasets = collect(mech)
     settings = solver_settings(scene)
     _check_finite(datasets, settings, scene, _reductions(mech))
+    if recorder is not None:  # its own time: after the check of the sampled datasets
+        datasets.update(recorder.datasets())
     import tomli_w
 
     result = CaseResult(name, to_toml(scene), datasets, counters=counters,
                         solver_settings_toml=tomli_w.dumps(settings))
+    result.attrs.update(flexible_link_attrs(scene, datasets, _reductions(mech)))
     if solver_choice is not None:
         result.attrs.update(solver_choice.attrs())
     warning = validity_warning(scene, datasets)
     if warning:
         result.attrs[VALIDITY_WARNING] = warning
     return result
+
+
+def _nodal_recorder(mech: Mechanism):
+    """A :class:`flex.bodies.nonlinear.NodalRecorder` for a nonlinear FE coupler, else None."""
+    if mech.scene["coupler"]["model"] != "nonlinear_fe":
+        return None
+    from flex.bodies.nonlinear import NodalRecorder
+
+    settings = solver_settings(mech.scene)
+    return NodalRecorder(mech.mbs, mech.coupler["nodes"], settings["step_s"],
+                         settings["output_step_s"], settings["end_time_s"])
 
 
 # ------------------------------------------------------------------------------------------

@@ -7,7 +7,8 @@ when the end time is a whole number of doubled steps, else one at half the step 
 returns an :class:`ErrorEstimate`:
 
 - ``values``: for each headline quantity (:data:`HEADLINES`: the crank angle and the slider
-  position at the end time, the peak elastic midpoint deflection of each flexible link), the
+  position at the end time, the peak elastic midpoint deflection of each flexible link, the
+  peak von Mises stress of each FFRF link away from its joint faces), the
   estimated error of the run's value [the quantity's units], by Richardson extrapolation.
   With the runs at h, 2h and 4h: the larger of ``|q_h - q_2h| / (2^p - 1)`` and the pair
   (2h, 4h)'s, scaled to h by ``2^-p``, with p the order the three runs show
@@ -91,6 +92,8 @@ PEAK_PATHS = {"coupler_peak_deflection_m": "coupler/midpoint_deflection",
               "crank_peak_deflection_m": "crank/midpoint_deflection",
               "coupler_peak_bending_stress_Pa": "coupler/peak_bending_stress",
               "crank_peak_bending_stress_Pa": "crank/peak_bending_stress",
+              "coupler_peak_von_mises_Pa": "coupler/peak_von_mises_stress",
+              "crank_peak_von_mises_Pa": "crank/peak_von_mises_stress",
               **{f"joint_{joint}_peak_force_N": f"joints/{joint}/force_modulus"
                  for joint in "ABC"}}
 _PEAK_WHAT = {"coupler_peak_deflection_m": ("m", "peak elastic midpoint deflection of the "
@@ -98,6 +101,10 @@ _PEAK_WHAT = {"coupler_peak_deflection_m": ("m", "peak elastic midpoint deflecti
               "crank_peak_deflection_m": ("m", "peak elastic midpoint deflection of the crank"),
               "coupler_peak_bending_stress_Pa": ("Pa", "peak bending stress of the coupler"),
               "crank_peak_bending_stress_Pa": ("Pa", "peak bending stress of the crank"),
+              "coupler_peak_von_mises_Pa": ("Pa", "peak von Mises stress of the coupler (away "
+                                                  "from the joint faces)"),
+              "crank_peak_von_mises_Pa": ("Pa", "peak von Mises stress of the crank (away "
+                                                "from the joint faces)"),
               **{f"joint_{joint}_peak_force_N": ("N", f"peak force of joint {joint}")
                  for joint in "ABC"}}
 #: headline quantity -> (units, what, reader of a result's datasets; None: not in this run)

@@ -209,6 +209,7 @@ def format_description(info: dict[str, Any]) -> str:
         if case["attributes"].get("validity_warning"):
             lines.append(f"  WARNING: {case['attributes']['validity_warning']}")
         lines += _estimate_lines(case["attributes"])
+        lines += [f"  {line}" for line in stress_lines(case["attributes"])]
         if case["scene_changes"]:
             changes = ", ".join(f"{k} = {_short(v)}" for k, v in case["scene_changes"].items())
             lines.append(f"  scene: the file's scene with {changes}")
@@ -253,6 +254,31 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
     for key in ("method", "leaves_out", "validity"):
         if attrs.get(PREFIX + key):
             lines.append(f"    {key.replace('_', ' ')}: {attrs[PREFIX + key]}")
+    return lines
+
+
+def stress_lines(attrs: dict[str, Any]) -> list[str]:
+    """The peak von Mises stress of each FFRF link (case attributes of
+    :func:`flex.bodies.stress.peak_attrs`), where and when, with its estimated error:
+    one line per link."""
+    from flex.fidelity.error_estimate import PREFIX
+
+    lines = []
+    for link in ("coupler", "crank"):
+        parts = []
+        for suffix, where in (("", "away from the joint faces"), ("_at_joints", "at them")):
+            name = f"{link}_peak_von_mises{suffix}"
+            if f"{name}_Pa" not in attrs:
+                continue
+            x, y, z = (1e3 * float(v) for v in np.ravel(attrs[f"{name}_position_m"]))
+            error = attrs.get(f"{PREFIX}{name}_Pa")
+            parts.append(f"{attrs[f'{name}_Pa'] / 1e6:.4g} MPa {where} at t = "
+                         f"{attrs[f'{name}_time_s'] * 1e3:.4g} ms, (x, y, z) = ({x:.3g}, "
+                         f"{y:.3g}, {z:.3g}) mm on the plate"
+                         + (f" (estimated error {error / 1e6:.2g} MPa: step + modes + mesh "
+                            f"+ model)" if error is not None else ""))
+        if parts:
+            lines.append(f"peak von Mises stress, {link}: " + "; ".join(parts))
     return lines
 
 

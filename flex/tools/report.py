@@ -37,6 +37,7 @@ import numpy as np
 from flex.base.errors import OutputError
 from flex.data.outputs import RESULT_SUFFIXES, check_writable_folder, figures_folder
 from flex.data.results import atomic_path, attribute_value, case_names, reading
+from flex.tools.inspect import stress_lines
 
 REPORT_SUFFIX = ".md"
 #: arrays with more elements than this are summarised (shape, minimum, maximum)
@@ -353,6 +354,7 @@ def _case_notes(attrs: dict[str, Any]) -> list[str]:
         notes.append(f"message: {attrs['message']}")
     if attrs.get("validity_warning"):
         notes.append(f"**validity warning**: {attrs['validity_warning']}")
+    notes += stress_lines(attrs)
     for link in _fidelity_links(attrs):
         prefix = f"fidelity_{link}_"
         modes = attrs.get(prefix + "modes")
@@ -372,6 +374,9 @@ def _shown_in_notes(key: str, attrs: dict[str, Any]) -> bool:
     if key in CASE_KNOWN or key.startswith(("counter_", "solver_defaults_", "estimated_error_",
                                             "headline_")):
         return True
+    if key.startswith(("coupler_peak_von_mises", "crank_peak_von_mises")) or key.endswith(
+            ("_reduction_basis_sha256", "_reduction_basis_fingerprint")):
+        return True  # the peaks are in the notes; the basis identity is for flex export
     return any(key.startswith(f"fidelity_{link}_") for link in _fidelity_links(attrs))
 
 
