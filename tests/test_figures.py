@@ -326,8 +326,10 @@ def test_estimates_figure_and_summary_synthetic(tmp_path, reviewed):
             "reference_accuracy_crank_angle_end_rad": true / 100,
             "estimated_error_validity": validity})
     result = estimates.summarize({}, results)
-    assert "asymptotic runs: 2 pairs, 100% within 3x" in result.report
-    assert "under-resolved runs: 1 pairs, 0% within 3x, most optimistic" in result.report
+    # true / estimated: 1/0.95 and 1/1.2 within [1/3, 1.5], 100 (optimistic) outside
+    assert "2 of 3 judged pairs within the target" in result.report
+    assert "most optimistic true/estimated 100" in result.report
+    assert "scenes with every judged pair within: 2 of 3" in result.report
     paths = estimates.figures(results, result, tmp_path)
     check_pngs(paths, tmp_path, {"estimates.png"})
 

@@ -1,43 +1,46 @@
 """Geometric stiffness of an FFRF plate link: the softening of its bending modes under its own
-axial force.
+axial force, and the shortening of its chord by its bending.
 
 A floating-frame body is linear elastic in its own frame: a compressed link keeps its bending
 stiffness, so a thin coupler near its Euler load bends far less in the linear FFRF model than
-in the fully nonlinear FE one (docs/geometric-stiffness.md). The missing term is the
-initial-stress (geometric) stiffness of the axial force N (tension positive) [N]::
+in the fully nonlinear FE one (docs/geometric-stiffness.md). The missing part of the Green
+strain is the transverse rotations' ``1/2 (du_y/dx)^2 + 1/2 (du_z/dx)^2``. Projected on the
+reduction's mode basis Phi once per reduction::
 
-    K_sigma(N) = N / A * integral over the plate of  du/dx . dv/dx  dV      (A = t w)
+    K_G = Phi^T [ (1/A) integral (du_y/dx dv_y/dx + du_z/dx dv_z/dx) dV ] Phi     [1/m]
 
-the second-order work of the axial stress through the rotations of the material lines (the
-1/2 (du_y/dx)^2 + 1/2 (du_z/dx)^2 part of the Green strain the linear body drops). Projected
-on the reduction's mode basis Phi once per reduction, ``K_G = Phi^T K_sigma(1 N) Phi`` [1/m].
-The body gets the generalized force on its modal coordinates q (:class:`_GeometricForce`)::
+(A = t w): ``b(q) = q^T K_G q / 2`` is the shortening of the chord that the bending q makes
+[m], and a uniform axial tension N stores ``-N b``. The link's axial force comes from its
+stretch including that shortening, ``N(q) = k_N . q + k_a b(q)`` (``k_N``: the ``end_b``
+axial static mode's row of the reduced stiffness matrix, ``k_a`` its diagonal, E A / L), so the
+energy added to the linear body's is::
 
-    f(q) = -N(q) K_G q,        N(q) = k_N . q
+    U_G(q) = (k_N . q) b(q) + k_a b(q)^2 / 2         (= k_a (u + b)^2 / 2 - k_a u^2 / 2)
 
-with N the link's axial force from its own stretch: the elastic force of the ``end_b`` axial
-static mode (``k_N`` its row of the reduced stiffness matrix). f depends on q alone, so its
-Jacobian is exact (``N K_G + (K_G q) k_N^T``) and Newton converges as for the linear body,
-whatever the modes and the step.
+and the generalized force on the modal coordinates (:class:`_GeometricForce`) is
+``f = -grad U_G = -[N(q) K_G q + b(q) k_N]``: the bending softened (or stiffened, in tension)
+by the axial force, and the axial coordinate pulled by the bending's shortening. f depends
+on q alone and derives from an energy, so its Jacobian is exact and symmetric,
+``N K_G + K_G q k_N^T + k_N q^T K_G + k_a K_G q q^T K_G``, and the body stays conservative:
+Newton converges as for the linear body, whatever the modes and the step.
 
 Why this is the whole correction: the reduction's floating frame is the chord B-C
-(:mod:`flex.bodies.reduction`), so the joint forces' axial part acts along the frame's x axis
-and the linear FFRF body is blind to it; the geometric potential of the axial force is then
-exactly -N/2 integral(w'^2) over the elastic field w measured from the chord, q^T K_G q / 2
-over the whole basis (static modes included). :func:`pinned_pinned_eigen` checks it against
-the Euler load and f(P) = f0 sqrt(1 - P / P_E).
+(:mod:`flex.bodies.reduction`), so the joint forces' axial part acts along the frame's x
+axis, the linear FFRF body is blind to it, and the second-order potential of the axial force
+is exactly -N/2 integral(w'^2) over the elastic field w measured from the chord.
+:func:`pinned_pinned_eigen` checks it against the Euler load and f(P) = f0 sqrt(1 - P / P_E).
 
 What was measured and dropped (docs/geometric-stiffness.md): with the frame on the joint-B
-face (Exudyn's default), the chord turns against the frame and the linear body puts the axial
-force through that turn (compression stiffened it); its correction needed the tension at C
-read from joint C's Lagrange multiplier, which is not in the Jacobian, and failed Newton with
-2 to 24 modes on loaded scenes. A conservative form (the energy 1/2 k_N (stretch + 1/2 q^T
-K_G q)^2, bending feeding back on the stretch) ran but overshot the nonlinear FE coupler by
-up to 3.4 % in a narrow band of thickness (0.60-0.61 mm) where the reduced model's axial and
-bending frequencies meet; the form above stays within 0.35 % from 0.5 to 10 mm.
+face (Exudyn's default) the chord turns against the frame, compression stiffens the linear
+body, and its correction needed the tension at C read from a joint's Lagrange multiplier,
+outside the Jacobian (Newton failed with 2-24 modes on loaded scenes); in the chord frame,
+the force -N K_G q without the shortening's pull (not conservative) went unstable on a crank
+bent to 3 % of its length; K_G with the axial gradient's square (du_x/dx)^2 as well made the
+reduced coupler resonate in a band of thickness where the nonlinear FE one does not.
 
-Validity: below the Euler load. The model is linear in N: beyond it the body buckles without
-bound and the run fails, where only the nonlinear FE coupler holds.
+Validity: the axial force is uniform along the link; below the Euler load the softening is
+that of the beam; beyond it the bending's shortening is all that holds the buckled plate,
+and the run carries a validity warning (only the nonlinear FE coupler is valid there).
 
 Cached beside the reduction (``<key>.geometric.hdf5`` in the reduction's cache folder, keyed
 by the reduction's key and a digest of its mode basis, its content checked on load by a
@@ -58,7 +61,7 @@ from typing import Any
 import numpy as np
 
 #: bump when the content or layout of a cache entry changes (old entries are then rebuilt)
-GEOMETRIC_FORMAT_VERSION = 3
+GEOMETRIC_FORMAT_VERSION = 4  # 4: transverse gradients only
 _SUFFIX = ".geometric.hdf5"
 
 
@@ -67,9 +70,10 @@ class GeometricStiffness:
     """The reduced geometric stiffness of one :class:`flex.bodies.reduction.Reduction`.
 
     ``matrix_per_N`` (K_G, m x m over the modal coordinates, [1/m]: generalized stiffness
-    per newton of uniform axial tension); ``axial_force_row_N_per_m`` (k_N: the link's axial
-    force N = k_N . q [N], tension positive); ``axial_mode`` (column of the ``end_b`` axial
-    static mode); ``from_cache``.
+    per newton of uniform axial tension; q^T K_G q / 2 is the bending's shortening of the
+    chord [m]); ``axial_force_row_N_per_m`` (k_N: the linear part of the link's axial force,
+    k_N . q [N], tension positive); ``axial_mode`` (column of the ``end_b`` axial static
+    mode); ``from_cache``.
     """
 
     matrix_per_N: np.ndarray
@@ -79,8 +83,19 @@ class GeometricStiffness:
 
     def axial_force_N(self, modal_coordinates: np.ndarray) -> np.ndarray:
         """The link's axial force [N] (tension > 0) at modal coordinates of shape (m,) or
-        (n, m)."""
-        return np.asarray(modal_coordinates, dtype=float) @ self.axial_force_row_N_per_m
+        (n, m): its stretch, the bending's shortening of the chord included."""
+        q = np.asarray(modal_coordinates, dtype=float)
+        shortening = 0.5 * np.einsum("...i,ij,...j->...", q, self.matrix_per_N, q)
+        row = self.axial_force_row_N_per_m
+        return q @ row + row[self.axial_mode] * shortening
+
+    def energy_J(self, modal_coordinates: np.ndarray) -> np.ndarray:
+        """U_G = (k_N . q) b + k_a b^2 / 2 [J] (module doc) at modal coordinates of shape
+        (m,) or (n, m): what the geometric stiffness adds to the linear strain energy."""
+        q = np.asarray(modal_coordinates, dtype=float)
+        shortening = 0.5 * np.einsum("...i,ij,...j->...", q, self.matrix_per_N, q)
+        row = self.axial_force_row_N_per_m
+        return (q @ row) * shortening + 0.5 * row[self.axial_mode] * shortening**2
 
 
 # ------------------------------------------------------------------------------------------
@@ -108,9 +123,12 @@ def _axial_mode(reduction: Any) -> int:
 
 def unit_axial_stress_matrices(reduction: Any, rising: bool = False) -> Any:
     """K_sigma for 1 N of axial tension over the plate's mesh, Exudyn coordinate order
-    (x, y, z per node), scipy CSR [1/m]: (1 / A) integral du/dx . dv/dx dV; with ``rising``
-    the same weighted by x / L (a tension of 1 N at ``end_b`` falling linearly to zero at
-    ``end_a``: a distributed axial load).
+    (x, y, z per node), scipy CSR [1/m]: (1 / A) integral (du_y/dx dv_y/dx + du_z/dx dv_z/dx)
+    dV, the transverse rotations only (the axial gradient's square, (du_x/dx)^2, is a
+    strain's square, not a rotation's: near the rigid faces it made the reduced coupler
+    resonate, docs/geometric-stiffness.md); with ``rising`` the same weighted by x / L (a
+    tension of 1 N at ``end_b`` falling linearly to zero at ``end_a``: a distributed axial
+    load).
 
     The mesh is remade with the reduction's arguments (the same mesh and node numbering, as
     :mod:`flex.bodies.nonlinear` relies on); the node positions are checked against the
@@ -130,14 +148,14 @@ def unit_axial_stress_matrices(reduction: Any, rising: bool = False) -> Any:
         raise RuntimeError("the remade mesh differs from the reduction's: cannot project")
     space = ngs.NodalFESpace(plate.mesh, order=2) ** 3
     u, v = space.TnT()
-    along = ngs.CF((1.0, 0.0, 0.0))
     n_nodes = len(positions)
     coordinate = np.arange(3 * n_nodes)
     ngsolve_index = (coordinate % 3) * n_nodes + coordinate // 3  # of Exudyn 3 i + c
     weight = ngs.x / r.length_m if rising else 1.0
     form = ngs.BilinearForm(space)
-    form += (weight / (r.thickness_m * r.width_m)) * ngs.InnerProduct(
-        ngs.Grad(u) * along, ngs.Grad(v) * along) * ngs.dx
+    gradient_u, gradient_v = ngs.Grad(u), ngs.Grad(v)  # [i, j] = d u_i / d x_j
+    form += (weight / (r.thickness_m * r.width_m)) * (
+        gradient_u[1, 0] * gradient_v[1, 0] + gradient_u[2, 0] * gradient_v[2, 0]) * ngs.dx
     form.Assemble()
     values, columns, pointers = form.mat.CSR()
     matrix = csr_matrix((np.asarray(values), np.asarray(columns).astype(np.int64),
@@ -245,24 +263,33 @@ def geometric_stiffness(reduction: Any) -> GeometricStiffness:
 # Exudyn
 # ------------------------------------------------------------------------------------------
 class _GeometricForce:
-    """f(q) = -N(q) K_G q, N(q) = k_N . q, and its exact Jacobian, as the user functions of an
-    Exudyn ``ObjectGenericODE2`` on the modal node."""
+    """f(q) = -[N(q) K_G q + b(q) k_N] with b = q^T K_G q / 2 and N = k_N . q + k_a b, the
+    gradient of U_G (module doc), and its exact Jacobian, as the user functions of an Exudyn
+    ``ObjectGenericODE2`` on the modal node."""
 
     def __init__(self, stiffness: GeometricStiffness) -> None:
         self.matrix = np.asarray(stiffness.matrix_per_N, dtype=float)
         self.row = np.asarray(stiffness.axial_force_row_N_per_m, dtype=float)
+        self.axial = float(self.row[stiffness.axial_mode])
+
+    def _parts(self, q: np.ndarray) -> tuple[np.ndarray, float, float]:
+        bent = self.matrix @ q
+        shortening = 0.5 * float(q @ bent)
+        return bent, shortening, float(self.row @ q) + self.axial * shortening
 
     def force(self, mbs, t, item_index, q, q_t) -> np.ndarray:
-        """-N(q) K_G q [N per modal coordinate]."""
-        q = np.asarray(q)
-        return -float(self.row @ q) * (self.matrix @ q)
+        """-[N K_G q + b k_N] [N per modal coordinate]."""
+        bent, shortening, axial_force = self._parts(np.asarray(q))
+        return -(axial_force * bent + shortening * self.row)
 
     def jacobian(self, mbs, t, item_index, q, q_t, f_ode2, f_ode2_t):
-        """``f_ode2`` times the derivative of minus :meth:`force` in q (Exudyn's sign)."""
+        """``f_ode2`` times the Hessian of U_G (the derivative of minus :meth:`force`)."""
         import exudyn as exu
 
-        q = np.asarray(q)
-        tangent = float(self.row @ q) * self.matrix + np.outer(self.matrix @ q, self.row)
+        bent, _, axial_force = self._parts(np.asarray(q))
+        cross = np.outer(bent, self.row)
+        tangent = (axial_force * self.matrix + cross + cross.T
+                   + self.axial * np.outer(bent, bent))
         container = exu.MatrixContainer()
         container.SetWithDenseMatrix(float(f_ode2) * tangent, useDenseMatrix=True)
         return container

@@ -383,8 +383,9 @@ class _Builder:
         for name, link in (("coupler", self.mech.coupler), ("crank", self.mech.crank)):
             values = self.scene[name]
             if values["model"] == "ffrf" and values["geometric_stiffness"]:
+                link["geometric_data"] = geometric_stiffness(link["reduction"])
                 link["geometric_stiffness"] = add_geometric_stiffness(
-                    self.mbs, link["node_modal"], geometric_stiffness(link["reduction"]), name)
+                    self.mbs, link["node_modal"], link["geometric_data"], name)
 
     def add_joints(self) -> None:
         """Revolute A and B, the in-plane pin C, the prismatic slide (or penalty springs for

@@ -345,8 +345,10 @@ def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s:
     """Kinetic, strain, spring and total energy; none when a link's energy is unknown.
 
     Rigid bodies from their sensed velocities; FFRF links from Exudyn's body outputs
-    (kinetic energy of rigid and elastic motion, strain energy). The nonlinear FE coupler
-    reports no energy, so its runs have no energy datasets.
+    (kinetic energy of rigid and elastic motion, linear strain energy) and, with geometric
+    stiffness, its energy (:meth:`flex.bodies.geometric_stiffness.GeometricStiffness.
+    energy_J`). The nonlinear FE coupler reports no energy, so its runs have no energy
+    datasets.
     """
     scene = mech.scene
     if scene["coupler"]["model"] == "nonlinear_fe":
@@ -358,9 +360,12 @@ def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s:
         omega = _sensor(mech, f"{name}.AngularVelocity")[:, 1:4]
         kinetic += 0.5 * mass_kg * np.sum(velocity**2, axis=1)
         kinetic += 0.5 * np.einsum("ij,jk,ik->i", omega, inertia, omega)
-    for kinetic_sensor, strain_sensor in mech.flexible_energy.values():
+    for link, (kinetic_sensor, strain_sensor) in mech.flexible_energy.items():
         kinetic += np.asarray(mech.mbs.GetSensorStoredData(kinetic_sensor))[:, 1]
         strain += np.asarray(mech.mbs.GetSensorStoredData(strain_sensor))[:, 1]
+        stiffness = (mech.crank if link == "crank" else mech.coupler).get("geometric_data")
+        if stiffness is not None:  # the geometric stiffness's energy: not in Exudyn's body
+            strain += stiffness.energy_J(_sensor(mech, f"{link}.modal_coordinates")[:, 1:])
     out = {"energy/kinetic": Dataset(kinetic, "J", "kinetic energy of all links")}
     if mech.flexible_energy:
         out["energy/strain"] = Dataset(strain, "J", "elastic strain energy of the flexible links")
