@@ -170,7 +170,10 @@ def _result_tools(commands) -> None:
         description="Compare curves of A (under test) with B (reference) after "
                     "interpolating onto a common time base (the overlap of both time "
                     "ranges, on the finer grid). A curve (each column of a two-column "
-                    "curve) passes when max|a - b| <= atol + rtol * max|b|. Exit status: 0 "
+                    "curve) passes when max|a - b| <= atol + rtol * max|b| and the common "
+                    "time base covers B's whole time span with at least two samples (a "
+                    "shorter, shifted or one-sample run fails, saying which span was "
+                    "compared; --partial accepts the overlap). Exit status: 0 "
                     "all within tolerance, 1 some not, 2 a bad file or a PATH missing from "
                     "either file. Without PATH every curve of the cases both files have "
                     "is compared (/summary only when named; wall-clock timings never).")
@@ -186,6 +189,9 @@ def _result_tools(commands) -> None:
                          help="interpolation onto the common time base (default cubic)")
     compare.add_argument("--limit", type=int, default=20, metavar="N",
                          help="show the N largest deviations (failures always; 0: all)")
+    compare.add_argument("--partial", action="store_true",
+                         help="compare on the overlap when A does not cover B's time span "
+                              "(the report says which span; default: such a curve fails)")
     compare.add_argument("--json", action="store_true", help="print JSON (for scripts)")
 
     report = commands.add_parser(
@@ -225,7 +231,7 @@ def _result_tool(args: argparse.Namespace) -> int:
     from flex.tools.compare import compare_files
 
     report = compare_files(args.file_a, args.file_b, args.paths, args.rtol, args.atol,
-                           args.interp)
+                           args.interp, args.partial)
     _print(json.dumps(report.as_dict(), indent=2) if args.json
            else report.format(args.limit))
     return EXIT_OK if report.passed else EXIT_FAILED

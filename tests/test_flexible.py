@@ -85,7 +85,8 @@ def deviation_from_reference(tmp_path: Path, modes: int, step_s: float,
     path = run_to_file(tmp_path / f"modes{modes}_step{step_s:g}.h5",
                        [f"coupler.modes={modes}", f"simulation.step_s={step_s}",
                         f"simulation.end_time_s={end_time_s}"])
-    report = compare_files(path, REFERENCE, [PATH], rtol=RTOL, atol=ATOL)
+    report = compare_files(path, REFERENCE, [PATH], rtol=RTOL, atol=ATOL,
+                           partial=end_time_s < 0.03)  # a shorter run: over its own span
     (deviation,) = report.deviations
     return deviation.max_abs_deviation / (deviation.allowed / RTOL)
 
