@@ -355,11 +355,13 @@ def _dispatch(argv: list[str] | None) -> int:
     if args.command == "scene":
         from flex.config.usage import explicit_keys
         from flex.data.scene import to_toml
-        from flex.study import check_cases, load_study, study_scene
+        from flex.study import check_cases, check_structure, load_study, study_scene
 
         module = load_study(args.study)
+        given = explicit_keys(args.scene, args.overrides)
+        check_structure(module, given)
         scene = study_scene(module, args.scene, args.overrides)
-        check_cases(module, module.cases(scene), explicit_keys(args.scene, args.overrides))
+        check_cases(module, module.cases(scene), given)
         _print(_auto_note(scene) + to_toml(scene), end="")
         return EXIT_OK
     return _result_tool(args)
