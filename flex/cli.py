@@ -116,6 +116,7 @@ def _design_command(commands) -> None:
 
 def _design(args: argparse.Namespace) -> int:
     from flex.bodies.reduction import reduction_cache_dir
+    from flex.config.settings import tolerance_beyond_reach
     from flex.data.outputs import check_output
     from flex.data.scene import load_scene
     from flex.experiments import design_question as dq
@@ -127,6 +128,10 @@ def _design(args: argparse.Namespace) -> int:
     question.check()
     path = check_output(args.out, [args.scene] if args.scene else [])
     scene = load_scene(args.scene, BASE_OVERRIDES + list(args.overrides))
+    dq.check_scene(scene, question)
+    beyond = tolerance_beyond_reach(scene)
+    if beyond:  # each case's own warning is not printed (flex.experiments.design.design_case)
+        print(f"flex: warning: design: {beyond}", file=sys.stderr, flush=True)
     result = dq.answer(scene, question, reduction_cache_dir(os.environ))
     _print(dq.answer_text(result))
     _print(f"wrote {dq.write_answer(result, scene, path)}")
