@@ -428,13 +428,11 @@ def _check_options(options: Mapping[str, Any], accepted: Mapping[str, str], func
 
 
 def _check_study_options(options: Mapping[str, Any]) -> None:
-    sweep = options.get("sweep")
-    if sweep is not None:
-        from flex.sweep import SweepSettings
-
-        if not isinstance(sweep, SweepSettings):
-            raise ArgumentError(f"sweep: expected a flex.sweep.SweepSettings or None, got "
-                                f"{_kind(sweep)}")
+    sweep = options.get("sweep")  # flex.sweep is a higher layer: its fields, not its class
+    if sweep is not None and not all(hasattr(sweep, name) for name in (
+            "scheduler", "workers", "folder", "retry_failed", "progress")):
+        raise ArgumentError(f"sweep: expected a flex.sweep.SweepSettings or None, got "
+                            f"{_kind(sweep)}")
     environment = options.get("environment")
     if environment is not None and not (isinstance(environment, Mapping) and all(
             isinstance(k, str) and isinstance(v, str) for k, v in environment.items())):

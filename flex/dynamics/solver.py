@@ -32,6 +32,7 @@ import re
 import signal
 import threading
 import time
+from collections.abc import Callable
 from contextlib import redirect_stdout
 from pathlib import Path
 from typing import Any
@@ -161,17 +162,23 @@ class _SolverOutput(io.StringIO):
     _STEP = re.compile(r"STEP(\d+), t = ([-+0-9.eE]+)s, timeToGo = ([-+0-9.eE]+)s")
     _NOISE = ("+++", "EXUDYN V", "STEP", "Solver terminated successfully", "solver finished")
 
-    def __init__(self, label: str, end_time_s: float) -> None:
+    def __init__(self, label: str, end_time_s: float,
+                 stop: Callable[[], None] | None = None) -> None:
         super().__init__()
         self.end_time_s = end_time_s
         self.progress = Progress(f"integrating {label}" if label else "integrating")
+        self.stop = stop
         self._line = ""
 
     def write(self, text: str) -> int:
-        self._line += text
-        while "\n" in self._line:
-            line, self._line = self._line.split("\n", 1)
-            self._take(line)
+        try:
+            self._line += text
+            while "\n" in self._line:
+                line, self._line = self._line.split("\n", 1)
+                self._take(line)
+        except KeyboardInterrupt:  # a signal handled while Exudyn called us: Exudyn would
+            if self.stop is not None:  # drop the exception, so stop the solve (run() then
+                self.stop()  # raises the interrupt it noted)
         return len(text)
 
     def _take(self, line: str) -> None:
@@ -184,6 +191,12 @@ class _SolverOutput(io.StringIO):
         elif line.strip() and not line.lstrip().startswith(self._NOISE):
             super().write(line + "\n")
 
+    def getvalue(self) -> str:
+        """What was kept, with a last line not yet ended by a newline."""
+        pending = self._line if self._line.strip() and not self._line.lstrip().startswith(
+            self._NOISE) else ""
+        return super().getvalue() + pending
+
 
 def run(mech: Mechanism, label: str = "") -> dict[str, Any]:
     """Integrate ``mech`` in place; return counters. Raises SimulationError on failure.
@@ -194,7 +207,8 @@ def run(mech: Mechanism, label: str = "") -> dict[str, Any]:
     settings = solver_settings(mech.scene)
     solver = (exu.MainSolverExplicit() if _is_explicit(settings)
               else exu.MainSolverImplicitSecondOrder())
-    captured = _SolverOutput(label, settings["steps"] * settings["step_s"])
+    captured = _SolverOutput(label, settings["steps"] * settings["step_s"],
+                             lambda: mech.mbs.SetRenderEngineStopFlag(True))
     if mech.scene["coupler"]["model"] == "nonlinear_fe":
         captured.progress.first_s = float("inf")  # the nonlinear FE body reports its own
     start = time.perf_counter()
@@ -228,7 +242,8 @@ def run(mech: Mechanism, label: str = "") -> dict[str, Any]:
         failure = "explicit solver failed" if _is_explicit(settings) else "Newton failed"
         detail = " ".join(captured.getvalue().split())[-300:]
         raise SimulationError(f"solver diverged at step {step} (t = {now:.6g} s, step "
-                              f"{settings['step_s']:g} s): {detail or failure}; "
+                              f"{settings['step_s']:g} s): {failure}"
+                              f"{f' ({detail})' if detail else ''}; "
                               f"{divergence_advice(mech.scene, _reductions(mech))}")
     return {"steps": int(solver.it.currentStepIndex), "newton_iterations":
             int(solver.it.newtonStepsCount), "jacobian_updates": int(solver.it.newtonJacobiCount),
@@ -613,9 +628,18 @@ def _elastic_datasets(mech: Mechanism, link: str, start_marker: str, end_marker:
     reduction = body["reduction"]
     if reduction.has_stress_modes:
         out[f"{link}/peak_bending_stress"] = Dataset(
-            bending_stress_history(reduction, modal), "Pa",
+            bending_stress_history(reduction, modal, stress_window_m(reduction)), "Pa",
             "largest |sigma_xx| away from the end faces (bending + membrane)")
     return out
+
+
+def stress_window_m(reduction: Any) -> tuple[float, float]:
+    """Where a link's peak bending stress is read [m along it]: one thickness from each end
+    face (Saint-Venant), but never narrower than one element about the midpoint, so a plate
+    as thick as half its length (the stubbiest accepted) still has mesh nodes in it."""
+    length, half = reduction.length_m, 0.5 * reduction.length_m - reduction.thickness_m
+    half = max(half, 0.5 * min(reduction.mesh_size_m, length))
+    return (0.5 * length - half, 0.5 * length + half)
 
 
 def _wing_datasets(mech: Mechanism) -> dict[str, Dataset]:
