@@ -268,20 +268,22 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
               environment: Mapping[str, str] | None = None) -> StudyOutput:
     """Run study ``name``, write its HDF5 file (default ``results/<name>.h5``) and figures
     (``figures/<file stem>-*.png`` beside it) and its report (``reports/<file stem>.md``
-    beside it, generated from the file: :func:`flex.tools.report.write_report`), print the
+    beside it, generated from the file: :func:`flex.tools.report.render_report`), print the
     study's report, and return the output.
     ``sweep``: where and how a sweep study runs (:class:`flex.sweep.SweepSettings`);
     ``cache_dir``: the reduction cache folder (None: reductions built in memory, no disk
     cache); ``environment``: the study's declared variables (:class:`StudyRun`); the edges
     pass both from :func:`from_environment`.
 
-    Nothing is lost: the output is checked before any case runs (:func:`flex.data.outputs.
-    check_output`); a run that does not end as the study declares (an unexpected failed
-    case) does not replace an existing result file but is written beside it
-    (:func:`flex.data.outputs.failed_path`); figures are drawn only for a run that ended as
-    declared. Failed cases are reported on
-    stderr, also with ``quiet``. An interrupt raises :class:`Interrupted` saying which files
-    were already written.
+    Nothing is lost: a key the study does not honour (:func:`check_structure`) and every
+    output (:func:`flex.data.outputs.check_output`, :func:`check_outputs`) are checked before
+    any case runs; the result file, the figures and the report are written under private
+    names and moved into place together (:class:`flex.data.outputs.Staging`), so an error or
+    an interrupt before that changes no file; a run that does not end as the study declares
+    (an unexpected failed case) does not replace an existing result file but is written
+    beside it (:func:`flex.data.outputs.failed_path`); figures are drawn only for a run that
+    ended as declared. Failed cases are reported on stderr, also with ``quiet``. An interrupt
+    raises :class:`Interrupted` saying which files were already in place.
     """
     module = load_study(name)
     given = explicit_keys(source, overrides)

@@ -123,7 +123,7 @@ def test_a_reduction_to_many_modes_is_estimated_and_announced(capsys):
 ])
 def test_a_long_integration_is_announced_before_it_starts(capsys, sets, announced):
     from flex.config.settings import resolve_solver_settings
-    from flex.dynamics.solver import announce_integration
+    from flex.dynamics.runtime import announce_integration
 
     scene, _ = resolve_solver_settings(load_scene(overrides=sets))
     announce_integration(scene, "case", {})
@@ -132,9 +132,9 @@ def test_a_long_integration_is_announced_before_it_starts(capsys, sets, announce
 
 
 def test_exudyns_step_lines_become_progress_lines(capsys):
-    from flex.dynamics.solver import _SolverOutput
+    from flex.dynamics.runtime import SolverOutput
 
-    output = _SolverOutput("case", 5.0)
+    output = SolverOutput("case", 5.0)
     output.progress.first_s = output.progress.interval_s = 0.0
     output.write("+++++\nEXUDYN V1.13 solver: implicit\nSTEP1631, t = 1.631s, timeToGo = ")
     output.write("4.1s, Nit/step = 1.0\nNewton did not converge\n")
