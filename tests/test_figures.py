@@ -72,7 +72,7 @@ def run_and_draw(name: str, overrides: list[str], folder: Path, cache_dir: Path 
     assert output.as_expected, output.unexpected()
     if name == "wing":  # its auto decisions are for the links it simulated (issue 26)
         assert "crank as simulated" in output.summary.report
-        assert "3 mm" not in output.summary.report
+        assert "coupler as a 3 mm" not in output.summary.report
     return module.figures(output.results, output.summary, folder)
 
 

@@ -528,9 +528,10 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
         _say_unproven(cache_file)
         with _ngsolve_thread_count(ngsolve_threads):
             fem, ffrf_interface = _build_fem(parameters, key)
-        if cache_file is not None:
-            store(cache_file, lambda temporary: fem.SaveToFile(str(temporary), mode="HDF5"),
-                  REDUCTION_CACHE)
+        if cache_file is not None and not store(
+                cache_file, lambda temporary: fem.SaveToFile(str(temporary), mode="HDF5"),
+                REDUCTION_CACHE):
+            cache_file = None  # not kept (said): nothing is cached beside it either
 
     meta = fem.metaData["flex"]
     end_a, end_b, mid = (_node_set(fem, name) for name in (END_A, END_B, MID))
