@@ -26,7 +26,16 @@ Conventions shared by every function here:
   is one line naming the key or file and the accepted range: :class:`~flex.base.errors.SceneError`
   (a scene or override), :class:`~flex.base.errors.SimulationError` (a run diverged; the message
   names the step and the time), :class:`~flex.base.errors.ResultFileError` (a result file),
-  :class:`~flex.base.errors.OutputError` (an output that cannot be written).
+  :class:`~flex.base.errors.OutputError` (an output that cannot be written),
+  :class:`~flex.base.errors.ArgumentError` (an argument of the wrong type or value, naming
+  the argument; also a :class:`TypeError`).
+- **The same checks as the command line.** A scene handed to :func:`simulate` or
+  :func:`derive_scene` is checked as ``--scene`` and ``--set`` are (a dict edited by hand
+  too: ``scene["drive"]["spring_preload_m"] = -0.02`` is refused, ``wing.enabled = "no"``
+  is not true), and :func:`simulate` refuses, as ``flex run simulate`` does, a value that
+  differs from the bundled scene's but that the scene's models would not read. Numpy
+  scalars in a scene are accepted as the numbers they hold. The caller's scene is never
+  modified.
 - The **reduction cache** (Craig-Bampton reductions of ``ffrf`` plates) is a folder argument,
   ``cache_dir``; left out, these functions read the user's from the environment when called
   (``FLEX_CACHE_DIR``/reductions, else ``$XDG_CACHE_HOME/flex/reductions``, else
@@ -41,7 +50,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from flex.base.errors import SceneError
+from flex.base.errors import ArgumentError, SceneError
 
 if TYPE_CHECKING:  # type names only; nothing heavy is imported at run time
     import xarray
@@ -63,14 +72,17 @@ def override_strings(overrides: Overrides | None) -> list[str]:
     if overrides is None:
         return []
     if isinstance(overrides, str):
-        raise TypeError("overrides: a list of 'section.key=value' strings or a dict, not one "
-                        f"string (write [{overrides!r}])")
+        raise ArgumentError("overrides: a list of 'section.key=value' strings or a dict, not "
+                            f"one string (write [{_shown(overrides)}])")
     if not isinstance(overrides, Mapping):
+        if not isinstance(overrides, list | tuple):
+            raise ArgumentError(f"overrides: expected a list of 'section.key=value' strings or "
+                                f"a dict, got {_kind(overrides)}")
         items = list(overrides)
         for item in items:
             if not isinstance(item, str):
-                raise TypeError(f"overrides: expected 'section.key=value' strings, got "
-                                f"{type(item).__name__} {item!r}")
+                raise ArgumentError(f"overrides: expected 'section.key=value' strings, got "
+                                    f"{_kind(item)}")
         return items
     import tomli_w
 
@@ -126,7 +138,7 @@ def load_scene(source: str | Path | None = None, overrides: Overrides | None = N
     """
     from flex.data.scene import load_scene as _load
 
-    return _load(source, override_strings(overrides))
+    return _load(_source(source), override_strings(overrides))
 
 
 def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
@@ -152,7 +164,7 @@ def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
     """
     from flex.data.scene import apply_overrides, validate
 
-    derived = apply_overrides(scene, override_strings(overrides))
+    derived = apply_overrides(_plain_scene(scene), override_strings(overrides))
     validate(derived)
     return derived
 
@@ -197,14 +209,28 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
         help); :class:`ImportError` only in a broken installation.
     """
     from flex.fidelity.simulation import simulate as simulate_scene
+    from flex.study import check_cases, load_study
 
-    return simulate_scene(scene, name, cache_dir=_cache_dir(cache_dir), **options)
+    scene = checked_scene(scene)
+    _check_case_name(name)
+    _check_options(options, {"reduction": "a flex.bodies.reduction.Reduction",
+                             "crank_reduction": "a flex.bodies.reduction.Reduction",
+                             "criterion": "a flex.fidelity.criteria.Criterion",
+                             "crank_criterion": "a flex.fidelity.criteria.Criterion"},
+                   "simulate")
+    folder = _cache_dir(cache_dir)
+    check_cases(load_study("simulate"), {name: scene}, given_keys(scene))
+    return simulate_scene(scene, name, cache_dir=folder, **options)
 
 
 def _cache_dir(given: str | Path | None) -> Path:
     """``given`` as a folder, or the user's reduction cache folder from the environment."""
+    from flex.data.cache import REDUCTION_CACHE, check_folder
+
     if given is not None:
-        return Path(given)
+        folder = _path(given, "cache_dir", "a folder")
+        check_folder(folder, REDUCTION_CACHE)
+        return folder
     from flex.bodies.reduction import reduction_cache_dir
 
     return reduction_cache_dir(os.environ)  # the environment, read at this public edge
@@ -246,12 +272,24 @@ def run_study(name: str, source: str | Path | None = None, overrides: Overrides 
         (:class:`~flex.base.errors.OutputError`); :class:`flex.study.Interrupted` (a
         :class:`KeyboardInterrupt`) on Ctrl-C, naming the files already written.
     """
-    from flex.study import from_environment
+    from flex.study import STUDIES, from_environment
     from flex.study import run_study as _run
 
+    if not isinstance(name, str) or name not in STUDIES:
+        raise ArgumentError(f"name: {_kind(name)} is not a study; accepted: "
+                            f"{', '.join(STUDIES)}")
+    source = _source(source)
+    out = None if out is None else _path(out, "out", "a result file path ending in .h5")
+    for flag, value in (("figures", figures), ("quiet", quiet)):
+        if not isinstance(value, bool):
+            raise ArgumentError(f"{flag}: expected True or False, got {_kind(value)}")
+    _check_options(options, {"sweep": "a flex.sweep.SweepSettings or None",
+                             "environment": "a dict of environment variable names to "
+                                            "strings"}, "run_study")
+    _check_study_options(options)
     edge = from_environment(name, os.environ)  # the environment, read at this public edge
     options.setdefault("environment", edge["environment"])
-    folder = edge["cache_dir"] if cache_dir is None else Path(cache_dir)
+    folder = edge["cache_dir"] if cache_dir is None else _cache_dir(cache_dir)
     return _run(name, source, override_strings(overrides), out, figures, quiet,
                 cache_dir=folder, **options)
 
@@ -278,7 +316,128 @@ def open_result(path: str | Path, case: str | None = None) -> xarray.Dataset:
     """
     from flex.data.results import to_xarray
 
+    path = _path(path, "path", "a result file path")
+    if case is not None and not isinstance(case, str):
+        raise ArgumentError(f"case: expected a case name (a string) or None, got {_kind(case)}")
     return to_xarray(path, case)
+
+
+# ------------------------------------------------------------------------------------------
+# argument checks: the command line's rules for what a script hands over
+# ------------------------------------------------------------------------------------------
+def _kind(value: Any) -> str:
+    """``value`` described in an error message: its type and a short repr."""
+    return f"{type(value).__name__} {_shown(value)}"
+
+
+def _shown(value: Any, limit: int = 60) -> str:
+    try:
+        text = repr(value)
+    except Exception:  # noqa: BLE001 - a repr that fails is still an argument to name
+        text = f"<{type(value).__name__}>"
+    text = " ".join(text.split())
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _path(value: Any, argument: str, what: str) -> Path:
+    """A str or path-like argument as a :class:`Path` (not empty), else ArgumentError."""
+    if isinstance(value, bytes) or not isinstance(value, str | os.PathLike):
+        raise ArgumentError(f"{argument}: expected {what} (a str or pathlib.Path), got "
+                            f"{_kind(value)}")
+    text = os.fspath(value)
+    if not isinstance(text, str) or not text.strip():
+        raise ArgumentError(f"{argument}: expected {what}, got an empty path")
+    return Path(text)
+
+
+def _source(source: Any) -> str | Path | None:
+    """A scene source: None, a bundled parameter set's name or a TOML file path."""
+    if source is None:
+        return None
+    if isinstance(source, Mapping):
+        raise ArgumentError("source: expected a scene file path or the name of a bundled "
+                            "parameter set, got a dict (a scene already loaded): pass its "
+                            "changes as overrides=, or write it to a file with "
+                            "flex.data.scene.to_toml")
+    return _path(source, "source", "a scene file path or bundled parameter set name")
+
+
+def _plain_scene(scene: Any, argument: str = "scene") -> dict[str, dict[str, Any]]:
+    """A copy of a scene handed over by a caller, as plain dicts of plain values: a
+    mapping of section names to mappings of keys (numpy scalars become Python numbers).
+    Nothing is validated here beyond that shape."""
+    if not isinstance(scene, Mapping):
+        hint = ""
+        if isinstance(scene, str | os.PathLike):
+            hint = f"; read it first: load_scene({_shown(os.fspath(scene))})"
+        raise ArgumentError(f"{argument}: expected a scene (the dict load_scene or "
+                            f"derive_scene returns), got {_kind(scene)}{hint}")
+    plain: dict[str, dict[str, Any]] = {}
+    for section, table in scene.items():
+        if not isinstance(section, str):
+            raise SceneError(f"{argument}: section name {_shown(section)} is not a string")
+        if not isinstance(table, Mapping):
+            raise SceneError(f"{argument}: [{section}] must be a table of keys (a dict), got "
+                             f"{_kind(table)}")
+        plain[section] = {}
+        for key, value in table.items():
+            if not isinstance(key, str):
+                raise SceneError(f"{argument}: key {_shown(key)} in [{section}] is not a "
+                                 f"string")
+            if hasattr(value, "item") and getattr(value, "shape", None) == ():
+                value = value.item()  # a numpy scalar -> the Python number it holds
+            plain[section][key] = value
+    return plain
+
+
+def checked_scene(scene: Any, argument: str = "scene") -> Scene:
+    """A validated copy of a scene a caller hands over (:func:`_plain_scene`, then
+    :func:`flex.data.scene.validate`: the checks ``--scene`` and ``--set`` get); raises
+    :class:`~flex.base.errors.ArgumentError` or :class:`~flex.base.errors.SceneError`."""
+    from flex.data.scene import validate
+
+    plain = _plain_scene(scene, argument)
+    validate(plain)
+    return plain
+
+
+def given_keys(scene: Scene) -> dict[str, Any]:
+    """The values of ``scene`` that differ from the bundled scene's, ``{"section.key":
+    value}``: what a caller changed, as :func:`flex.config.usage.explicit_keys` counts a
+    scene file's keys."""
+    from flex.data.scene import default_scene
+
+    bundled = default_scene()
+    return {f"{section}.{key}": value for section, table in scene.items()
+            for key, value in table.items() if bundled[section].get(key) != value}
+
+
+def _check_case_name(name: Any) -> None:
+    if not isinstance(name, str) or not name.strip() or "/" in name or not name.isprintable():
+        raise ArgumentError(f"name: expected a case name (a non-empty string without '/' or "
+                            f"control characters), got {_kind(name)}")
+
+
+def _check_options(options: Mapping[str, Any], accepted: Mapping[str, str], function: str
+                   ) -> None:
+    for key in options:
+        if key not in accepted:
+            listed = "; ".join(f"{name}: {what}" for name, what in accepted.items())
+            raise ArgumentError(f"{function}: unknown keyword argument {key!r}; accepted "
+                                f"beside the named ones: {listed}")
+
+
+def _check_study_options(options: Mapping[str, Any]) -> None:
+    sweep = options.get("sweep")  # flex.sweep is a higher layer: its fields, not its class
+    if sweep is not None and not all(hasattr(sweep, name) for name in (
+            "scheduler", "workers", "folder", "retry_failed", "progress")):
+        raise ArgumentError(f"sweep: expected a flex.sweep.SweepSettings or None, got "
+                            f"{_kind(sweep)}")
+    environment = options.get("environment")
+    if environment is not None and not (isinstance(environment, Mapping) and all(
+            isinstance(k, str) and isinstance(v, str) for k, v in environment.items())):
+        raise ArgumentError(f"environment: expected a dict of variable names to strings, got "
+                            f"{_kind(environment)}")
 
 
 __all__ = ["load_scene", "derive_scene", "simulate", "run_study", "open_result"]

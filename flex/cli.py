@@ -162,6 +162,7 @@ def _design_command(commands) -> None:
 
 def _design(args: argparse.Namespace) -> int:
     from flex.bodies.reduction import reduction_cache_dir
+    from flex.config.settings import tolerance_beyond_reach
     from flex.data.outputs import check_output
     from flex.data.scene import load_scene
     from flex.experiments import design_question as dq
@@ -173,6 +174,10 @@ def _design(args: argparse.Namespace) -> int:
     question.check()
     path = check_output(args.out, [args.scene] if args.scene else [])
     scene = load_scene(args.scene, BASE_OVERRIDES + list(args.overrides))
+    dq.check_scene(scene, question)
+    beyond = tolerance_beyond_reach(scene)
+    if beyond:  # each case's own warning is not printed (flex.experiments.design.design_case)
+        print(f"flex: warning: design: {beyond}", file=sys.stderr, flush=True)
     result = dq.answer(scene, question, reduction_cache_dir(os.environ))
     _print(dq.answer_text(result))
     _print(f"wrote {dq.write_answer(result, scene, path)}")
@@ -216,7 +221,10 @@ def _result_tools(commands) -> None:
         description="Compare curves of A (under test) with B (reference) after "
                     "interpolating onto a common time base (the overlap of both time "
                     "ranges, on the finer grid). A curve (each column of a two-column "
-                    "curve) passes when max|a - b| <= atol + rtol * max|b|. Exit status: 0 "
+                    "curve) passes when max|a - b| <= atol + rtol * max|b| and the common "
+                    "time base covers B's whole time span with at least two samples (a "
+                    "shorter, shifted or one-sample run fails, saying which span was "
+                    "compared; --partial accepts the overlap). Exit status: 0 "
                     "all within tolerance, 1 some not, 2 a bad file or a PATH missing from "
                     "either file. Without PATH every curve of the cases both files have "
                     "is compared (/summary only when named; wall-clock timings never).")
@@ -232,6 +240,9 @@ def _result_tools(commands) -> None:
                          help="interpolation onto the common time base (default cubic)")
     compare.add_argument("--limit", type=int, default=20, metavar="N",
                          help="show the N largest deviations (failures always; 0: all)")
+    compare.add_argument("--partial", action="store_true",
+                         help="compare on the overlap when A does not cover B's time span "
+                              "(the report says which span; default: such a curve fails)")
     compare.add_argument("--json", action="store_true", help="print JSON (for scripts)")
 
     report = commands.add_parser(
@@ -273,7 +284,7 @@ def _result_tool(args: argparse.Namespace) -> int:
     from flex.tools.compare import compare_files
 
     report = compare_files(args.file_a, args.file_b, args.paths, args.rtol, args.atol,
-                           args.interp)
+                           args.interp, args.partial)
     _print(json.dumps(report.as_dict(), indent=2) if args.json
            else report.format(args.limit))
     return EXIT_OK if report.passed else EXIT_FAILED
@@ -421,11 +432,13 @@ def _dispatch(argv: list[str] | None) -> int:
     if args.command == "scene":
         from flex.config.usage import explicit_keys
         from flex.data.scene import to_toml
-        from flex.study import check_cases, load_study, study_scene
+        from flex.study import check_cases, check_structure, load_study, study_scene
 
         module = load_study(args.study)
+        given = explicit_keys(args.scene, args.overrides)
+        check_structure(module, given)
         scene = study_scene(module, args.scene, args.overrides)
-        check_cases(module, module.cases(scene), explicit_keys(args.scene, args.overrides))
+        check_cases(module, module.cases(scene), given)
         _print(_auto_note(scene) + to_toml(scene), end="")
         return EXIT_OK
     return _result_tool(args)

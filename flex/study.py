@@ -34,26 +34,35 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-from flex.base.errors import FlexError, SceneError
+from flex.base.errors import FlexError, OutputError, ResultFileError, SceneError
 from flex.config.settings import check_runnable
 from flex.config.usage import explicit_keys, unused_keys
 from flex.data.outputs import (
+    Staging,
     check_output,
     check_writable_folder,
     failed_path,
     figures_folder,
-    staged_figures,
 )
 from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import Scene, load_scene, to_toml
 from flex.fidelity.caseloop import run_each
 from flex.fidelity.simulation import simulate_case
-from flex.tools.report import default_report_path, write_report
+from flex.tools.report import default_report_path, figures_of, render_report
 
 STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring", "kfit",
            "tradeoff", "stability", "bench", "wing", "crank", "estimates",
            "calibrate", "design", "validation", "ladder", "spring_mass")
 RESULTS_DIR = Path("results")
+#: keys that change what a study simulates in kind, not in degree: the drive, the wing, the
+#: links' models and geometry, the spring's model, the integrator. A study runs with its own
+#: value of each (the bundled scene's, or its ``OVERRIDES``') unless it lists the key in
+#: ``HONOURS`` (its cases and report follow any value); another value given by the user is
+#: refused before any case is built (:func:`check_structure`), never run under a report
+#: written for the study's own.
+STRUCTURAL_KEYS = ("drive.kind", "wing.enabled", "crank.model", "crank.geometry",
+                   "coupler.model", "coupler.geometry", "coupler.geometric_stiffness",
+                   "drive.spring_model", "simulation.integrator")
 
 
 @dataclass
@@ -155,6 +164,50 @@ def progress_printer(stream=None) -> Callable[[str, int, int], None]:
     return report
 
 
+def check_structure(module: ModuleType, given: dict[str, object] | None) -> None:
+    """Refuse (:class:`SceneError`) a value the user gave (``given``, as for
+    :func:`check_cases`) for one of :data:`STRUCTURAL_KEYS` that differs from the study's
+    own, unless the study ``HONOURS`` the key. Cheap: call it before the study's cases are
+    built."""
+    honours = set(getattr(module, "HONOURS", ()))
+    own = None
+    for name, value in (given or {}).items():
+        if name not in STRUCTURAL_KEYS or name in honours:
+            continue
+        own = own or study_scene(module)
+        section, key = name.split(".", 1)
+        if value != own[section][key]:
+            raise SceneError(f"{name} = {_toml(value)}: study '{module.NAME}' runs with {name} "
+                             f"= {_toml(own[section][key])} ({module.DESCRIPTION}); its cases and "
+                             f"report are made for that and do not follow another value; use "
+                             f"'flex run simulate' to run a scene of your own")
+
+
+def _toml(value: object) -> str:
+    """A scene value as a scene file writes it (``false``, ``"spring"``, ``0.01``)."""
+    import tomli_w
+
+    try:
+        return tomli_w.dumps({"v": value}).strip().removeprefix("v = ")
+    except (TypeError, ValueError):
+        return repr(value)
+
+
+def check_outputs(path: Path, figures: bool) -> None:
+    """Refuse (:class:`~flex.base.errors.OutputError`) before anything runs an output of a
+    run to ``path`` that could not be written: its figures folder, its report (not a
+    folder, in a writable folder), for ``path`` and for the ``.failed.h5`` a failed run
+    would go to."""
+    for target in (path, failed_path(path)):
+        if figures:
+            check_writable_folder(figures_folder(target), f"figures of '{target}'")
+        report = default_report_path(target)
+        if report.is_dir():
+            raise OutputError(f"report of '{target}': '{report}' is a folder; move it away "
+                              f"or choose another --out")
+        check_writable_folder(report.parent, f"report of '{target}'")
+
+
 def check_cases(module: ModuleType, scenes: dict[str, Scene],
                 given: dict[str, object] | None = None) -> None:
     """Refuse (:class:`SceneError`), before any case runs, a case scene that cannot run or
@@ -215,51 +268,72 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
               environment: Mapping[str, str] | None = None) -> StudyOutput:
     """Run study ``name``, write its HDF5 file (default ``results/<name>.h5``) and figures
     (``figures/<file stem>-*.png`` beside it) and its report (``reports/<file stem>.md``
-    beside it, generated from the file: :func:`flex.tools.report.write_report`), print the
+    beside it, generated from the file: :func:`flex.tools.report.render_report`), print the
     study's report, and return the output.
     ``sweep``: where and how a sweep study runs (:class:`flex.sweep.SweepSettings`);
     ``cache_dir``: the reduction cache folder (None: reductions built in memory, no disk
     cache); ``environment``: the study's declared variables (:class:`StudyRun`); the edges
     pass both from :func:`from_environment`.
 
-    Nothing is lost: the output is checked before any case runs (:func:`flex.data.outputs.
-    check_output`); a run that does not end as the study declares (an unexpected failed
-    case) does not replace an existing result file but is written beside it
-    (:func:`flex.data.outputs.failed_path`); figures are drawn only for a run that ended as
-    declared. Failed cases are reported on
-    stderr, also with ``quiet``. An interrupt raises :class:`Interrupted` saying which files
-    were already written.
+    Nothing is lost: a key the study does not honour (:func:`check_structure`) and every
+    output (:func:`flex.data.outputs.check_output`, :func:`check_outputs`) are checked before
+    any case runs; the result file, the figures and the report are written under private
+    names and moved into place together (:class:`flex.data.outputs.Staging`), so an error or
+    an interrupt before that changes no file; a run that does not end as the study declares
+    (an unexpected failed case) does not replace an existing result file but is written
+    beside it (:func:`flex.data.outputs.failed_path`); figures are drawn only for a run that
+    ended as declared. Failed cases are reported on stderr, also with ``quiet``. An interrupt
+    raises :class:`Interrupted` saying which files were already in place.
     """
     module = load_study(name)
+    given = explicit_keys(source, overrides)
+    check_structure(module, given)
     scene = study_scene(module, source, overrides)
-    scenes = module.cases(scene)
-    check_cases(module, scenes, explicit_keys(source, overrides))
     path = check_output(RESULTS_DIR / f"{name}.h5" if out is None else out,
                         [source] if source is not None and Path(str(source)).exists() else [])
-    if figures and hasattr(module, "figures"):
-        check_writable_folder(figures_folder(path), f"figures of '{path}'")
-    check_writable_folder(default_report_path(path).parent, f"report of '{path}'")
-    written: list[Path] = []
+    draw = figures and hasattr(module, "figures")
+    check_outputs(path, draw)
+    scenes = module.cases(scene)
+    check_cases(module, scenes, given)
+    staging: Staging | None = None
     try:
         output = execute(module, scene, None if quiet else progress_printer(), scenes,
                          sweep, cache_dir=cache_dir, environment=environment)
         output.expected_failures = frozenset(getattr(module, "EXPECTED_FAILURES", ()))
-        output.path = _write_output(output, path, scene)
-        written.append(output.path)
-        if figures and hasattr(module, "figures") and output.as_expected:
-            with staged_figures(path, name) as (staging, placed):
-                module.figures(output.results, output.summary, staging)
-            output.figures = placed
-            written.extend(placed)
-        output.report = write_report(output.path)  # generated from the file just written
-        written.append(output.report)
+        target = path if output.as_expected or not path.exists() else failed_path(path)
+        with Staging(target, default_report_path(target), name) as staging:
+            try:
+                _write_output(output, staging.result, scene)
+            except ResultFileError as exc:  # named by its private name: name the target
+                raise ResultFileError(str(exc).replace(str(staging.result), str(target))
+                                      ) from None
+            if draw and output.as_expected:
+                module.figures(output.results, output.summary, staging.figures())
+            planned = staging.planned_figures()
+            text = render_report(staging.result, staging.report_target.parent,
+                                 shown_as=target,
+                                 figures=sorted(set(figures_of(target)) | set(planned)))
+            _write_text(staging.report, text, staging.report_target)
+            staging.commit()  # result, figures, report: each renamed into place
+        output.path, output.figures, output.report = target, planned, staging.report_target
     except KeyboardInterrupt as exc:
-        raise Interrupted(written, type(exc)) from None
+        raise Interrupted(staging.placed if staging else [], type(exc)) from None
     except Exception as exc:  # an interrupt inside a C extension surfaces as another error
-        exc.written = written  # what the run had written, for the CLI's message
+        exc.written = staging.placed if staging else []  # for the CLI's message
         raise
     _report(output, path, quiet)
     return output
+
+
+def _write_text(path: Path, text: str, target: Path) -> None:
+    """Write a staged text output (``target``'s private name); a full disk or a refused
+    write is an OutputError: nothing has been replaced yet."""
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise OutputError(f"cannot write report '{target}': {exc.strerror or exc}; nothing "
+                          f"was changed") from None
 
 
 class Interrupted(KeyboardInterrupt):
@@ -272,13 +346,9 @@ class Interrupted(KeyboardInterrupt):
         self.kind = kind
 
 
-def _write_output(output: StudyOutput, path: Path, scene: Scene) -> Path:
-    """Write the run to ``path``, or beside it when it did not end as declared and ``path``
-    holds an earlier run (which is then kept as it was)."""
+def _write_output(output: StudyOutput, target: Path, scene: Scene) -> Path:
+    """Write the run's result file to ``target`` (its staged name)."""
     failed = [case for case in output.results.values() if case.status != "ok"]
-    target = path
-    if not output.as_expected and path.exists():
-        target = failed_path(path)
     return write_results(target, output.name, list(output.results.values()), to_toml(scene),
                          output.summary.datasets,
                          {"wall_time_s": output.wall_time_s, "failed_cases": len(failed),

@@ -55,7 +55,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from flex.base.errors import FlexError
+from flex.base.errors import FlexError, ResultFileError
+from flex.data.cache import SWEEP_CASES, content_digest, folder_problem, say
 from flex.data.results import CaseResult, Dataset, open_results, write_results
 from flex.data.scene import Scene, to_toml
 
@@ -64,7 +65,8 @@ CaseFunction = Callable[[str, Scene], CaseResult]
 #: computes: left out of its identity (:func:`case_hash`), so a moved cache resumes
 LOCATION_ARGUMENTS = frozenset({"cache_dir"})
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
-SWEEP_FORMAT = "flex-sweep-case/1"
+#: 2: a content digest of the case (``sweep_content_digest``), checked when a rerun resumes
+SWEEP_FORMAT = "flex-sweep-case/2"
 
 
 # ------------------------------------------------------------------------------------------
@@ -309,9 +311,27 @@ def case_path(folder: str | Path, name: str) -> Path:
 
 
 def write_case_file(folder: str | Path, case: CaseResult, digest: str, study: str) -> Path:
-    """Write one case to its own file, atomically (the hash goes in the root attributes)."""
+    """Write one case to its own file, atomically (the hash of what it ran and the digest of
+    what it holds, :func:`case_content_digest`, go in the root attributes)."""
     return write_results(case_path(folder, case.name), study, [case], case.scene_toml,
-                         attrs={"sweep_case_hash": digest, "sweep_format": SWEEP_FORMAT})
+                         attrs={"sweep_case_hash": digest, "sweep_format": SWEEP_FORMAT,
+                                "sweep_content_digest": case_content_digest(case)})
+
+
+def case_content_digest(case: CaseResult) -> str:
+    """Digest of everything a case file holds (:func:`flex.data.cache.content_digest`):
+    status, message, scenes, counters, attributes, and every dataset's values, units and
+    description; the same for a case and for the case read back from its file."""
+    parts: list[tuple[str, Any]] = [("name", case.name), ("status", case.status),
+                                    ("message", case.message), ("scene", case.scene_toml),
+                                    ("solver", case.solver_settings_toml)]
+    parts += [(f"counter:{key}", case.counters[key]) for key in sorted(case.counters)]
+    parts += [(f"attr:{key}", case.attrs[key]) for key in sorted(case.attrs)]
+    for name in sorted(case.datasets):
+        dataset = case.datasets[name]
+        parts += [(f"data:{name}", dataset.data), (f"units:{name}", dataset.units),
+                  (f"description:{name}", dataset.description)]
+    return content_digest(parts)
 
 
 def _text(value: Any) -> Any:
@@ -327,6 +347,7 @@ def read_case_file(path: str | Path) -> tuple[CaseResult, str]:
 
     with open_results(path) as h5:
         digest = str(_text(h5.attrs.get("sweep_case_hash", "")))
+        content = str(_text(h5.attrs.get("sweep_content_digest", "")))
         names = list(h5["cases"])
         if len(names) != 1:
             raise FlexError(f"case file '{path}' holds {len(names)} cases, expected 1")
@@ -351,6 +372,9 @@ def read_case_file(path: str | Path) -> tuple[CaseResult, str]:
                       message=str(attrs.get("message", "")), counters=counters,
                       solver_settings_toml=str(attrs.get("solver_settings_toml", "")),
                       attrs=extra)
+    if content != case_content_digest(case):
+        raise ResultFileError(f"case file '{path}' did not prove its content (its content "
+                              f"digest does not match: damaged, edited or of an older format)")
     return case, digest
 
 
@@ -517,6 +541,9 @@ def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
         if not _NAME.match(name):
             raise FlexError(f"sweep case name {name!r}: use letters, digits and _ . + - only "
                             f"(it becomes a file name)")
+    problem = folder_problem(case_path(folder, "case").parent)
+    if problem:  # refused before any case runs: no case could be kept
+        raise SWEEP_CASES.error(folder, problem)
     digests = {name: case_hash(scene, case_function) for name, scene in scenes.items()}
     results = _resumable(scenes, folder, digests, retry_failed)
     own_executor = executor is None
@@ -543,12 +570,13 @@ def _resumable(scenes: Mapping[str, Scene], folder: Path, digests: dict[str, str
     results: dict[str, CaseResult] = {}
     for name in scenes:
         path = case_path(folder, name)
-        if not path.exists():
+        if not (path.exists() or path.is_symlink()):
             continue
         try:
             case, digest = read_case_file(path)
-        except FlexError:
-            continue  # damaged or foreign: run again (the write replaces it atomically)
+        except FlexError as exc:  # damaged or foreign: run again (replaced atomically)
+            say(SWEEP_CASES, f"{' '.join(str(exc).split())[:300]}; running case {name} again")
+            continue
         if digest == digests[name] and (case.status == "ok" or not retry_failed):
             results[name] = case
     return results

@@ -18,10 +18,11 @@ from typing import Any
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.experiments import single_case
-from flex.study import Summary
+from flex.study import STRUCTURAL_KEYS, Summary
 
 NAME = "simulate"
 DESCRIPTION = "one case: exactly the given scene"
+HONOURS = STRUCTURAL_KEYS  # it runs whatever scene it is given
 
 
 def cases(scene: Scene) -> dict[str, Scene]:

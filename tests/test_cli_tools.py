@@ -153,10 +153,17 @@ def test_common_time_base_is_the_overlap_on_the_finer_grid(tmp_path):
     b = write_results(tmp_path / "b.h5", "demo", [CaseResult("other", "", {
         "time": Dataset(fine, "s"),
         "p": Dataset(np.stack([np.sin(3 * fine), np.cos(3 * fine) + 0.01], axis=1), "m")})])
-    report = compare_files(a, b, ["p"], rtol=0.0, atol=1e-5)  # one case each: paired
+    # one case each: paired; A (0 .. 1 s) covers 0.2 .. 1 s of B's 0.2 .. 1.5 s: compared
+    # only on the overlap when asked (--partial), and said so
+    report = compare_files(a, b, ["p"], rtol=0.0, atol=1e-5, partial=True)
     assert [(d.column, d.passed) for d in report.deviations] == [(0, True), (1, False)]
     assert report.time_bases[0].samples == 801
-    assert compare_files(a, b, rtol=0, atol=1e-5).deviations  # no PATH: the cases pair up
+    assert report.time_bases[0].coverage == pytest.approx(0.8 / 1.3)
+    assert all("partial: compared 0.2 .. 1 s of B's 0.2 .. 1.5 s" in d.note
+               for d in report.deviations)
+    strict = compare_files(a, b, ["p"], rtol=0.0, atol=1e-5)
+    assert not strict.passed and "not the whole reference" in strict.deviations[0].note
+    assert compare_files(a, b, rtol=0, atol=1e-5, partial=True).deviations  # cases pair up
 
 
 def test_compare_bad_input_exits_2_with_one_line(study_files, tmp_path, capsys):

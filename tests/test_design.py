@@ -181,5 +181,7 @@ def test_cli_refuses_an_unreachable_target_in_one_line(capsys, tmp_path):
                    "--out", str(tmp_path / "q.h5")])
     err = capsys.readouterr().err
     assert status == EXIT_BAD_INPUT
-    assert err.count("\n") == 1 and "unreachable" in err and "Traceback" not in err
+    errors = [line for line in err.splitlines() if line.startswith("flex: error:")]
+    assert len(errors) == 1 and "unreachable" in errors[0] and "Traceback" not in err
+    assert all(line.startswith("flex: ") for line in err.splitlines())  # progress: one line each
     assert not (tmp_path / "q.h5").exists()

@@ -62,7 +62,8 @@ def ffrf_file(tmp_path_factory, reduction_cache) -> Path:
 
 @pytest.fixture(scope="module")
 def nonlinear_file(tmp_path_factory) -> Path:
-    scene = load_scene(overrides=[*PLATE, 'coupler.model="nonlinear_fe"',
+    plate = [item for item in PLATE if not item.startswith("coupler.modes")]  # no modes
+    scene = load_scene(overrides=[*plate, 'coupler.model="nonlinear_fe"',
                                   "simulation.error_estimate=false",
                                   "simulation.end_time_s=0.0004"])
     path = tmp_path_factory.mktemp("nl") / "nl.h5"

@@ -32,17 +32,28 @@ and repeat a comparison by hand, e.g. against a study run, with
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import h5py
 import numpy as np
 import pytest
 
-from flex.api import simulate  # the public face: reductions cached in the user's folder
+from flex.bodies.reduction import reduction_cache_dir
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import load_scene, to_toml
+from flex.fidelity.simulation import simulate as simulate_scene
 from flex.tools.compare import compare_files
+
+
+def simulate(scene, name: str = "case", **options):
+    """The library's simulate with the user's reduction cache (as the command line finds it):
+    these twin scenes carry keys a rigid or nonlinear FE twin does not read (its plate's
+    modes), which the public :func:`flex.simulate` refuses as ``flex run simulate`` does."""
+    options.setdefault("cache_dir", reduction_cache_dir(os.environ))
+    return simulate_scene(scene, name, **options)
+
 
 FOLDER = Path(__file__).resolve().parent / "reference_curves"
 REFERENCE = FOLDER / "ffrf_t1mm_midpoint_deflection.h5"
@@ -84,7 +95,8 @@ def deviation_from_reference(tmp_path: Path, modes: int, step_s: float,
     path = run_to_file(tmp_path / f"modes{modes}_step{step_s:g}.h5",
                        [f"coupler.modes={modes}", f"simulation.step_s={step_s}",
                         f"simulation.end_time_s={end_time_s}"])
-    report = compare_files(path, REFERENCE, [PATH], rtol=RTOL, atol=ATOL)
+    report = compare_files(path, REFERENCE, [PATH], rtol=RTOL, atol=ATOL,
+                           partial=end_time_s < 0.03)  # a shorter run: over its own span
     (deviation,) = report.deviations
     return deviation.max_abs_deviation / (deviation.allowed / RTOL)
 

@@ -58,5 +58,15 @@ class OutputError(FlexError):
     input."""
 
 
+class ArgumentError(FlexError, TypeError):
+    """An argument of a public function (:mod:`flex.api`) that is not of an accepted type or
+    value, e.g. ``simulate(None)``; a :class:`TypeError` too, as Python code expects."""
+
+
+class CacheError(OutputError):
+    """A cache folder (the reduction cache) that cannot be used; the message names the cache
+    and how to move it."""
+
+
 class Terminated(KeyboardInterrupt):
     """SIGTERM, raised like Ctrl-C so that every clean-up that handles an interrupt runs."""

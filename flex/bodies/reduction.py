@@ -45,7 +45,6 @@ import json
 import math
 import numbers
 import os
-import tempfile
 import time
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -56,6 +55,14 @@ import numpy as np
 
 from flex.base.errors import SceneError
 from flex.bodies.plate import PlateLink, plate_mesh
+from flex.data.cache import (
+    REDUCTION_CACHE,
+    content_digest,
+    entry_problem,
+    number_text,
+    say,
+    store,
+)
 
 #: Bump when the content or layout of a cache file changes; old entries are then rebuilt.
 CACHE_FORMAT_VERSION = 2  # 2: the chord frame (end_a rotation static modes)
@@ -216,21 +223,6 @@ def _content_digest(fem) -> str:
     return digest.hexdigest()
 
 
-def _save_atomically(fem, path: Path) -> None:
-    """Write to a temporary file in the same directory, then rename: readers never see a
-    half-written entry, and concurrent builders of one key just replace each other."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=path.stem + ".", suffix=".tmp.hdf5",
-                                         dir=path.parent)
-    os.close(handle)
-    try:
-        fem.SaveToFile(temporary, mode="HDF5")
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
-
-
 def _load_cached(path: Path, key: str):
     """Return the FEMinterface stored under ``path`` if it is whole and made for ``key``.
 
@@ -256,7 +248,8 @@ def _load_cached(path: Path, key: str):
     try:
         fem.LoadFromFile(str(path), mode="HDF5")
         meta = fem.metaData["flex"]
-        if meta["digest"] != _content_digest(fem):
+        if (meta["digest"] != _content_digest(fem)
+                or meta.get("meta_digest") != _meta_digest(meta)):
             return None
         n_nodes = fem.NumberOfNodes()
         if fem.modeBasis["matrix"].shape[0] != 3 * n_nodes:
@@ -264,6 +257,23 @@ def _load_cached(path: Path, key: str):
     except Exception:
         return None
     return fem
+
+
+def _meta_digest(meta: Mapping[str, Any]) -> str:
+    """Digest of the entry's own numbers (mass, frequency, ...: read by :class:`Reduction`
+    as they are stored), beside :func:`_content_digest` of its arrays."""
+    return content_digest((name, number_text(meta[name])) for name in sorted(meta)
+                          if name not in ("digest", "meta_digest"))
+
+
+def _say_unproven(path: Path | None) -> None:
+    """One line when an existing entry is about to be rebuilt (it did not prove its
+    content: damaged, edited, foreign, an older format, or not a file)."""
+    if path is None or not path.is_file() or entry_problem(path):
+        return  # missing, or not a file: store() says why it cannot be kept
+    say(REDUCTION_CACHE, f"entry '{path}' did not prove its content (its key or content "
+                         f"digest does not match: damaged, edited, foreign or of an older "
+                         f"format); building the reduction again")
 
 
 # ------------------------------------------------------------------------------------------
@@ -578,10 +588,13 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
     from_cache = fem is not None
     ffrf_interface = None
     if fem is None:
+        _say_unproven(cache_file)
         with _ngsolve_thread_count(ngsolve_threads):
             fem, ffrf_interface = _build_fem(parameters, key)
-        if cache_file is not None:
-            _save_atomically(fem, cache_file)
+        if cache_file is not None and not store(
+                cache_file, lambda temporary: fem.SaveToFile(str(temporary), mode="HDF5"),
+                REDUCTION_CACHE):
+            cache_file = None  # not kept (said): nothing is cached beside it either
 
     meta = fem.metaData["flex"]
     end_a, end_b, mid = (_node_set(fem, name) for name in (END_A, END_B, MID))
@@ -666,6 +679,7 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
         "cold_build_time_s": time.perf_counter() - start,
         "digest": _content_digest(fem),
     }
+    fem.metaData["flex"]["meta_digest"] = _meta_digest(fem.metaData["flex"])
     # handed to the Reduction (not stored): saves re-projecting on the first add
     return fem, ffrf_interface
 

@@ -152,6 +152,8 @@ def load_time_scale_s(scene: Mapping[str, Mapping[str, Any]]) -> float:
         return math.pi / speed if speed > 0 else float(scene["simulation"]["end_time_s"])
     mass = scene["slider"]["mass_kg"] + sum(plate_mass_properties(scene, link)[0]
                                             for link in ("crank", "coupler"))
+    if drive["spring_stiffness_N_per_m"] <= 0:  # a spring of no stiffness loads nothing
+        return float(scene["simulation"]["end_time_s"])
     return 0.5 * math.pi * math.sqrt(mass / drive["spring_stiffness_N_per_m"])
 
 

@@ -129,6 +129,37 @@ def choose_entry(scene: Scene) -> tuple[str, str, RulePick | None]:
     return "ffrf_rule", reason, chosen
 
 
+def finest_certified_accuracy() -> tuple[float, str]:
+    """The smallest relative error any model's settings are certified to (the solver
+    defaults' ``accuracy`` and the FFRF rule's calibrated levels), and where it comes from."""
+    from flex.config.ffrf_rule import rule_constants
+
+    # the fallback's and the rule entry's "accuracy" are placeholders, not certifications
+    found = [(float(entry["accuracy"]), f"solver defaults entry '{name}'")
+             for name, entry in solver_defaults().items()
+             if "accuracy" in entry and name not in ("flexible_fallback", "ffrf_rule")]
+    found += [(float(level["tolerance"]), "the FFRF settings rule's finest level")
+              for level in rule_constants()["levels"]]
+    return min(found)
+
+
+def tolerance_beyond_reach(scene: Scene) -> str:
+    """Why ``fidelity.tolerance`` asks for more than flex can certify ("" if it does not, or
+    if no ``auto`` choice reads it): a tolerance below :func:`finest_certified_accuracy`
+    is met by no model flex has measured (``auto`` then takes its most accurate model, up to
+    the nonlinear FE coupler, whose own error is not known to be that small)."""
+    from flex.config.usage import unused_keys
+
+    tolerance = float(scene["fidelity"]["tolerance"])
+    finest, source = finest_certified_accuracy()
+    if tolerance >= finest * (1 - 1e-9) or "fidelity.tolerance" in unused_keys(scene):
+        return ""
+    return (f"fidelity.tolerance = {tolerance:g} is beyond reach: no model's settings are "
+            f"certified finer than {finest:g} ({source}); \"auto\" takes its most accurate "
+            f"choice (up to the nonlinear FE coupler, slow and uncertified), which is not "
+            f"known to meet it; accepted: a tolerance >= {finest:g} for a certified result")
+
+
 def whole_steps_s(step_s: float, end_time_s: float, multiple: int) -> float:
     """The largest step [s] at most ``step_s`` that divides ``end_time_s`` into a whole
     number of ``multiple`` steps."""

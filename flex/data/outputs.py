@@ -6,9 +6,9 @@
 - Figures go to ``figures/`` beside the result file, named after it:
   ``results/dynamics.h5`` -> ``results/figures/dynamics-*.png``, ``runs/a.h5`` ->
   ``runs/figures/a-*.png``, so two result files never share a figure.
-- :func:`staged_figures` lets a study draw into a private folder and moves the figures into
-  place only when every one was drawn: an error or an interrupt leaves the previous figures
-  as they were.
+- :class:`Staging`: a run writes its result file, its figures and its report under private
+  names and moves them into place together only when all are written: an error (a full disk,
+  a report path that is a folder) or an interrupt leaves the previous files as they were.
 - A run that did not end as its study declares never replaces an existing result file: it
   is written beside it as :func:`failed_path` (``<name>.failed.h5``).
 """
@@ -16,10 +16,10 @@
 from __future__ import annotations
 
 import os
+import secrets
 import shutil
 import tempfile
-from collections.abc import Iterable, Iterator
-from contextlib import contextmanager
+from collections.abc import Iterable
 from pathlib import Path
 
 from flex.base.errors import OutputError
@@ -79,31 +79,90 @@ def figures_folder(result_path: Path) -> Path:
     return result_path.parent / "figures"
 
 
-@contextmanager
-def staged_figures(result_path: Path, study: str) -> Iterator[tuple[Path, list[Path]]]:
-    """Yield ``(private folder, placed)``: the study draws its ``<study>-*.png`` into the
-    private folder; on success each is renamed ``<result stem>-*`` into
-    :func:`figures_folder` and listed in ``placed``. On any error or interrupt nothing is
-    placed and the private folder is removed."""
-    target = figures_folder(result_path)
-    try:
-        target.mkdir(parents=True, exist_ok=True)
-        staging = Path(tempfile.mkdtemp(prefix=f".{result_path.stem}.", suffix=".figures",
-                                        dir=target))
-    except OSError as exc:
-        raise OutputError(f"cannot write figures to '{target}': "
-                          f"{exc.strerror or exc}") from None
-    placed: list[Path] = []
-    try:
-        yield staging, placed
-        for drawn in sorted(staging.iterdir()):
+class Staging:
+    """One run's outputs written under private names beside their targets, and moved into
+    place together by :meth:`commit`: until then no existing file is changed, so an error or
+    an interrupt while writing any of them (a full disk while drawing figures, a report that
+    cannot be written) leaves the previous result, figures and report as they were.
+
+    ``result``: the private name of the result file (``.<name>.<pid>.<random>.part`` beside
+    ``target``, removed by a later write if this process is killed); :meth:`figures`: the
+    private folder the study draws its ``<study>-*.png`` into (``figures/.<stem>.*.figures``
+    beside the target); ``report``: the private name of the report. :meth:`discard` removes
+    whatever was not committed (use ``with``).
+    """
+
+    def __init__(self, target: Path, report_target: Path, study: str) -> None:
+        self.target, self.report_target, self.study = Path(target), Path(report_target), study
+        self.result = self._part(self.target)
+        self.report = self._part(self.report_target)
+        self._figures: Path | None = None
+        self.placed: list[Path] = []
+
+    @staticmethod
+    def _part(path: Path) -> Path:
+        return path.parent / f".{path.name}.{os.getpid()}.{secrets.token_hex(8)}.part"
+
+    def __enter__(self) -> Staging:
+        return self
+
+    def __exit__(self, *exc_info) -> None:
+        self.discard()
+
+    def figures(self) -> Path:
+        """The private folder to draw figures into (created on first use)."""
+        if self._figures is None:
+            folder = figures_folder(self.target)
+            try:
+                folder.mkdir(parents=True, exist_ok=True)
+                self._figures = Path(tempfile.mkdtemp(prefix=f".{self.target.stem}.",
+                                                      suffix=".figures", dir=folder))
+            except OSError as exc:
+                raise OutputError(f"cannot write figures to '{folder}': "
+                                  f"{exc.strerror or exc}; nothing was changed") from None
+        return self._figures
+
+    def planned_figures(self) -> list[Path]:
+        """Where the figures drawn so far will go: ``<study>-x.png`` -> ``<stem>-x.png``."""
+        if self._figures is None:
+            return []
+        folder = figures_folder(self.target)
+        names = []
+        for drawn in sorted(self._figures.iterdir()):
             name = drawn.name
-            if name.startswith(f"{study}-"):
-                name = f"{result_path.stem}-{name[len(study) + 1:]}"
-            os.replace(drawn, target / name)
-            placed.append(target / name)
-    except OSError as exc:
-        raise OutputError(f"cannot write figures to '{target}': "
-                          f"{exc.strerror or exc}") from None
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+            if name.startswith(f"{self.study}-"):
+                name = f"{self.target.stem}-{name[len(self.study) + 1:]}"
+            names.append(folder / name)
+        return names
+
+    def commit(self) -> list[Path]:
+        """Move the result file, the figures and the report into place, in that order; each
+        move is a rename within its folder. Every target is checked first (a folder where a
+        file goes is refused with nothing moved). Returns the files placed (also in
+        ``placed`` as they go, for an interrupt's message)."""
+        moves = [(self.result, self.target)]
+        if self._figures is not None:
+            moves += list(zip(sorted(self._figures.iterdir()), self.planned_figures(),
+                              strict=True))
+        if self.report.exists():
+            moves.append((self.report, self.report_target))
+        for _, target in moves:
+            if target.is_dir():
+                raise OutputError(f"'{target}' is a folder: it cannot be replaced by this run's "
+                                  f"file; nothing was changed")
+        try:
+            for source, target in moves:
+                os.replace(source, target)
+                self.placed.append(target)
+        except OSError as exc:
+            done = ", ".join(str(path) for path in self.placed) or "nothing"
+            raise OutputError(f"cannot move '{source}' to '{target}': {exc.strerror or exc}; "
+                              f"already in place: {done}") from None
+        return list(self.placed)
+
+    def discard(self) -> None:
+        """Remove what was not committed."""
+        for part in (self.result, self.report):
+            part.unlink(missing_ok=True)
+        if self._figures is not None:
+            shutil.rmtree(self._figures, ignore_errors=True)

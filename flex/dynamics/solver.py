@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import FlexError, SimulationError, Terminated
+from flex.base.progress import heartbeat
 from flex.config.settings import (
     check_runnable,
     has_auto_link_keys,
@@ -49,6 +50,7 @@ from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, check_meshed_plate, estimate_mesh, to_toml
 from flex.dynamics import planar
 from flex.dynamics.mechanism import Mechanism, _rotation_z, build_mechanism
+from flex.dynamics.runtime import SolverOutput, announce_integration
 
 # a constraint norm above this is a failed assembly, not a tolerance question
 CONSTRAINT_NORM_LIMIT_M = 1e-4
@@ -141,7 +143,7 @@ def _exudyn_settings(settings: dict[str, Any]):
     ti.newton.modifiedNewtonJacUpdatePerStep = settings.get("jacobian_per_step", False)
     if "linear_solver" in settings:
         s.linearSolver.solverType = getattr(exu.LinearSolverType, settings["linear_solver"])
-    ti.verboseMode = 0
+    ti.verboseMode = 1  # Exudyn's step lines every 2 s: progress (:class:`_SolverOutput`)
     s.solution.file.write = False
     s.solution.sensors.writePeriod = settings["output_step_s"]
     s.solution.sensors.writeHeader = False
@@ -150,14 +152,19 @@ def _exudyn_settings(settings: dict[str, Any]):
     return s
 
 
-def run(mech: Mechanism) -> dict[str, Any]:
-    """Integrate ``mech`` in place; return counters. Raises SimulationError on failure."""
+def run(mech: Mechanism, label: str = "") -> dict[str, Any]:
+    """Integrate ``mech`` in place; return counters. Raises SimulationError on failure.
+    A solve that takes more than a few seconds prints progress lines to stderr (``label``
+    names the case in them)."""
     import exudyn as exu
 
     settings = solver_settings(mech.scene)
     solver = (exu.MainSolverExplicit() if _is_explicit(settings)
               else exu.MainSolverImplicitSecondOrder())
-    captured = io.StringIO()
+    captured = SolverOutput(label, settings["steps"] * settings["step_s"],
+                             lambda: mech.mbs.SetRenderEngineStopFlag(True))
+    if mech.scene["coupler"]["model"] == "nonlinear_fe":
+        captured.progress.first_s = float("inf")  # the nonlinear FE body reports its own
     start = time.perf_counter()
     # Ctrl-C (or SIGTERM) inside Exudyn's C++ loop may come back as a failed solve; note it
     # ourselves so an interrupt is never mistaken for (and stored as) a diverged case
@@ -189,7 +196,8 @@ def run(mech: Mechanism) -> dict[str, Any]:
         failure = "explicit solver failed" if _is_explicit(settings) else "Newton failed"
         detail = " ".join(captured.getvalue().split())[-300:]
         raise SimulationError(f"solver diverged at step {step} (t = {now:.6g} s, step "
-                              f"{settings['step_s']:g} s): {detail or failure}; "
+                              f"{settings['step_s']:g} s): {failure}"
+                              f"{f' ({detail})' if detail else ''}; "
                               f"{divergence_advice(mech.scene, _reductions(mech))}")
     return {"steps": int(solver.it.currentStepIndex), "newton_iterations":
             int(solver.it.newtonStepsCount), "jacobian_updates": int(solver.it.newtonJacobiCount),
@@ -420,11 +428,13 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
         scene, _ = resolve_link_keys(scene)
     c = scene[link]
     check_meshed_plate(link, dict(c, model="ffrf"))  # refused before any meshing
-    _announce_mesh(link, c, "reduction (instant if cached)")
-    return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
-                           c["youngs_modulus_Pa"], c["density_kg_per_m3"], c["poisson_ratio"],
-                           c["mesh_size_m"], c["modes"], cache_dir,
-                           mode_selection=c["mode_selection"])
+    _announce_mesh(link, c, f"reduction with {c['modes']} modes (instant if cached)",
+                   c["modes"])
+    with heartbeat(f"{link} reduction ({c['modes']} modes)"):
+        return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
+                               c["youngs_modulus_Pa"], c["density_kg_per_m3"],
+                               c["poisson_ratio"], c["mesh_size_m"], c["modes"], cache_dir,
+                               mode_selection=c["mode_selection"])
 
 
 def scene_reductions(scene: Scene, reduction: Any = None, crank_reduction: Any = None, *,
@@ -452,13 +462,12 @@ def _highest_retained_omega(values: dict[str, Any]) -> float:
 
 #: a mesh whose estimated build takes longer than this is announced on stderr first [s]
 ANNOUNCE_MESH_S = 30.0
-
-
-def _announce_mesh(link: str, values: dict[str, Any], what: str) -> None:
-    """Say on stderr what a long meshing job will cost before it starts (so a big mesh is
-    not a silent hang)."""
+def _announce_mesh(link: str, values: dict[str, Any], what: str, modes: int | None = None
+                   ) -> None:
+    """Say on stderr what a long meshing job will cost before it starts (so a big mesh, or
+    a reduction to many modes, is not a silent hang)."""
     estimate = estimate_mesh(values["length_m"], values["thickness_m"], values["width_m"],
-                             values["mesh_size_m"])
+                             values["mesh_size_m"], modes)
     if estimate.build_time_s > ANNOUNCE_MESH_S:
         import sys
 
@@ -536,7 +545,7 @@ def _elastic_datasets(mech: Mechanism, link: str, start_marker: str, end_marker:
     reduction = body["reduction"]
     if reduction.has_stress_modes:
         out[f"{link}/peak_bending_stress"] = Dataset(
-            bending_stress_history(reduction, modal), "Pa",
+            bending_stress_history(reduction, modal, stress_window_m(reduction)), "Pa",
             "largest |sigma_xx| away from the end faces (bending + membrane)")
         out.update(peak_datasets(link, reduction, modal))
     out.update(_frame_datasets(mech, link))
@@ -568,6 +577,15 @@ def flexible_link_attrs(scene: Scene, datasets: dict[str, Dataset],
             out.update(peak_attrs(link, reduction, datasets[f"{link}/modal_coordinates"].data,
                                   datasets["time"].data))
     return out
+
+
+def stress_window_m(reduction: Any) -> tuple[float, float]:
+    """Where a link's peak bending stress is read [m along it]: one thickness from each end
+    face (Saint-Venant), but never narrower than one element about the midpoint, so a plate
+    as thick as half its length (the stubbiest accepted) still has mesh nodes in it."""
+    length, half = reduction.length_m, 0.5 * reduction.length_m - reduction.thickness_m
+    half = max(half, 0.5 * min(reduction.mesh_size_m, length))
+    return (0.5 * length - half, 0.5 * length + half)
 
 
 def _wing_datasets(mech: Mechanism) -> dict[str, Dataset]:
@@ -657,9 +675,11 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
                                                   cache_dir=cache_dir)
     if scene["coupler"]["model"] == "nonlinear_fe" and reduction is None:
         _announce_mesh("coupler", scene["coupler"], "nonlinear FE body")
-    mech = build_mechanism(scene, reduction, crank_reduction)
+    announce_integration(scene, name, {"coupler": reduction, "crank": crank_reduction})
+    with heartbeat(f"building {name}"):
+        mech = build_mechanism(scene, reduction, crank_reduction)
     recorder = _nodal_recorder(mech)
-    counters = run(mech)
+    counters = run(mech, name)
     with np.errstate(all="ignore"):  # a diverged run overflows; _check_finite reports it
         datasets = collect(mech)
     settings = solver_settings(scene)

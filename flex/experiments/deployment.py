@@ -13,6 +13,7 @@ energy drift; :func:`draw_figures` draws the thesis's figures 14-23 and the ener
 
 from __future__ import annotations
 
+import math
 import tomllib
 from pathlib import Path
 from typing import Any
@@ -45,7 +46,8 @@ THESIS_ROWS = (
     ("slider_initial_position", "slider position at t = 0", THESIS_SLIDER_INITIAL_POSITION_M,
      "m"),
     ("constraint_norm_max", "norm of constraint equations", THESIS_CONSTRAINT_NORM_MAX_M, "m"),
-    ("half_swing_time", "deployment time delta_t (sec. 6.2)", THESIS_DELTA_T_S, "s"),
+    ("half_swing_time", "half-swing time, against the thesis's delta_t (sec. 6.2; flex's "
+                        "delta_t is the time of the crank angle maximum)", THESIS_DELTA_T_S, "s"),
 )
 #: why flex and the thesis differ, per row, for the two preload readings (22 mm and 11 mm)
 REASONS = {
@@ -61,9 +63,31 @@ REASONS = {
     "slider_initial_position": "geometry only: L1 cos(34.19 deg) + L2 cos(theta2)",
     "constraint_norm_max": "flex's index-3 integrator satisfies the constraints to "
                            "round-off; the thesis's integration of accelerations drifts",
-    "half_swing_time": "source not stated in the thesis and not reproduced; flex reports one "
-                       "candidate definition, the time at which the crank covers half its swing",
+    "half_swing_time": "the thesis's delta_t: source not stated and not reproduced; this row "
+                       "is one candidate definition, the time at which the crank covers half "
+                       "its swing (flex's own delta_t, of auto and docs/criterion.md, is the "
+                       "time of the first crank angle maximum, two rows up)",
 }
+#: keys whose values the reasons above were written for: the bundled thesis scene's
+REASON_SECTIONS = ("crank", "coupler", "wing", "slider", "drive")
+
+
+def scene_differences(scene: dict[str, dict[str, Any]]) -> list[str]:
+    """The keys of a case's scene (sections :data:`REASON_SECTIONS`, the spring preload
+    aside: the study's cases set it) whose values differ from the bundled thesis scene's:
+    ``["drive.spring_stiffness_N_per_m = 3000", ...]``."""
+    from flex.data.scene import default_scene
+
+    bundled = default_scene()
+    found = []
+    for section in REASON_SECTIONS:
+        for key, value in scene.get(section, {}).items():
+            if key == "spring_preload_m" and section == "drive":
+                continue
+            if bundled[section].get(key) != value:
+                shown = f"{value:g}" if isinstance(value, float) else repr(value)
+                found.append(f"{section}.{key} = {shown}")
+    return found
 
 
 def measures(data: dict[str, np.ndarray]) -> dict[str, float]:
@@ -71,34 +95,53 @@ def measures(data: dict[str, np.ndarray]) -> dict[str, float]:
     from one case's stored curves."""
     time_s, angle, speed = data["time"], data["crank/angle"], data["crank/angular_velocity"]
     peak = first_maximum_index(angle)
-    peak = len(angle) - 1 if peak is None else peak  # still rising: its last sample
-    half_time = half_swing_time(time_s, angle, peak)
-    return {"angle_max": float(angle[peak]), "angle_max_time": float(time_s[peak]),
-            "speed_max": float(speed.max()), "speed_max_time": float(time_s[np.argmax(speed)]),
+    values = {"speed_max": float(speed.max()), "speed_max_time": float(time_s[np.argmax(speed)]),
+              "slider_initial_position": float(data["slider/position"][0]),
+              "constraint_norm_max": float(data["constraint_norm"].max())}
+    if peak is None:  # still rising at the end: the maximum did not happen within the run
+        return {**values, "angle_max": math.nan, "angle_max_time": math.nan,
+                "slider_travel_at_angle_max": math.nan, "half_swing_time": math.nan}
+    return {**values, "angle_max": float(angle[peak]), "angle_max_time": float(time_s[peak]),
             "slider_travel_at_angle_max": float(data["slider/displacement"][peak]),
-            "slider_initial_position": float(data["slider/position"][0]),
-            "constraint_norm_max": float(data["constraint_norm"].max()),
-            "half_swing_time": half_time}
+            "half_swing_time": half_swing_time(time_s, angle, peak)}
 
 
-def comparison_table(table: dict[str, dict[str, float]]) -> str:
+def reasons_for(differences: list[str]) -> dict[str, str]:
+    """The "why" column: :data:`REASONS` for the thesis's scene, else one note naming how the
+    run's scene differs (the reasons were written for the thesis's values only)."""
+    if not differences:
+        return dict(REASONS)
+    note = (f"not known for this scene: it differs from the thesis's in "
+            f"{', '.join(differences[:4])}{', ...' if len(differences) > 4 else ''} (the "
+            f"reasons of the thesis's scene do not carry over)")
+    return {key: note for key in REASONS}
+
+
+def comparison_table(table: dict[str, dict[str, float]],
+                     reasons: dict[str, str] | None = None) -> str:
     """Markdown table: every thesis number beside flex's for each case (README copy);
-    ``table``: ``{case: measures(...)}``."""
+    ``table``: ``{case: measures(...)}``; ``reasons``: the "why" column (default
+    :data:`REASONS`). A quantity the run did not reach (NaN) reads "not reached"."""
+    reasons = REASONS if reasons is None else reasons
     names = list(table)
     head = "| quantity | unit | thesis | " + " | ".join(f"flex {n}" for n in names) + " | why |"
     lines = [head, "|" + "---|" * (4 + len(names))]
     for key, label, thesis, unit in THESIS_ROWS:
         values = " | ".join(_fmt(table[n][key]) for n in names)
-        lines.append(f"| {label} | {unit} | {_fmt(thesis)} | {values} | {REASONS[key]} |")
+        lines.append(f"| {label} | {unit} | {_fmt(thesis)} | {values} | {reasons[key]} |")
     return "\n".join(lines)
 
 
 def _fmt(value: float) -> str:
-    """A table cell: 4 significant digits, or scientific below 1e-3."""
+    """A table cell: 4 significant digits, or scientific below 1e-3; NaN: "not reached"
+    (the crank angle had no maximum within the run)."""
+    if math.isnan(value):
+        return "not reached"
     return f"{value:.2e}" if abs(value) < 1e-3 else f"{value:.4g}"
 
 
-def comparison_datasets(table: dict[str, dict[str, float]]) -> dict[str, Dataset]:
+def comparison_datasets(table: dict[str, dict[str, float]],
+                        reasons: dict[str, str] | None = None) -> dict[str, Dataset]:
     """The comparison table as ``thesis_comparison/*`` datasets (one column per case)."""
     datasets = {
         "thesis_comparison/quantity": Dataset(
@@ -110,8 +153,9 @@ def comparison_datasets(table: dict[str, dict[str, float]]) -> dict[str, Dataset
     for name in table:
         datasets[f"thesis_comparison/{name}"] = Dataset(
             np.array([table[name][row[0]] for row in THESIS_ROWS]), "see units", name)
+    reasons = REASONS if reasons is None else reasons
     datasets["thesis_comparison/reason"] = Dataset(
-        np.array([REASONS[row[0]] for row in THESIS_ROWS], dtype=object), "1",
+        np.array([reasons[row[0]] for row in THESIS_ROWS], dtype=object), "1",
         "why flex and the thesis differ")
     return datasets
 
@@ -146,18 +190,25 @@ def summary(results: dict[str, CaseResult]) -> tuple[dict[str, Dataset], str]:
     datasets: dict[str, Dataset] = {}
     table = {}
     lines = []
+    differences: list[str] = []
     for name, case in results.items():
         if case.status != "ok":
             lines.append(f"dynamics: case {name} failed: {case.message}")
             continue
         table[name] = measures({k: v.data for k, v in case.datasets.items()})
+        if math.isnan(table[name]["angle_max"]):
+            lines.append(f"  {name}: the crank angle is still rising at the end of the run "
+                         f"(t = {case.datasets['time'].data[-1]:g} s): its maximum, the "
+                         f"deployment time and what is read at it are not reached")
+        differences = differences or scene_differences(tomllib.loads(case.scene_toml))
         checked, line = reference_check(name, case)
         datasets.update(checked)
         lines.append(line)
+    reasons = reasons_for(differences)
     report = ["dynamics: thesis sec. 5.5 against flex (both spring-preload readings)",
-              comparison_table(table)] + lines
+              comparison_table(table, reasons)] + lines
     if table:
-        datasets.update(comparison_datasets(table))
+        datasets.update(comparison_datasets(table, reasons))
     return datasets, "\n".join(report)
 
 

@@ -61,7 +61,7 @@ from flex.experiments.lawfit import case_data
 from flex.fidelity.criteria import first_maximum_index, quasi_static_stress
 from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection
 
-CASE_VERSION = 1
+CASE_VERSION = 2  # 2: a deployment not completed within the run has no deployment time
 #: what the design charts and ``flex design`` put on the scene before the user's values: the
 #: coupler as the steel plate of Table 1's 77.67 g (12.37 mm thick), decided by ``auto``;
 #: no companion error run (the measures are compared at the tolerance of ``auto``)
@@ -282,8 +282,11 @@ def case_measures(data: Mapping[str, np.ndarray], scene: Scene, attrs: Mapping[s
     values = {
         "peak_crank_speed": float(speed.max()),
         "peak_crank_speed_time": float(data["time"][int(np.argmax(speed))]),
-        "deployment_time": float(data["time"][stop]), "final_crank_angle": float(angle[-1]),
-        "slider_travel": float(data["slider/displacement"][stop]),
+        # not completed within the run: the deployment time, the final angle and the travel
+        # did not happen (missing, not the end time)
+        "deployment_time": float(data["time"][stop]) if complete else math.nan,
+        "final_crank_angle": float(angle[-1]) if complete else math.nan,
+        "slider_travel": float(data["slider/displacement"][stop]) if complete else math.nan,
         **{f"peak_joint_force_{j}": value for j, value in forces.items()},
         "peak_joint_force": max(forces.values()), "peak_coupler_stress": stress["peak"],
         "peak_coupler_stress_quasi_static": stress["quasi_static"],

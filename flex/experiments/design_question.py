@@ -19,6 +19,8 @@ evaluated case is evidence: :func:`write_answer` stores them in an HDF5 file lik
 from __future__ import annotations
 
 import math
+import sys
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -109,6 +111,22 @@ class Answer:
     note: str = ""
 
 
+def check_scene(scene: Scene, question: Question) -> None:
+    """Refuse (FlexError, one line) a scene the question cannot be asked of: a spring that
+    stores no energy whatever the varied value (no rate when the preload varies, no preload
+    when the rate varies), or a drive without a spring."""
+    drive = scene["drive"]
+    if drive["kind"] != "spring":
+        raise FlexError(f'design: drive.kind = "{drive["kind"]}": flex design varies a '
+                        f'spring-driven deployment; accepted: drive.kind = "spring"')
+    for vary, key, what in (("preload", "spring_stiffness_N_per_m", "rate"),
+                            ("rate", "spring_preload_m", "preload")):
+        if question.vary == vary and drive[key] <= 0:
+            raise FlexError(f"design: --vary {vary} with drive.{key} = {drive[key]:g}: the "
+                            f"spring stores no energy at any {vary} (k delta^2 / 2), nothing "
+                            f"deploys; accepted: a {what} > 0")
+
+
 def scene_for(scene: Scene, vary: str, value: float) -> Scene:
     """``scene`` with the varied input set (a thickness also sets its mesh)."""
     section, key = VARIABLES[vary][:2]
@@ -121,16 +139,22 @@ def scene_for(scene: Scene, vary: str, value: float) -> Scene:
 
 
 def evaluator(scene: Scene, question: Question, cache_dir: Path | None,
-              simulate: Callable[..., CaseResult] = design.design_case
+              simulate: Callable[..., CaseResult] = design.design_case,
+              say: Callable[[str], None] | None = None
               ) -> tuple[Callable[[float], Evaluation], dict[float, Evaluation]]:
-    """A memoised function value -> :class:`Evaluation`, and the memo it fills (in order)."""
-    measure, sense, scale, _ = TARGETS[question.target]
+    """A memoised function value -> :class:`Evaluation`, and the memo it fills (in order).
+    ``say``: where a progress line per evaluated case goes (default: stderr). A target
+    measure the run did not reach (a deployment not completed within the run: NaN) is not
+    met."""
+    measure, sense, scale, unit = TARGETS[question.target]
     target = question.value * scale
     seen: dict[float, Evaluation] = {}
+    say = say or (lambda text: print(f"flex: design: {text}", file=sys.stderr, flush=True))
 
     def evaluate(value: float) -> Evaluation:
         if value not in seen:
             name = f"{question.vary}_{len(seen):02d}"
+            start = time.perf_counter()
             case = simulate(name, scene_for(scene, question.vary, value), cache_dir=cache_dir)
             values = {key[len("measures/"):]: float(np.asarray(d.data))
                       for key, d in case.datasets.items() if key.startswith("measures/")}
@@ -138,9 +162,15 @@ def evaluator(scene: Scene, question: Question, cache_dir: Path | None,
                 seen[value] = Evaluation(value, case, values, -1.0, -1.0)
             else:
                 stress = values["peak_coupler_stress"] * question.safety_factor
+                reached = sense * (values[measure] - target) / target
                 seen[value] = Evaluation(value, case, values,
-                                         sense * (values[measure] - target) / target,
+                                         -1.0 if math.isnan(reached) else reached,
                                          1 - stress / question.allowable_stress_Pa)
+            got = seen[value].measures.get(measure, math.nan) / scale
+            say(f"case {name}: {question.vary} = {value:.6g} {VARIABLES[question.vary][3]} -> "
+                f"coupler {seen[value].model}, {question.target} "
+                f"{'not reached' if math.isnan(got) else f'{got:.5g} {unit}'}, margin "
+                f"{seen[value].margin:+.2%} ({time.perf_counter() - start:.1f} s)")
         return seen[value]
 
     return evaluate, seen
@@ -168,8 +198,14 @@ def answer(scene: Scene, question: Question, cache_dir: Path | None = None,
            simulate: Callable[..., CaseResult] = design.design_case) -> Answer:
     """Answer ``question`` about ``scene`` (module doc); FlexError for an unreachable target."""
     question.check()
+    check_scene(scene, question)
     evaluate, seen = evaluator(scene, question, cache_dir, simulate)
     values = scan_values(question)
+    low, high = question.range()
+    print(f"flex: design: {len(values)} scan values of {question.vary} over [{low:g}, {high:g}] "
+          f"{VARIABLES[question.vary][3]}, then a bisection (~10 more cases); each case is "
+          f"one run with coupler.model = auto (about a second rigid, minutes when auto "
+          f"chooses a flexible coupler)", file=sys.stderr, flush=True)
     scanned = [evaluate(float(v)) for v in values]
     feasible = [e.margin >= 0 for e in scanned]
     if not any(feasible):
@@ -209,12 +245,16 @@ def unreachable(question: Question, scanned: list[Evaluation]) -> str:
     """The one-line refusal of a target no scanned value meets."""
     measure, sense, scale, unit = TARGETS[question.target]
     variable_unit = VARIABLES[question.vary][3]
-    ran = [e for e in scanned if e.measures]
+    ran = [e for e in scanned if e.measures and not math.isnan(e.measures[measure])]
     low, high = question.range()
     what = (f"design: {question.target} {'>=' if sense > 0 else '<='} {question.value:g} "
             f"{unit} with stress x {question.safety_factor:g} <= "
             f"{question.allowable_stress_Pa / 1e6:g} MPa is unreachable by varying "
             f"{question.vary} over [{low:g}, {high:g}] {variable_unit}")
+    if not ran and any(e.measures for e in scanned):
+        end = scanned[0].case.scene_toml and _end_time(scanned[0].case.scene_toml)
+        return (what + f": no scanned case reached its {measure.replace('_', ' ')} within the "
+                f"run (simulation.end_time_s = {end:g} s: the deployment did not complete)")
     if not ran:
         return what + ": auto refused every scanned scene (near buckling)"
     best = max(ran, key=lambda e: sense * e.measures[measure])
@@ -226,6 +266,12 @@ def unreachable(question: Question, scanned: list[Evaluation]) -> str:
         text += (f", the best within the stress limit {top.measures[measure] / scale:.4g} "
                  f"{unit} at {top.value:.4g} {variable_unit}")
     return text
+
+
+def _end_time(scene_toml: str) -> float:
+    import tomllib
+
+    return float(tomllib.loads(scene_toml)["simulation"]["end_time_s"])
 
 
 def answer_text(result: Answer) -> str:

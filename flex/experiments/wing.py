@@ -8,7 +8,7 @@ The thesis gives only the outcome (peak wing-tip angular velocity
 values it leaves open, stiffness [N/m] and preload [m], to the peak on the reference DAE;
 :func:`wing_flexibility` rates the wing plate as a cantilever (frequencies [Hz], n, quasi-static
 tip deflection [m]); :func:`summary` reports a run's loads, timing and flexibility, and the
-``auto`` fidelity decisions for the other links.
+``auto`` fidelity decisions for the other links as the run simulated them.
 """
 
 from __future__ import annotations
@@ -181,25 +181,33 @@ def summary(case: CaseResult, cache_dir: Path | None = None) -> tuple[dict[str, 
 
 def auto_decisions(scene: Scene, datasets: dict[str, Dataset],
                    cache_dir: Path | None = None) -> list[str]:
-    """The ``auto`` fidelity decisions for the coupler (as a 3 mm steel plate) and the crank:
-    stored as ``auto/<link>/model`` in ``datasets``; the report lines. ``cache_dir``: the
-    reduction cache folder of the crank's frequency analysis (None: built in memory)."""
+    """The ``auto`` fidelity decisions for the links as this run simulated them (its own
+    scene, ``model = "auto"`` in place of each link's model): the crank (a lumped crank is
+    analysed as the plate of its mass) and the coupler when it is a plate (a lumped coupler
+    has no stiffness to decide on: said so). Stored as ``auto/<link>/model`` in
+    ``datasets``; the report lines. ``cache_dir``: the reduction cache folder of the crank's
+    frequency analysis (None: built in memory)."""
     try:
         from flex.fidelity.criteria import resolve_fidelity
     except ImportError:
         return ["  auto fidelity: no fitted criterion in this installation"]
-    trial = apply_overrides(scene, ['coupler.geometry="plate"', "coupler.thickness_m=0.003",
-                                    'coupler.model="auto"', 'crank.model="auto"'])
+    trial = apply_overrides(scene, ['crank.model="auto"'])
+    lines = []
+    if scene["coupler"]["geometry"] == "plate":
+        trial = apply_overrides(trial, ['coupler.model="auto"'])
+    else:
+        lines.append('  auto fidelity: coupler as simulated: lumped (mass and inertia only), '
+                     'no stiffness to decide on (auto needs coupler.geometry = "plate")')
     try:
         validate(trial)
         _, decisions = resolve_fidelity(trial, cache_dir=cache_dir)
     except Exception as exc:  # a refusal is itself the answer worth reporting
-        return [f"  auto fidelity (coupler as a 3 mm plate): {exc}"]
-    lines = []
+        return lines + [f"  auto fidelity (the links as simulated): {exc}"]
     for decision in decisions:
         datasets[f"auto/{decision.link}/model"] = Dataset(np.array(decision.model, dtype=object),
                                                           "1", decision.reason)
-        lines.append(f"  auto fidelity: {decision.reason} -> {decision.model}")
+        lines.append(f"  auto fidelity: {decision.link} as simulated: {decision.reason} -> "
+                     f"{decision.model}")
     return lines
 
 

@@ -210,8 +210,9 @@ def estimate_step_error(scene: Scene, result: CaseResult,
                   "not cover it")
     order = integrator_order(sim)
     steps = [step, other]
-    if other > step:  # a second pair: guards against a lucky first one, shows the order
-        steps.append(companion_step_s(other, float(sim["end_time_s"])))
+    further = companion_step_s(other, float(sim["end_time_s"])) if other > step else 0.0
+    if further > other:  # a second pair: guards against a lucky first one, shows the order
+        steps.append(further)  # (only a doubling: a halving would repeat the run's own step)
     at = ", ".join(f"{h:g}" for h in steps[1:])
     method = (f"step doubling: {'companion runs' if len(steps) > 2 else 'a companion run'} "
               f"at h = {at} s (the run: {step:g} s), Richardson extrapolation with the "

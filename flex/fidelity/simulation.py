@@ -21,10 +21,14 @@ from pathlib import Path
 from typing import Any
 
 from flex.base.errors import FlexError
-from flex.config.settings import check_runnable, resolve_solver_settings
+from flex.config.settings import (
+    check_runnable,
+    resolve_solver_settings,
+    tolerance_beyond_reach,
+)
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
-from flex.dynamics.solver import integrate, scene_reductions, time_scales
+from flex.dynamics.solver import VALIDITY_WARNING, integrate, scene_reductions, time_scales
 from flex.fidelity.criteria import Criterion, FidelityDecision, resolve_fidelity
 from flex.fidelity.error_budget import error_budget
 from flex.fidelity.spring_choice import decide_spring
@@ -79,6 +83,9 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     ``estimated_error_leaves_out``.
     """
     check_runnable(scene)  # before anything is built or probed
+    beyond = tolerance_beyond_reach(scene)
+    if beyond:  # said before the (possibly long) work starts, and stored with the result
+        print(f"flex: warning: case {name}: {beyond}", file=sys.stderr, flush=True)
     scene, decisions = resolve_auto(scene, criterion, crank_criterion, cache_dir=cache_dir)
     if decisions:
         reduction = crank_reduction = None
@@ -88,6 +95,12 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     result = integrate(scene, name, reduction, crank_reduction, cache_dir=cache_dir)
     for decision in decisions:
         result.attrs.update(decision.attrs())
+    if result.attrs.get("solver_defaults_entry") == "flexible_fallback":
+        print(f"flex: note: case {name}: outside the calibrated family: "
+              f"{result.attrs.get('solver_defaults_reason', '')}", file=sys.stderr, flush=True)
+    if beyond:
+        result.attrs[VALIDITY_WARNING] = "; ".join(
+            filter(None, [str(result.attrs.get(VALIDITY_WARNING, "")), beyond]))
     if scene["simulation"]["error_estimate"]:
         resolved, _ = resolve_solver_settings(scene)
         reductions = {link: built for link, built in (("coupler", reduction),

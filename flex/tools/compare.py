@@ -12,6 +12,12 @@ column by column. A curve (or column) **passes** when
 
 ``a`` from the first file (A, the run under test) and ``b`` from the second (B, the
 reference). A NaN in either curve, different units, or time ranges that do not overlap fail.
+The comparison must cover the reference's time span: a curve whose common time base does not
+reach from B's first to its last sample (a run that stops early or starts late, a shifted
+curve) or holds a single instant (a one-sample file, either way round) fails, its note and
+the time-base line saying exactly which span was compared and what fraction of B's span it
+is (:class:`flex.tools.timebase.TimeBase`); ``partial=True`` (``--partial``) compares the
+overlap anyway and says so.
 Datasets without a time axis (``/summary`` tables, scalars) are compared element by element
 with the same rule; text must be equal. A case that failed (status ``"failed"``) in either
 file, among the cases compared, is a failure of its own: its row reads ``case X failed in A:
@@ -51,6 +57,10 @@ from flex.data.results import (
     select_datasets,
     split_case_path,
 )
+from flex.tools.timebase import TimeBase, common_time_base, resample
+
+__all__ = ["Comparison", "Deviation", "TimeBase", "common_time_base", "compare_arrays",
+           "compare_files", "resample"]
 
 DEFAULT_RTOL = 1e-6
 DEFAULT_ATOL = 0.0
@@ -104,28 +114,6 @@ class Deviation:
 
 
 @dataclass
-class TimeBase:
-    """The common time base of one pair of cases."""
-
-    case_a: str
-    case_b: str
-    start_s: float
-    end_s: float
-    samples: int
-    source: str  # "identical", "A" or "B": whose samples are used
-
-    def describe(self, interpolation: str) -> str:
-        case = self.case_a if self.case_a == self.case_b else f"{self.case_a} ~ {self.case_b}"
-        if self.source == "identical":
-            how = "identical grids, no interpolation"
-        else:
-            other = "B" if self.source == "A" else "A"
-            how = f"{self.source}'s samples, {other} interpolated: {interpolation}"
-        return (f"time base {case}: {self.start_s:.6g} .. {self.end_s:.6g} s, "
-                f"{self.samples} samples ({how})")
-
-
-@dataclass
 class Comparison:
     """Everything ``python -m flex compare`` found; ``passed`` decides the exit status."""
 
@@ -140,6 +128,8 @@ class Comparison:
     only_in_a: list[str] = field(default_factory=list)
     only_in_b: list[str] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)
+    #: compare the overlap when A does not cover B's time span (``--partial``)
+    partial: bool = False
 
     @property
     def failures(self) -> list[Deviation]:
@@ -155,7 +145,8 @@ class Comparison:
         return shlex.join(["python", "-m", "flex", "compare", self.file_a, self.file_b,
                            "--rtol", f"{self.rtol:g}", "--atol", f"{self.atol:g}",
                            *(["--interp", self.interpolation]
-                             if self.interpolation != "cubic" else []), *self.specs])
+                             if self.interpolation != "cubic" else []),
+                           *(["--partial"] if self.partial else []), *self.specs])
 
     def format(self, limit: int = 20) -> str:
         """A table, largest deviation (relative to its tolerance) first.
@@ -186,8 +177,12 @@ class Comparison:
         if hidden:
             lines.append(f"... {hidden} more within tolerance (--limit 0 shows all)")
         failed = len(self.failures)
+        partly = [base for base in self.time_bases if base.shortfall()]
         lines.append(f"{len(self.deviations)} compared: {len(self.deviations) - failed} pass, "
-                     f"{failed} fail -> {'PASS' if self.passed else 'FAIL'}")
+                     f"{failed} fail -> {'PASS' if self.passed else 'FAIL'}"
+                     + (f" (partial: {len(partly)} time base(s) do not cover the reference's "
+                        f"span{'; accepted by --partial' if self.partial else ''})"
+                        if partly else ""))
         for label, names in (("only in A", self.only_in_a), ("only in B", self.only_in_b),
                              ("not compared", self.skipped)):
             if names:
@@ -198,8 +193,8 @@ class Comparison:
     def as_dict(self) -> dict[str, Any]:
         return {"file_a": self.file_a, "file_b": self.file_b, "rtol": self.rtol,
                 "atol": self.atol, "interpolation": self.interpolation,
-                "passed": self.passed, "command": self.command(),
-                "time_bases": [base.__dict__ for base in self.time_bases],
+                "passed": self.passed, "partial": self.partial, "command": self.command(),
+                "time_bases": [base.as_dict() for base in self.time_bases],
                 "deviations": [d.as_dict() for d in self.deviations],
                 "only_in_a": self.only_in_a, "only_in_b": self.only_in_b,
                 "not_compared": self.skipped}
@@ -218,50 +213,6 @@ def allowed_deviation(reference: np.ndarray, rtol: float, atol: float) -> float:
     magnitude = np.abs(np.asarray(reference, dtype=float))
     finite = magnitude[np.isfinite(magnitude)]
     return atol + rtol * (float(finite.max()) if finite.size else 0.0)
-
-
-def common_time_base(time_a: np.ndarray, time_b: np.ndarray
-                     ) -> tuple[np.ndarray, str, np.ndarray, np.ndarray] | None:
-    """The samples two time grids are compared on, or ``None`` if they do not overlap.
-
-    Returns ``(base, source, in_a, in_b)``: ``source`` is ``"identical"`` (same samples in
-    the overlap), ``"A"`` or ``"B"`` (the grid with more samples in the overlap; ties take
-    A); ``in_a``/``in_b`` are boolean masks of each grid's samples inside the overlap.
-    """
-    start, end = max(time_a[0], time_b[0]), min(time_a[-1], time_b[-1])
-    if start > end:
-        return None
-    slack = 1e-9 * max(abs(start), abs(end), end - start, 1e-300)
-    in_a = (time_a >= start - slack) & (time_a <= end + slack)
-    in_b = (time_b >= start - slack) & (time_b <= end + slack)
-    if in_a.sum() == in_b.sum() and np.array_equal(time_a[in_a], time_b[in_b]):
-        return time_a[in_a], "identical", in_a, in_b
-    if in_a.sum() >= in_b.sum():
-        return time_a[in_a], "A", in_a, in_b
-    return time_b[in_b], "B", in_a, in_b
-
-
-def resample(time_s: np.ndarray, values: np.ndarray, base: np.ndarray,
-             interpolation: str = "cubic") -> np.ndarray:
-    """``values`` (n,) or (n, k) sampled at ``time_s`` (strictly increasing), at ``base``.
-
-    ``interpolation``: ``"cubic"`` (not-a-knot cubic spline; linear below 4 samples) or
-    ``"linear"``. ``base`` must lie within ``time_s``'s range (the overlap).
-    """
-    values = np.asarray(values, dtype=float)
-    base = np.clip(base, time_s[0], time_s[-1])
-    with np.errstate(all="ignore"):
-        if interpolation == "cubic" and len(time_s) >= 4 and np.isfinite(values).all():
-            from scipy.interpolate import CubicSpline
-
-            try:
-                return CubicSpline(time_s, values, axis=0)(base)
-            except ValueError:  # slopes overflow (values near the float limit): linear
-                pass
-        # linear: a NaN or inf stays where it is, and the comparison reports it
-        if values.ndim == 1:
-            return np.interp(base, time_s, values)
-        return np.stack([np.interp(base, time_s, column) for column in values.T], axis=1)
 
 
 def compare_arrays(a: np.ndarray, b: np.ndarray, rtol: float, atol: float,
@@ -325,11 +276,13 @@ class _Side:
 
 def compare_files(file_a: str | Path, file_b: str | Path, specs: Sequence[str] = (),
                   rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
-                  interpolation: str = "cubic") -> Comparison:
+                  interpolation: str = "cubic", partial: bool = False) -> Comparison:
     """Compare the datasets ``specs`` name (all common ones when empty) of two result files.
 
-    See the module documentation for the rule. Raises :class:`~flex.base.errors.FlexError`
-    (:class:`ResultFileError` for a bad file or a missing path) when nothing can be compared.
+    See the module documentation for the rule; ``partial``: compare a curve that does not
+    cover B's time span on the overlap (else it fails). Raises
+    :class:`~flex.base.errors.FlexError` (:class:`ResultFileError` for a bad file or a
+    missing path) when nothing can be compared.
     """
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
@@ -337,7 +290,7 @@ def compare_files(file_a: str | Path, file_b: str | Path, specs: Sequence[str] =
     if interpolation not in INTERPOLATIONS:
         raise FlexError(f"--interp {interpolation!r}: must be one of {', '.join(INTERPOLATIONS)}")
     report = Comparison(str(file_a), str(file_b), float(rtol), float(atol), interpolation,
-                        list(specs))
+                        list(specs), partial=bool(partial))
     with reading(file_a) as h5a, reading(file_b) as h5b:
         pairs = _pairs(h5a, h5b, report, specs)
         if not pairs and not report.deviations:
@@ -538,6 +491,7 @@ def _compare_sides(a: _Side, b: _Side, column: int | None, report: Comparison,
         return failed("text differs")
     if (a.time_s is None) != (b.time_s is None):
         return failed("a curve in one file, not in the other (no matching time base)")
+    short = ""
     if a.time_s is None:
         values_a, values_b = np.asarray(a.values), np.asarray(b.values)
         if values_a.shape != values_b.shape:
@@ -550,12 +504,18 @@ def _compare_sides(a: _Side, b: _Side, column: int | None, report: Comparison,
             bases[key] = common_time_base(a.time_s, b.time_s)
             if bases[key] is not None:
                 base, source, _, _ = bases[key]
-                report.time_bases.append(TimeBase(key[0], key[1], float(base[0]),
-                                                  float(base[-1]), len(base), source))
+                report.time_bases.append(TimeBase(
+                    key[0], key[1], float(base[0]), float(base[-1]), len(base), source,
+                    float(a.time_s[0]), float(a.time_s[-1]), float(b.time_s[0]),
+                    float(b.time_s[-1])))
         if bases[key] is None:
             return failed(f"time ranges do not overlap: {a.time_s[0]:g}..{a.time_s[-1]:g} s "
                           f"in A, {b.time_s[0]:g}..{b.time_s[-1]:g} s in B")
         base, source, in_a, in_b = bases[key]
+        short = next(t for t in report.time_bases if (t.case_a, t.case_b) == key).shortfall()
+        if short and not report.partial:
+            return failed(f"not the whole reference: {short}; --partial compares the "
+                          f"overlap only")
         values_a = np.asarray(a.values, dtype=float)
         values_b = np.asarray(b.values, dtype=float)
         if values_a.shape[1:] != values_b.shape[1:]:
@@ -566,6 +526,9 @@ def _compare_sides(a: _Side, b: _Side, column: int | None, report: Comparison,
             b.time_s, values_b, base, report.interpolation)
         rows = compare_arrays(on_a, on_b, report.rtol, report.atol, time_s=base,
                               column_names=(column,))
+    if a.time_s is not None and short:
+        rows = [(*row[:6], "; ".join(filter(None, [row[6], f"partial: {short}"])))
+                for row in rows]
     return [Deviation(a.path, b.path, col, a.units, worst, allowed, passed, time_s, where, note)
             for col, worst, allowed, passed, time_s, where, note in rows]
 

@@ -18,7 +18,15 @@ from typing import Any
 
 import numpy as np
 
-from flex.data.results import attribute_value, case_names, reading, select_datasets, split_case_path
+from flex.data.results import (
+    ResultPathError,
+    attribute_value,
+    case_names,
+    parse_spec,
+    reading,
+    select_datasets,
+    split_case_path,
+)
 
 PROVENANCE_KEYS = ("flex_format", "study", "flex_version", "git_commit", "git_dirty",
                    "exudyn_version", "ngsolve_version", "h5py_version", "numpy_version",
@@ -34,8 +42,11 @@ def describe(path: str | Path, spec: str | None = None) -> dict[str, Any]:
     ``spec``, ``selection`` and (one dataset) ``dataset``. Raises
     :class:`~flex.base.errors.ResultFileError` for a bad file or a path it does not have.
     """
+    name, column = parse_spec(spec) if spec else ("", None)
     with reading(path) as h5:
-        selected = set(select_datasets(h5, spec, path)) if spec else None
+        selected = set(select_datasets(h5, name, path)) if spec else None
+        if column is not None:  # a [i] suffix: one column of a two-column dataset
+            _check_column(h5, selected or set(), column, name, path)
         root = {key: attribute_value(value) for key, value in h5.attrs.items()}
         provenance = {key: root.pop(key) for key in PROVENANCE_KEYS if key in root}
         scene_toml = str(root.pop("scene_toml", ""))
@@ -78,8 +89,19 @@ def describe(path: str | Path, spec: str | None = None) -> dict[str, Any]:
             out["selection"] = spec
             if len(selected or ()) == 1:
                 (only,) = selected
-                out["dataset"] = _statistics(h5, only)
+                out["dataset"] = _statistics(h5, only, column)
         return out
+
+
+def _check_column(h5, selected: set[str], column: int, name: str, label) -> None:
+    """A ``[column]`` suffix must name a column of every dataset selected (two-column
+    curves: 0 = x, 1 = y)."""
+    for full in sorted(selected):
+        shape = h5[full].shape
+        if len(shape) != 2 or column >= shape[1]:
+            raise ResultPathError(f"{full}[{column}] in '{label}': no such column (shape "
+                                  f"{tuple(shape)}; a [i] suffix picks column i of a "
+                                  f"two-column dataset; {name!r} without it shows them all)")
 
 
 def _entries(group, prefix: str, selected: set[str] | None,
@@ -143,12 +165,16 @@ def _changes(base: dict[str, Any] | None, scene: dict[str, Any] | None,
     return out
 
 
-def _statistics(h5, path: str) -> dict[str, Any]:
-    """Minimum, maximum (with their time), first and last value of a numeric dataset."""
+def _statistics(h5, path: str, column: int | None = None) -> dict[str, Any]:
+    """Minimum, maximum (with their time), first and last value of a numeric dataset (of
+    one of its columns)."""
     dataset = h5[path]
-    info: dict[str, Any] = {"path": path, "shape": list(dataset.shape),
+    info: dict[str, Any] = {"path": path if column is None else f"{path}[{column}]",
+                            "shape": list(dataset.shape),
                             "dtype": _dtype(dataset), **_units_description(dataset)}
     values = dataset[()]
+    if column is not None:
+        values = values[:, column]
     if not isinstance(values, np.ndarray) or values.dtype.kind not in "biuf" or values.size == 0:
         info["value"] = attribute_value(values) if np.size(values) <= 20 else None
         return info

@@ -100,6 +100,11 @@ def format_value(value: Any) -> str:
     return str(value)
 
 
+def figures_of(path: str | Path) -> list[Path]:
+    """The figures a result file's report lists: ``figures/<stem>-*.png`` beside it."""
+    return _figures_of(Path(path))
+
+
 def default_report_path(path: str | Path) -> Path:
     """Where a result file's report goes: ``reports/<stem>.md`` beside it
     (``results/dynamics.h5`` -> ``results/reports/dynamics.md``)."""
@@ -107,22 +112,28 @@ def default_report_path(path: str | Path) -> Path:
     return path.parent / "reports" / f"{path.stem}{REPORT_SUFFIX}"
 
 
-def render_report(path: str | Path, report_folder: str | Path | None = None) -> str:
+def render_report(path: str | Path, report_folder: str | Path | None = None, *,
+                  shown_as: str | Path | None = None,
+                  figures: list[Path] | None = None) -> str:
     """The Markdown report of the result file ``path``.
 
     ``report_folder`` is where the report will be saved (default: that of
     :func:`default_report_path`); links to the result file and its figures are relative to
-    it. Raises :class:`~flex.base.errors.ResultFileError` for a missing or malformed file.
+    it. ``shown_as``: the name the file will have (a run renders its report from the file
+    still under its private name, :class:`flex.data.outputs.Staging`); ``figures``: its
+    figures (default: those beside it). Raises :class:`~flex.base.errors.ResultFileError`
+    for a missing or malformed file.
     """
     path = Path(path)
+    shown = Path(shown_as) if shown_as is not None else path
     folder = Path(report_folder) if report_folder is not None else default_report_path(
-        path).parent
+        shown).parent
     root, cases, items = _read(path)
-    lines = _title_section(path, folder, root)
+    lines = _title_section(shown, folder, root)
     lines += _provenance_section(root)
     lines += _cases_section(cases)
     lines += _data_section(items)
-    lines += _figures_section(path, folder)
+    lines += _figures_section(shown, folder, figures)
     lines += _scene_section(str(root.get("scene_toml") or ""))
     return "\n".join(lines).rstrip("\n") + "\n"
 
@@ -490,11 +501,11 @@ def _large_row(item: _Item) -> list[Any]:
     return [_code(item.name), shape, low, high, item.units, item.description]
 
 
-def _figures_section(path: Path, folder: Path) -> list[str]:
+def _figures_section(path: Path, folder: Path, figures: list[Path] | None = None) -> list[str]:
     """Every ``figures/<stem>-*.png`` beside the result file (not those of another result
-    file beside it whose name starts with ``<stem>-``)."""
+    file beside it whose name starts with ``<stem>-``), or the ``figures`` given."""
     lines = ["## Figures", ""]
-    figures = _figures_of(path)
+    figures = _figures_of(path) if figures is None else sorted(figures)
     if not figures:
         return lines + [f"No figures `{figures_folder(Path(path.name)).as_posix()}/"
                         f"{path.stem}-*.png` beside the file.", ""]

@@ -1,0 +1,82 @@
+"""Progress of long work, in lines that read well in a log (no carriage returns, no bars).
+
+- :func:`duration_text`: ``42 s``, ``3.5 min``, ``2.1 h``.
+- :func:`heartbeat`: a context manager printing ``flex: <what>: still running after 30 s``
+  lines to stderr at a fixed interval while a long call that reports nothing itself runs
+  (a mesh, an eigen-solve), from a daemon thread that ends with the block.
+- :class:`Progress`: a throttled reporter for work that knows how far it is: the first
+  line after ``first_s`` seconds, then at most one every ``interval_s``.
+
+Nothing here keeps state between calls (no module-level state); the stream is an argument
+(stderr by default).
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from typing import TextIO
+
+#: seconds between two progress lines of one job
+PROGRESS_INTERVAL_S = 10.0
+
+
+def duration_text(seconds: float) -> str:
+    """``seconds`` for a person: ``0.5 s``, ``42 s``, ``3.5 min``, ``2.1 h``, ``3 days``."""
+    if seconds < 120:
+        return f"{seconds:.2g} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.2g} min"
+    if seconds < 2 * 86400:
+        return f"{seconds / 3600:.2g} h"
+    return f"{seconds / 86400:.2g} days"
+
+
+@contextmanager
+def heartbeat(what: str, interval_s: float = 30.0, stream: TextIO | None = None
+              ) -> Iterator[None]:
+    """Print ``flex: <what>: still running after <t>`` every ``interval_s`` seconds while the
+    block runs (nothing for a block shorter than that)."""
+    out = stream or sys.stderr
+    done = threading.Event()
+    start = time.perf_counter()
+
+    def beat() -> None:
+        while not done.wait(interval_s):
+            print(f"flex: {what}: still running after "
+                  f"{duration_text(time.perf_counter() - start)}", file=out, flush=True)
+
+    thread = threading.Thread(target=beat, name="flex-heartbeat", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        done.set()
+        thread.join(timeout=1.0)
+
+
+class Progress:
+    """Throttled progress lines ``flex: <what>: <text>`` for work that knows how far it is:
+    :meth:`update` prints only once ``first_s`` seconds have passed since the start and
+    then at most every ``interval_s`` seconds."""
+
+    def __init__(self, what: str, first_s: float = 2.0,
+                 interval_s: float = PROGRESS_INTERVAL_S, stream: TextIO | None = None) -> None:
+        self.what, self.first_s, self.interval_s = what, first_s, interval_s
+        self.stream = stream
+        self.start = time.perf_counter()
+        self.last: float | None = None
+
+    def update(self, text: str) -> bool:
+        """Print ``text`` if it is time to; return whether it was printed."""
+        now = time.perf_counter()
+        if now - self.start < self.first_s:
+            return False
+        if self.last is not None and now - self.last < self.interval_s:
+            return False
+        self.last = now
+        print(f"flex: {self.what}: {text}", file=self.stream or sys.stderr, flush=True)
+        return True
