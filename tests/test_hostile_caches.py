@@ -348,8 +348,6 @@ def test_content_digest_reads_like_a_loader():
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="flex/bodies/geometric_stiffness.py is being rewritten "
-                   "elsewhere; its cache is to adopt flex.data.cache (content digest, store)")
 def test_a_damaged_geometric_stiffness_entry_is_not_trusted(built, capsys):
     from flex.bodies.geometric_stiffness import geometric_stiffness
 

@@ -50,15 +50,13 @@ bilinear form: about as long as meshing the plate).
 
 from __future__ import annotations
 
-import hashlib
-import os
-import sys
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from flex.data.cache import REDUCTION_CACHE, content_digest, say, store
 
 #: bump when the content or layout of a cache entry changes (old entries are then rebuilt)
 GEOMETRIC_FORMAT_VERSION = 4  # 4: transverse gradients only
@@ -184,12 +182,7 @@ def compute_geometric_stiffness(reduction: Any) -> GeometricStiffness:
 # cache
 # ------------------------------------------------------------------------------------------
 def _digest(*arrays: np.ndarray) -> str:
-    digest = hashlib.sha256()
-    for array in arrays:
-        array = np.ascontiguousarray(array)
-        digest.update(str(array.dtype).encode() + str(array.shape).encode())
-        digest.update(array.tobytes())
-    return digest.hexdigest()[:24]
+    return content_digest((f"array{index}", array) for index, array in enumerate(arrays))
 
 
 def _cache_path(reduction: Any) -> Path | None:
@@ -201,7 +194,8 @@ def _cache_path(reduction: Any) -> Path | None:
 
 def _load(path: Path, basis_digest: str) -> GeometricStiffness | None:
     """The entry at ``path`` if whole, made for this basis and unchanged since it was
-    written (its content digest), else None."""
+    written (its content digest, :func:`flex.data.cache.content_digest`), else None (one
+    line says why when the entry was there but did not prove its content)."""
     import h5py
 
     try:
@@ -211,36 +205,35 @@ def _load(path: Path, basis_digest: str) -> GeometricStiffness | None:
                 return None
             matrix = h5["matrix_per_N"][()]
             row = h5["axial_force_row_N_per_m"][()]
-            if h5.attrs["content_digest"] != _digest(matrix, row):
-                print(f"flex: reduction cache: {path} does not match its content digest "
-                      f"(damaged or edited); rebuilding it", file=sys.stderr, flush=True)
-                return None
-            return GeometricStiffness(matrix_per_N=matrix, axial_force_row_N_per_m=row,
-                                      axial_mode=int(h5.attrs["axial_mode"]), from_cache=True)
+            stored = h5.attrs.get("content_digest")
+            mode = int(h5.attrs["axial_mode"])
     except Exception:  # missing, truncated or foreign: rebuilt by the caller
+        say(REDUCTION_CACHE, f"geometric-stiffness entry '{path}' cannot be read; rebuilding it")
         return None
+    if stored != _digest(matrix, row, np.array([mode])):
+        say(REDUCTION_CACHE, f"geometric-stiffness entry '{path}' did not prove its content "
+                             f"(damaged or edited); rebuilding it")
+        return None
+    return GeometricStiffness(matrix_per_N=matrix, axial_force_row_N_per_m=row,
+                              axial_mode=mode, from_cache=True)
 
 
 def _save(path: Path, stiffness: GeometricStiffness, basis_digest: str) -> None:
-    """Write atomically (a temporary file renamed): readers never see half an entry."""
+    """Write atomically (:func:`flex.data.cache.store`: a temporary file renamed; a location
+    that cannot be used is said in one line and the entry is not kept)."""
     import h5py
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    handle, temporary = tempfile.mkstemp(prefix=path.stem + ".", suffix=".tmp",
-                                         dir=path.parent)
-    os.close(handle)
-    try:
+    def write(temporary: Path) -> None:
         with h5py.File(temporary, "w") as h5:
             h5["matrix_per_N"] = stiffness.matrix_per_N
             h5["axial_force_row_N_per_m"] = stiffness.axial_force_row_N_per_m
             h5.attrs.update(format_version=GEOMETRIC_FORMAT_VERSION, basis_digest=basis_digest,
                             axial_mode=stiffness.axial_mode,
                             content_digest=_digest(stiffness.matrix_per_N,
-                                                   stiffness.axial_force_row_N_per_m))
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+                                                   stiffness.axial_force_row_N_per_m,
+                                                   np.array([stiffness.axial_mode])))
+
+    store(path, write, REDUCTION_CACHE)
 
 
 def geometric_stiffness(reduction: Any) -> GeometricStiffness:

@@ -17,12 +17,11 @@ case files (:mod:`flex.sweep`, where a rerun resumes). The rules, shared by both
   never worth losing a run for, so :func:`store` reports and goes on (the entry is simply
   not kept).
 
-Adopting it for another entry kind (the geometric-stiffness entries beside a reduction,
-``<key>.geometric.hdf5``, still check only the mode basis they were made from): write the
-arrays with ``store(path, writer, REDUCTION_CACHE)``, store ``content_digest([(name, array),
-...])`` of them as an attribute, and on load recompute it from what was read; when it
-differs (or is absent), ``say(REDUCTION_CACHE, f"entry '{path}' did not prove its content
-...")`` and rebuild.
+Adopting it for another entry kind (as the geometric-stiffness entries beside a reduction,
+``<key>.geometric.hdf5``, do): write the arrays with ``store(path, writer,
+REDUCTION_CACHE)``, store ``content_digest([(name, array), ...])`` of them as an attribute,
+and on load recompute it from what was read; when it differs (or is absent),
+``say(REDUCTION_CACHE, f"entry '{path}' did not prove its content ...")`` and rebuild.
 
 Pure helpers: nothing here reads the environment; what to say goes to the ``stream`` given
 (stderr by default).
