@@ -143,16 +143,24 @@ def finest_certified_accuracy() -> tuple[float, str]:
     return min(found)
 
 
+def reads_tolerance(scene: Scene) -> bool:
+    """Whether ``fidelity.tolerance`` is read: by an ``auto`` link or spring model (validated:
+    only with a spring drive), or by ``"auto"`` solver keys choosing the FFRF coupler's entry
+    (:func:`choose_entry`)."""
+    crank, coupler = scene["crank"]["model"], scene["coupler"]["model"]
+    if AUTO in (crank, coupler) or scene["drive"]["spring_model"] == AUTO:
+        return True
+    return has_auto(scene) and coupler == "ffrf" and crank == "rigid"
+
+
 def tolerance_beyond_reach(scene: Scene) -> str:
     """Why ``fidelity.tolerance`` asks for more than flex can certify ("" if it does not, or
     if no ``auto`` choice reads it): a tolerance below :func:`finest_certified_accuracy`
     is met by no model flex has measured (``auto`` then takes its most accurate model, up to
     the nonlinear FE coupler, whose own error is not known to be that small)."""
-    from flex.config.usage import unused_keys
-
     tolerance = float(scene["fidelity"]["tolerance"])
     finest, source = finest_certified_accuracy()
-    if tolerance >= finest * (1 - 1e-9) or "fidelity.tolerance" in unused_keys(scene):
+    if tolerance >= finest * (1 - 1e-9) or not reads_tolerance(scene):
         return ""
     return (f"fidelity.tolerance = {tolerance:g} is beyond reach: no model's settings are "
             f"certified finer than {finest:g} ({source}); \"auto\" takes its most accurate "

@@ -19,6 +19,7 @@ from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
+from flex.config.settings import reads_tolerance
 from flex.data.scene import Scene, default_scene, parse_override, read_source
 
 AUTO = "auto"
@@ -81,7 +82,7 @@ def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset()) -> dic
         for key in _SOLVER_EXPLICIT:
             unused[f"simulation.{key}"] = ('simulation.integrator = "generalized_alpha": used '
                                            'with integrator = "explicit_penalty"')
-    if not _reads_tolerance(scene):
+    if not reads_tolerance(scene):
         unused["fidelity.tolerance"] = ('no "auto" choice reads it: used by model = "auto" '
                                         'links, and by "auto" solver keys of an FFRF coupler '
                                         "on a rigid crank")
@@ -130,18 +131,6 @@ def _link_unused(link: str, scene: Scene) -> dict[str, str]:
              f'its axial force (the nonlinear FE body has it exactly); used with model = '
              f'"ffrf" or "auto"')
     return unused
-
-
-def _reads_tolerance(scene: Scene) -> bool:
-    """Whether ``fidelity.tolerance`` is read: by an ``auto`` link or spring model (validated:
-    only with a spring drive), or by ``"auto"`` solver
-    keys choosing the FFRF coupler's entry (:func:`flex.config.settings.choose_entry`)."""
-    from flex.config.settings import has_auto
-
-    crank, coupler = scene["crank"]["model"], scene["coupler"]["model"]
-    if AUTO in (crank, coupler) or scene["drive"]["spring_model"] == AUTO:
-        return True
-    return has_auto(scene) and coupler == "ffrf" and crank == "rigid"
 
 
 def explicit_keys(source: str | Path | None = None,
