@@ -715,11 +715,11 @@ def _nodal_recorder(mech: Mechanism):
 # ------------------------------------------------------------------------------------------
 #: case attribute holding why a finished (``ok``) run may not mean what it says
 VALIDITY_WARNING = "validity_warning"
-#: largest peak elastic midpoint deflection of a linear FFRF link, as a fraction of its
-#: length, within which its results are trusted: the FFRF body is linear elasticity in a
-#: floating frame (small strains and elastic rotations, no geometric stiffening by the
-#: axial force); beyond ~1 % of the length the stability study's comparison with the
-#: nonlinear FE coupler (README "Numerical stability") shows the two models part
+#: largest peak elastic midpoint deflection of an FFRF link, as a fraction of its length,
+#: within which its results are trusted: the FFRF body is linear elasticity in a floating
+#: frame (small strains and elastic rotations; its geometric stiffness is of second order);
+#: beyond ~1 % of the length the stability study's comparison with the nonlinear FE coupler
+#: (README "Numerical stability") shows the two models part
 FFRF_DEFLECTION_LIMIT = 0.01
 
 
@@ -760,8 +760,8 @@ def validity_warning(scene: Scene, datasets: dict[str, Dataset]) -> str:
             warnings.append(
                 f"{link}: peak elastic midpoint deflection {peak:.3g} m is "
                 f"{100 * peak / length:.3g} % of {link}.length_m = {length:g} m, beyond the "
-                f"{100 * FFRF_DEFLECTION_LIMIT:g} % within which the linear FFRF body (small "
-                f"elastic deformation in its floating frame) is trusted; "
+                f"{100 * FFRF_DEFLECTION_LIMIT:g} % within which the FFRF body (small "
+                f"elastic rotations in its floating frame) is trusted; "
                 + ('compare with coupler.model = "nonlinear_fe" or use a stiffer coupler'
                    if link == "coupler" else "use a stiffer crank"))
     return "; ".join(warnings)
