@@ -95,10 +95,10 @@ rule-install: results/calibrate.h5 | $(STAMP)
 	$(PY) -m flex.experiments.calibration_report $< flex/config/ffrf_rule.toml
 
 test: $(STAMP)
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 2
 
 test-slow: $(STAMP)
-	$(PY) -m pytest -q -m slow
+	$(PY) -m pytest -q -n 2 -m slow
 
 lint: $(STAMP)
 	$(PY) -m ruff check flex studies tests

@@ -84,8 +84,8 @@ def test_inspect_prints_the_estimated_error(tmp_path):
     case = simulate(load_scene(overrides={"simulation.end_time_s": 0.005}), cache_dir=None)
     path = write_results(tmp_path / "one.h5", "simulate", [case], to_toml(load_scene()))
     text = format_description(describe(path))
-    assert "estimated error (total = the sum of the terms):" in text
-    assert "crank angle at the end time: " in text and " = step " in text
+    assert "estimated error (total = the root-sum-square of the terms):" in text
+    assert "crank angle at the end time: " in text and "(root-sum-square of step " in text
     assert "method: step: step doubling" in text and "validity: asymptotic" in text
     assert "leaves out: " in text and "the elasticity of the rigid crank and coupler" in text
 
@@ -182,7 +182,8 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
             "coupler_peak_bending_stress_Pa", "joint_C_peak_force_N"} <= set(rows)
     for row in rows.values():
         assert set(row.terms) == set(TERMS)
-        assert row.total == pytest.approx(sum(row.terms.values()), rel=1e-12)
+        assert row.total == pytest.approx(math.sqrt(sum(v * v for v in row.terms.values())),
+                                          rel=1e-12)
         assert row.relative == pytest.approx(row.total / abs(row.value), rel=1e-12)
     deflection = rows["coupler_peak_deflection_m"]
     assert deflection.value == pytest.approx(

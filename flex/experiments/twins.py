@@ -149,7 +149,7 @@ def _pair_values(thickness_m: float, facts: dict[str, Any], flex_case: CaseResul
         "n_physical": (n["physical"], "1", "delta_t / (2 pi / omega)"),
         "peak_midpoint_deflection": (peak, "m", "max |elastic midpoint deflection|, FFRF"),
         "peak_midpoint_deflection_estimated_error": (
-            deflection_error, "m", "its estimated error (step + modes + mesh + model)"),
+            deflection_error, "m", "its estimated error (the error budget)"),
         "peak_midpoint_deflection_estimated_relative_error": (
             deflection_relative, "1", "that over the peak"),
         "peak_deflection_over_length": (peak / length_m, "1", "peak deflection / L2"),
@@ -163,7 +163,7 @@ def _pair_values(thickness_m: float, facts: dict[str, Any], flex_case: CaseResul
             flex_data.get("coupler/peak_bending_stress", np.array([np.nan])).max(), "Pa",
             "FFRF peak |sigma_xx|"),
         "peak_bending_stress_estimated_error": (
-            stress_error, "Pa", "its estimated error (step + modes + mesh + model)"),
+            stress_error, "Pa", "its estimated error (the error budget)"),
         "peak_bending_stress_estimated_relative_error": (stress_relative, "1",
                                                          "that over the peak stress"),
         "ffrf_wall_time": (flex_case.counters["wall_time_s"], "s", "FFRF simulation wall time"),

@@ -215,6 +215,15 @@ x`` (x the rigid probe's compression / Euler load, :func:`euler_load_ratio`; mea
 at x = 1e-4, 0.53 % at 0.0076, 3.2 % at 0.049, 13 % at 0.13, 16 % at 0.20, 18 % at 0.33)."""
 
 
+FFRF_MOTION_ERROR_FRACTION = 0.15
+"""The FFRF body's error against the nonlinear FE coupler on the quantities of the motion
+(crank angle and slider position at the end time, peak joint forces, deployment time), as a
+fraction of what the link's elasticity changes in them (the FFRF run against its rigid twin),
+measured by ``make flexible`` (1-10 mm plates over the reference's span; its report prints
+the run's fractions): up to 0.13 on the joint forces' peaks (the axial ringing the reduced
+body represents with one axial mode), up to 0.16 on the crank angle."""
+
+
 def flexible_rung(load_ratio: float, tolerance: float, geometric_stiffness: bool = True
                   ) -> tuple[str, float]:
     """The coupler's flexible rung for ``tolerance`` (relative to the quantity: the peak

@@ -17,17 +17,22 @@ peak bending stress), four named terms and their total [the quantity's units]:
   :data:`MESH_FACTOR` times coarser, taken whole (first order assumed: the peak stress from
   the nodes converges about that slowly, the deflection faster, so the term leans safe);
 - ``model``: the link model against the next rung of flex's ladder (rigid, linear FFRF,
-  FFRF with geometric stiffness, nonlinear FE). An FFRF link with geometric stiffness:
-  :data:`flex.fidelity.criteria.GEOMETRIC_FFRF_ERROR` (``make ladder``'s measured bound
-  against the nonlinear FE coupler, relative) times what the elasticity changes in the
-  quantity (its difference to a companion whose flexible links are rigid twins: the whole
-  deflection, the whole stress); a linear FFRF link (``geometric_stiffness = false``) adds
-  its difference to a companion with geometric stiffness; a nonlinear FE link is the top
-  rung (no term); rigid links: not estimated here (the ``auto`` decision predicts a rigid
-  link's deflection error, ``fidelity_*``).
+  FFRF with geometric stiffness, nonlinear FE). An FFRF link with geometric stiffness: its
+  measured error against the nonlinear FE coupler as a fraction of what the elasticity
+  changes in the quantity (the difference to a companion whose flexible links are rigid
+  twins): :data:`flex.fidelity.criteria.GEOMETRIC_FFRF_ERROR` of the link's own peak
+  deflection and stress (``make ladder``), :data:`flex.fidelity.criteria.
+  FFRF_MOTION_ERROR_FRACTION` of the elastic part of the motion and the joint forces (``make
+  flexible``); a linear FFRF link (``geometric_stiffness = false``) adds its difference to
+  a companion with geometric stiffness; a nonlinear FE link is the top rung (no term);
+  rigid links: not estimated here (the ``auto`` decision predicts a rigid link's deflection
+  error, ``fidelity_*``).
 
-``total`` is the sum of the terms (their signs are not known: a bound-like sum, not a
-root-sum-square); ``relative`` is the total over the quantity's magnitude. What no term
+``total`` is the root-sum-square of the terms: they come from independent directions of
+refinement (step, basis, mesh, model), whose errors add with unknown signs (the practice of
+the GUM for independent components; ``make estimates`` measured the plain sum 3-30x
+pessimistic on most FFRF quantities, the root-sum-square never optimistic by more than 1.5x);
+``relative`` is the total over the quantity's magnitude. What no term
 covers is said in :attr:`ErrorBudget.leaves_out`. Companions that fail leave their term out
 and say why. :meth:`ErrorBudget.attrs` are the case attributes ``estimated_error_*``.
 """
@@ -43,7 +48,7 @@ from typing import Any
 from flex.base.errors import FlexError
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, apply_overrides
-from flex.fidelity.criteria import GEOMETRIC_FFRF_ERROR
+from flex.fidelity.criteria import FFRF_MOTION_ERROR_FRACTION, GEOMETRIC_FFRF_ERROR
 from flex.fidelity.error_estimate import (
     HEADLINES,
     PREFIX,
@@ -80,8 +85,8 @@ class ErrorBudget:
     companion_wall_time_s: float = 0.0
 
     def total(self, quantity: str) -> float:
-        """The sum of the quantity's terms [its units]."""
-        return float(math.fsum(self.terms[quantity].values()))
+        """The root-sum-square of the quantity's terms [its units] (module doc)."""
+        return combined(self.terms[quantity].values())
 
     def relative(self, quantity: str) -> float:
         """The total over the quantity's magnitude (NaN for a zero quantity)."""
@@ -105,6 +110,16 @@ class ErrorBudget:
                     f"{PREFIX}validity": self.validity,
                     f"{PREFIX}companion_wall_time_s": self.companion_wall_time_s})
         return out
+
+
+def combined(terms: Any) -> float:
+    """The total of independent error terms: their root-sum-square [their units]."""
+    return float(math.sqrt(math.fsum(value * value for value in terms)))
+
+
+#: the headline quantities of a link's own elastic response (their model term is
+#: GEOMETRIC_FFRF_ERROR of the quantity); the others are quantities of the motion
+OWN = ("_peak_deflection_m", "_peak_bending_stress_Pa", "_peak_von_mises_Pa")
 
 
 def _flexible(scene: Scene, model: str | None = None) -> list[str]:
@@ -187,10 +202,14 @@ def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
             scene, [f'{link}.model="rigid"' for link in ffrf]
             + [f'{link}.geometry="plate"' for link in ffrf]))
         elastic = _differences(result, twin)
-        terms = {name: GEOMETRIC_FFRF_ERROR * value for name, value in elastic.items()}
-        sentences.append(f"FFRF with geometric stiffness: {GEOMETRIC_FFRF_ERROR:g} (make "
-                         f"ladder's bound against the nonlinear FE coupler) of what the "
-                         f"elasticity changes (difference to rigid twins)")
+        terms = {name: (GEOMETRIC_FFRF_ERROR if name.endswith(OWN)
+                        else FFRF_MOTION_ERROR_FRACTION) * value
+                 for name, value in elastic.items()}
+        sentences.append(f"FFRF with geometric stiffness against the nonlinear FE coupler: "
+                         f"{GEOMETRIC_FFRF_ERROR:g} of a link's own peak deflection and "
+                         f"stress (make ladder), {FFRF_MOTION_ERROR_FRACTION:g} of what the "
+                         f"elasticity changes in the motion and the joint forces (make "
+                         f"flexible; the difference to rigid twins)")
         linear = [link for link in ffrf if not scene[link]["geometric_stiffness"]]
         if linear:
             stiffened = companions.run("model", _companion(
@@ -257,12 +276,12 @@ class BudgetRow:
     terms: dict[str, float]
 
     def text(self) -> str:
-        """``what: value units +- total (relative %): step a, modes b, ...``."""
+        """``what: value units +- total (relative %) = rss of step a, modes b, ...``."""
         relative = (f" ({100 * self.relative:.2g} %)" if math.isfinite(self.relative)
                     else "")
         terms = ", ".join(f"{term} {value:.2g}" for term, value in self.terms.items())
         return (f"{self.what}: {self.value:.6g} {self.units} +- {self.total:.2g} "
-                f"{self.units}{relative} = {terms}")
+                f"{self.units}{relative} (root-sum-square of {terms})")
 
 
 def budget_rows(attrs: dict[str, Any]) -> list[BudgetRow]:
@@ -285,4 +304,4 @@ def budget_rows(attrs: dict[str, Any]) -> list[BudgetRow]:
 
 
 __all__ = ["BudgetRow", "ErrorBudget", "HEADLINE_PREFIX", "MESH_FACTOR", "TERMS",
-           "budget_rows", "error_budget", "richer_modes"]
+           "budget_rows", "combined", "error_budget", "richer_modes"]

@@ -88,6 +88,34 @@ def _model_values(data: dict[str, np.ndarray], reference: dict[str, np.ndarray],
     }
 
 
+#: the motion quantities whose FFRF error is compared with the elasticity's effect on them:
+#: name -> (series, how it is read over the span: "peak" of |series| or "end" value)
+MOTION = {"joint A peak force": ("joints/A/force_modulus", "peak"),
+          "joint B peak force": ("joints/B/force_modulus", "peak"),
+          "joint C peak force": ("joints/C/force_modulus", "peak"),
+          "crank angle": ("crank/angle", "end"),
+          "slider position": ("slider/position", "end")}
+
+
+def motion_error_fractions(ffrf: dict[str, np.ndarray], rigid: dict[str, np.ndarray],
+                           reference: dict[str, np.ndarray], samples: int) -> dict[str, float]:
+    """|FFRF - reference| / |FFRF - rigid twin| of each :data:`MOTION` quantity over the
+    reference's ``samples``: the FFRF body's model error as a fraction of what the
+    elasticity changes (what :data:`flex.fidelity.criteria.FFRF_MOTION_ERROR_FRACTION`
+    bounds)."""
+    out = {}
+    for name, (path, how) in MOTION.items():
+        if how == "peak":
+            ffrf_value, rigid_value, reference_value = (
+                float(np.abs(data[path][:samples]).max()) for data in (ffrf, rigid, reference))
+        else:
+            ffrf_value, rigid_value, reference_value = (
+                float(data[path][samples - 1]) for data in (ffrf, rigid, reference))
+        effect = abs(ffrf_value - rigid_value)
+        out[name] = abs(ffrf_value - reference_value) / effect if effect > 0 else float("nan")
+    return out
+
+
 def _error_text(value: float) -> str:
     return f"{value:+.2%}" if np.isfinite(value) else "-"
 
@@ -146,6 +174,16 @@ def compare_with_reference(label: str, cases: dict[str, CaseResult], reference: 
                      f"({_error_text(v['peak_error'])}), first peak "
                      f"{_error_text(v['first_peak_error'])}, curves "
                      f"{v['max_curve_difference_over_peak']:.1%} of the peak apart")
+    if "ffrf" in found and "rigid" in found:
+        fractions = motion_error_fractions(
+            {k: v.data for k, v in cases["ffrf"].datasets.items()},
+            {k: v.data for k, v in cases["rigid"].datasets.items()}, ref, samples)
+        datasets.update({f"{prefix}/ffrf/motion_error_fraction/{name.replace(' ', '_')}":
+                         Dataset(value, "1", f"|FFRF - reference| / |FFRF - rigid twin|, "
+                                 f"{name} over the span") for name, value in fractions.items()})
+        lines.append("  FFRF against the reference on the motion, as a fraction of the "
+                     "elasticity's effect (FFRF - rigid twin): " + ", ".join(
+                         f"{name} {value:.3g}" for name, value in fractions.items()))
     if skipped:
         lines.append(f"  not compared: {', '.join(skipped)}")
     return datasets, lines

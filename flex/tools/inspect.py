@@ -275,7 +275,7 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
     rows = budget_rows(attrs)
     if not rows and f"{PREFIX}validity" not in attrs:
         return []
-    lines = ["  estimated error (total = the sum of the terms):"]
+    lines = ["  estimated error (total = the root-sum-square of the terms):"]
     lines += [f"    {row.text()}" for row in rows] or ["    none"]
     for key in ("method", "leaves_out", "validity"):
         if attrs.get(PREFIX + key):
@@ -301,8 +301,8 @@ def stress_lines(attrs: dict[str, Any]) -> list[str]:
             parts.append(f"{attrs[f'{name}_Pa'] / 1e6:.4g} MPa {where} at t = "
                          f"{attrs[f'{name}_time_s'] * 1e3:.4g} ms, (x, y, z) = ({x:.3g}, "
                          f"{y:.3g}, {z:.3g}) mm on the plate"
-                         + (f" (estimated error {error / 1e6:.2g} MPa: step + modes + mesh "
-                            f"+ model)" if error is not None else ""))
+                         + (f" (estimated error {error / 1e6:.2g} MPa: the budget above)"
+                            if error is not None else ""))
         if parts:
             lines.append(f"peak von Mises stress, {link}: " + "; ".join(parts))
     return lines

@@ -336,8 +336,8 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
                     case["name"])
     if not rows:
         return []
-    lines = ["Estimated error of each headline quantity (total = the sum of the terms, in "
-             "the quantity's unit):", ""]
+    lines = ["Estimated error of each headline quantity (total = the root-sum-square of the "
+             "terms, in the quantity's unit):", ""]
     lines += _table(["case", "quantity", "value", "estimated error", "relative", *TERMS], rows)
     for key, texts in notes.items():
         for text, names in texts.items():
