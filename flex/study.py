@@ -35,7 +35,6 @@ from types import ModuleType
 from typing import Any
 
 from flex.base.errors import FlexError, OutputError, ResultFileError, SceneError
-from flex.config.settings import check_runnable
 from flex.config.usage import explicit_keys, unused_keys
 from flex.data.outputs import (
     Staging,
@@ -46,6 +45,7 @@ from flex.data.outputs import (
 )
 from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import Scene, load_scene, to_toml
+from flex.fidelity.auto import check
 from flex.fidelity.caseloop import run_each
 from flex.fidelity.simulation import simulate_case
 from flex.tools.report import default_report_path, figures_of, render_report
@@ -211,13 +211,13 @@ def check_outputs(path: Path, figures: bool) -> None:
 def check_cases(module: ModuleType, scenes: dict[str, Scene],
                 given: dict[str, object] | None = None) -> None:
     """Refuse (:class:`SceneError`), before any case runs, a case scene that cannot run or
-    would mean nothing (:func:`flex.config.settings.check_runnable`), and a value the user gave
+    would mean nothing (:func:`flex.fidelity.auto.check`), and a value the user gave
     (``given``: ``{"section.key": value}``, :func:`flex.config.usage.explicit_keys`) that no case
     uses: one the study sets itself in each case, or one no case's models read
     (:func:`flex.config.usage.unused_keys`, minus the keys the study declares it reads itself in
     ``READS``)."""
     for scene in scenes.values():
-        check_runnable(scene)
+        check(scene)
     reads = set(getattr(module, "READS", ()))
     for name, value in (given or {}).items():
         if name in reads:

@@ -3,7 +3,7 @@
 The thesis models only the coupler as flexible. flex also meshes the crank (a steel plate
 A-B, ``[crank] geometry = "plate"``, reduced like the coupler) and lets ``auto`` choose
 rigid or FFRF for it from a fitted criterion, with the crank's first in-plane elastic
-frequency in the assembled mechanism (:func:`flex.fidelity.criteria.crank_elastic_omega`). Without a
+frequency in the assembled mechanism (:func:`flex.fidelity.auto.crank_elastic_omega`). Without a
 wing that is the plate's pinned-pinned frequency; with the wing welded at A the crank is a
 cantilever from the wing carrying coupler and slider at B, an order of magnitude softer.
 

@@ -5,7 +5,8 @@ import pytest
 
 from flex.base.errors import SceneError
 from flex.data.scene import load_scene
-from flex.fidelity.criteria import crank_elastic_omega, pinned_pinned_omega, resolve_fidelity
+from flex.fidelity.auto import crank_elastic_omega, decide_links
+from flex.fidelity.criteria import pinned_pinned_omega
 from flex.fidelity.simulation import simulate
 
 PLATE = ['crank.geometry="plate"', "simulation.step_s=2e-5", "simulation.end_time_s=0.01"]
@@ -84,11 +85,11 @@ def test_bad_crank_scenes_are_refused(overrides, message):
 def test_auto_picks_ffrf_for_a_soft_crank_and_rigid_for_a_stiff_one(reduction_cache):
     soft = load_scene(None, ['crank.geometry="plate"', "crank.thickness_m=0.001",
                              "wing.enabled=true", 'crank.model="auto"', "simulation.step_s=1e-4"])
-    resolved, decisions = resolve_fidelity(soft, cache_dir=reduction_cache)
+    resolved, decisions = decide_links(soft, cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "ffrf" and resolved["crank"]["modes"] >= 2
     assert "crank_criteria_fit.toml" in decisions[0].reason  # the crank's own law
     stiff = load_scene(None, ['crank.model="auto"', "simulation.step_s=1e-4"])
-    resolved, decisions = resolve_fidelity(stiff, cache_dir=reduction_cache)
+    resolved, decisions = decide_links(stiff, cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "rigid"
     assert decisions[0].n_physical > decisions[0].k_physical
 
@@ -99,7 +100,7 @@ def test_auto_refuses_a_flexible_lumped_crank(reduction_cache):
                               "wing.enabled=true", 'crank.model="auto"',
                               "simulation.step_s=1e-4"])
     with pytest.raises(SceneError, match='crank.geometry = "plate"'):
-        resolve_fidelity(scene, cache_dir=reduction_cache)
+        decide_links(scene, cache_dir=reduction_cache)
 
 
 def test_crank_law_beats_the_coupler_law_where_the_coupler_law_failed(reduction_cache):
@@ -108,7 +109,7 @@ def test_crank_law_beats_the_coupler_law_where_the_coupler_law_failed(reduction_
     scene = load_scene(None, ['crank.geometry="plate"', "crank.thickness_m=0.0015",
                               "wing.enabled=true", 'crank.model="auto"',
                               "simulation.step_s=1e-4"])
-    resolved, _ = resolve_fidelity(scene, cache_dir=reduction_cache)
+    resolved, _ = decide_links(scene, cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "ffrf"
 
 

@@ -120,16 +120,16 @@ def _strict_criterion():
 
 
 def test_without_a_wing_the_loads_decide_the_crank_with_one_the_n_law(reduction_cache):
-    from flex.fidelity.criteria import resolve_fidelity
+    from flex.fidelity.auto import decide_links
 
     strict = _strict_criterion()
     bare = apply_overrides(default_scene(), ['crank.model="auto"', "simulation.step_s=1e-4"])
-    resolved, (decision,) = resolve_fidelity(bare, strict, strict, cache_dir=reduction_cache)
+    resolved, (decision,) = decide_links(bare, strict, strict, cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "rigid"  # the thesis crank: ~1e-5 predicted
     assert "n-law baseline (would pick ffrf)" in decision.reason
     assert 0 < decision.predicted_rigid_error < 1e-4
     winged = apply_overrides(bare, ['crank.geometry="plate"', "wing.enabled=true"])
-    resolved, (decision,) = resolve_fidelity(winged, strict, strict, cache_dir=reduction_cache)
+    resolved, (decision,) = decide_links(winged, strict, strict, cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "ffrf"  # the n-law's verdict stands
     assert "stored, not deciding" in decision.reason
     assert decision.predicted_rigid_error < 0.01  # what the loads alone would have allowed
@@ -168,7 +168,8 @@ def test_with_the_wing_the_prediction_meets_the_deflection_not_the_governing_err
     within [0.8, 1.25] of the FFRF crank's deflection error (measured 1.05), but the
     crank-angle error governs, about 3 x larger (measured prediction / governing 0.34):
     why ``auto`` does not decide a winged crank by it."""
-    from flex.fidelity.criteria import crank_elastic_omega, deployment_probe
+    from flex.fidelity.auto import crank_elastic_omega
+    from flex.fidelity.probe import deployment_probe
 
     scene = apply_overrides(default_scene(), [*STUDY, "crank.thickness_m=0.002",
                                               "wing.enabled=true"])
@@ -209,7 +210,8 @@ def test_the_prediction_meets_ffrf_cranks(name, reduction_cache):
     20000 N/m, P / P_E = 0.11); without the wing the deflection is the governing error
     (measured: the crank-angle and slider errors below 8 % of it), with the wing
     prediction / governing error within [0.25, 0.5] (measured 0.33-0.35)."""
-    from flex.fidelity.criteria import crank_elastic_omega, deployment_probe
+    from flex.fidelity.auto import crank_elastic_omega
+    from flex.fidelity.probe import deployment_probe
 
     scene = apply_overrides(default_scene(), [*STUDY, *MEASURED[name]])
     delta_t_s, _, probe = deployment_probe(scene)

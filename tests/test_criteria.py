@@ -8,7 +8,8 @@ import pytest
 
 from flex.base.errors import FlexError, SceneError
 from flex.data.scene import load_scene
-from flex.fidelity import criteria
+from flex.fidelity import auto, criteria
+from flex.fidelity.auto import decide_links
 from flex.fidelity.criteria import (
     Criterion,
     ErrorLaw,
@@ -16,7 +17,6 @@ from flex.fidelity.criteria import (
     load_criterion,
     n_values,
     pinned_pinned_omega,
-    resolve_fidelity,
 )
 
 
@@ -248,14 +248,14 @@ def test_modes_for_cutoff_follow_the_beam_estimates():
     assert [kind for _, kind in estimates[:4]] == ["in_plane", "in_plane", "torsion",
                                                    "in_plane"]
     assert hz == pytest.approx([827, 2282, 4113, 4487], rel=0.1)
-    assert criteria.modes_for_cutoff(scene, 2 * math.pi * 1000) == 2  # at least 2
+    assert auto.modes_for_cutoff(scene, 2 * math.pi * 1000) == 2  # at least 2
     # in_plane reductions keep no torsion mode: below 4300 Hz only the two bending modes
-    assert criteria.modes_for_cutoff(scene, 2 * math.pi * 4300) == 2
-    assert criteria.modes_for_cutoff(scene, 2 * math.pi * 4600) == 3
+    assert auto.modes_for_cutoff(scene, 2 * math.pi * 4300) == 2
+    assert auto.modes_for_cutoff(scene, 2 * math.pi * 4600) == 3
     every_kind = load_scene(None, ['coupler.geometry="plate"', "coupler.thickness_m=0.001",
                                    'coupler.mode_selection="all"'])
-    assert criteria.modes_for_cutoff(every_kind, 2 * math.pi * 4300) == 3
-    assert criteria.modes_for_cutoff(scene, 1e9) == criteria.MAX_AUTO_MODES
+    assert auto.modes_for_cutoff(every_kind, 2 * math.pi * 4300) == 3
+    assert auto.modes_for_cutoff(scene, 1e9) == auto.MAX_AUTO_MODES
 
 
 def _auto_scene(thickness_m: float, tolerance: float = 0.01, *extra: str):
@@ -267,7 +267,7 @@ def _auto_scene(thickness_m: float, tolerance: float = 0.01, *extra: str):
 
 def test_auto_decides_rigid_for_a_stiff_coupler_and_ffrf_for_a_soft_one():
     criterion = _synthetic_criterion()  # k(1 %) = sqrt(8) = 2.83, k(0.1 %) = 8.9
-    thick, decisions = resolve_fidelity(_auto_scene(0.010), criterion)
+    thick, decisions = decide_links(_auto_scene(0.010), criterion)
     assert thick["coupler"]["model"] == "rigid"
     (decision,) = decisions
     assert decision.model == "rigid" and decision.n_physical >= decision.k_physical
@@ -275,7 +275,7 @@ def test_auto_decides_rigid_for_a_stiff_coupler_and_ffrf_for_a_soft_one():
     assert decision.delta_t_s == pytest.approx(0.0246, abs=5e-4)  # 10 mm plate's stop time
     # 0.6 mm: the rigid probe predicts 0.5 % of the length (x 1.15 margin > 0.55 %); the
     # FFRF rung's model error (0.5 % of the deflection) meets 0.55 %
-    thin, decisions = resolve_fidelity(_auto_scene(0.0006, 0.0055), criterion)
+    thin, decisions = decide_links(_auto_scene(0.0006, 0.0055), criterion)
     assert thin["coupler"]["model"] == "ffrf"
     assert decisions[0].modes == thin["coupler"]["modes"] >= 1  # the tolerance rule's
     assert "tolerance rule" in decisions[0].reason
@@ -287,7 +287,7 @@ def test_auto_decides_rigid_for_a_stiff_coupler_and_ffrf_for_a_soft_one():
 def test_auto_refuses_a_coupler_near_buckling():
     # 0.3 mm plate: Euler load 6.9 N, the 22 mm spring preload pushes with ~33 N
     with pytest.raises(SceneError, match="Euler buckling load"):
-        resolve_fidelity(_auto_scene(0.0003), _synthetic_criterion())
+        decide_links(_auto_scene(0.0003), _synthetic_criterion())
 
 
 def test_euler_load_ratio_of_a_compressed_link():
@@ -305,16 +305,16 @@ def test_auto_crank_is_rigid_ffrf_or_refused_with_a_reason(reduction_cache):
     # with the wing the crank's n-law decides (without one its loads do: test_crank_predictor)
     scene = load_scene(None, ['crank.model="auto"', "simulation.step_s=1e-4",
                               "wing.enabled=true"])
-    resolved, decisions = resolve_fidelity(scene, criterion, criterion,
+    resolved, decisions = decide_links(scene, criterion, criterion,
                                            cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "rigid"
     assert decisions[0].link == "crank" and "plate of its mass" in decisions[0].reason
     strict = _synthetic_criterion(c=1e9)  # every link flexible
     with pytest.raises(SceneError, match='set crank.geometry = "plate"'):
-        resolve_fidelity(scene, strict, strict, cache_dir=reduction_cache)  # lumped: no mesh
+        decide_links(scene, strict, strict, cache_dir=reduction_cache)  # lumped: no mesh
     plate = load_scene(None, ['crank.model="auto"', 'crank.geometry="plate"',
                               "simulation.step_s=1e-4", "wing.enabled=true"])
-    resolved, decisions = resolve_fidelity(plate, strict, strict, cache_dir=reduction_cache)
+    resolved, decisions = decide_links(plate, strict, strict, cache_dir=reduction_cache)
     assert resolved["crank"]["model"] == "ffrf" and resolved["crank"]["modes"] >= 2
 
 

@@ -257,14 +257,14 @@ def test_auto_reads_the_tolerance_against_the_deflection_past_rigid():
     # 1 mm plate: the rigid probe predicts ~0.2 % of the length (rigid at 1 %); at 1e-3 rigid
     # is refused and the FFRF body's model error (0.5 % of the deflection, measured up to
     # 0.35 %) does not meet 0.1 % of the deflection: the nonlinear FE coupler
-    from flex.fidelity.criteria import resolve_fidelity
+    from flex.fidelity.auto import decide_links
 
     def scene(tolerance: float):
         return load_scene(overrides=['coupler.geometry="plate"', 'coupler.model="auto"',
                                      f"fidelity.tolerance={tolerance!r}"])
 
-    tight, (decision,) = resolve_fidelity(scene(1e-3))
+    tight, (decision,) = decide_links(scene(1e-3))
     assert tight["coupler"]["model"] == decision.model == "nonlinear_fe"
     assert "ladder: nonlinear_fe (FFRF model error 0.005 of the deflection" in decision.reason
-    loose, (decision,) = resolve_fidelity(scene(1e-2))
+    loose, (decision,) = decide_links(scene(1e-2))
     assert loose["coupler"]["model"] == "rigid"

@@ -23,7 +23,6 @@ import pytest
 from hostile import check_refused, run_cli
 
 from flex.base.errors import SceneError, SimulationError
-from flex.config.settings import check_runnable
 from flex.config.usage import explicit_keys, unused_keys
 from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import SCHEMA, estimate_mesh, load_scene
@@ -33,6 +32,7 @@ from flex.dynamics.solver import (
     divergence_advice,
     validity_warning,
 )
+from flex.fidelity.auto import check as check_runnable
 from flex.fidelity.simulation import simulate_case
 
 PLATE = ["--set", 'coupler.geometry="plate"', "--set", 'coupler.model="ffrf"']

@@ -141,7 +141,9 @@ def test_auto_is_refused_where_flex_has_no_choice():
 
 
 def test_solver_settings_report_the_resolved_values():
-    settings = solver_settings(load_scene(None, PLATE))
+    from flex.fidelity.auto import resolve
+
+    settings = solver_settings(resolve(load_scene(None, PLATE)).scene)
     step = _rule_step()[0]
     assert settings["step_s"] == pytest.approx(step, rel=1e-9)
     assert settings["modified_newton"] is True
@@ -192,3 +194,45 @@ def test_flex_scene_says_what_auto_resolves_to(capsys):
     assert main(["scene", "simulate", "--set", 'coupler.geometry="plate"',
                  "--set", 'coupler.model="auto"']) == 0
     assert "chosen at run time" in capsys.readouterr().out
+
+
+def test_one_simulate_resolves_each_scene_once(monkeypatch, reduction_cache):
+    """flex.fidelity.auto.resolve is the one place "auto" is decided: one simulate() of an
+    FFRF coupler with "auto" modes, mesh and solver keys (its error budget's companion runs
+    included) resolves the scene once, the rigid probe's scene once, nothing below it."""
+    import flex.config.settings as settings
+    from flex.data.scene import to_toml
+    from flex.fidelity import auto
+    from flex.fidelity.simulation import simulate
+
+    seen = {"resolve": 0, "solver": [], "links": []}
+    real_resolve, real_solver = auto.resolve, settings.resolve_solver_settings
+    real_links = settings.resolve_link_keys
+
+    def counting_resolve(*args, **kwargs):
+        seen["resolve"] += 1
+        return real_resolve(*args, **kwargs)
+
+    def counting_solver(scene):
+        seen["solver"].append(to_toml(scene))
+        return real_solver(scene)
+
+    def counting_links(scene):
+        seen["links"].append(to_toml(scene))
+        return real_links(scene)
+
+    monkeypatch.setattr("flex.fidelity.simulation.resolve", counting_resolve)
+    monkeypatch.setattr("flex.fidelity.auto.resolve_solver_settings", counting_solver)
+    monkeypatch.setattr("flex.config.settings.resolve_link_keys", counting_links)
+    monkeypatch.setattr("flex.fidelity.auto.resolve_link_keys", counting_links)
+    # 0.6 mm: auto takes the FFRF body at 0.55 % (tests/test_criteria.py)
+    scene = load_scene(None, PLATE + ['coupler.model="auto"', "coupler.thickness_m=0.0006",
+                                      "coupler.mesh_size_m=0.005", "coupler.modes=2",
+                                      "fidelity.tolerance=0.0055",
+                                      "simulation.end_time_s=0.002"])
+    result = simulate(scene, cache_dir=reduction_cache)
+    assert result.attrs["fidelity_coupler_model"] == "ffrf"
+    assert "coupler" in result.attrs["estimated_error_method"]  # FFRF companions ran
+    assert seen["resolve"] == 1
+    assert seen["solver"] and len(seen["solver"]) == len(set(seen["solver"]))
+    assert len(seen["links"]) == len(set(seen["links"]))

@@ -13,12 +13,14 @@ from scipy.linalg import eigh
 from flex.base import physics
 from flex.base.errors import SceneError
 from flex.bodies.spring import surge_frequency_fixed_free_Hz
+from flex.config.settings import pinned_overrides
 from flex.config.usage import unused_keys
 from flex.data.scene import load_scene
 from flex.dynamics.solver import integrate
 from flex.experiments.spring_mass import chain_matrices, governing_error
-from flex.fidelity.criteria import deployment_probe
-from flex.fidelity.simulation import resolve_auto, simulate
+from flex.fidelity.auto import resolve
+from flex.fidelity.probe import deployment_probe
+from flex.fidelity.simulation import simulate
 from flex.fidelity.spring_choice import (
     CHAIN_ERROR_CONSTANT,
     SPRING_PREDICTION_MARGIN,
@@ -36,8 +38,8 @@ def _arrays(case) -> dict[str, np.ndarray]:
 
 
 def _run(*sets: str, end_s: float = 0.035) -> dict[str, np.ndarray]:
-    return _arrays(integrate(load_scene(overrides=[*QUICK, f"simulation.end_time_s={end_s}",
-                                                   *sets])))
+    return _arrays(integrate(resolve(load_scene(
+        overrides=[*QUICK, f"simulation.end_time_s={end_s}", *sets]), quiet=True).scene))
 
 
 def _chain(segments: int) -> list[str]:
@@ -135,13 +137,14 @@ def test_predicted_massless_error_bounds_the_measured_one(coil_kg, slider_kg):
 
 
 def test_auto_picks_massless_at_a_loose_tolerance_and_a_chain_at_a_tight_one():
-    def resolve(tolerance: float):
-        return resolve_auto(load_scene(overrides=['drive.spring_model="auto"',
-                                                  f"fidelity.tolerance={tolerance}"]))
+    def decided(tolerance: float):
+        resolution = resolve(load_scene(overrides=['drive.spring_model="auto"',
+                                                   f"fidelity.tolerance={tolerance}"]))
+        return resolution.scene, resolution.decisions
 
-    loose, (decision,) = resolve(0.5)
+    loose, (decision,) = decided(0.5)
     assert loose["drive"]["spring_model"] == "massless" and decision.segments == 0
-    tight, (decision,) = resolve(0.01)
+    tight, (decision,) = decided(0.01)
     segments = tight["drive"]["spring_segments"]
     assert tight["drive"]["spring_model"] == "chain" and decision.segments == segments
     assert 2 <= segments <= 16
@@ -174,8 +177,10 @@ def test_auto_spring_with_a_constant_speed_drive_is_refused():
 
 
 def test_an_unresolved_auto_spring_is_not_built_as_massless():
-    with pytest.raises(SceneError, match="must be resolved"):
-        integrate(load_scene(overrides=['drive.spring_model="auto"', *QUICK]))
+    # below flex.fidelity.auto.resolve every scene is concrete: integrate refuses "auto"
+    with pytest.raises(ValueError, match="resolve"):
+        integrate(load_scene(overrides=['drive.spring_model="auto"', *QUICK,
+                                        *pinned_overrides()]))
 
 
 def test_more_segments_than_a_chain_may_have_are_refused():

@@ -22,6 +22,7 @@ from flex.experiments.spring_mass import (
     deployment_cases,
     wing_spring_mass_kg,
 )
+from flex.fidelity.auto import resolve
 
 QUIET = ["simulation.error_estimate=false"]
 
@@ -31,7 +32,7 @@ def chain(segments: int, *extra: str) -> list[str]:
 
 
 def run(overrides: list[str]) -> dict[str, np.ndarray]:
-    case = integrate(load_scene(None, overrides), "case")
+    case = integrate(resolve(load_scene(None, overrides), quiet=True).scene, "case")
     return {k: np.asarray(v.data) for k, v in case.datasets.items()}
 
 
@@ -115,7 +116,8 @@ def test_three_dimensional_build_matches_planar():
     from flex.dynamics.solver import collect
     from flex.dynamics.solver import run as solve
 
-    scene = load_scene(None, chain(3, "simulation.end_time_s=0.01", "simulation.step_s=1e-5"))
+    scene = resolve(load_scene(None, chain(3, "simulation.end_time_s=0.01",
+                                           "simulation.step_s=1e-5")), quiet=True).scene
     curves = []
     for planar in (True, False):
         mech = build_mechanism(scene, planar=planar)

@@ -214,13 +214,17 @@ def test_index2_with_numerical_damping_is_first_order(rigid_reference):
 
 
 def test_solver_settings_record_the_knobs():
-    settings = solver_settings(load_scene(overrides=['simulation.formulation="index2"',
-                                                     "simulation.spectral_radius=0.5"]))
+    from flex.fidelity.auto import resolve
+
+    settings = solver_settings(resolve(load_scene(overrides=['simulation.formulation="index2"',
+                                                             "simulation.spectral_radius=0.5"]
+                                                  )).scene)
     assert settings["integrator"].startswith("Newmark")
     assert settings["newmark_gamma"] == pytest.approx(0.5 + 1 / 3)
     assert settings["newmark_beta"] == pytest.approx((1 + 1 / 3) ** 2 / 4)
     assert settings["adaptive_step"] is False
-    explicit = solver_settings(load_scene(overrides=['simulation.integrator="explicit_penalty"']))
+    explicit = solver_settings(resolve(load_scene(
+        overrides=['simulation.integrator="explicit_penalty"'])).scene)
     assert explicit["explicit_method"] == "RK44" and "penalty" in explicit["integrator"]
 
 

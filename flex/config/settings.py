@@ -18,20 +18,20 @@ a certified accuracy:
   fraction of the first bending period (4e-5 s) erred by 2.4 % in make tradeoff.
 
 Contract: input a validated scene whose links are concrete (``model = "auto"`` already
-resolved, :func:`flex.fidelity.criteria.resolve_fidelity`); output the scene with numbers in place
+resolved, :func:`flex.fidelity.auto.resolve`); output the scene with numbers in place
 of
 ``"auto"`` and a :class:`SolverChoice` (which entry, why; stored with every result). A scene
 without ``"auto"`` values is returned unchanged with ``None``.
 
-:func:`check_runnable` resolves what can be resolved cheaply and refuses, before anything is
-built, a scene that cannot run or would mean nothing (step count, irregular samples, an
-aliased crank, meshed plates that mean nothing or do not fit this machine).
+:func:`check_concrete` refuses, before anything is built, a concrete scene that cannot run or
+would mean nothing (step count, irregular samples, an aliased crank, meshed plates that mean
+nothing or do not fit this machine); :func:`flex.fidelity.auto.check` applies it to what a
+scene's ``"auto"`` values may become.
 """
 
 from __future__ import annotations
 
 import copy
-import itertools
 import math
 import tomllib
 from dataclasses import dataclass
@@ -41,7 +41,7 @@ from typing import Any
 
 from flex.base.errors import SceneError
 from flex.config.ffrf_rule import LINK_KEYS, RulePick, fill_link_keys, pick
-from flex.data.scene import MAX_STEPS, Scene, check_drive_steps, check_meshed_plate, check_steps
+from flex.data.scene import Scene, check_drive_steps, check_meshed_plate, check_steps
 
 #: the ``[simulation]`` keys that may be ``"auto"``
 AUTO_KEYS = ("step_s", "spectral_radius", "newton", "newton_relative_tolerance")
@@ -238,97 +238,38 @@ def pinned_overrides(entry: str = "rigid") -> list[str]:
         PINNED_COUPLER_DISCRETIZATION)
 
 
-def check_runnable(scene: Scene) -> None:
-    """Refuse, before anything is built, meshed or simulated, a scene that cannot run or
-    whose result would mean nothing; return None when it can run.
-
-    Contract: ``scene`` is validated (:func:`flex.data.scene.load_scene` or
-    :func:`flex.data.scene.validate`); links and solver keys may be ``"auto"``. Takes
-    milliseconds: nothing is meshed or simulated. Raises :class:`SceneError` with one line
-    naming the key and the accepted range. Checks, with the ``"auto"`` solver keys resolved
-    as :func:`flex.dynamics.solver.simulate` resolves them (:func:`resolve_solver_settings`):
+def check_concrete(scene: Scene, choice: SolverChoice | None = None) -> None:
+    """Refuse, before anything is built, meshed or simulated, a concrete scene (no
+    ``"auto"`` left: :func:`flex.fidelity.auto.resolve`) that cannot run or whose result
+    would mean nothing; return None when it can run. Takes milliseconds. ``choice``: the
+    solver choice that filled its ``"auto"`` keys (named in a refusal of its step).
 
     - steps (:func:`flex.data.scene.check_steps`): step <= end time, at most 5e7 steps, output
       interval 0 or an integer multiple of the step;
     - a constant-speed crank turns at most 0.1 rad per step and pi/4 per stored sample
       (:func:`flex.data.scene.check_drive_steps`);
     - every plate that will be meshed makes sense as a meshed link and fits this machine
-      (:func:`flex.data.scene.check_meshed_plate`, with the mesh estimate in the message);
-    - ``model = "auto"`` links: the rigid probe ``auto`` runs first
-      (:func:`flex.fidelity.criteria.deployment_probe`) must fit the step limit, and the step checks
-      must pass for at least one model ``auto`` may choose (a check that fails for only
-      some choices is left to the run, which then stores a failed case naming it).
+      (:func:`flex.data.scene.check_meshed_plate`, with the mesh estimate in the message).
     """
-    scene, _ = resolve_link_keys(scene)
-    for link in ("crank", "coupler"):
-        check_meshed_plate(link, scene[link])
-    candidates = _model_candidates(scene)
-    errors: list[SceneError] = []
-    for candidate in candidates:
-        try:
-            resolved, choice = resolve_solver_settings(candidate)
-            check_steps(resolved["simulation"])
-            try:
-                check_drive_steps(resolved)
-            except SceneError as exc:
-                if choice is None or "step_s" not in choice.keys:
-                    raise
-                raise SceneError(f"{exc} (step_s = \"auto\" chose {choice.keys['step_s']:g} s "
-                                 f"for {choice.entry}: set simulation.step_s explicitly)"
-                                 ) from None
-        except SceneError as exc:
-            errors.append(exc)
-    if len(errors) == len(candidates):
-        if len(candidates) == 1:
-            raise errors[0]
-        raise SceneError(f'{errors[0]} (for every model "auto" may choose)')
-    if len(candidates) > 1 or AUTO in (scene["crank"]["model"], scene["coupler"]["model"]):
-        _check_probe(scene)
-
-
-def _model_candidates(scene: Scene) -> list[Scene]:
-    """The concrete scenes ``model = "auto"`` may turn ``scene`` into (itself if none)."""
-    choices = []
     for link in ("crank", "coupler"):
         values = scene[link]
-        if values["model"] != AUTO:
-            choices.append([values["model"]])
-        elif link == "crank" and (values["geometry"] != "plate"
-                                  or scene["drive"]["kind"] != "spring"):
-            choices.append(["rigid"])  # auto refuses a flexible choice of these
-        else:
-            choices.append(["rigid", "ffrf"])
-    if all(len(options) == 1 and options[0] == scene[link]["model"]
-           for options, link in zip(choices, ("crank", "coupler"), strict=True)):
-        return [scene]
-    out = []
-    for crank, coupler in itertools.product(*choices):
-        candidate = copy.deepcopy(scene)
-        candidate["crank"]["model"], candidate["coupler"]["model"] = crank, coupler
-        out.append(candidate)
-    return out
+        meshed = values["model"] in ("ffrf", "nonlinear_fe")  # a lumped or rigid link
+        # keeps its unused "auto" modes and mesh (never read)
+        if values["model"] == AUTO or (meshed and AUTO in (values.get(key)
+                                                          for key in LINK_KEYS)):
+            raise ValueError(f"{link}: resolve its \"auto\" values first "
+                             f"(flex.fidelity.auto.resolve)")
+        check_meshed_plate(link, values)
+    if has_auto(scene) or scene["drive"]["spring_model"] == AUTO:
+        raise ValueError('[simulation] or drive.spring_model: resolve its "auto" values first '
+                         "(flex.fidelity.auto.resolve)")
+    check_steps(scene["simulation"])
+    try:
+        check_drive_steps(scene)
+    except SceneError as exc:
+        if choice is None or "step_s" not in choice.keys:
+            raise
+        raise SceneError(f"{exc} (step_s = \"auto\" chose {choice.keys['step_s']:g} s for "
+                         f"{choice.entry}: set simulation.step_s explicitly)") from None
 
 
-def _check_probe(scene: Scene) -> None:
-    """The rigid run ``model = "auto"`` makes first
-    (:func:`flex.fidelity.criteria.deployment_probe`:
-    step min(step_s, 1e-4, end/200) s over the end time, or half a crank turn)."""
-    end = scene["simulation"]["end_time_s"]
-    drive = scene["drive"]
-    if drive["kind"] == "constant_speed":
-        speed = abs(drive["crank_speed_rad_per_s"])
-        if speed == 0:
-            raise SceneError('model = "auto" with a constant-speed drive needs '
-                             "drive.crank_speed_rad_per_s != 0 (the criterion uses half a "
-                             "crank turn as the deployment time)")
-        end = min(end, math.pi / speed)
-    step = scene["simulation"]["step_s"]
-    if step == AUTO:
-        step = solver_defaults()["rigid"]["step_s"]  # the probe's links are rigid
-    step = min(step, 1e-4, end / 200)
-    if end / step > MAX_STEPS:
-        raise SceneError(f"simulation.end_time_s = {scene['simulation']['end_time_s']:g}: "
-                         f'model = "auto" first runs the rigid model over it at a step of '
-                         f"{step:g} s to find the deployment time: {end / step:.3g} steps; "
-                         f"accepted: at most {MAX_STEPS:g} (end_time_s <= "
-                         f"{MAX_STEPS * step:.3g})")

@@ -331,7 +331,7 @@ def validate(scene: Scene) -> None:
     Checks: known sections and keys, every key present, types, finiteness, ranges, and the
     geometry: the crank must be able to turn (``L1 + |offset| < L2``), the step settings
     consistent (an explicit step: :func:`check_steps`, :func:`check_drive_steps`; an
-    ``"auto"`` one is checked once resolved, :func:`flex.config.settings.check_runnable`), FFRF
+    ``"auto"`` one is checked once resolved, :func:`flex.fidelity.auto.check`), FFRF
     couplers need plate geometry, and plates that will be meshed must make sense and fit
     this machine (:func:`check_meshed_plate`).
     """
@@ -637,7 +637,7 @@ def meshed_plate(link: str, values: dict[str, Any]) -> tuple[float, str, str] | 
 
     ``ffrf`` and ``nonlinear_fe`` links are meshed; an ``auto`` crank always is (its
     frequency is computed on the mesh; a lumped crank as the plate of its mass, of thickness
-    mass / (density x length x width), as :func:`flex.fidelity.criteria.equivalent_crank_plate`); an
+    mass / (density x length x width), as :func:`flex.fidelity.auto.equivalent_crank_plate`); an
     ``auto`` coupler is when the criterion chooses ``ffrf``.
     """
     model = values["model"]
@@ -687,7 +687,7 @@ def check_meshed_plate(link: str, values: dict[str, Any]) -> None:
             raise SceneError(f"{name} = {thickness:g}: a meshed plate link must be at "
                              f"{word} {link}.length_m / {ratio:g} = {bound:g} m thick "
                              f"({why}){as_mass(relation, bound)}; {meaning}")
-    if mesh == "auto":  # checked once resolved (flex.config.settings.check_runnable)
+    if mesh == "auto":  # checked once resolved (flex.fidelity.auto.check)
         return
     if mesh > length * (1 + 1e-9):
         raise SceneError(f"{link}.mesh_size_m = {mesh:g} must be <= {link}.length_m = "

@@ -108,7 +108,7 @@ def spring_chain(scene: Scene) -> SpringChain | None:
     if drive["kind"] == "spring" and drive["spring_model"] == "auto":
         raise SceneError('drive.spring_model = "auto" must be resolved before building '
                          "(flex.fidelity.simulation.simulate does it with "
-                         "flex.fidelity.criteria.resolve_fidelity)")
+                         "flex.fidelity.auto.resolve)")
     if drive["kind"] != "spring" or drive["spring_model"] != "chain":
         return None
     segments, mass_kg = int(drive["spring_segments"]), drive["spring_mass_kg"]

@@ -61,7 +61,7 @@ def build_mechanism(scene: Scene, reduction: Any = None, crank_reduction: Any = 
         if scene[link]["model"] == "auto":
             raise SceneError('model = "auto" must be resolved before building '
                              "(flex.fidelity.simulation.simulate does it with "
-                             "flex.fidelity.criteria.resolve_fidelity)")
+                             "flex.fidelity.auto.resolve)")
     if planar and not is_planar(scene):
         raise SceneError("a planar build needs rigid crank and coupler and an implicit "
                          "integrator (simulation.integrator != \"explicit_penalty\")")

@@ -6,7 +6,7 @@
 - output: a :class:`~flex.data.results.CaseResult` whose datasets are the quantities of the
   result layout (``time``, ``crank/...``, ``slider/...``, ``joints/<A|B|C>/...``,
   ``constraint_norm``, ``energy/...`` (rigid and FFRF links), ``coupler/...``), each with units;
-- refused before anything is built: what :func:`flex.config.settings.check_runnable` refuses
+- refused before anything is built: what :func:`flex.config.settings.check_concrete` refuses
   (:class:`~flex.base.errors.SceneError`, a ``failed`` case from :func:`simulate_case`);
 - status: ``ok``; a diverging run (solver failure, NaN, exploding constraint norm) raises
   :class:`~flex.base.errors.SimulationError` naming the step and time and what may help
@@ -37,15 +37,9 @@ from typing import Any
 
 import numpy as np
 
-from flex.base.errors import FlexError, SimulationError, Terminated
+from flex.base.errors import SimulationError, Terminated
 from flex.base.progress import heartbeat
-from flex.config.settings import (
-    check_runnable,
-    has_auto_link_keys,
-    resolve_link_keys,
-    resolve_solver_settings,
-    resolved_simulation,
-)
+from flex.config.settings import check_concrete
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, check_meshed_plate, estimate_mesh, to_toml
 from flex.dynamics import planar
@@ -71,9 +65,9 @@ NONLINEAR_FE_NEWTON_ABSOLUTE_TOLERANCE = 1e-6
 
 
 def solver_settings(scene: Scene) -> dict[str, Any]:
-    """The integrator settings used for ``scene`` (stored in every result file); ``"auto"``
-    keys resolved as :func:`simulate` resolves them (:mod:`flex.config.settings`)."""
-    sim = resolved_simulation(scene)
+    """The integrator settings used for a concrete ``scene`` (stored in every result
+    file)."""
+    sim = scene["simulation"]
     settings = {
         "integrator": "generalized-alpha (Exudyn, index 3)",
         "step_s": sim["step_s"],
@@ -424,9 +418,10 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
     """
     from flex.bodies.reduction import build_reduction
 
-    if has_auto_link_keys(scene):  # "auto" modes and mesh: the rule's (flex.config.ffrf_rule)
-        scene, _ = resolve_link_keys(scene)
     c = scene[link]
+    if "auto" in (c["modes"], c["mesh_size_m"]):
+        raise ValueError(f'{link}: resolve its "auto" modes and mesh first '
+                         f"(flex.fidelity.auto.resolve, flex.config.settings.resolve_link_keys)")
     check_meshed_plate(link, dict(c, model="ffrf"))  # refused before any meshing
     _announce_mesh(link, c, f"reduction with {c['modes']} modes (instant if cached)",
                    c["modes"])
@@ -653,24 +648,14 @@ def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any],
 
 def integrate(scene: Scene, name: str = "case", reduction: Any = None,
               crank_reduction: Any = None, *, cache_dir: Path | None = None) -> CaseResult:
-    """Build, integrate and collect one case of a scene whose links have concrete models
-    (rigid, ffrf, nonlinear_fe); raises on divergence (see module doc).
-
-    ``model = "auto"`` links are resolved a layer above (:func:`flex.fidelity.simulation.simulate`);
-    here they are refused. ``reduction`` / ``crank_reduction``: the reductions of an
+    """Build, integrate and collect one case of a concrete scene (every ``"auto"`` decided
+    a layer above, :func:`flex.fidelity.auto.resolve`; here it is refused); raises on
+    divergence (see module doc). ``reduction`` / ``crank_reduction``: the reductions of an
     ``ffrf`` coupler / crank (None: :func:`reduction_for_scene` builds them, or loads them from
     ``cache_dir``: the reduction cache folder; None: built in memory, no disk cache).
-    ``"auto"`` solver keys are filled by model (:func:`flex.config.settings.
-    resolve_solver_settings`; attributes ``solver_defaults_*``). ``scene_toml`` holds the
-    resolved scene.
+    ``scene_toml`` holds the scene.
     """
-    for link in ("crank", "coupler"):
-        if scene[link]["model"] == "auto":
-            raise FlexError(f'{link}.model = "auto" is resolved by '
-                            f"flex.fidelity.simulation.simulate, not by "
-                            f"flex.dynamics.solver.integrate")
-    scene, solver_choice = resolve_solver_settings(scene)
-    check_runnable(scene)  # the concrete models and steps, before anything is built
+    check_concrete(scene)  # no "auto" left, steps and meshes, before anything is built
     reduction, crank_reduction = scene_reductions(scene, reduction, crank_reduction,
                                                   cache_dir=cache_dir)
     if scene["coupler"]["model"] == "nonlinear_fe" and reduction is None:
@@ -691,8 +676,6 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     result = CaseResult(name, to_toml(scene), datasets, counters=counters,
                         solver_settings_toml=tomli_w.dumps(settings))
     result.attrs.update(flexible_link_attrs(scene, datasets, _reductions(mech)))
-    if solver_choice is not None:
-        result.attrs.update(solver_choice.attrs())
     warning = validity_warning(scene, datasets)
     if warning:
         result.attrs[VALIDITY_WARNING] = warning

@@ -5,7 +5,7 @@ coupler's
 law under-predicts the error of a rigid crank that carries the wing (measured about 2x at
 equal n: the wing makes the crank a cantilever under a larger quasi-static load), so the
 crank gets its own, with n = delta_t / T and T the period of the crank's first in-plane
-elastic mode in the assembled mechanism (:func:`flex.fidelity.criteria.crank_elastic_omega`).
+elastic mode in the assembled mechanism (:func:`flex.fidelity.auto.crank_elastic_omega`).
 
 Cases (:func:`cases`): each fit scene (with the wing: the harder case, so the law is
 conservative for cranks without one) as ``<name>__rigid`` and ``<name>__full`` (an FFRF
@@ -28,10 +28,10 @@ from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides
 from flex.experiments import lawfit
 from flex.experiments.lawfit import REPORT_TOLERANCES, Validation, case_data
+from flex.fidelity.auto import crank_elastic_omega
 from flex.fidelity.criteria import (
     DELTA_T_DEFINITIONS,
     GOVERNING,
-    crank_elastic_omega,
     deployment_times,
     errors_against_full,
     load_criterion,

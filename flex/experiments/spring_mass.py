@@ -414,7 +414,7 @@ def massless_predictions(cases: Mapping[str, Scene], table: Mapping[str, Mapping
     (:func:`flex.fidelity.spring_choice.predict_massless_spring_error`) from the case's
     rigid probe (:func:`flex.fidelity.criteria.deployment_probe`: an FFRF coupler's rigid
     twin), as ``drive.spring_model = "auto"`` makes it."""
-    from flex.fidelity.criteria import deployment_probe
+    from flex.fidelity.probe import deployment_probe
     from flex.fidelity.spring_choice import predict_massless_spring_error
 
     out = {}

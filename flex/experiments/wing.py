@@ -188,7 +188,7 @@ def auto_decisions(scene: Scene, datasets: dict[str, Dataset],
     ``datasets``; the report lines. ``cache_dir``: the reduction cache folder of the crank's
     frequency analysis (None: built in memory)."""
     try:
-        from flex.fidelity.criteria import resolve_fidelity
+        from flex.fidelity.auto import decide_links
     except ImportError:
         return ["  auto fidelity: no fitted criterion in this installation"]
     trial = apply_overrides(scene, ['crank.model="auto"'])
@@ -200,7 +200,7 @@ def auto_decisions(scene: Scene, datasets: dict[str, Dataset],
                      'no stiffness to decide on (auto needs coupler.geometry = "plate")')
     try:
         validate(trial)
-        _, decisions = resolve_fidelity(trial, cache_dir=cache_dir)
+        _, decisions = decide_links(trial, cache_dir=cache_dir)
     except Exception as exc:  # a refusal is itself the answer worth reporting
         return lines + [f"  auto fidelity (the links as simulated): {exc}"]
     for decision in decisions:

@@ -27,7 +27,7 @@ links and an FFRF coupler judged by its rigid twin's probe, coil masses 3-300 g 
 masses 26.4 and 100 g; m_s / M_min 0.017-3.1), predicted / measured 1.00-1.17 (the
 quasi-static part alone 0.87-1.00; the chain's deployment time within 1 %; docs/spring-mass.md).
 
-``auto`` (:func:`decide_spring`, called first by :func:`flex.fidelity.simulation.resolve_auto`):
+``auto`` (:func:`decide_spring`, called first by :func:`flex.fidelity.auto.resolve`):
 ``"massless"`` when the prediction times :data:`SPRING_PREDICTION_MARGIN` meets
 ``fidelity.tolerance``; otherwise ``"chain"`` with the fewest segments N whose discretization
 error, :data:`CHAIN_ERROR_CONSTANT` x that bound / N^2, stays within
@@ -53,7 +53,8 @@ from flex.base.physics import (
 )
 from flex.bodies.spring import surge_frequency_fixed_end_mass_Hz
 from flex.data.scene import SCHEMA
-from flex.fidelity.criteria import FidelityDecision, deployment_probe, first_maximum_index
+from flex.fidelity.criteria import first_maximum_index
+from flex.fidelity.probe import FidelityDecision, deployment_probe
 
 #: what ``auto`` multiplies the predicted massless error by before it compares it with the
 #: tolerance. The prediction is a bound: predicted / measured 1.001-1.17 on the 14 massless
