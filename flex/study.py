@@ -6,7 +6,7 @@ A study is a module in ``studies/`` that declares what it runs and what it store
     DESCRIPTION = "one line"
     OVERRIDES = ["drive.kind=\"constant_speed\"", ...]   # applied to the base scene
     def cases(scene) -> dict[str, Scene]                   # the scenes it simulates
-    def summarize(scene, results, notes) -> Summary        # tables, report text
+    def summarize(scene, results, run) -> Summary          # tables, report text
     def figures(results, summary, folder) -> list[Path]    # PNGs (optional)
 
 Optionally ``def simulate_cases(scenes, run: StudyRun) -> dict[str, CaseResult]`` replaces
@@ -50,9 +50,15 @@ from flex.fidelity.caseloop import run_each
 from flex.fidelity.simulation import simulate_case
 from flex.tools.report import default_report_path, figures_of, render_report
 
-STUDIES = ("simulate", "kinematics", "dynamics", "modal", "flexible", "spring", "kfit",
-           "tradeoff", "stability", "bench", "wing", "crank", "estimates",
-           "calibrate", "design", "validation", "ladder", "spring_mass")
+#: the one registry of studies (each a module ``studies/<name>.py``): what ``make all`` runs,
+#: in its order; the long studies, each its own ``make`` target only; and ``simulate`` (one
+#: scene, ``flex run simulate``). The Makefile's ``STUDIES`` and ``LONG``, the command line's
+#: choices and the README's study table are checked against it (tests/test_make.py).
+MAKE_ALL_STUDIES = ("kinematics", "dynamics", "modal", "flexible", "spring", "wing", "crank",
+                    "kfit")
+LONG_STUDIES = ("tradeoff", "stability", "bench", "estimates", "calibrate", "design",
+                "validation", "ladder", "spring_mass")
+STUDIES = ("simulate", *MAKE_ALL_STUDIES, *LONG_STUDIES)
 RESULTS_DIR = Path("results")
 #: keys that change what a study simulates in kind, not in degree: the drive, the wing, the
 #: links' models and geometry, the spring's model, the integrator. A study runs with its own
@@ -78,10 +84,10 @@ class Summary:
 @dataclass
 class StudyRun:
     """What a study's ``simulate_cases`` gets beside its scenes, and hands on to
-    ``summarize``: the progress callback, the sweep settings (sweep studies:
-    :class:`flex.sweep.SweepSettings`, None for their defaults), and ``notes``: what the
-    run measured beside its cases (references, verdicts, executor figures), read by
-    ``summarize(scene, results, notes)``. One per run: nothing is kept in a study module.
+    ``summarize(scene, results, run)``: the progress callback, the sweep settings (sweep
+    studies: :class:`flex.sweep.SweepSettings`, None for their defaults), and ``notes``: what
+    the run measured beside its cases (references, verdicts, executor figures). One per run:
+    nothing is kept in a study module.
 
     ``cache_dir``: the reduction cache folder, passed on to everything that builds a
     reduction (None: reductions are built in memory, with no disk cache; the command lines
@@ -258,7 +264,7 @@ def execute(module: ModuleType, scene: Scene,
     run = StudyRun(progress, sweep, cache_dir=cache_dir, environment=dict(environment or {}))
     simulate_cases = getattr(module, "simulate_cases", simulate_each)
     results = simulate_cases(scenes, run)
-    summary = module.summarize(scene, results, run.notes)
+    summary = module.summarize(scene, results, run)
     return StudyOutput(module.NAME, scene, results, summary, time.perf_counter() - start)
 
 

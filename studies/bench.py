@@ -137,10 +137,10 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     """The table and the per-part datasets
     (:func:`flex.experiments.benchmark_report.bench_summary`)."""
-    return Summary(*bench_summary(notes or {}, PLAN))
+    return Summary(*bench_summary(run.notes, PLAN))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:

@@ -15,7 +15,6 @@ from __future__ import annotations
 import tomllib
 from functools import partial
 from pathlib import Path
-from typing import Any
 
 from flex.config.ffrf_rule import rule_constants
 from flex.data.results import CaseResult
@@ -65,7 +64,7 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     all_scenes = cases(scene)
     return Summary(*calibration_summary(
         results, {name: all_scenes[name] for name in CALIBRATION},

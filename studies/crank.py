@@ -29,7 +29,6 @@ largest (governing) is fitted and held against the tolerance.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M
 from flex.config.settings import pinned_overrides
@@ -82,8 +81,8 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
-    return Summary(*crankfit.summarize(cases(scene), results, (notes or {}).get("analysis"),
+              run: StudyRun) -> Summary:
+    return Summary(*crankfit.summarize(cases(scene), results, run.notes.get("analysis"),
                                        CRITERION_PATH))
 
 

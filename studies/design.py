@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import functools
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -68,13 +67,13 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     from flex.experiments import design_report
 
     names = design.reference_names(scene, GRID, REFERENCE_ANGLES_DEG)
     datasets = design.summary_datasets(scene, GRID, results,
                                        design.run_references(results, names))
-    return Summary(datasets, design_report.report_text(datasets, (notes or {}).get("sweep")))
+    return Summary(datasets, design_report.report_text(datasets, run.notes.get("sweep")))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:

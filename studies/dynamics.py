@@ -19,14 +19,13 @@ under ``/summary``.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.api import derive_scene
 from flex.base.thesis import THESIS_COMPRESSION_M, THESIS_SLIDER_TRAVEL_M
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.experiments import deployment
-from flex.study import Summary
+from flex.study import StudyRun, Summary
 
 NAME = "dynamics"
 DESCRIPTION = "spring-driven deployment, both preload readings, against the reference DAE"
@@ -41,7 +40,7 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     return Summary(*deployment.summary(results))
 
 

@@ -16,7 +16,6 @@ nonlinear FE reference's cost); the rigid ones the whole deployment (the deploym
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, derived_scenes
@@ -60,7 +59,7 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     return Summary(*estimate_summary(results))
 
 

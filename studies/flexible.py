@@ -22,7 +22,6 @@ largest difference, the compression over the Euler load (:mod:`flex.fidelity.sof
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.base.thesis import THESIS_DELTA_T_S
 from flex.config.settings import pinned_overrides
@@ -64,8 +63,8 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
-    return Summary(*summarize_twins(scene, results, notes or {}, MODELS,
+              run: StudyRun) -> Summary:
+    return Summary(*summarize_twins(scene, results, run.notes, MODELS,
                                     THESIS_DEPLOYMENT_TIME_S))
 
 

@@ -39,7 +39,6 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -122,8 +121,8 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
-    return Summary(*couplerfit.summarize(results, notes or {},
+              run: StudyRun) -> Summary:
+    return Summary(*couplerfit.summarize(results, run.notes,
                                          couplerfit.left_out_cases(scene, *_grid())))
 
 

@@ -10,12 +10,11 @@ the crank midpoint must trace a circle of radius L1/2; the constraint norm stays
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.experiments import constant_speed
-from flex.study import Summary
+from flex.study import StudyRun, Summary
 
 NAME = "kinematics"
 DESCRIPTION = "constant-speed crank, one turn per second, against the closed form"
@@ -29,7 +28,7 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     return Summary(*constant_speed.summary(results["constant_speed"]))
 
 

@@ -16,7 +16,6 @@ on 2 cores, most of it the nonlinear FE runs.
 from __future__ import annotations
 
 import math
-from typing import Any
 
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
@@ -68,7 +67,7 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     rungs, datasets = [], {}
     for thickness_mm in PLATES:
         label = _label(thickness_mm)

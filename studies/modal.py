@@ -15,7 +15,6 @@ is :func:`flex.experiments.modal.survey`; nothing is simulated.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
@@ -35,13 +34,12 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
-    run.notes["progress"] = run.progress  # the survey (in summarize) reports its long steps
     return {}
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
-    return Summary(*modal.survey(scene, (notes or {}).get("progress")))
+              run: StudyRun) -> Summary:
+    return Summary(*modal.survey(scene, run.progress))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:

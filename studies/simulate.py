@@ -13,12 +13,11 @@ here.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.experiments import single_case
-from flex.study import STRUCTURAL_KEYS, Summary
+from flex.study import STRUCTURAL_KEYS, StudyRun, Summary
 
 NAME = "simulate"
 DESCRIPTION = "one case: exactly the given scene"
@@ -30,7 +29,7 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     return Summary(*single_case.summary(results["case"]))
 
 

@@ -14,12 +14,11 @@ simulated.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.experiments import spring_check
-from flex.study import Summary
+from flex.study import StudyRun, Summary
 
 NAME = "spring"
 DESCRIPTION = "helical spring: rate, stress (Wahl, FE), surge and the rigid criterion"
@@ -33,7 +32,7 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     return Summary(*spring_check.summary(scene))
 
 

@@ -13,12 +13,11 @@ segments, rigid links and an FFRF plate coupler (:mod:`flex.experiments.spring_m
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.experiments import spring_mass
-from flex.study import Summary
+from flex.study import StudyRun, Summary
 
 NAME = "spring_mass"
 DESCRIPTION = "the deployment spring with its mass: chain convergence, deployment changes"
@@ -36,7 +35,7 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     return Summary(*spring_mass.summary(_scenes(scene), results))
 
 

@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any
 
 from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M
 from flex.config.settings import pinned_overrides
@@ -159,8 +158,8 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
-    return Summary(*summarize_extremes(results, notes or {}, TOLERANCE))
+              run: StudyRun) -> Summary:
+    return Summary(*summarize_extremes(results, run.notes, TOLERANCE))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:

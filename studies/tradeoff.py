@@ -20,7 +20,6 @@ runs (:mod:`~flex.experiments.defaults_check`, :mod:`~flex.experiments.rule_chec
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
@@ -179,10 +178,10 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
+              run: StudyRun) -> Summary:
     """Per scene the run table, the reference and its evidence, the recommendations and the
     defaults check (:func:`flex.experiments.workprecision_report.summarize_work_precision`)."""
-    datasets, report = summarize_work_precision((notes or {}).get("runs", {}), cases(scene),
+    datasets, report = summarize_work_precision(run.notes.get("runs", {}), cases(scene),
                                                 FFRF_DEFAULT_SCENE)
     return Summary(datasets, report)
 

@@ -13,7 +13,6 @@ each comparison means: :mod:`flex.experiments.validation`, docs/validation.md.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
@@ -59,8 +58,8 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
-    solutions = (notes or {}).get("two_mode") or validation.two_mode_runs()
+              run: StudyRun) -> Summary:
+    solutions = run.notes.get("two_mode") or validation.two_mode_runs()
     return Summary(*validation.analyse(scene, results, solutions, REFERENCE))
 
 

@@ -18,7 +18,6 @@ the ``auto`` fidelity decision of :mod:`flex.fidelity.criteria` where a fitted c
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
@@ -40,13 +39,12 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Each case on its own; the summary's ``auto`` decisions get the reduction cache."""
-    run.notes["cache_dir"] = run.cache_dir  # the crank's frequency analysis (in summarize)
     return simulate_each(scenes, run)
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
-              notes: dict[str, Any] | None = None) -> Summary:
-    return Summary(*wing.summary(results["wing_deployment"], (notes or {}).get("cache_dir")))
+              run: StudyRun) -> Summary:
+    return Summary(*wing.summary(results["wing_deployment"], run.cache_dir))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:

@@ -317,6 +317,7 @@ def test_bench_figures_synthetic(tmp_path, reviewed):
 
 
 def test_estimates_figure_and_summary_synthetic(tmp_path, reviewed):
+    from flex.study import StudyRun
     from studies import estimates
 
     results = {}
@@ -328,7 +329,7 @@ def test_estimates_figure_and_summary_synthetic(tmp_path, reviewed):
             "true_error_crank_angle_end_rad": true,
             "reference_accuracy_crank_angle_end_rad": true / 100,
             "estimated_error_validity": validity})
-    result = estimates.summarize({}, results)
+    result = estimates.summarize({}, results, StudyRun())
     # true / estimated: 1/0.95 and 1/1.2 within [1/3, 1.5], 100 (optimistic) outside
     assert "2 of 3 judged pairs within the target" in result.report
     assert "most optimistic true/estimated 100" in result.report

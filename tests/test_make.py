@@ -357,3 +357,29 @@ def test_nonlinear_fe_progress_reports_time_steps_and_remaining(monkeypatch, cap
     assert lines[0] == ("nonlinear FE coupler: t = 10 ms of 30 ms (33 %), step 100, 10 s "
                         "elapsed, ~20 s left (200 force, 1 Jacobian evaluations)")
     assert "\r" not in "".join(lines)
+
+
+def test_one_registry_of_studies_ties_the_makefile_the_cli_and_the_readme():
+    """flex.study's registry is the one list: make all runs MAKE_ALL_STUDIES in order, the
+    long ones are LONG_STUDIES, every study has its module, the command line offers exactly
+    them, and the README's study table has one row per study."""
+    import argparse
+
+    from flex.cli import _parser
+    from flex.study import LONG_STUDIES, MAKE_ALL_STUDIES, STUDIES
+
+    assert set(STUDIES) == {"simulate", *MAKE_ALL_STUDIES, *LONG_STUDIES}
+    assert len(STUDIES) == 1 + len(MAKE_ALL_STUDIES) + len(LONG_STUDIES)
+    assert globals()["STUDIES"] == list(MAKE_ALL_STUDIES)  # the Makefile's, in its order
+    assert LONG == list(LONG_STUDIES)
+    for study in STUDIES:
+        assert (ROOT / "studies" / f"{study}.py").is_file()
+    commands = next(action for action in _parser()._actions
+                    if isinstance(action, argparse._SubParsersAction))
+    for verb in ("run", "scene"):
+        (study,) = [action for action in commands.choices[verb]._actions
+                    if action.dest == "study"]
+        assert tuple(study.choices) == STUDIES
+    rows = re.findall(r"^\| `(?:make|flex run) (\w+)`", (ROOT / "README.md").read_text(),
+                      re.MULTILINE)
+    assert sorted(rows) == sorted(STUDIES)

@@ -312,14 +312,15 @@ def test_the_study_summary_checks_the_bundled_defaults(rigid_reference):
         default_setting,
         within_default_tolerance,
     )
+    from flex.study import StudyRun
 
     base = load_scene(overrides=study.OVERRIDES + SHORT)
     default = measure(base, default_setting(), rigid_reference, repeats=1)
     coarse = measure(base, Setting.of("h=1e-4", step_s=1e-4), rigid_reference, repeats=1)
     assert within_default_tolerance(default, base)
     assert not within_default_tolerance(coarse, base)  # its step is above 1e-5 s
-    summary = study.summarize(base, {}, {"runs": {"rigid": (rigid_reference, [default, coarse],
-                                                          0.0)}})
+    summary = study.summarize(base, {}, StudyRun(notes={"runs": {"rigid": (
+        rigid_reference, [default, coarse], 0.0)}}))
     assert summary.datasets["rigid/default/setting"].data == DEFAULT_LABEL
     assert bool(summary.datasets["rigid/default/matches_table"].data)
     assert "defaults flex defaults (auto)" in summary.report
