@@ -51,7 +51,9 @@ def estimated_run_time_s(scene: Scene, modes: dict[str, int] | None = None) -> f
 
 def announce_integration(scene: Scene, name: str, reductions: dict[str, Any]) -> None:
     """Say on stderr, before it starts, what a long integration will cost (estimate)."""
-    modes = {link: built.modes for link, built in reductions.items() if built is not None}
+    # a nonlinear FE coupler's plate has no modes: its cost comes from its mesh
+    modes = {link: built.modes for link, built in reductions.items()
+             if getattr(built, "modes", None) is not None}
     estimate = estimated_run_time_s(scene, modes)
     if estimate > ANNOUNCE_RUN_S:
         sim = scene["simulation"]
