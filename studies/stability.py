@@ -137,9 +137,16 @@ def extremes() -> list[Extreme]:
     out.append(Extreme("diverge_explicit_above_limit", "divergence",
                        ('simulation.integrator="explicit_penalty"', "simulation.step_s=3e-5"),
                        "scipy", 3e-5, expect="diverges"))
-    out.append(Extreme("diverge_thin_plate_h1e-4", "divergence",
-                       _plate(0.3) + ("simulation.end_time_s=0.01", "simulation.step_s=1e-4"),
-                       "none", 1e-4, expect="diverges"))
+    # the bundled scene's own solver choice (auto modes, modified Newton) at 1e-3 s on the
+    # 0.3 mm plate: 0.1 steps per period of its highest mode, Newton cannot follow (measured:
+    # at 1e-4 s, or with full Newton, the stiffened body runs -- the scheme damps what it misses)
+    auto_solver = ('coupler.modes="auto"', 'simulation.newton="auto"',
+                   'simulation.newton_relative_tolerance="auto"',
+                   'simulation.spectral_radius="auto"')
+    out.append(Extreme("diverge_thin_plate_h1e-3", "divergence",
+                       _plate(0.3) + auto_solver + ("simulation.end_time_s=0.01",
+                                                    "simulation.step_s=1e-3"),
+                       "none", 1e-3, expect="diverges"))
     return out
 
 

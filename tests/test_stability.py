@@ -182,7 +182,20 @@ def test_the_stability_study_declares_its_forced_divergences():
     from studies import stability
 
     assert stability.EXPECTED_FAILURES == {"diverge_explicit_above_limit",
-                                           "diverge_thin_plate_h1e-4", "long_rigid_rho1"}
+                                           "diverge_thin_plate_h1e-3", "long_rigid_rho1"}
+
+
+def test_the_thin_plate_built_to_diverge_does_diverge_and_names_its_step():
+    from studies import stability
+
+    (extreme,) = [e for e in stability.extremes() if e.name == "diverge_thin_plate_h1e-3"]
+    from flex.config.settings import pinned_overrides
+    from flex.experiments.stability import extreme_cases
+
+    (scene,) = extreme_cases(load_scene(None, pinned_overrides()), [extreme]).values()
+    result = simulate_case(scene, extreme.name)
+    assert result.status == "failed" and "diverged" in result.message
+    assert "simulation.step_s" in result.message
 
 
 # ------------------------------------------------------------------------------------------
