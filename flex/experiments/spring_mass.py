@@ -138,8 +138,8 @@ def wing_spring_mass_kg(rate_N_per_m: float) -> float:
 
 def wing_spring_scene(scene: Scene) -> Scene:
     """``scene`` with the wing welded on and the wing study's fitted spring
-    (:func:`flex.experiments.wing.fit_spring`), its mass from :func:`wing_spring_mass_kg`."""
-    from flex.experiments.wing import fit_spring
+    (:func:`flex.experiments.thesis.wing.fit_spring`), its mass from :func:`wing_spring_mass_kg`."""
+    from flex.experiments.thesis.wing import fit_spring
 
     fitted, values = fit_spring(apply_overrides(scene, ["wing.enabled=true"]))
     return apply_overrides(fitted, [
