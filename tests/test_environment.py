@@ -25,7 +25,7 @@ EDGES = {
     # configures Exudyn itself (no user settings file) before it is imported
     ("dynamics/builder.py", "<module>"): "os.environ.setdefault('EXUDYN_NO_USER_SETTINGS')",
     # the environment of a child `make` process (with its own FLEX_CACHE_DIR)
-    ("experiments/benchmark.py", "bench_make_all"): "the child make's environment",
+    ("experiments/workprecision/benchmark.py", "bench_make_all"): "the child make's environment",
 }
 
 

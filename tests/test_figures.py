@@ -298,7 +298,7 @@ def test_bench_figures_synthetic(tmp_path, reviewed):
         for which, scale in (("profile_untuned", 1.0), ("profile_tuned", 0.8)):
             for phase, share in (("newton", 40.0), ("jacobian", 30.0), ("output", 10.0)):
                 data[f"{part}/{which}/exudyn_{phase}_percent"] = share * scale
-    from flex.experiments.benchmark_report import _step_cost_rows
+    from flex.experiments.workprecision.benchmark_report import _step_cost_rows
 
     step_cost: dict = {}
     rows = _step_cost_rows([

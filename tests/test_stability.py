@@ -191,7 +191,7 @@ def test_the_stability_study_declares_its_forced_divergences():
 def test_a_constant_speed_run_is_judged_against_the_closed_form():
     from flex.config.settings import pinned_overrides
     from flex.experiments.stability import Extreme, References, extreme_cases, judge
-    from flex.experiments.tradeoff import ReductionPool
+    from flex.experiments.workprecision.measurement import ReductionPool
 
     extreme = Extreme("crank_speed", "stiff_drive", (
         'drive.kind="constant_speed"', "simulation.end_time_s=0.01"), "closed_form", 1.0)

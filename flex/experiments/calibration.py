@@ -7,8 +7,8 @@ and materials, springs and drives) :func:`measure_scene` runs
   32, at least :data:`REFERENCE_MESH_FLOOR_M`) and a step that resolves the 12th mode
   (:data:`REFERENCE_STEPS_PER_TOP_PERIOD` steps per period, at most T1 / 400), with the
   evidence of three one-level coarsenings (8 modes, twice the step, 1.5 x the mesh; their
-  changes summed are the reference's accuracy, :func:`flex.experiments.tradeoff.
-  converged_reference`);
+  changes summed are the reference's accuracy,
+  :func:`flex.experiments.workprecision.convergence.converged_reference`);
 - the **grid**: every pair of :data:`GRID_MODES` and :data:`GRID_STEPS_PER_PERIOD` (step T1 /
   N) on the rule's mesh, each timed as a user runs it (whole ``simulate``, warm reduction
   cache, median of ``repeats``) and measured against the reference (relative error of the
@@ -52,12 +52,12 @@ from flex.config.ffrf_rule import (
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
 from flex.dynamics.solver import FFRF_DEFLECTION_LIMIT
-from flex.experiments.tradeoff import (
+from flex.experiments.workprecision.convergence import converged_reference
+from flex.experiments.workprecision.measurement import (
     ReductionPool,
     Reference,
     Setting,
     certifies,
-    converged_reference,
     measure,
     scene_for,
 )
@@ -250,7 +250,7 @@ def within_linear_validity(case: CaseResult) -> bool:
 def certifiable(case: CaseResult, level: float) -> bool:
     """Whether the case can certify ``level``: its reference within the linear FFRF validity
     (:func:`within_linear_validity`) and accurate to at most 1 / REFERENCE_MARGIN of the
-    level (:data:`flex.experiments.tradeoff.REFERENCE_MARGIN`)."""
+    level (:data:`flex.experiments.workprecision.measurement.REFERENCE_MARGIN`)."""
     return (case.status == "ok" and within_linear_validity(case)
             and certifies(case.attrs["reference_accuracy"], level))
 

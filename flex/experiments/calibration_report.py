@@ -43,7 +43,7 @@ from flex.experiments.calibration import (
     validate,
 )
 from flex.experiments.rule_designs import TWIN_CLOSENESS, design_frontier, near_twins
-from flex.experiments.tradeoff import pareto_front
+from flex.experiments.workprecision.pareto import pareto_front
 
 
 def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[str, Scene],

@@ -1,21 +1,21 @@
-"""What a work-precision run reports: per scene the run table, the reference and its evidence,
-the recommendations, the defaults check, and the work-precision diagram.
+"""What the ``tradeoff`` study reports: per scene the run table, the reference and its
+evidence, the recommendations, the defaults check, and the work-precision diagram.
 
-:func:`summarize_work_precision` turns ``notes["runs"]`` of :func:`flex.experiments.workprecision.
-run_work_precision` into datasets under ``<scene>/``: ``runs/...`` (the table of
-:func:`flex.experiments.tradeoff.measurements_table`, with ``on_pareto_front``), ``reference/...``
-(what it
-is and its convergence evidence), ``recommended/...`` (per accuracy level 1 %, 0.1 %, 0.01 %),
-``default/...`` and ``rule/...`` (the flex rule's picks, :mod:`flex.experiments.rule_check`),
-and into the report text. :func:`work_precision_figures` draws, from those datasets, one diagram
-per scene: error against wall time (log-log), the Pareto fronts, the rule's picks (open stars),
-the accuracy levels and the band the reference cannot resolve.
+:func:`summarize_work_precision` turns ``notes["runs"]`` of
+:func:`flex.experiments.workprecision.tradeoff.run_work_precision` into datasets under
+``<scene>/``: ``runs/...`` (the table of :func:`measurements_table`, with ``on_pareto_front``),
+``reference/...`` (what it is and its convergence evidence), ``recommended/...`` (per accuracy
+level 1 %, 0.1 %, 0.01 %), ``default/...`` and ``rule/...`` (the flex rule's picks,
+:mod:`flex.experiments.workprecision.rule_check`), and into the report text.
+:func:`work_precision_figures` draws, from those datasets, one diagram per scene: error against
+wall time (log-log), the Pareto fronts, the rule's picks (open stars), the accuracy levels and
+the band the reference cannot resolve.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -24,22 +24,55 @@ import numpy as np
 from flex.base.plotting import figure, legend_below
 from flex.data.results import Dataset
 from flex.data.scene import Scene
-from flex.experiments.defaults_check import ffrf_defaults_check, rigid_defaults_check
-from flex.experiments.rule_check import rule_check
-from flex.experiments.tradeoff import (
-    ACCURACY_LEVELS,
-    Measurement,
-    Reference,
-    describe,
-    fastest,
-    measurements_table,
-    pareto_front,
-    recommend,
-)
-from flex.experiments.workprecision import SceneRuns
+from flex.experiments.workprecision.defaults_check import ffrf_defaults_check, rigid_defaults_check
+from flex.experiments.workprecision.measurement import Measurement, Reference, describe
+from flex.experiments.workprecision.pareto import ACCURACY_LEVELS, fastest, pareto_front, recommend
+from flex.experiments.workprecision.rule_check import rule_check
+from flex.experiments.workprecision.tradeoff import SceneRuns
 
 HEADER = ("work-precision (error = largest relative error of crank angle / swing, slider / "
           "travel, peak deflection / peak; wall = median integration time)")
+
+
+def measurements_table(measurements: Sequence[Measurement], front: Iterable[int] = ()
+                       ) -> dict[str, Dataset]:
+    """Columns of the per-run table (stored under ``/summary/<scene>/runs/``)."""
+    on_front = set(front)
+    rows = list(measurements)
+
+    def column(values, units, text, dtype=float):
+        return Dataset(np.array(values, dtype=dtype), units, text)
+
+    return {
+        "label": column([m.setting.label for m in rows], "1", "setting", object),
+        "group": column([m.setting.group for m in rows], "1", "sweep the setting belongs to",
+                        object),
+        "knobs": column([repr(m.setting.knobs()) for m in rows], "1",
+                        "engine and scene overrides of the setting", object),
+        "status": column([m.status for m in rows], "1", "ok | failed", object),
+        "message": column([m.message for m in rows], "1", "why a run failed", object),
+        "wall_time": column([m.wall_time_s for m in rows], "s",
+                            "median integration wall time over the repeats"),
+        "repeats": column([len(m.wall_times_s) for m in rows], "1", "runs timed", int),
+        "total_time": column([m.total_time_s for m in rows], "s",
+                             "median build + integration + output time"),
+        "steps": column([m.steps for m in rows], "1", "time steps", int),
+        "newton_iterations": column([m.newton_iterations for m in rows], "1",
+                                    "Newton iterations", int),
+        "jacobian_updates": column([m.jacobian_updates for m in rows], "1",
+                                   "Jacobian computations", int),
+        "crank_angle_error": column([m.errors.get("crank_angle_rad", np.nan) for m in rows],
+                                    "rad", "max |crank angle - reference|"),
+        "slider_position_error": column([m.errors.get("slider_position_m", np.nan)
+                                         for m in rows], "m", "max |slider x - reference|"),
+        "peak_deflection_error": column([m.errors.get("peak_deflection_m", np.nan)
+                                         for m in rows], "m",
+                                        "|peak midpoint deflection - reference peak|"),
+        "error": column([m.error for m in rows], "1",
+                        "largest relative error (angle / swing, slider / travel, peak / peak)"),
+        "on_pareto_front": column([i in on_front for i in range(len(rows))], "1",
+                                  "not beaten in both wall time and error", bool),
+    }
 
 
 def _evidence_column(evidence: Mapping[str, Mapping[str, Any]], key: str, default: Any
@@ -49,8 +82,8 @@ def _evidence_column(evidence: Mapping[str, Mapping[str, Any]], key: str, defaul
 
 def evidence_datasets(prefix: str, evidence: Mapping[str, Mapping[str, Any]]
                       ) -> dict[str, Dataset]:
-    """The reference's evidence (:attr:`flex.experiments.tradeoff.Reference.evidence`) as columns
-    under
+    """The reference's evidence
+    (:attr:`flex.experiments.workprecision.measurement.Reference.evidence`) as columns under
     ``prefix``, one row per knob sequence or coarsening."""
     names = list(evidence)
     values = np.full((len(names), 3), np.nan)

@@ -22,7 +22,13 @@ from flex.config.ffrf_rule import LINK_KEYS, pick
 from flex.config.settings import AUTO_OVERRIDES, resolve_solver_settings
 from flex.data.results import Dataset
 from flex.data.scene import Scene
-from flex.experiments.tradeoff import Measurement, Reference, Setting, certifies, scene_for
+from flex.experiments.workprecision.measurement import (
+    Measurement,
+    Reference,
+    Setting,
+    certifies,
+    scene_for,
+)
 
 RULE_GROUP = "flex rule"
 #: the accuracy levels (``fidelity.tolerance``, relative) at which the study asks flex for the
