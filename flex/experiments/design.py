@@ -56,8 +56,8 @@ from flex.base.mechanism_checks import (
 from flex.base.thesis import THESIS_ANGLE_MAX_TIME_S, THESIS_SPRING_RATE_N_PER_M
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, validate
-from flex.experiments.couplerfit import mesh_size_m
-from flex.experiments.lawfit import case_data
+from flex.experiments.fitting.kfit import mesh_size_m
+from flex.experiments.fitting.lawfit import case_data
 from flex.fidelity.criteria import first_maximum_index, quasi_static_stress
 from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection
 
@@ -211,7 +211,7 @@ def family_points(scene: Scene, grid: Grid) -> dict[str, list[Point]]:
 
 def point_scene(scene: Scene, point: Point) -> Scene:
     """The case scene of a point: its inputs, the coupler's mesh for its thickness
-    (:func:`flex.experiments.couplerfit.mesh_size_m`), and an end time long enough for the
+    (:func:`flex.experiments.fitting.kfit.mesh_size_m`), and an end time long enough for the
     deployment (:data:`END_TIME_FACTOR`)."""
     angle, preload, rate, thickness = point
     end = END_TIME_FACTOR * THESIS_ANGLE_MAX_TIME_S * math.sqrt(THESIS_SPRING_RATE_N_PER_M / rate)
