@@ -186,11 +186,11 @@ def test_the_stability_study_declares_its_forced_divergences():
 
 
 # ------------------------------------------------------------------------------------------
-# flex.experiments.stability: references, verdicts, trust boundary
+# flex.experiments.models.stability: references, verdicts, trust boundary
 # ------------------------------------------------------------------------------------------
 def test_a_constant_speed_run_is_judged_against_the_closed_form():
     from flex.config.settings import pinned_overrides
-    from flex.experiments.stability import Extreme, References, extreme_cases, judge
+    from flex.experiments.models.stability import Extreme, References, extreme_cases, judge
     from flex.experiments.workprecision.measurement import ReductionPool
 
     extreme = Extreme("crank_speed", "stiff_drive", (
@@ -210,7 +210,7 @@ def test_a_constant_speed_run_is_judged_against_the_closed_form():
 
 
 def test_trust_boundary_interpolates_where_ffrf_comes_within_one_percent():
-    from flex.experiments.stability import trust_boundary
+    from flex.experiments.models.stability import trust_boundary
 
     def verdicts(errors):
         return {f"nonlinear_{t:g}mm": {"group": "nonlinear", "parameter": t,
