@@ -28,6 +28,7 @@ from flex.config.ffrf_rule import (
 )
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
+from flex.data.tables import table_datasets
 from flex.experiments.fitting.calibration import (
     LEVELS,
     MARGIN,
@@ -117,29 +118,24 @@ DESIGN_COLUMNS = (("judged", "pairs"), ("no_pick", "no pick"),
 def _design_datasets(designs: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]:
     """:func:`flex.experiments.fitting.rule_designs.design_frontier`'s tallies as
     ``design_frontier/*``."""
-    out = {f"design_frontier/{key}": Dataset(np.array([row[key] for row in designs]), "1",
-                                             f"(scene, level) pairs: {text}")
-           for key, text in DESIGN_COLUMNS}
-    out["design_frontier/design"] = Dataset(np.array([row["design"] for row in designs],
-                                                     dtype=object), "1", "rule design")
-    out["design_frontier/worst_ratio"] = Dataset(
-        np.array([row["worst_ratio"] for row in designs]), "1",
-        "largest certified error of a pick / its level")
-    return out
+    columns = {key: ("1", f"(scene, level) pairs: {text}") for key, text in DESIGN_COLUMNS}
+    columns |= {"design": ("1", "rule design", object),
+                "worst_ratio": ("1", "largest certified error of a pick / its level")}
+    return table_datasets(designs, columns, "design_frontier")
+
+
+#: ``near_twins/<column>``: one row per pair of near twins (:func:`_twin_datasets`)
+TWIN_COLUMNS = {"scene_a": ("1", "first scene of the pair", object),
+                "scene_b": ("1", "second scene", object),
+                "tolerance": ("1", "level"),
+                "slowdown": ("1", "least worse-of-the-two modelled slowdown of a grid pair "
+                                  "robust on both (inf: none)")}
 
 
 def _twin_datasets(twins: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]:
     """:func:`flex.experiments.fitting.rule_designs.near_twins`' rows as ``near_twins/*``."""
-    return {
-        "near_twins/scene_a": Dataset(np.array([row["scenes"][0] for row in twins],
-                                               dtype=object), "1", "first scene of the pair"),
-        "near_twins/scene_b": Dataset(np.array([row["scenes"][1] for row in twins],
-                                               dtype=object), "1", "second scene"),
-        "near_twins/tolerance": Dataset(np.array([row["tolerance"] for row in twins]), "1",
-                                        "level"),
-        "near_twins/slowdown": Dataset(np.array([row["slowdown"] for row in twins]), "1",
-                                       "least worse-of-the-two modelled slowdown of a grid "
-                                       "pair robust on both (inf: none)")}
+    return table_datasets(({"scene_a": row["scenes"][0], "scene_b": row["scenes"][1], **row}
+                           for row in twins), TWIN_COLUMNS, "near_twins")
 
 
 def _twin_lines(twins: Sequence[Mapping[str, Any]]) -> list[str]:
@@ -195,21 +191,21 @@ def _design_lines(designs: Sequence[Mapping[str, Any]]) -> list[str]:
     return lines
 
 
+#: ``<group>/<column>``: one row per judged (scene, level) pair (:func:`_row_datasets`)
+JUDGED_COLUMNS = {"rule_error": ("1", "certified error of the rule's pick"),
+                  "rule_time_s": ("s", "time of the rule's pick"),
+                  "best_time_s": ("s", "fastest grid pair within the level"),
+                  "slowdown": ("1", "rule / fastest"),
+                  "tolerance": ("1", "level"),
+                  "certifiable": ("1", "the scene's reference can certify the level"),
+                  "meets": ("1", "within the level and the slowdown limit"),
+                  "scene": ("1", "scene", object)}
+
+
 def _row_datasets(group: str, rows: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]:
     """The judged rows of :func:`flex.experiments.fitting.calibration.validate` as ``group/*``."""
     judged = [row for row in rows if "failed" not in row and "outside" not in row]
-    out = {f"{group}/{key}": Dataset(np.array([row[key] for row in judged]), units, text)
-           for key, units, text in (
-               ("rule_error", "1", "certified error of the rule's pick"),
-               ("rule_time_s", "s", "time of the rule's pick"),
-               ("best_time_s", "s", "fastest grid pair within the level"),
-               ("slowdown", "1", "rule / fastest"),
-               ("tolerance", "1", "level"),
-               ("certifiable", "1", "the scene's reference can certify the level"),
-               ("meets", "1", "within the level and the slowdown limit"))}
-    out[f"{group}/scene"] = Dataset(np.array([row["scene"] for row in judged], dtype=object),
-                                    "1", "scene")
-    return out
+    return table_datasets(judged, JUDGED_COLUMNS, group)
 
 
 def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any]],
