@@ -92,7 +92,7 @@ crank-criterion: results/crank-criterion.toml
 # after make calibrate: install its fitted FFRF settings rule (flex/config/ffrf_rule.toml, read
 # by every "auto" modes, mesh and step of an FFRF coupler; commit it). Every study reads it.
 rule-install: results/calibrate.h5 | $(STAMP)
-	$(PY) -m flex.experiments.calibration_report $< flex/config/ffrf_rule.toml
+	$(PY) -m flex.experiments.fitting.calibration_report $< flex/config/ffrf_rule.toml
 
 test: $(STAMP)
 	$(PY) -m pytest -q -n 2

@@ -165,8 +165,8 @@ def _design(args: argparse.Namespace) -> int:
     from flex.config.settings import tolerance_beyond_reach
     from flex.data.outputs import check_output
     from flex.data.scene import load_scene
-    from flex.experiments import design_question as dq
-    from flex.experiments.design import BASE_OVERRIDES
+    from flex.experiments.design import question as dq
+    from flex.experiments.design.cases import BASE_OVERRIDES
 
     target = next(name for name in dq.TARGETS if getattr(args, name) is not None)
     question = dq.Question(args.vary, target, getattr(args, target), args.allowable_stress,
@@ -176,7 +176,7 @@ def _design(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene, BASE_OVERRIDES + list(args.overrides))
     dq.check_scene(scene, question)
     beyond = tolerance_beyond_reach(scene)
-    if beyond:  # each case's own warning is not printed (flex.experiments.design.design_case)
+    if beyond:  # each case's own warning is not printed (flex.experiments.design.cases.design_case)
         print(f"flex: warning: design: {beyond}", file=sys.stderr, flush=True)
     result = dq.answer(scene, question, reduction_cache_dir(os.environ))
     _print(dq.answer_text(result))

@@ -2,7 +2,7 @@
 
 Every number is measured by this run, on whatever else the machine is doing: wall times are
 medians of :data:`REPEATS` runs, and each comparison is a ratio of two times measured here
-(:mod:`flex.experiments.benchmark`).
+(:mod:`flex.experiments.workprecision.benchmark`).
 
 - ``rigid``: the thesis deployment (0.03 s) at 1e-7 rad crank-angle accuracy. The reference
   is the scipy DAE at rtol 1e-13 (shown converged by rtol 1e-12 and by flex at h = 1e-6 s).
@@ -29,7 +29,7 @@ and handed to the run as ``run.environment``.
 
 Stored: one case per timed configuration (attrs: knobs, errors, counters; dataset
 ``wall_times``) and ``/summary/table`` (the printed table) plus ``/summary/<part>/...``
-(:mod:`flex.experiments.benchmark_report`).
+(:mod:`flex.experiments.workprecision.benchmark_report`).
 """
 
 from __future__ import annotations
@@ -40,10 +40,10 @@ from typing import Any
 from flex.config.settings import AUTO_OVERRIDES, pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, derived_scenes
-from flex.experiments.benchmark import BenchPlan, PlatesPlan, StepCostPlan, run_bench
-from flex.experiments.benchmark_report import bench_figures, bench_summary
-from flex.experiments.reference_plans import ReferencePlan
-from flex.experiments.tradeoff import Setting
+from flex.experiments.workprecision.benchmark import BenchPlan, PlatesPlan, StepCostPlan, run_bench
+from flex.experiments.workprecision.benchmark_report import bench_figures, bench_summary
+from flex.experiments.workprecision.measurement import Setting
+from flex.experiments.workprecision.reference_plans import ReferencePlan
 from flex.study import StudyRun, Summary
 
 NAME = "bench"
@@ -139,7 +139,7 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
     """The table and the per-part datasets
-    (:func:`flex.experiments.benchmark_report.bench_summary`)."""
+    (:func:`flex.experiments.workprecision.benchmark_report.bench_summary`)."""
     return Summary(*bench_summary(run.notes, PLAN))
 
 

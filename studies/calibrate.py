@@ -1,13 +1,13 @@
 """Study ``calibrate``: the FFRF settings rule fitted on a family of scenes, validated on others.
 
 Per scene (FFRF coupler, rigid crank, thesis deployment) a converged reference and a grid of
-in-plane modes x steps per first period (:mod:`flex.experiments.calibration`); the rule
+in-plane modes x steps per first period (:mod:`flex.experiments.fitting.calibration`); the rule
 (:mod:`flex.config.ffrf_rule`) is fitted per damping class and level on ``CALIBRATION`` and
 validated on ``VALIDATION`` (the scenes: ``calibrate.toml`` beside this file). Some scenes
 carry 1 % damping: an undamped thick plate's peak is the highest of many crests, which no
 affordable reference pins to 1 %. Stored: a case per scene, ``/summary/rule/toml`` (``make
 rule-install``), ``levels/*``, ``validation/*``, ``cross_validation/*`` and
-``design_frontier/*`` (rule designs compared, :mod:`flex.experiments.rule_designs`).
+``design_frontier/*`` (rule designs compared, :mod:`flex.experiments.fitting.rule_designs`).
 """
 
 from __future__ import annotations
@@ -19,8 +19,8 @@ from pathlib import Path
 from flex.config.ffrf_rule import rule_constants
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, derived_scenes
-from flex.experiments.calibration import measure_case
-from flex.experiments.calibration_report import calibration_summary, draw_calibration
+from flex.experiments.fitting.calibration import measure_case
+from flex.experiments.fitting.calibration_report import calibration_summary, draw_calibration
 from flex.study import RESULTS_DIR, StudyRun, Summary
 
 NAME = "calibrate"

@@ -10,8 +10,8 @@ cantilever from the wing carrying coupler and slider at B, an order of magnitude
 The kfit law, fitted on couplers, under-predicts the error of a rigid crank that carries
 the wing (measured about 2x at equal n: at the same n the wing makes the crank a cantilever
 under a larger quasi-static load). So the crank gets its own law, through the same pipeline
-as the coupler's (:mod:`flex.experiments.lawfit`, the crank's half in
-:mod:`flex.experiments.crankfit`). Phase 1
+as the coupler's (:mod:`flex.experiments.fitting.lawfit`, the crank's half in
+:mod:`flex.experiments.fitting.crank`). Phase 1
 (fit): crank thicknesses 0.8-5 mm x two spring rates, all with the wing (the harder case;
 cranks without a wing err less at equal n, so the law is conservative for them), each run
 rigid and as the full model, an FFRF crank with 12 modes; the governing error against n is
@@ -34,7 +34,7 @@ from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments import crankfit, lawfit
+from flex.experiments.fitting import crank, lawfit
 from flex.study import RESULTS_DIR, StudyRun, Summary
 
 NAME = "crank"
@@ -67,7 +67,7 @@ CRITERION_PATH = RESULTS_DIR / "crank-criterion.toml"
 def cases(scene: Scene) -> dict[str, Scene]:
     """Fit scenes as ``__rigid`` and ``__full`` cases; validation scenes as ``__auto`` and
     ``__full`` cases (run after the fit, see :func:`simulate_cases`)."""
-    return crankfit.cases(scene, FIT_CASES, SCENES)
+    return crank.cases(scene, FIT_CASES, SCENES)
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
@@ -75,18 +75,18 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
     cases, ``auto`` reading the law just fitted (passed as an argument)."""
     runner = lawfit.SerialRunner("crank", NAME, len(scenes), run.progress,
                                  cache_dir=run.cache_dir)
-    results, run.notes["analysis"] = crankfit.fit_then_validate(scenes, runner, CRITERION_PATH,
+    results, run.notes["analysis"] = crank.fit_then_validate(scenes, runner, CRITERION_PATH,
                                                                 run.cache_dir)
     return results
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
-    return Summary(*crankfit.summarize(cases(scene), results, run.notes.get("analysis"),
+    return Summary(*crank.summarize(cases(scene), results, run.notes.get("analysis"),
                                        CRITERION_PATH))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    from flex.experiments.lawplots import crank_figures
+    from flex.experiments.fitting.lawplots import crank_figures
 
     return crank_figures(results, summary, list(SCENES), folder)

@@ -10,10 +10,8 @@ these two readings are run as named cases:
   swing (sec. 5.5.1 reading; the thesis never states this preload).
 
 Each case is also solved by the independent 9-coordinate DAE (:mod:`flex.dynamics.reference`) and
-the
-deviation stored; the thesis comparison table (:mod:`flex.experiments.deployment`) is printed and
-stored
-under ``/summary``.
+the deviation stored; the thesis comparison table (:mod:`flex.experiments.thesis.dynamics`) is
+printed and stored under ``/summary``.
 """
 
 from __future__ import annotations
@@ -24,7 +22,7 @@ from flex.api import derive_scene
 from flex.base.thesis import THESIS_COMPRESSION_M, THESIS_SLIDER_TRAVEL_M
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments import deployment
+from flex.experiments.thesis import dynamics
 from flex.study import StudyRun, Summary
 
 NAME = "dynamics"
@@ -41,11 +39,11 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
-    return Summary(*deployment.summary(results))
+    return Summary(*dynamics.summary(results))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    return deployment.draw_figures(results, summary.datasets, folder)
+    return dynamics.draw_figures(results, summary.datasets, folder)
 
 
 if __name__ == "__main__":

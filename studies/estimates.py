@@ -1,16 +1,16 @@
 """Study ``estimates``: is the error budget every run stores honest?
 
-Each scene runs as a user would run it (its own, "auto", settings; the error budget on:
-step, modes, mesh and model, :mod:`flex.fidelity.error_budget`) and against its reference,
-the next rung of flex's ladder converged in step, modes and mesh
-(:mod:`flex.experiments.estimate_check`: an FFRF coupler against the nonlinear FE coupler at a
-quarter of the step, mesh-corrected; rigid links against the same rigid model at a quarter of
-the step). Stored per case: the run, its ``estimated_error_*``, ``true_error_*``,
-``reference_accuracy_*`` and ``estimate_ratio_*`` attributes; under ``/summary/pairs`` one
-entry per case and headline quantity. Target (issue 25): true / estimated within [1/3, 1.5]
-on every headline quantity, on at least 10 scenes (thin and thick plates, springs, a
-constant-speed drive, the crank as FFRF). The flexible scenes run the first 10 ms (the
-nonlinear FE reference's cost); the rigid ones the whole deployment (the deployment time).
+Each scene runs as a user would run it (its own, "auto", settings; the error budget on: step, modes,
+mesh and model, :mod:`flex.fidelity.error_budget`) and against its reference, the next rung of
+flex's ladder converged in step, modes and mesh
+(:mod:`flex.experiments.workprecision.estimate_check`: an FFRF coupler against the nonlinear FE
+coupler at a quarter of the step, mesh-corrected; rigid links against the same rigid model at a
+quarter of the step). Stored per case: the run, its ``estimated_error_*``, ``true_error_*``,
+``reference_accuracy_*`` and ``estimate_ratio_*`` attributes; under ``/summary/pairs`` one entry per
+case and headline quantity. Target (issue 25): true / estimated within [1/3, 1.5] on every headline
+quantity, on at least 10 scenes (thin and thick plates, springs, a constant-speed drive, the crank
+as FFRF). The flexible scenes run the first 10 ms (the nonlinear FE reference's cost); the rigid
+ones the whole deployment (the deployment time).
 """
 
 from __future__ import annotations
@@ -19,7 +19,11 @@ from pathlib import Path
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, derived_scenes
-from flex.experiments.estimate_check import check_estimates, draw_estimates, estimate_summary
+from flex.experiments.workprecision.estimate_check import (
+    check_estimates,
+    draw_estimates,
+    estimate_summary,
+)
 from flex.study import StudyRun, Summary
 
 NAME = "estimates"

@@ -1,12 +1,12 @@
 """Study ``flexible`` (thesis sec. 6.2, figs. 35-50): coupler plates of four thicknesses.
 
 The coupler becomes a steel plate 0.08 x 0.01 x t (Table 5, models 0-3: t = 1, 3, 5, 10 mm)
-modelled in the same mechanism as flex's default flexible body (``<model>_ffrf``: FFRF on
-the chord frame with the geometric stiffness of its axial force), as the linear FFRF body
-(``<model>_linear``), as its rigid twin (``<model>_rigid``: the plate's own mass and
-inertia) and as the fully nonlinear FE coupler, the reference, over ``REFERENCE_SPANS_S``
-(``<model>_nonlinear_fe``; :mod:`flex.experiments.twins`). The spring deployment is the thesis
-scene (22 mm preload reading, undamped).
+modelled in the same mechanism as flex's default flexible body (``<model>_ffrf``: FFRF on the chord
+frame with the geometric stiffness of its axial force), as the linear FFRF body
+(``<model>_linear``), as its rigid twin (``<model>_rigid``: the plate's own mass and inertia) and as
+the fully nonlinear FE coupler, the reference, over ``REFERENCE_SPANS_S`` (``<model>_nonlinear_fe``;
+:mod:`flex.experiments.thesis.flexible`). The spring deployment is the thesis scene (22 mm preload
+reading, undamped).
 
 Stored per case: the rigid-body quantities, ``coupler/midpoint_deflection`` (elastic,
 relative to the chord B-C), ``coupler/chord_change``, ``coupler/midpoint_acceleration``,
@@ -27,7 +27,12 @@ from flex.base.thesis import THESIS_DELTA_T_S
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments.twins import simulate_twins, summarize_twins, twin_cases, twin_figures
+from flex.experiments.thesis.flexible import (
+    simulate_twins,
+    summarize_twins,
+    twin_cases,
+    twin_figures,
+)
 from flex.study import StudyRun, Summary
 
 NAME = "flexible"

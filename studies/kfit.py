@@ -24,10 +24,11 @@ error measures of :mod:`flex.fidelity.criteria` compare the two over the deploym
   ``coupler.model = "auto"``, each against a full FFRF run (12 modes, geometric
   stiffness), using the law just fitted.
 
-Mesh, time step and end time per case: :func:`flex.experiments.couplerfit.tuned`. The pipeline (fit
-cases, laws, criterion, validation) is :mod:`flex.experiments.lawfit`'s, with the coupler's cases,
-fit and summary from :mod:`flex.experiments.couplerfit` and its figures from
-:mod:`flex.experiments.lawplots`.
+Mesh, time step and end time per case: :func:`flex.experiments.fitting.kfit.tuned`. The
+pipeline (fit cases, laws, criterion, validation) is :mod:`flex.experiments.fitting.lawfit`'s,
+with the coupler's cases from :mod:`flex.experiments.fitting.kfit`, its fit and summary from
+:mod:`flex.experiments.fitting.kfit_law` and its figures from
+:mod:`flex.experiments.fitting.lawplots`.
 
 Every case's file is ``<sweep folder>/cases/<case>.h5`` (default ``results/kfit-cases``);
 the sweep resumes from them. The fit (``results/kfit-criterion.toml``) is what
@@ -45,8 +46,8 @@ import numpy as np
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments import couplerfit, lawfit
-from flex.experiments.couplerfit import THESIS_MODELS
+from flex.experiments.fitting import kfit, kfit_law, lawfit
+from flex.experiments.fitting.kfit import THESIS_MODELS
 from flex.study import RESULTS_DIR, StudyRun, Summary
 
 SWEEP = True  # cases run on the sweep engine: --scheduler and --workers apply
@@ -67,7 +68,7 @@ THICKNESSES_M = tuple(sorted({round(float(t), 6) for t in np.geomspace(0.5e-3, 1
 STIFFNESS_THICKNESSES_M = (0.5e-3, 1e-3, 3e-3)
 STIFFNESSES_N_PER_M = (150.0, 500.0, 5000.0, 15000.0, 50000.0)
 #: fast deployments of thicker plates: (thickness, spring rate); preload from
-#: flex.experiments.couplerfit.FAST_EULER_RATIO
+#: flex.experiments.fitting.kfit.FAST_EULER_RATIO
 FAST_CASES = ((3e-3, 1.5e5), (3e-3, 5e5), (5e-3, 5e5), (5e-3, 1.5e6), (10e-3, 5e6))
 PRELOAD_THICKNESSES_M = (0.826e-3, 1e-3, 1.91e-3, 3e-3, 5.2e-3)
 PRELOADS_M = (0.011, 0.016, 0.033)
@@ -92,44 +93,43 @@ VALIDATION: dict[str, tuple[list[str], float]] = {
 
 
 def _grid() -> tuple:
-    """The fit grid, as :func:`flex.experiments.couplerfit.fit_cases` takes it."""
+    """The fit grid, as :func:`flex.experiments.fitting.kfit.fit_cases` takes it."""
     return (DAMPING_RATIOS, THICKNESSES_M, (STIFFNESS_THICKNESSES_M, STIFFNESSES_N_PER_M),
             FAST_CASES, (PRELOAD_THICKNESSES_M, PRELOADS_M))
 
 
 def cases(scene: Scene) -> dict[str, Scene]:
     """Fit cases, then validation cases (run after the fit, see :func:`simulate_cases`)."""
-    fit = couplerfit.fit_cases(scene, *_grid())
-    return {**fit, **couplerfit.validation_cases(scene, VALIDATION)}
+    fit = kfit.fit_cases(scene, *_grid())
+    return {**fit, **kfit.validation_cases(scene, VALIDATION)}
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
-    """The :mod:`flex.experiments.lawfit` pipeline on the sweep engine (``run.sweep``: where and
-    how;
-    None: a process pool on all cores, ``results/kfit-cases``); the criterion goes beside
-    the case folder (``kfit-criterion.toml``)."""
+    """The :mod:`flex.experiments.fitting.lawfit` pipeline on the sweep engine (``run.sweep``:
+    where and how; None: a process pool on all cores, ``results/kfit-cases``); the criterion
+    goes beside the case folder (``kfit-criterion.toml``)."""
     from flex.sweep import SweepSettings, make_executor, run_sweep
 
     settings = run.sweep or SweepSettings()
     folder = settings.folder or RESULTS_DIR / "kfit-cases"
     runner = lawfit.SweepRunner(run_sweep, make_executor(settings.scheduler, settings.workers),
-                                folder, couplerfit.sweep_phases(run.cache_dir), NAME,
+                                folder, kfit.sweep_phases(run.cache_dir), NAME,
                                 run.notes.setdefault("sweep", {}), settings.retry_failed,
                                 settings.progress)
-    results, run.notes["analysis"] = couplerfit.fit_then_validate(scenes, runner, folder)
+    results, run.notes["analysis"] = kfit_law.fit_then_validate(scenes, runner, folder)
     return results
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
-    return Summary(*couplerfit.summarize(results, run.notes,
-                                         couplerfit.left_out_cases(scene, *_grid())))
+    return Summary(*kfit_law.summarize(results, run.notes,
+                                       kfit.left_out_cases(scene, *_grid())))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    from flex.experiments.lawplots import coupler_figures
+    from flex.experiments.fitting.lawplots import coupler_figures
 
-    return coupler_figures(summary.figure_data.get("analysis") or couplerfit.analyse(results),
+    return coupler_figures(summary.figure_data.get("analysis") or kfit_law.analyse(results),
                            folder)
 
 

@@ -4,7 +4,7 @@ One crank turn per second for 1 s (sec. 4.3; the data sheet's check shows the re
 stroke, velocity and acceleration extremes belong to omega = 2 pi rad/s). Exudyn's slider
 position, velocity and acceleration are compared with the closed-form in-line slider-crank;
 the crank midpoint must trace a circle of radius L1/2; the constraint norm stays at round-off
-(:mod:`flex.experiments.constant_speed`).
+(:mod:`flex.experiments.thesis.kinematics`).
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from pathlib import Path
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments import constant_speed
+from flex.experiments.thesis import kinematics
 from flex.study import StudyRun, Summary
 
 NAME = "kinematics"
@@ -29,11 +29,11 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
-    return Summary(*constant_speed.summary(results["constant_speed"]))
+    return Summary(*kinematics.summary(results["constant_speed"]))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    return constant_speed.draw_figures(results["constant_speed"], summary.datasets, folder)
+    return kinematics.draw_figures(results["constant_speed"], summary.datasets, folder)
 
 
 if __name__ == "__main__":

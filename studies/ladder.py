@@ -2,7 +2,7 @@
 
 The thesis deployment (spring release, 22 mm preload reading) with a steel plate coupler
 0.08 x 0.01 x t, t = 0.3 ... 10 mm, each thickness run three times on the same mesh, step and
-samples (:mod:`flex.experiments.ladder`): the linear FFRF body (``coupler.geometric_stiffness
+samples (:mod:`flex.experiments.models.ladder`): the linear FFRF body (``coupler.geometric_stiffness
 = false``), flex's default FFRF body (chord frame, the geometric stiffness of its axial
 force, :mod:`flex.bodies.geometric_stiffness`) and the fully nonlinear FE body (the
 reference), over max(1.1 first bending periods, 5 ms). Stored per thickness under
@@ -20,7 +20,7 @@ import math
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments.ladder import (
+from flex.experiments.models.ladder import (
     MODELS,
     REFERENCE,
     first_period_s,

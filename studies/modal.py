@@ -9,7 +9,7 @@ period conventions (thesis T = 1/omega; physical T = 2 pi/omega) with n = delta_
 Tables 7 and 9 (ANSYS BEAM188, units and sections not stated) with flex's reading of them.
 Mesh convergence is part of the result: per model the element count, DOF and frequency of
 each refinement level, and the production mesh (coarsest level within tolerance). The survey
-is :func:`flex.experiments.modal.survey`; nothing is simulated.
+is :func:`flex.experiments.thesis.modal.survey`; nothing is simulated.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pathlib import Path
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments import modal
+from flex.experiments.thesis import modal
 from flex.study import StudyRun, Summary
 
 NAME = "modal"

@@ -5,8 +5,8 @@
 Every study follows this protocol (:mod:`flex.study`; copy this file to start one): ``NAME``,
 ``DESCRIPTION``, ``OVERRIDES`` declare it; ``cases(scene)`` names the scenes flex simulates
 and stores (here ``/cases/case/...``); ``summarize`` returns the report and the datasets stored
-under ``/summary``; ``figures`` draws PNGs. Each hook declares, or makes one call into the
-library module of its concept (:mod:`flex.experiments.single_case`): no loops, fits or measurements
+under ``/summary``; ``figures`` draws PNGs. Each hook declares, or makes one call into the library
+module of its concept (:mod:`flex.experiments.thesis.simulate`): no loops, fits or measurements
 here.
 """
 
@@ -16,7 +16,7 @@ from pathlib import Path
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments import single_case
+from flex.experiments.thesis import simulate
 from flex.study import STRUCTURAL_KEYS, StudyRun, Summary
 
 NAME = "simulate"
@@ -30,11 +30,11 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
-    return Summary(*single_case.summary(results["case"]))
+    return Summary(*simulate.summary(results["case"]))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    return single_case.draw_crank_angle(results["case"], folder)
+    return simulate.draw_crank_angle(results["case"], folder)
 
 
 if __name__ == "__main__":

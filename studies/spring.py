@@ -7,7 +7,7 @@ reproduces 1500 N/m, carries on with the stated consistent design
 Bergstrasser-corrected shear stress at the 22 mm press and at solid against ASTM A228's
 allowable stress; solid length and clash allowance; surge frequency and the thesis's
 rigid-or-flexible ratio n for the spring itself; an NGsolve model of a helix segment for
-the peak stress, compared with Wahl (:mod:`flex.experiments.spring_check`). No mechanism is
+the peak stress, compared with Wahl (:mod:`flex.experiments.thesis.spring`). No mechanism is
 simulated.
 """
 
@@ -17,7 +17,7 @@ from pathlib import Path
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments import spring_check
+from flex.experiments.thesis import spring
 from flex.study import StudyRun, Summary
 
 NAME = "spring"
@@ -33,11 +33,11 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
-    return Summary(*spring_check.summary(scene))
+    return Summary(*spring.summary(scene))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    return spring_check.draw_stress(summary.datasets, folder)
+    return spring.draw_stress(summary.datasets, folder)
 
 
 if __name__ == "__main__":

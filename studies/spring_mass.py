@@ -7,7 +7,7 @@ massless. ``drive.spring_model = "chain"`` lumps the coil's mass along it
 the continuous coil (``beta tan beta = m_s / M``) and what the mass changes in the thesis
 deployment (bundled scene, 22 mm preload) and the wing deployment (the wing study's fitted
 spring, its coil re-sized from the thesis design): massless against chains of 1-16
-segments, rigid links and an FFRF plate coupler (:mod:`flex.experiments.spring_mass`).
+segments, rigid links and an FFRF plate coupler (:mod:`flex.experiments.models.spring_mass`).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from pathlib import Path
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments import spring_mass
+from flex.experiments.models import spring_mass
 from flex.study import StudyRun, Summary
 
 NAME = "spring_mass"

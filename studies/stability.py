@@ -21,7 +21,7 @@ the step and the time, with no data. Groups:
 References: rigid -- the scipy DAE (rtol 1e-12, shown converged by rtol 1e-11); FFRF --
 flex's model at a finer step (shown converged by twice that step); constant crank speed --
 the closed-form slider-crank (exact). The references, the judging, the verdict tables, the
-trust boundary and the figures are :mod:`flex.experiments.stability`'s.
+trust boundary and the figures are :mod:`flex.experiments.models.stability`'s.
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments.stability import (
+from flex.experiments.models.stability import (
     Extreme,
     extreme_cases,
     plate_overrides,

@@ -1,20 +1,22 @@
 """Study ``tradeoff``: work-precision of every knob, for the rigid and the FFRF coupler.
 
-Three scenes of the thesis deployment (22 mm preload, 0.03 s): the rigid Table 1 model
-(``rigid``) and a steel-plate FFRF coupler 1 mm and 10 mm thick (``ffrf_1mm``, ``ffrf_10mm``).
-For each, a converged reference is run and shown converged
-(:mod:`flex.experiments.reference_plans`), then the knobs are varied one at a time around a base
-setting and in combination (:func:`settings`): time step, generalized-alpha spectral radius,
-index-3 versus index-2 (Newmark) constraints, full versus modified Newton and its tolerance,
-explicit Runge-Kutta with penalty joints (rigid), number of modes, mesh size and element order,
-the fully nonlinear FE coupler instead of the FFRF reduction, and the independent scipy
-reference DAE (rigid) at several tolerances.
+Three scenes of the thesis deployment (22 mm preload, 0.03 s): the rigid Table 1 model (``rigid``)
+and a steel-plate FFRF coupler 1 mm and 10 mm thick (``ffrf_1mm``, ``ffrf_10mm``). For each, a
+converged reference is run and shown converged
+(:mod:`flex.experiments.workprecision.reference_plans`), then the knobs are varied one at a time
+around a base setting and in combination (:func:`settings`): time step, generalized-alpha spectral
+radius, index-3 versus index-2 (Newmark) constraints, full versus modified Newton and its tolerance,
+explicit Runge-Kutta with penalty joints (rigid), number of modes, mesh size and element order, the
+fully nonlinear FE coupler instead of the FFRF reduction, and the independent scipy reference DAE
+(rigid) at several tolerances.
 
-Stored (:mod:`flex.experiments.workprecision`): a case ``<scene>__<setting>`` per run (a diverged
-run: a ``failed`` case); under ``/summary/<scene>/`` (:mod:`flex.experiments.workprecision_report`)
-``runs/...``, ``reference/...``, ``recommended/...`` (1 %, 0.1 %, 0.01 %), ``default/...`` and
-(FFRF) ``rule/...``: the bundled "auto" keys and the rule's picks at 1 % and 0.1 % against the
-runs (:mod:`~flex.experiments.defaults_check`, :mod:`~flex.experiments.rule_check`); figures.
+Stored (:mod:`flex.experiments.workprecision.tradeoff`): a case ``<scene>__<setting>`` per run (a
+diverged run: a ``failed`` case); under ``/summary/<scene>/``
+(:mod:`flex.experiments.workprecision.tradeoff_report`) ``runs/...``, ``reference/...``,
+``recommended/...`` (1 %, 0.1 %, 0.01 %), ``default/...`` and (FFRF) ``rule/...``: the bundled
+"auto" keys and the rule's picks at 1 % and 0.1 % against the runs
+(:mod:`~flex.experiments.workprecision.defaults_check`,
+:mod:`~flex.experiments.workprecision.rule_check`); figures.
 """
 
 from __future__ import annotations
@@ -24,12 +26,15 @@ from pathlib import Path
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, derived_scenes
-from flex.experiments.defaults_check import default_setting
-from flex.experiments.reference_plans import scipy_setting
-from flex.experiments.rule_check import rule_settings
-from flex.experiments.tradeoff import Setting
-from flex.experiments.workprecision import nonlinear_available, run_work_precision
-from flex.experiments.workprecision_report import summarize_work_precision, work_precision_figures
+from flex.experiments.workprecision.defaults_check import default_setting
+from flex.experiments.workprecision.measurement import Setting, nonlinear_available
+from flex.experiments.workprecision.reference_plans import scipy_setting
+from flex.experiments.workprecision.rule_check import rule_settings
+from flex.experiments.workprecision.tradeoff import run_work_precision
+from flex.experiments.workprecision.tradeoff_report import (
+    summarize_work_precision,
+    work_precision_figures,
+)
 from flex.study import StudyRun, Summary
 
 NAME = "tradeoff"
@@ -180,7 +185,8 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
     """Per scene the run table, the reference and its evidence, the recommendations and the
-    defaults check (:func:`flex.experiments.workprecision_report.summarize_work_precision`)."""
+    defaults check
+    (:func:`flex.experiments.workprecision.tradeoff_report.summarize_work_precision`)."""
     datasets, report = summarize_work_precision(run.notes.get("runs", {}), cases(scene),
                                                 FFRF_DEFAULT_SCENE)
     return Summary(datasets, report)

@@ -7,7 +7,7 @@ damping. Runs: flex's rigid rod (against the closed form), flex's default FFRF r
 frame, geometric stiffness) under step, mode and mesh refinement, the linear FFRF rod, the
 nonlinear FE rod at two steps (the reference), and the independent two-mode model
 (:mod:`flex.dynamics.ivp_crank`) with the published settings and one change at a time. What
-each comparison means: :mod:`flex.experiments.validation`, docs/validation.md.
+each comparison means: :mod:`flex.experiments.models.validation`, docs/validation.md.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from pathlib import Path
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments import validation
+from flex.experiments.models import validation
 from flex.study import StudyRun, Summary, simulate_each
 
 NAME = "validation"

@@ -1,14 +1,12 @@
 """Study ``wing`` (thesis sec. 6.4, figs. 59-60): a missile wing deployed by the mechanism.
 
-The thesis gives only the outcome: deployment ~0.017 s, wing-tip angular velocity peaking
-near 7219 deg/s at ~0.008 s; no wing geometry, inertia or spring. flex states a wing (an
-aluminium switchblade plate in the mechanism plane, welded to the crank at the pivot A, the
-``[wing]`` keys of the scene) and fits the two spring values the thesis leaves open --
-stiffness and preload -- so that the deployment reproduces the reported peak speed and its
-time (:func:`flex.experiments.wing.fit_spring`). The deployment time (first crank-angle maximum) is
-then
-a prediction, compared with the thesis's ~0.017 s.
-
+The thesis gives only the outcome: deployment ~0.017 s, wing-tip angular velocity peaking near 7219
+deg/s at ~0.008 s; no wing geometry, inertia or spring. flex states a wing (an aluminium switchblade
+plate in the mechanism plane, welded to the crank at the pivot A, the ``[wing]`` keys of the scene)
+and fits the two spring values the thesis leaves open -- stiffness and preload -- so that the
+deployment reproduces the reported peak speed and its time
+(:func:`flex.experiments.thesis.wing.fit_spring`). The deployment time (first crank-angle maximum)
+is then a prediction, compared with the thesis's ~0.017 s.
 Reported beside it: the joint loads and the wing-root bending moment; the wing's own
 flexibility (cantilever bending frequencies in and out of plane, the thesis's ratio n, and
 the quasi-static tip deflection under the peak inertial load); and, for the other bodies,
@@ -21,7 +19,7 @@ from pathlib import Path
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments import wing
+from flex.experiments.thesis import wing
 from flex.study import StudyRun, Summary, simulate_each
 
 NAME = "wing"

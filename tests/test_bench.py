@@ -6,8 +6,8 @@ from __future__ import annotations
 import math
 
 from flex.data.scene import apply_overrides, default_scene
-from flex.experiments.benchmark import StepCostPlan, bench_step_cost
-from flex.experiments.tradeoff import ReductionPool
+from flex.experiments.workprecision.benchmark import StepCostPlan, bench_step_cost
+from flex.experiments.workprecision.measurement import ReductionPool
 
 
 def test_step_cost_measures_both_joint_marker_kinds(reduction_cache):

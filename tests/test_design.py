@@ -28,23 +28,26 @@ from flex.base.mechanism_checks import (
 )
 from flex.base.physics import plate_thickness_for_mass_m
 from flex.data.scene import load_scene
-from flex.experiments import design, design_question
-from flex.experiments.design_report import draw_figures, report_text
+from flex.experiments.design import cases as design_cases
+from flex.experiments.design import mechanism as design_mechanism
+from flex.experiments.design import question as design_question
+from flex.experiments.design import summary as design_summary
+from flex.experiments.design.report import draw_figures, report_text
 from flex.sweep import run_sweep
 
-TINY = design.Grid(angles_deg=(5.0, 60.0), preload_factors=(1.0,), energy_rate_factors=(4.0,),
+TINY = design_cases.Grid(angles_deg=(5.0, 60.0), preload_factors=(1.0,), energy_rate_factors=(4.0,),
                    thicknesses_m=(), thickness_rate_factors=(1.0,), final_angle_step_deg=45.0)
 
 
 @pytest.fixture(scope="module")
 def scene():
-    return load_scene(None, design.BASE_OVERRIDES)
+    return load_scene(None, design_cases.BASE_OVERRIDES)
 
 
 @pytest.fixture(scope="module")
 def sweep(scene, tmp_path_factory):
-    scenes, _ = design.plan(scene, TINY)
-    outcome = run_sweep(scenes, tmp_path_factory.mktemp("design"), design.design_case,
+    scenes, _ = design_cases.plan(scene, TINY)
+    outcome = run_sweep(scenes, tmp_path_factory.mktemp("design"), design_cases.design_case,
                         scheduler="serial", progress=False, study="design")
     return outcome.results
 
@@ -90,7 +93,7 @@ def test_dead_centres_and_transmission_angle_in_closed_form():
 
 
 def test_the_thesis_mechanism_has_one_freedom_and_no_redundant_constraint(scene):
-    checks = design.mechanism_checks(scene, np.radians([34.19, 60.0, 95.0]))
+    checks = design_mechanism.mechanism_checks(scene, np.radians([34.19, 60.0, 95.0]))
     assert checks["mechanism/gruebler_mobility"].data == 1
     assert checks["mechanism/kutzbach_mobility"].data == 1
     assert checks["mechanism/jacobian_mobility"].data == 1
@@ -108,8 +111,8 @@ def test_the_design_point_is_the_thesis_mechanism(scene):
 
 
 def test_sweep_measures_match_the_reference_dae(scene, sweep):
-    names = design.reference_names(scene, TINY, (5.0, 60.0))
-    checks = design.run_references(sweep, names)
+    names = design_cases.reference_names(scene, TINY, (5.0, 60.0))
+    checks = design_cases.run_references(sweep, names)
     assert set(checks) == set(names)  # every point rigid, so every one checked
     for values in checks.values():
         assert values["crank_angle"][0] < 1e-5  # rad
@@ -119,9 +122,9 @@ def test_sweep_measures_match_the_reference_dae(scene, sweep):
 
 
 def test_rest_angle_and_travel_follow_the_attached_spring(scene, sweep):
-    rows = design.table(sweep)
-    rest = math.degrees(design.rest_angle_rad(scene))
-    design_row = list(rows["case"]).index(design.design_case_name(scene))
+    rows = design_summary.table(sweep)
+    rest = math.degrees(design_cases.rest_angle_rad(scene))
+    design_row = list(rows["case"]).index(design_cases.design_case_name(scene))
     assert math.degrees(rows["final_crank_angle"][design_row]) == pytest.approx(rest, abs=0.01)
     simulated = rows["outcome"] == "simulated"
     np.testing.assert_allclose(rows["slider_travel"][simulated],
@@ -129,7 +132,7 @@ def test_rest_angle_and_travel_follow_the_attached_spring(scene, sweep):
 
 
 def test_report_and_figures_come_from_the_datasets(scene, sweep, tmp_path):
-    datasets = design.summary_datasets(scene, TINY, sweep, {})
+    datasets = design_summary.summary_datasets(scene, TINY, sweep, {})
     text = report_text(datasets)
     assert "Does 34.19 deg maximise the peak crank speed?" in text
     assert "Gruebler (Eq. 1) 1" in text
@@ -142,7 +145,7 @@ def test_report_and_figures_come_from_the_datasets(scene, sweep, tmp_path):
 def test_optimiser_finds_the_closed_form_preload(scene):
     """The smallest preload that brings the crank (from 34.19 deg) to rest at 80 deg or
     beyond: half the slider travel between the two angles, x(theta0) - x(theta_f)."""
-    expected = design.preload_for_rest_angle_m(scene, math.radians(34.19), math.radians(80.0))
+    expected = design_cases.preload_for_rest_angle_m(scene, math.radians(34.19), math.radians(80.0))
     found = design_question.answer(scene, design_question.Question("preload", "final_angle",
                                                                    80.0))
     assert found.value == pytest.approx(expected, rel=2e-3)

@@ -25,7 +25,7 @@ EDGES = {
     # configures Exudyn itself (no user settings file) before it is imported
     ("dynamics/builder.py", "<module>"): "os.environ.setdefault('EXUDYN_NO_USER_SETTINGS')",
     # the environment of a child `make` process (with its own FLEX_CACHE_DIR)
-    ("experiments/benchmark.py", "bench_make_all"): "the child make's environment",
+    ("experiments/workprecision/benchmark.py", "bench_make_all"): "the child make's environment",
 }
 
 
@@ -98,7 +98,7 @@ def test_the_cache_folder_is_not_part_of_a_sweep_case(tmp_path):
     import pickle
 
     from flex.data.scene import load_scene
-    from flex.experiments import couplerfit
+    from flex.experiments.fitting import kfit
     from flex.sweep import case_hash, simulate_scene_case
 
     scene = load_scene()
@@ -107,12 +107,12 @@ def test_the_cache_folder_is_not_part_of_a_sweep_case(tmp_path):
         bound = functools.partial(simulate_scene_case, cache_dir=folder)
         assert case_hash(scene, bound) == plain
     # kfit's cases keep the identity they had before the folder became an argument
-    phases = couplerfit.sweep_phases(tmp_path)
+    phases = kfit.sweep_phases(tmp_path)
     fit = phases["fit"].case_function(None)
-    assert case_hash(scene, fit) == case_hash(scene, couplerfit.fit_case)
+    assert case_hash(scene, fit) == case_hash(scene, kfit.fit_case)
     validation = phases["validation"].case_function("law")
     assert case_hash(scene, validation) == case_hash(
-        scene, functools.partial(couplerfit.validation_case, criterion_toml="law"))
+        scene, functools.partial(kfit.validation_case, criterion_toml="law"))
     assert case_hash(scene, validation) != case_hash(
         scene, phases["validation"].case_function("another law"))
     assert pickle.loads(pickle.dumps(fit)).keywords == {"cache_dir": tmp_path}  # to workers

@@ -4,7 +4,7 @@ import re
 
 import pytest
 
-from flex.experiments import deployment
+from flex.experiments.thesis import dynamics
 from flex.study import execute, load_study, study_scene
 
 
@@ -23,7 +23,7 @@ def test_dynamics_against_the_datasheet_checks():
     _, output = run("dynamics")
     peak = output.summary.datasets["thesis_comparison/preload_22mm"].data[2]
     assert peak == pytest.approx(60.686, abs=0.01)  # data sheet check: 60.7 rad/s
-    table = {name: deployment.measures({k: v.data for k, v in case.datasets.items()})
+    table = {name: dynamics.measures({k: v.data for k, v in case.datasets.items()})
              for name, case in output.results.items()}
     # independent checks of ../shared/thesis-datasheet.md (rigid model, both preloads), to
     # the digits the data sheet quotes
@@ -37,8 +37,8 @@ def test_dynamics_against_the_datasheet_checks():
         assert measured["angle_max_time"] == pytest.approx(angle_time, abs=2.5e-4)
         # exact joints: the constraint norm stays at round-off, compared by order only
         assert measured["constraint_norm_max"] < 1e-12
-    rendered = deployment.comparison_table(table)
-    assert rendered.count("\n") == len(deployment.THESIS_ROWS) + 1  # head, rule, one row each
+    rendered = dynamics.comparison_table(table)
+    assert rendered.count("\n") == len(dynamics.THESIS_ROWS) + 1  # head, rule, one row each
 
 
 def test_simulate_runs_the_given_scene():

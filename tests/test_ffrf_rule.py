@@ -1,5 +1,5 @@
 """The FFRF settings rule (flex/config/ffrf_rule.py) and its calibration's fit and validation
-(flex/experiments/calibration.py) on synthetic grids whose answer is known."""
+(flex/experiments/fitting/calibration.py) on synthetic grids whose answer is known."""
 
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ from flex.config.ffrf_rule import (
 )
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import load_scene
-from flex.experiments.calibration import (
+from flex.experiments.fitting.calibration import (
     GRID_MODES,
     GRID_STEPS_PER_PERIOD,
     fit_levels,
@@ -215,7 +215,7 @@ def cost(m, n, n_load):
 
 
 def test_robustly_within_refuses_a_lucky_coarse_step():
-    from flex.experiments.calibration import grid_table
+    from flex.experiments.fitting.calibration import grid_table
 
     case = _case("lucky", 0.001, lambda m, n, _: 1e-4 if n == 4 else (0.05 if n == 8 else 1e-4),
                  cost)
@@ -226,7 +226,7 @@ def test_robustly_within_refuses_a_lucky_coarse_step():
 
 
 def test_the_fitted_law_covers_every_calibration_scene():
-    from flex.experiments.calibration import (
+    from flex.experiments.fitting.calibration import (
         MARGIN,
         coupler_of,
         grid_table,
@@ -249,7 +249,7 @@ def test_the_fitted_law_covers_every_calibration_scene():
 def test_the_fit_s_time_model_recovers_a_noisy_grid_s_time_per_step():
     """Times a x N (1 + 0.1 m) with every other pair timed 3x slow (a busy machine): the
     modelled time is the median time per step with those modes times the steps."""
-    from flex.experiments.calibration import grid_table, modelled_time_s
+    from flex.experiments.fitting.calibration import grid_table, modelled_time_s
 
     def noisy(m, n, n_load):
         return cost(m, n, n_load) * (3.0 if int(math.log2(n)) % 2 else 1.0)
@@ -268,7 +268,7 @@ def test_the_law_reaches_each_scene_s_needed_steps_before_rounding():
     """C is the smallest for which the law itself reaches every scene's needed steps: one
     scene sits on the law, and 10 % less C leaves it short of its needed value (before the
     rounding up to the grid, which would hide a shortfall of up to one grid step)."""
-    from flex.experiments.calibration import _step_law
+    from flex.experiments.fitting.calibration import _step_law
 
     needed, n_load = np.array([32.0, 16.0, 8.0]), np.array([2.0, 5.0, 30.0])
     law = _step_law(needed, n_load, np.zeros(3), 0.5)
@@ -283,7 +283,7 @@ def test_a_level_rests_on_the_longest_run_of_scenes_the_grid_can_meet():
     """Ordered by n: three scenes the grid meets, one it cannot (its errors never fall
     within the level), one more it meets: the level keeps the first three, leaves out the
     rest, and so holds only over their n."""
-    from flex.experiments.calibration import grid_table, reachable_run
+    from flex.experiments.fitting.calibration import grid_table, reachable_run
 
     def unreachable(m, n, n_load):
         return 0.05
@@ -302,7 +302,7 @@ def test_cross_validation_judges_each_scene_by_a_fit_without_it():
     """Four scenes follow one law, a fifth needs 4x the steps: in the fit it is covered
     (the law bends to it), left out it is not: the leave-one-out row says so. A scene at
     either end of n, left out, lies outside the others' range."""
-    from flex.experiments.calibration import cross_validate
+    from flex.experiments.fitting.calibration import cross_validate
 
     def hard(m, n, n_load):
         return 16.0 * step_law_error(m, n, n_load)
@@ -323,8 +323,8 @@ def test_the_local_design_picks_the_cheapest_pair_robust_on_the_nearest_scenes()
     """Left out, the 1 mm scene takes, with one neighbour, the cheapest pair robust on the
     nearest scene (1.2 mm); with two, a pair robust on the far one too, which needs 16x the
     error's steps squared: the pick moves to more steps."""
-    from flex.experiments.calibration import grid_table, modelled_time_s
-    from flex.experiments.rule_designs import neighbour_pick
+    from flex.experiments.fitting.calibration import grid_table, modelled_time_s
+    from flex.experiments.fitting.rule_designs import neighbour_pick
 
     def hard(m, n, n_load):
         return 16.0 * step_law_error(m, n, n_load)
@@ -344,8 +344,8 @@ def test_the_local_design_picks_the_cheapest_pair_robust_on_the_nearest_scenes()
 
 
 def test_every_rule_design_is_judged_on_the_installed_design_s_pairs():
-    from flex.experiments.calibration import cross_validate
-    from flex.experiments.rule_designs import INSTALLED, design_frontier
+    from flex.experiments.fitting.calibration import cross_validate
+    from flex.experiments.fitting.rule_designs import INSTALLED, design_frontier
 
     cases = {f"t{t}": _case(f"t{t}", t, step_law_error, cost)
              for t in (0.001, 0.0012, 0.0015, 0.002, 0.003)}
@@ -364,7 +364,7 @@ def test_near_twins_one_setting_cannot_serve_fast_are_found():
     """Two plates 5 % apart in thickness, one needing 4x the steps of the other (16x the
     error): the pair robust on both is the harder one's, 4x slower on the easier one. A plate
     3x thicker is nobody's twin."""
-    from flex.experiments.rule_designs import near_twins
+    from flex.experiments.fitting.rule_designs import near_twins
 
     def hard(m, n, n_load):
         return 16.0 * step_law_error(m, n, n_load)
@@ -379,8 +379,8 @@ def test_near_twins_one_setting_cannot_serve_fast_are_found():
 
 
 def test_the_calibration_summary_stores_and_reports_the_designs_compared():
-    from flex.experiments.calibration_report import calibration_summary
-    from flex.experiments.rule_designs import NEIGHBOUR_MARGINS, NEIGHBOURS
+    from flex.experiments.fitting.calibration_report import calibration_summary
+    from flex.experiments.fitting.rule_designs import NEIGHBOUR_MARGINS, NEIGHBOURS
 
     thicknesses = {f"t{t}": t for t in (0.001, 0.0012, 0.0015, 0.002, 0.003)}
     results = {name: _case(name, t, step_law_error, cost) for name, t in thicknesses.items()}
@@ -403,7 +403,7 @@ def test_a_level_too_few_references_can_certify_is_not_fitted():
 
 
 def test_a_scene_beyond_the_linear_ffrf_validity_does_not_certify():
-    from flex.experiments.calibration import certifiable
+    from flex.experiments.fitting.calibration import certifiable
 
     case = _case("big", 0.001, step_law_error, cost)
     assert certifiable(case, 0.01)
@@ -425,7 +425,7 @@ def test_validation_compares_the_rule_with_the_fastest_robust_pair():
 
 def test_install_refuses_a_foreign_result_file(tmp_path):
     from flex.data.results import write_results
-    from flex.experiments.calibration_report import install_rule
+    from flex.experiments.fitting.calibration_report import install_rule
 
     path = write_results(tmp_path / "other.h5", "simulate", [], "")
     rule = tmp_path / "rule.toml"

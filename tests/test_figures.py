@@ -206,7 +206,7 @@ def test_crank_figures_synthetic(tmp_path, reviewed):
 
 
 def test_kfit_figures_synthetic(tmp_path, reviewed):
-    from flex.experiments.couplerfit import label
+    from flex.experiments.fitting.kfit import label
     from studies import kfit
 
     rng = np.random.default_rng(1)
@@ -242,7 +242,7 @@ def test_kfit_figures_synthetic(tmp_path, reviewed):
     paths = kfit.figures({}, Summary({}, "", {"analysis": analysis}), tmp_path)
     check_pngs(paths, tmp_path, {"kfit-error-vs-n.png", "kfit-k-vs-tolerance.png",
                                  "kfit-predictors.png"})
-    from flex.experiments.couplerfit import predictor_lines
+    from flex.experiments.fitting.kfit_law import predictor_lines
 
     datasets: dict = {}
     lines = predictor_lines(table, fits, datasets)
@@ -298,7 +298,7 @@ def test_bench_figures_synthetic(tmp_path, reviewed):
         for which, scale in (("profile_untuned", 1.0), ("profile_tuned", 0.8)):
             for phase, share in (("newton", 40.0), ("jacobian", 30.0), ("output", 10.0)):
                 data[f"{part}/{which}/exudyn_{phase}_percent"] = share * scale
-    from flex.experiments.benchmark_report import _step_cost_rows
+    from flex.experiments.workprecision.benchmark_report import _step_cost_rows
 
     step_cost: dict = {}
     rows = _step_cost_rows([

@@ -307,10 +307,10 @@ def test_ffrf_coupler_with_a_constant_speed_crank_follows_the_closed_form():
 
 
 # ------------------------------------------------------------------------------------------
-# flex.experiments.twins and flex.fidelity.softening
+# flex.experiments.thesis.flexible and flex.fidelity.softening
 # ------------------------------------------------------------------------------------------
 def test_twin_cases_model_each_plate_every_way_and_add_references_when_undamped():
-    from flex.experiments.twins import twin_cases
+    from flex.experiments.thesis.flexible import twin_cases
 
     plates = {"a_t3mm": (0.003, 0.003), "b_t5mm": (0.005, 0.005)}
     base = load_scene(None, [*pinned_overrides(), 'coupler.geometry="plate"'])

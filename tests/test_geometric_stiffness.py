@@ -227,7 +227,7 @@ def test_deployment_peak_matches_the_nonlinear_fe_coupler(reduction_cache):
     # is ~3 % below the nonlinear FE one (compression 0.08 of the Euler load; measured
     # -3.2 %); with the geometric stiffness within 0.5 % (measured +0.05 %)
     from flex.config.settings import pinned_overrides
-    from flex.experiments.ladder import ladder_rung
+    from flex.experiments.models.ladder import ladder_rung
 
     base = load_scene(overrides=pinned_overrides())
     rung = ladder_rung(base, 0.001, 0.002, 1e-4, 0.005, reduction_cache)

@@ -7,17 +7,17 @@ import math
 import numpy as np
 import pytest
 
-from flex.experiments import couplerfit, lawfit
+from flex.experiments.fitting import kfit, kfit_law, lawfit
 from flex.fidelity.criteria import EULER_LOAD_LIMIT, load_criterion
 from flex.fidelity.predictor import PREDICTION_MARGIN
 from flex.study import study_scene
-from studies import kfit
+from studies import kfit as kfit_study
 
 
 @pytest.fixture(scope="module")
 def study():
-    scene = study_scene(kfit)
-    return scene, kfit.cases(scene)
+    scene = study_scene(kfit_study)
+    return scene, kfit_study.cases(scene)
 
 
 def test_every_reference_has_geometric_stiffness_and_auto_keeps_the_default(study):
@@ -29,7 +29,7 @@ def test_every_reference_has_geometric_stiffness_and_auto_keeps_the_default(stud
     assert all(s["coupler"]["model"] == "ffrf" for s in fit.values())
     for s in validation.values():  # auto is validated as a user gets it (key at default)
         assert s["coupler"]["model"] == "auto" and s["coupler"]["geometric_stiffness"] is True
-        full = couplerfit.full_scene(s)
+        full = kfit.full_scene(s)
         assert full["coupler"]["model"] == "ffrf"
         assert full["coupler"]["geometric_stiffness"] is True
         assert full["coupler"]["modes"] == lawfit.FULL_MODES
@@ -39,12 +39,12 @@ def _closed_form_ratio(scene, thickness_m, spring_N_per_m, preload_m):
     c = scene["coupler"]
     euler_N = (math.pi**2 * c["youngs_modulus_Pa"] * c["width_m"] * thickness_m**3 / 12
                / c["length_m"] ** 2)
-    return couplerfit.COMPRESSION_SHARE * spring_N_per_m * preload_m / euler_N
+    return kfit.COMPRESSION_SHARE * spring_N_per_m * preload_m / euler_N
 
 
 def test_cases_beyond_the_euler_load_limit_are_left_out_and_named(study):
     scene, cases = study
-    left_out = couplerfit.left_out_cases(scene, *kfit._grid())
+    left_out = kfit.left_out_cases(scene, *kfit_study._grid())
     assert not set(left_out) & set(cases)
     for name, ratio in left_out.items():
         assert ratio > EULER_LOAD_LIMIT, name
@@ -82,15 +82,15 @@ def test_prediction_margin_is_the_quantile_of_measured_over_predicted_fitted_cas
     measured = np.linspace(1.0, 2.0, 21)
     data = _table(np.r_[measured, 50.0, np.nan], np.r_[np.ones(21), 1.0, 1.0],
                   [True] * 21 + [False, True])  # the outlier is not fitted, NaN is skipped
-    assert couplerfit.prediction_margin(data) == pytest.approx(1.95)  # 95 % of 1..2
-    assert math.isnan(couplerfit.prediction_margin(_table([1.0], [1.0], [False])))
+    assert kfit_law.prediction_margin(data) == pytest.approx(1.95)  # 95 % of 1..2
+    assert math.isnan(kfit_law.prediction_margin(_table([1.0], [1.0], [False])))
 
 
 def test_report_names_every_case_not_in_the_fit_and_why():
     data = _table([0.001, 0.08, 0.002], [0.001, 0.05, 0.002], [True, False, False],
                   ratio=[0.1, 0.4, 0.3], names=["ok_case", "bent_case", "loaded_case"])
     datasets: dict = {}
-    lines = "\n".join(couplerfit.exclusion_lines(data, {"never_run": 0.41}, datasets))
+    lines = "\n".join(kfit_law.exclusion_lines(data, {"never_run": 0.41}, datasets))
     assert "never_run (0.41)" in lines and "not generated (1)" in lines
     assert "bent_case (0.40 P_E)" in lines and "deflection > 5% of L2" in lines
     assert "loaded_case (0.30 P_E)" in lines and "compression > 0.25" in lines

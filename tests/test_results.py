@@ -71,3 +71,28 @@ def test_failed_write_leaves_previous_file_intact(tmp_path):
         write_results(path, "demo", [good, bad])
     assert path.read_bytes() == before
     assert [p.name for p in tmp_path.iterdir()] == ["r.h5"]  # no temporary left behind
+
+
+def test_a_declared_table_becomes_one_dataset_per_column_and_reads_back(tmp_path):
+    from flex.data.tables import table_datasets
+
+    rows = [{"name": "a", "time": 0.5, "steps": 3, "ok": True},
+            {"name": "b", "time": 1.5, "steps": 4, "ok": False}]
+    columns = {"name": ("1", "case"), "time": ("s", "wall time"),
+               "steps": ("1", "time steps", float), "ok": ("1", "within tolerance")}
+    datasets = table_datasets(rows, columns, "runs")
+    assert list(datasets) == ["runs/name", "runs/time", "runs/steps", "runs/ok"]
+    assert datasets["runs/time"].units == "s" and datasets["runs/time"].description == "wall time"
+    assert datasets["runs/name"].data.dtype == object  # text stays Python strings
+    assert datasets["runs/steps"].data.dtype == float  # the declared dtype wins
+    assert datasets["runs/ok"].data.dtype == bool
+    empty = table_datasets([], columns)
+    assert list(empty) == list(columns) and empty["name"].data.shape == (0,)
+    with pytest.raises(KeyError):
+        table_datasets([{"name": "c"}], columns)  # a row without a declared column
+    path = tmp_path / "table.h5"
+    write_results(path, "demo", [CaseResult("c", "", datasets)])
+    with h5py.File(path) as h5:
+        assert [v.decode() for v in h5["cases/c/runs/name"][()]] == ["a", "b"]
+        np.testing.assert_array_equal(h5["cases/c/runs/time"][()], [0.5, 1.5])
+        assert h5["cases/c/runs/time"].attrs["units"] == "s"

@@ -1,5 +1,6 @@
 """The tradeoff study runs what flex's FFRF rule picks per accuracy level, and its report and
-figures mark those picks (flex.experiments.defaults_check, flex.experiments.workprecision_report).
+figures mark those picks (flex.experiments.workprecision.defaults_check,
+flex.experiments.workprecision.tradeoff_report).
 
 Nothing here simulates: the rule's picks are resolved, the measurements are synthetic."""
 
@@ -15,25 +16,28 @@ from flex.config.ffrf_rule import pick
 from flex.config.settings import resolve_solver_settings
 from flex.data.results import Dataset
 from flex.data.scene import Scene, load_scene
-from flex.experiments.rule_check import (
+from flex.experiments.workprecision.measurement import (
+    Measurement,
+    Observables,
+    ReductionPool,
+    Reference,
+    Setting,
+    scene_for,
+)
+from flex.experiments.workprecision.pareto import pareto_front
+from flex.experiments.workprecision.rule_check import (
     RULE_GROUP,
     RULE_LEVELS,
     rule_level,
     rule_run,
     rule_settings,
 )
-from flex.experiments.tradeoff import (
-    Measurement,
-    Observables,
-    ReductionPool,
-    Reference,
-    Setting,
+from flex.experiments.workprecision.tradeoff import SceneRuns
+from flex.experiments.workprecision.tradeoff_report import (
     measurements_table,
-    pareto_front,
-    scene_for,
+    summarize_work_precision,
+    work_precision_figures,
 )
-from flex.experiments.workprecision import SceneRuns
-from flex.experiments.workprecision_report import summarize_work_precision, work_precision_figures
 
 FFRF_SCENES = ("ffrf_1mm", "ffrf_10mm")
 

@@ -17,7 +17,7 @@ from flex.config.settings import pinned_overrides
 from flex.config.usage import unused_keys
 from flex.data.scene import load_scene
 from flex.dynamics.solver import integrate
-from flex.experiments.spring_mass import chain_matrices, governing_error
+from flex.experiments.models.spring_mass import chain_matrices, governing_error
 from flex.fidelity.auto import resolve
 from flex.fidelity.probe import deployment_probe
 from flex.fidelity.simulation import simulate
@@ -50,7 +50,7 @@ def _chain(segments: int) -> list[str]:
 
 @pytest.mark.parametrize("segments", [1, 4, 16, 256])
 def test_rayleigh_mass_is_the_chain_kinetic_energy_in_the_limit(segments):
-    # the chain's own lumped masses (flex.experiments.spring_mass.chain_matrices, no end
+    # the chain's own lumped masses (flex.experiments.models.spring_mass.chain_matrices, no end
     # mass beyond a negligible one) moving with the linear profile of a quasi-static coil:
     # sum m_i (x_i / L)^2 = m_s / 3 + m_s / (6 N^2), the second-order convergence
     mass, _ = chain_matrices(COIL_KG, RATE_N_PER_M, 1e-300, segments)

@@ -15,7 +15,7 @@ from flex.config.usage import unused_keys
 from flex.data.scene import load_scene
 from flex.dynamics.planar import PlanarBuilder
 from flex.dynamics.solver import integrate
-from flex.experiments.spring_mass import (
+from flex.experiments.models.spring_mass import (
     chain_convergence,
     chain_matrices,
     continuous_first_omega_rad_per_s,
@@ -158,7 +158,7 @@ def test_deployment_cases_cover_every_model():
 
 def test_stop_index_skips_a_start_up_ripple():
     """A ripple maximum before half the rise is not the deployment's end."""
-    from flex.experiments.spring_mass import stop_index
+    from flex.experiments.models.spring_mass import stop_index
 
     time_s = np.linspace(0.0, 1.0, 1001)
     angle = np.sin(np.pi * time_s / 0.8)
@@ -171,7 +171,7 @@ def test_stop_index_skips_a_start_up_ripple():
 
 def test_governing_error_of_a_scaled_run():
     """A run whose angle and slider deviate by 1 % of their rise has error 0.01."""
-    from flex.experiments.spring_mass import governing_error
+    from flex.experiments.models.spring_mass import governing_error
 
     time_s = np.linspace(0.0, 1.0, 101)
     full = {"time": time_s, "crank/angle": np.sin(np.pi * time_s),

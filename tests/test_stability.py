@@ -190,7 +190,7 @@ def test_the_thin_plate_built_to_diverge_does_diverge_and_names_its_step():
 
     (extreme,) = [e for e in stability.extremes() if e.name == "diverge_thin_plate_h1e-3"]
     from flex.config.settings import pinned_overrides
-    from flex.experiments.stability import extreme_cases
+    from flex.experiments.models.stability import extreme_cases
 
     (scene,) = extreme_cases(load_scene(None, pinned_overrides()), [extreme]).values()
     result = simulate_case(scene, extreme.name)
@@ -199,12 +199,12 @@ def test_the_thin_plate_built_to_diverge_does_diverge_and_names_its_step():
 
 
 # ------------------------------------------------------------------------------------------
-# flex.experiments.stability: references, verdicts, trust boundary
+# flex.experiments.models.stability: references, verdicts, trust boundary
 # ------------------------------------------------------------------------------------------
 def test_a_constant_speed_run_is_judged_against_the_closed_form():
     from flex.config.settings import pinned_overrides
-    from flex.experiments.stability import Extreme, References, extreme_cases, judge
-    from flex.experiments.tradeoff import ReductionPool
+    from flex.experiments.models.stability import Extreme, References, extreme_cases, judge
+    from flex.experiments.workprecision.measurement import ReductionPool
 
     extreme = Extreme("crank_speed", "stiff_drive", (
         'drive.kind="constant_speed"', "simulation.end_time_s=0.01"), "closed_form", 1.0)
@@ -223,7 +223,7 @@ def test_a_constant_speed_run_is_judged_against_the_closed_form():
 
 
 def test_trust_boundary_interpolates_where_ffrf_comes_within_one_percent():
-    from flex.experiments.stability import trust_boundary
+    from flex.experiments.models.stability import trust_boundary
 
     def verdicts(errors):
         return {f"nonlinear_{t:g}mm": {"group": "nonlinear", "parameter": t,

@@ -174,7 +174,7 @@ def test_kfit_study_small_end_to_end(tmp_path, monkeypatch, reduction_cache):
     """A shrunken kfit (3 thicknesses, 1 stiffness family, 1 validation scene) through the
     study runner and the local process pool: cases, fit, criterion file, validation."""
     import studies.kfit as kfit
-    from flex.experiments.couplerfit import analyse
+    from flex.experiments.fitting.kfit_law import analyse
     from flex.study import run_study
 
     monkeypatch.setattr(kfit, "THICKNESSES_M", (1e-3, 3e-3, 10e-3))
@@ -207,13 +207,13 @@ def test_case_hash_follows_the_case_function_s_version(monkeypatch):
     # a case function that stores more (its case_version bumped) must not resume old files
     import functools
 
-    from flex.experiments import couplerfit
+    from flex.experiments.fitting import kfit
     from flex.sweep import case_hash
 
     scene = load_scene()
-    bound = functools.partial(couplerfit.fit_case, cache_dir=None)
+    bound = functools.partial(kfit.fit_case, cache_dir=None)
     before = case_hash(scene, bound)
-    monkeypatch.setattr(couplerfit.fit_case, "case_version", couplerfit.fit_case.case_version + 1)
+    monkeypatch.setattr(kfit.fit_case, "case_version", kfit.fit_case.case_version + 1)
     assert case_hash(scene, bound) != before
 
 

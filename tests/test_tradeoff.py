@@ -1,4 +1,5 @@
-"""Work-precision machinery (flex.experiments.tradeoff) and the [simulation] knobs it varies."""
+"""Work-precision machinery (flex.experiments.workprecision: measurement, convergence, pareto)
+and the [simulation] knobs it varies."""
 
 from __future__ import annotations
 
@@ -11,19 +12,16 @@ from flex.base.errors import SceneError
 from flex.config.settings import pinned_overrides, resolved_simulation
 from flex.data.scene import load_scene
 from flex.dynamics.solver import solver_settings
-from flex.experiments.tradeoff import (
+from flex.experiments.workprecision.convergence import Refinement, converged_reference, richardson
+from flex.experiments.workprecision.measurement import (
     Measurement,
     Observables,
     Reference,
-    Refinement,
     Setting,
-    converged_reference,
     measure,
-    pareto_front,
     peak_value,
-    recommend,
-    richardson,
 )
+from flex.experiments.workprecision.pareto import pareto_front, recommend
 from flex.fidelity.simulation import simulate
 
 SHORT = ["simulation.end_time_s=0.01"]
@@ -83,7 +81,11 @@ def test_recommend_counts_the_reference_accuracy_in_the_error(rigid_reference):
 
 
 def test_the_1mm_reference_sequences_run_through_the_reference():
-    from flex.experiments.reference_plans import FFRF_REFERENCE, reference_plan, through_reference
+    from flex.experiments.workprecision.reference_plans import (
+        FFRF_REFERENCE,
+        reference_plan,
+        through_reference,
+    )
 
     finest, _, _, _, refinements, anchor = reference_plan("ffrf_1mm")
     assert through_reference(FFRF_REFERENCE["ffrf_1mm"]) and anchor is None
@@ -253,7 +255,7 @@ def test_bundled_defaults_are_the_fastest_setting_within_the_default_tolerance()
     # knobs at the largest step allowed, the defaults must be within the study's timing tie of
     # its pick (full and modified Newton at 1e-8 both take one iteration per step and swap
     # places from run to run), and take one Newton iteration per step
-    from flex.experiments.defaults_check import (
+    from flex.experiments.workprecision.defaults_check import (
         DEFAULT_TIE,
         DEFAULT_TOLERANCE,
         default_recommendation,
@@ -285,8 +287,8 @@ def test_ffrf_default_reaches_the_scene_tolerance_much_faster_than_the_scene_set
     # the tradeoff study's certified 1 % pick) against a finer FFRF run (h = 5e-6 s, 1.5 mm,
     # 12 modes: within 1.2e-3 of the study's reference, which is itself estimated accurate to
     # ~2e-3); the margin keeps the check about the default, not the test's reference
-    from flex.experiments.defaults_check import default_setting
-    from flex.experiments.tradeoff import ReductionPool
+    from flex.experiments.workprecision.defaults_check import default_setting
+    from flex.experiments.workprecision.measurement import ReductionPool
     from studies.tradeoff import FFRF_DEFAULT_SCENE, SCENES
 
     base = load_scene(overrides=pinned_overrides() + SCENES[FFRF_DEFAULT_SCENE])
@@ -307,7 +309,7 @@ def test_the_study_summary_checks_the_bundled_defaults(rigid_reference):
     # the summary path make tradeoff ends with: the "auto" run is found, resolved and judged
     # against DEFAULT_TOLERANCE (1e-6 rad, 1e-7 m, h <= 1e-5 s, rho <= 0.95)
     import studies.tradeoff as study
-    from flex.experiments.defaults_check import (
+    from flex.experiments.workprecision.defaults_check import (
         DEFAULT_LABEL,
         default_setting,
         within_default_tolerance,
@@ -329,7 +331,7 @@ def test_the_study_summary_checks_the_bundled_defaults(rigid_reference):
 def test_the_work_precision_figure_draws_the_front_and_the_reference_band(tmp_path):
     import studies.tradeoff as study
     from flex.data.results import Dataset
-    from flex.experiments.tradeoff import measurements_table
+    from flex.experiments.workprecision.tradeoff_report import measurements_table
     from flex.study import Summary
 
     runs = [_measurement("coarse", 0.01, 5e-3), _measurement("fine", 1.0, 5e-5),
@@ -344,10 +346,10 @@ def test_the_work_precision_figure_draws_the_front_and_the_reference_band(tmp_pa
 
 
 def test_profile_times_flex_phases_and_reads_exudyn_shares():
-    # the bench study's profile (flex.experiments.benchmark.profile through
+    # the bench study's profile (flex.experiments.workprecision.benchmark.profile through
     # flex.dynamics.solver.run_profiled)
-    from flex.experiments.benchmark import profile
-    from flex.experiments.tradeoff import ReductionPool
+    from flex.experiments.workprecision.benchmark import profile
+    from flex.experiments.workprecision.measurement import ReductionPool
 
     scene = load_scene(overrides=pinned_overrides() + SHORT)
     prof = profile(scene, ReductionPool())

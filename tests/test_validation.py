@@ -16,7 +16,7 @@ import pytest
 from flex.base.kinematics import constant_speed_motion
 from flex.data.scene import load_scene
 from flex.dynamics import ivp_crank
-from flex.experiments import validation
+from flex.experiments.models import validation
 from flex.fidelity.simulation import simulate
 
 BENCH = ivp_crank.CrankBenchmark()

@@ -6,7 +6,7 @@ import pytest
 from flex.base.thesis import THESIS_WING_PEAK_RATE_DEG_PER_S, THESIS_WING_PEAK_TIME_S
 from flex.data.scene import load_scene
 from flex.dynamics.reference import crank_mass_properties, solve_reference
-from flex.experiments import wing
+from flex.experiments.thesis import wing
 from flex.fidelity.simulation import simulate
 from studies.wing import OVERRIDES
 

@@ -1,9 +1,9 @@
 """Closed forms of beam and plate theory used across flex (numpy and math only).
 
-Each formula exists once, here; the library and the studies import it (:mod:`flex.experiments.modal`
-adds the input checks of its public functions, Timoshenko beams and finite elements). Units
-are in the names; frequencies are circular [rad/s]. The thesis's own numbers are in
-:mod:`flex.base.thesis`.
+Each formula exists once, here; the library and the studies import it
+(:mod:`flex.experiments.thesis.modal` adds the input checks of its public functions, Timoshenko
+beams and finite elements). Units are in the names; frequencies are circular [rad/s]. The thesis's
+own numbers are in :mod:`flex.base.thesis`.
 
 Theory: Euler-Bernoulli beams, elementary rods and St-Venant torsion as tabulated in
 Blevins, *Formulas for Natural Frequency and Mode Shape* (1979), ch. 8 (straight beams:

@@ -3,7 +3,7 @@
 Cavezza, F. (2012). *Flexibility and Transient Dynamic Analysis of a Slider-Crank Deployment
 Mechanism*. MS thesis, West Virginia University ("the thesis"). Values the thesis reads off
 its own figures are marked "approx." as it marks them. The library and the studies import
-them from here (:mod:`flex.fidelity.criteria`, :mod:`flex.experiments.modal` and
+them from here (:mod:`flex.fidelity.criteria`, :mod:`flex.experiments.thesis.modal` and
 :mod:`flex.bodies.spring` re-export
 the ones they have always exposed); the closed forms that use them are in
 :mod:`flex.base.physics`. The bundled scene ``flex/scenes/cavezza2012.toml`` is the thesis's

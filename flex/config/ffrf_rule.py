@@ -22,7 +22,7 @@ most demanding headline quantity), the rule chooses for an FFRF coupler on a rig
   frequency within 0.1 %), and a thick one needs elements along its length.
 
 The mode cut-off ratio, ``C`` and ``B`` are calibrated per tolerance level and per damping class
-(:func:`damping_class`) by ``make calibrate`` (:mod:`flex.experiments.calibration`) over a
+(:func:`damping_class`) by ``make calibrate`` (:mod:`flex.experiments.fitting.calibration`) over a
 family of plates, materials, springs and drives, and live in ``flex/config/ffrf_rule.toml``
 with the family's bounds and the worst calibration error. A tolerance between levels uses
 the next finer level. Outside the calibrated family (slenderness, a tolerance finer than the

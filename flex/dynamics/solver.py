@@ -199,10 +199,10 @@ def run(mech: Mechanism, label: str = "") -> dict[str, Any]:
 
 
 def run_profiled(mech: Mechanism) -> tuple[dict[str, float], str]:
-    """Integrate ``mech`` once (implicit integrator) with Exudyn's CPU-time statistics on,
-    for benchmarks (:mod:`flex.experiments.benchmark`; :func:`run` is the production path): counters
-    (``steps``, ``newton_iterations``, ``jacobian_updates``; ``wall_time_s`` [s], the solve
-    alone) and the statistics text Exudyn printed. Raises SimulationError if it fails."""
+    """Integrate ``mech`` once (implicit integrator) with Exudyn's CPU-time statistics on, for
+    benchmarks (:mod:`flex.experiments.workprecision.benchmark`; :func:`run` is the production
+    path): counters (``steps``, ``newton_iterations``, ``jacobian_updates``; ``wall_time_s`` [s],
+    the solve alone) and the statistics text Exudyn printed. Raises SimulationError if it fails."""
     import exudyn as exu
 
     settings = _exudyn_settings(solver_settings(mech.scene))

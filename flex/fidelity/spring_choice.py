@@ -3,7 +3,7 @@ spring's error from the rigid probe's own run.
 
 The massless spring leaves out the coil's mass. Its error on the governing measure (largest of
 the crank-angle and slider-position deviations from the continuous coil over the deployment,
-relative to swing and travel: the ``governing_error`` of :mod:`flex.experiments.spring_mass`)
+relative to swing and travel: the ``governing_error`` of :mod:`flex.experiments.models.spring_mass`)
 is predicted here, with no fit, as the sum of two parts:
 
 - **quasi-static** (:func:`rayleigh_warp`): the coil carries Rayleigh's ``m_s / 3`` on the

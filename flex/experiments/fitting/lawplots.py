@@ -1,6 +1,6 @@
-"""Figures of the rigid-or-flexible law fits (:mod:`flex.experiments.lawfit`): the coupler's
-(``kfit``)
-errors and k against n and tolerance, the crank's law, its validation and deflections."""
+"""Figures of the rigid-or-flexible law fits (:mod:`flex.experiments.fitting.lawfit`): the
+coupler's (``kfit``) errors and k against n and tolerance, the crank's law, its validation and
+deflections."""
 
 from __future__ import annotations
 
@@ -22,16 +22,12 @@ from flex.base.plotting import (
     wrap,
 )
 from flex.data.results import CaseResult
-from flex.experiments.couplerfit import (
-    PREDICTOR_BAND,
-    THESIS_MODELS,
-    label,
-    predictor_ratios,
-)
-from flex.experiments.lawfit import FULL_MODES, REPORT_TOLERANCES
+from flex.experiments.fitting.kfit import THESIS_MODELS, label
+from flex.experiments.fitting.kfit_law import PREDICTOR_BAND, predictor_ratios
+from flex.experiments.fitting.lawfit import FULL_MODES, REPORT_TOLERANCES
 from flex.fidelity.criteria import GOVERNING, TWO_PI
 
-#: the coupler fit's case families spelt out (see :func:`flex.experiments.couplerfit.fit_cases`)
+#: the coupler fit's case families spelt out (see :func:`flex.experiments.fitting.kfit.fit_cases`)
 FAMILY_NAMES = {"thk": "thickness sweep", "stf": "spring stiffness sweep",
                 "pre": "preload sweep"}
 #: the error measures as axis labels (definitions: flex.fidelity.criteria.MEASURES)
@@ -57,7 +53,7 @@ def _thesis_entry(thesis_k: float) -> tuple[str, dict]:
 # ------------------------------------------------------------------------------------------
 def coupler_figures(analysis: dict[str, Any], folder: Path) -> list[Path]:
     """``kfit-error-vs-n.png`` and ``kfit-k-vs-tolerance.png`` from an analysis of
-    :func:`flex.experiments.couplerfit.analyse` (none without fits)."""
+    :func:`flex.experiments.fitting.kfit_law.analyse` (none without fits)."""
     if not analysis["fits"]:
         return []
     return [_error_vs_n(analysis, folder / "kfit-error-vs-n.png"),

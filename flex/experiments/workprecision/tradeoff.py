@@ -1,17 +1,17 @@
-"""Running a work-precision plan: per scene a converged reference, then every setting.
+"""The ``tradeoff`` study's runs: per scene a converged reference, then every setting.
 
 :func:`run_work_precision` runs, per scene, its
-:class:`~flex.experiments.reference_plans.ReferencePlan`
-(:func:`flex.experiments.reference_plans.build_reference`) and then measures each of its settings
-against
-that reference (:func:`flex.experiments.tradeoff.measure`), sharing reductions within the scene
-(:class:`~flex.experiments.tradeoff.ReductionPool`). It returns one case per run --
-``<scene>__reference``
-(the reference's curves) and ``<scene>__<setting>`` (:func:`measurement_case`: attrs knobs,
-group, label and errors; counters with the median wall time [s]; dataset ``wall_times``, every
-repeat [s]; a failed run is a ``failed`` case with its message and no data) -- and leaves the
-measurements in ``notes["runs"]`` (:class:`SceneRuns`), from which
-:mod:`flex.experiments.workprecision_report` builds the tables.
+:class:`~flex.experiments.workprecision.reference_plans.ReferencePlan`
+(:func:`flex.experiments.workprecision.reference_plans.build_reference`) and then measures each
+of its settings against that reference
+(:func:`flex.experiments.workprecision.measurement.measure`), sharing reductions within the scene
+(:class:`~flex.experiments.workprecision.measurement.ReductionPool`). It returns one case per
+run -- ``<scene>__reference`` (the reference's curves) and ``<scene>__<setting>``
+(:func:`flex.experiments.workprecision.measurement.measurement_case`: attrs knobs, group, label
+and errors; counters with the median wall time [s]; dataset ``wall_times``, every repeat [s];
+a failed run is a ``failed`` case with its message and no data) -- and leaves the measurements
+in ``notes["runs"]`` (:class:`SceneRuns`), from which
+:mod:`flex.experiments.workprecision.tradeoff_report` builds the tables.
 """
 
 from __future__ import annotations
@@ -22,22 +22,24 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 
-import numpy as np
-
-from flex.base.errors import FlexError
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
-from flex.experiments.reference_plans import ReferencePlan, build_reference, reference_plan
-from flex.experiments.tradeoff import (
+from flex.experiments.workprecision.measurement import (
     Measurement,
+    Progress,
     ReductionPool,
     Reference,
     Setting,
     measure,
+    measurement_attrs,
+    measurement_case,
     scene_for,
 )
-
-Progress = Callable[[str, int, int], None]
+from flex.experiments.workprecision.reference_plans import (
+    ReferencePlan,
+    build_reference,
+    reference_plan,
+)
 
 
 class SceneRuns(NamedTuple):
@@ -47,15 +49,6 @@ class SceneRuns(NamedTuple):
     reference: Reference
     measurements: list[Measurement]
     reference_time_s: float
-
-
-def nonlinear_available() -> bool:
-    """Whether the nonlinear FE coupler (:mod:`flex.bodies.nonlinear`, NGsolve) is installed."""
-    try:
-        from flex.bodies.nonlinear import add_nonlinear_fe_coupler  # noqa: F401
-    except ImportError:
-        return False
-    return True
 
 
 def case_name(scene_name: str, label: str) -> str:
@@ -82,39 +75,6 @@ def reference_case(scene_name: str, scene: Scene, reference: Reference) -> CaseR
                              "converged": reference.converged,
                              "accuracy": reference.accuracy,
                              "tolerance": reference.tolerance})
-
-
-def measurement_attrs(m: Measurement, group: bool = True) -> dict[str, Any]:
-    """Case attrs of a measurement: knobs, (``group``) its sweep, label, ``error_<measure>``
-    for each error measure and ``error``."""
-    attrs: dict[str, Any] = {"knobs": repr(m.setting.knobs())}
-    if group:
-        attrs["group"] = m.setting.group
-    attrs["label"] = m.setting.label
-    attrs.update({f"error_{key}": value for key, value in m.errors.items() if key != "error"})
-    attrs["error"] = m.error
-    return attrs
-
-
-def measurement_case(name: str, base: Scene, m: Measurement, attrs: dict[str, Any]
-                     ) -> CaseResult:
-    """The case of one measurement of a setting on ``base``: its scene (``base`` itself if the
-    setting was refused), ``attrs``, and if it ran: dataset ``wall_times`` [s] and counters
-    (median wall and total time [s], steps, Newton iterations, Jacobian updates, repeats);
-    a failed run carries its message and no data."""
-    try:
-        scene_toml = to_toml(scene_for(base, m.setting))
-    except FlexError:  # a refused setting: store the base scene and the message
-        scene_toml = to_toml(base)
-    if not m.ok:
-        return CaseResult(name, scene_toml, status="failed", message=m.message, attrs=attrs)
-    return CaseResult(name, scene_toml,
-                      {"wall_times": Dataset(np.array(m.wall_times_s), "s",
-                                             "integration wall time of each repeat")},
-                      counters={"wall_time_s": m.wall_time_s, "total_time_s": m.total_time_s,
-                                "steps": m.steps, "newton_iterations": m.newton_iterations,
-                                "jacobian_updates": m.jacobian_updates,
-                                "repeats": len(m.wall_times_s)}, attrs=attrs)
 
 
 def _work_precision_case(scene_name: str, scene: Scene, m: Measurement) -> CaseResult:

@@ -40,6 +40,7 @@ from flex.base.plotting import figure
 from flex.config.settings import resolve_solver_settings
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides
+from flex.data.tables import table_datasets
 from flex.fidelity.error_estimate import HEADLINES, PREFIX, integrator_order, richardson_error
 from flex.fidelity.simulation import simulate_case
 
@@ -192,21 +193,19 @@ def _rows(results: Mapping[str, CaseResult]) -> list[dict[str, Any]]:
     return rows
 
 
+#: ``/summary/pairs/<column>``: one row per (case, headline quantity) with a true error
+PAIR_COLUMNS = {"case": ("1", "case"), "quantity": ("1", "headline quantity (units in name)"),
+                "estimated": ("see quantity", "the run's estimated error (its budget's total)"),
+                "true": ("see quantity", "|run - reference|"),
+                "reference_accuracy": ("see quantity", "the reference's own error"),
+                "judged": ("1", "true error known and above the noise floor"),
+                "largest_term": ("1", "the budget's largest term")}
+
+
 def estimate_summary(results: Mapping[str, CaseResult]) -> tuple[dict[str, Dataset], str]:
     """``/summary`` datasets (one entry per case and quantity) and the report."""
     rows = _rows(results)
-    datasets: dict[str, Dataset] = {}
-    columns = {"case": ("1", "case"), "quantity": ("1", "headline quantity (units in name)"),
-               "estimated": ("see quantity", "the run's estimated error (its budget's total)"),
-               "true": ("see quantity", "|run - reference|"),
-               "reference_accuracy": ("see quantity", "the reference's own error"),
-               "judged": ("1", "true error known and above the noise floor"),
-               "largest_term": ("1", "the budget's largest term")}
-    for key, (units, text) in columns.items():
-        values = [row[key] for row in rows]
-        data = np.array(values, dtype=object if isinstance(values[0], str) else None) \
-            if values else np.array([])
-        datasets[f"pairs/{key}"] = Dataset(data, units, text)
+    datasets = table_datasets(rows, PAIR_COLUMNS, "pairs")
     ratio = np.array([r["true"] / r["estimated"] if r["estimated"] > 0 else np.inf
                       for r in rows])
     datasets["pairs/true_over_estimated"] = Dataset(ratio, "1", "true / estimated (above 1: "

@@ -16,13 +16,18 @@ from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
 from flex.config.ffrf_rule import LINK_KEYS, pick
 from flex.config.settings import AUTO_OVERRIDES, resolve_solver_settings
 from flex.data.results import Dataset
 from flex.data.scene import Scene
-from flex.experiments.tradeoff import Measurement, Reference, Setting, certifies, scene_for
+from flex.data.tables import table_datasets
+from flex.experiments.workprecision.measurement import (
+    Measurement,
+    Reference,
+    Setting,
+    certifies,
+    scene_for,
+)
 
 RULE_GROUP = "flex rule"
 #: the accuracy levels (``fidelity.tolerance``, relative) at which the study asks flex for the
@@ -157,9 +162,6 @@ def rule_check(group: str, measurements: Sequence[Measurement], reference: Refer
             if (level := rule_level(m.setting)) is not None and plate_scene is not None]
     if not rows:
         return {}, []
-    datasets = {f"{group}/rule/{key}": Dataset(
-        np.array([row[key] for row in rows],
-                 dtype=object if isinstance(rows[0][key], str) else None), units, text)
-        for key, (units, text) in RULE_COLUMNS.items()}
-    return datasets, ["    flex rule picks (fidelity.tolerance = level; coupler modes, mesh "
-                      "and solver keys auto):"] + [_rule_line(row) for row in rows]
+    lines = ["    flex rule picks (fidelity.tolerance = level; coupler modes, mesh and solver keys "
+             "auto):"] + [_rule_line(row) for row in rows]
+    return table_datasets(rows, RULE_COLUMNS, f"{group}/rule"), lines

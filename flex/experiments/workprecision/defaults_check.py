@@ -21,15 +21,14 @@ from flex.base.errors import SceneError
 from flex.config.settings import AUTO_OVERRIDES, resolve_solver_settings
 from flex.data.results import Dataset
 from flex.data.scene import Scene
-from flex.experiments.tradeoff import (
+from flex.experiments.workprecision.measurement import (
     Measurement,
     Reference,
     Setting,
     describe,
-    fastest,
-    recommend,
     scene_for,
 )
+from flex.experiments.workprecision.pareto import fastest, recommend
 
 DEFAULT_LABEL = "flex defaults (auto)"
 #: the default scene's tolerance, as the test suite holds it to the reference DAE (crank angle

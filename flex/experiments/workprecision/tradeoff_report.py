@@ -1,21 +1,21 @@
-"""What a work-precision run reports: per scene the run table, the reference and its evidence,
-the recommendations, the defaults check, and the work-precision diagram.
+"""What the ``tradeoff`` study reports: per scene the run table, the reference and its
+evidence, the recommendations, the defaults check, and the work-precision diagram.
 
-:func:`summarize_work_precision` turns ``notes["runs"]`` of :func:`flex.experiments.workprecision.
-run_work_precision` into datasets under ``<scene>/``: ``runs/...`` (the table of
-:func:`flex.experiments.tradeoff.measurements_table`, with ``on_pareto_front``), ``reference/...``
-(what it
-is and its convergence evidence), ``recommended/...`` (per accuracy level 1 %, 0.1 %, 0.01 %),
-``default/...`` and ``rule/...`` (the flex rule's picks, :mod:`flex.experiments.rule_check`),
-and into the report text. :func:`work_precision_figures` draws, from those datasets, one diagram
-per scene: error against wall time (log-log), the Pareto fronts, the rule's picks (open stars),
-the accuracy levels and the band the reference cannot resolve.
+:func:`summarize_work_precision` turns ``notes["runs"]`` of
+:func:`flex.experiments.workprecision.tradeoff.run_work_precision` into datasets under
+``<scene>/``: ``runs/...`` (the table of :func:`measurements_table`, with ``on_pareto_front``),
+``reference/...`` (what it is and its convergence evidence), ``recommended/...`` (per accuracy
+level 1 %, 0.1 %, 0.01 %), ``default/...`` and ``rule/...`` (the flex rule's picks,
+:mod:`flex.experiments.workprecision.rule_check`), and into the report text.
+:func:`work_precision_figures` draws, from those datasets, one diagram per scene: error against
+wall time (log-log), the Pareto fronts, the rule's picks (open stars), the accuracy levels and
+the band the reference cannot resolve.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -24,22 +24,55 @@ import numpy as np
 from flex.base.plotting import figure, legend_below
 from flex.data.results import Dataset
 from flex.data.scene import Scene
-from flex.experiments.defaults_check import ffrf_defaults_check, rigid_defaults_check
-from flex.experiments.rule_check import rule_check
-from flex.experiments.tradeoff import (
-    ACCURACY_LEVELS,
-    Measurement,
-    Reference,
-    describe,
-    fastest,
-    measurements_table,
-    pareto_front,
-    recommend,
-)
-from flex.experiments.workprecision import SceneRuns
+from flex.data.tables import table_datasets
+from flex.experiments.workprecision.defaults_check import ffrf_defaults_check, rigid_defaults_check
+from flex.experiments.workprecision.measurement import Measurement, Reference, describe
+from flex.experiments.workprecision.pareto import ACCURACY_LEVELS, fastest, pareto_front, recommend
+from flex.experiments.workprecision.rule_check import rule_check
+from flex.experiments.workprecision.tradeoff import SceneRuns
 
 HEADER = ("work-precision (error = largest relative error of crank angle / swing, slider / "
           "travel, peak deflection / peak; wall = median integration time)")
+
+
+#: ``/summary/<scene>/runs/<column>``: one row per measured setting (:func:`measurements_table`)
+RUN_COLUMNS = {
+    "label": ("1", "setting", object),
+    "group": ("1", "sweep the setting belongs to", object),
+    "knobs": ("1", "engine and scene overrides of the setting", object),
+    "status": ("1", "ok | failed", object),
+    "message": ("1", "why a run failed", object),
+    "wall_time": ("s", "median integration wall time over the repeats", float),
+    "repeats": ("1", "runs timed", int),
+    "total_time": ("s", "median build + integration + output time", float),
+    "steps": ("1", "time steps", int),
+    "newton_iterations": ("1", "Newton iterations", int),
+    "jacobian_updates": ("1", "Jacobian computations", int),
+    "crank_angle_error": ("rad", "max |crank angle - reference|", float),
+    "slider_position_error": ("m", "max |slider x - reference|", float),
+    "peak_deflection_error": ("m", "|peak midpoint deflection - reference peak|", float),
+    "error": ("1", "largest relative error (angle / swing, slider / travel, peak / peak)",
+              float),
+    "on_pareto_front": ("1", "not beaten in both wall time and error", bool),
+}
+
+
+def measurements_table(measurements: Sequence[Measurement], front: Iterable[int] = ()
+                       ) -> dict[str, Dataset]:
+    """Columns of the per-run table (stored under ``/summary/<scene>/runs/``,
+    :data:`RUN_COLUMNS`)."""
+    on_front = set(front)
+    rows = [{"label": m.setting.label, "group": m.setting.group,
+             "knobs": repr(m.setting.knobs()), "status": m.status, "message": m.message,
+             "wall_time": m.wall_time_s, "repeats": len(m.wall_times_s),
+             "total_time": m.total_time_s, "steps": m.steps,
+             "newton_iterations": m.newton_iterations, "jacobian_updates": m.jacobian_updates,
+             "crank_angle_error": m.errors.get("crank_angle_rad", np.nan),
+             "slider_position_error": m.errors.get("slider_position_m", np.nan),
+             "peak_deflection_error": m.errors.get("peak_deflection_m", np.nan),
+             "error": m.error, "on_pareto_front": i in on_front}
+            for i, m in enumerate(measurements)]
+    return table_datasets(rows, RUN_COLUMNS)
 
 
 def _evidence_column(evidence: Mapping[str, Mapping[str, Any]], key: str, default: Any
@@ -49,8 +82,8 @@ def _evidence_column(evidence: Mapping[str, Mapping[str, Any]], key: str, defaul
 
 def evidence_datasets(prefix: str, evidence: Mapping[str, Mapping[str, Any]]
                       ) -> dict[str, Dataset]:
-    """The reference's evidence (:attr:`flex.experiments.tradeoff.Reference.evidence`) as columns
-    under
+    """The reference's evidence
+    (:attr:`flex.experiments.workprecision.measurement.Reference.evidence`) as columns under
     ``prefix``, one row per knob sequence or coarsening."""
     names = list(evidence)
     values = np.full((len(names), 3), np.nan)
@@ -137,18 +170,27 @@ def reference_lines(scene_name: str, reference: Reference, reference_time_s: flo
     return lines
 
 
+#: ``/summary/<scene>/recommended/<column>``: one row per accuracy level
+#: (:data:`flex.experiments.workprecision.pareto.ACCURACY_LEVELS`)
+RECOMMENDED_COLUMNS = {"level": ("1", "relative accuracy level"),
+                       "setting": ("1", "fastest flex setting within it", object),
+                       "wall_time": ("s", "its median wall time"),
+                       "error": ("1", "its relative error"),
+                       "knobs": ("1", "its knobs, or why there is none", object)}
+
+
 def recommendations(group: str, measurements: Sequence[Measurement], reference: Reference
                     ) -> tuple[dict[str, Dataset], list[str]]:
     """``<group>/recommended/...`` and report lines: per accuracy level the fastest certified
     flex (Exudyn) setting, or why there is none."""
-    labels, walls, errors, reasons, lines = [], [], [], [], []
+    rows, lines = [], []
     for rec in recommend(measurements, reference,
                          eligible=lambda m: m.setting.engine == "exudyn"):
         m = rec.measurement
-        labels.append(m.setting.label if m else "")
-        walls.append(m.wall_time_s if m else np.nan)
-        errors.append(m.error if m else np.nan)
-        reasons.append(rec.reason or repr(m.setting.knobs()))
+        rows.append({"level": rec.level, "setting": m.setting.label if m else "",
+                     "wall_time": m.wall_time_s if m else np.nan,
+                     "error": m.error if m else np.nan,
+                     "knobs": rec.reason or repr(m.setting.knobs())})
         lines.append(f"    {rec.level * 100:g} %: {describe(m) if m else rec.reason}")
         if m is None and "certify" in rec.reason:
             unchecked = [c for c in measurements if c.ok and c.setting.engine == "exudyn"
@@ -156,14 +198,7 @@ def recommendations(group: str, measurements: Sequence[Measurement], reference: 
             if unchecked:
                 lines.append(f"      (fastest within it if the reference were exact: "
                              f"{describe(fastest(unchecked))})")
-    prefix = f"{group}/recommended"
-    return {f"{prefix}/level": Dataset(np.array(ACCURACY_LEVELS), "1", "relative accuracy level"),
-            f"{prefix}/setting": Dataset(np.array(labels, dtype=object), "1",
-                                         "fastest flex setting within it"),
-            f"{prefix}/wall_time": Dataset(np.array(walls), "s", "its median wall time"),
-            f"{prefix}/error": Dataset(np.array(errors), "1", "its relative error"),
-            f"{prefix}/knobs": Dataset(np.array(reasons, dtype=object), "1",
-                                       "its knobs, or why there is none")}, lines
+    return table_datasets(rows, RECOMMENDED_COLUMNS, f"{group}/recommended"), lines
 
 
 def _front_lines(measurements: Sequence[Measurement], front: Sequence[int]) -> list[str]:

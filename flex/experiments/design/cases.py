@@ -1,6 +1,6 @@
-"""Design charts of the spring-driven slider-crank: the sweep, each case's measures, the
-constraint lines through the design point, the thesis's optimum-angle claim and the mechanism
-checks (``make design``, ``studies/design.py``; docs/design.md).
+"""Design charts of the spring-driven slider-crank, its cases: the design point, the sweep's
+families, each case's measures, and a few cases against the reference DAE (``make design``,
+``studies/design.py``; docs/design.md).
 
 **The design point** is the study's base scene: its initial crank angle theta0, spring
 preload delta0 and rate k0, coupler thickness t0 (the thesis's: 34.19 deg, 22 mm, 1500 N/m,
@@ -26,6 +26,11 @@ quasi-static beam stress of its joint loads (:func:`flex.fidelity.criteria.quasi
 times the dynamic factor of the first-mode oscillator driven by the same loads
 (:func:`flex.fidelity.predictor.predict_deflection`: peak / quasi-static peak), because the
 sudden release makes the quasi-static stress an under-estimate (docs/criterion.md).
+
+The table of every case, the lines through the design point and the thesis's claim:
+:mod:`flex.experiments.design.summary`; the mechanism checks:
+:mod:`flex.experiments.design.mechanism`; the report and charts:
+:mod:`flex.experiments.design.report`; ``flex design``: :mod:`flex.experiments.design.question`.
 """
 
 from __future__ import annotations
@@ -45,19 +50,15 @@ from scipy.optimize import brentq
 from flex.base.errors import SceneError
 from flex.base.kinematics import slider_crank
 from flex.base.mechanism_checks import (
-    Joint,
     angle_to_dead_centres_rad,
-    counted_mobility,
     dead_centre_angles_rad,
-    jacobian_mobility,
-    smallest_singular_value,
     transmission_angle_rad,
 )
 from flex.base.thesis import THESIS_ANGLE_MAX_TIME_S, THESIS_SPRING_RATE_N_PER_M
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, validate
-from flex.experiments.couplerfit import mesh_size_m
-from flex.experiments.lawfit import case_data
+from flex.experiments.fitting.kfit import mesh_size_m
+from flex.experiments.fitting.lawfit import case_data
 from flex.fidelity.criteria import first_maximum_index, quasi_static_stress
 from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection
 
@@ -211,7 +212,7 @@ def family_points(scene: Scene, grid: Grid) -> dict[str, list[Point]]:
 
 def point_scene(scene: Scene, point: Point) -> Scene:
     """The case scene of a point: its inputs, the coupler's mesh for its thickness
-    (:func:`flex.experiments.couplerfit.mesh_size_m`), and an end time long enough for the
+    (:func:`flex.experiments.fitting.kfit.mesh_size_m`), and an end time long enough for the
     deployment (:data:`END_TIME_FACTOR`)."""
     angle, preload, rate, thickness = point
     end = END_TIME_FACTOR * THESIS_ANGLE_MAX_TIME_S * math.sqrt(THESIS_SPRING_RATE_N_PER_M / rate)
@@ -349,215 +350,6 @@ design_case.case_version = CASE_VERSION
 
 
 # ------------------------------------------------------------------------------------------
-# the table of every case
-# ------------------------------------------------------------------------------------------
-INPUTS = {"angle_deg": ("deg", "crank", "initial_angle_deg"),
-          "preload_m": ("m", "drive", "spring_preload_m"),
-          "rate_N_per_m": ("N/m", "drive", "spring_stiffness_N_per_m"),
-          "thickness_m": ("m", "coupler", "thickness_m")}
-
-
-def table(results: Mapping[str, CaseResult]) -> dict[str, np.ndarray]:
-    """One row per case (in ``results`` order): ``case``, ``outcome``, ``model``, the
-    :data:`INPUTS`, every measure (NaN where refused or failed) and ``valid``: 1 for a
-    deployment that comes to rest before the folded dead centre (a crank that turns through
-    it is no deployment: its speeds are left out of the extrema)."""
-    rows: dict[str, list] = {key: [] for key in ("case", "outcome", "model", *INPUTS, *MEASURES,
-                                                 "valid")}
-    for name, case in results.items():
-        scene = tomllib.loads(case.scene_toml)
-        fold = dead_centre_angles_rad(scene["crank"]["length_m"], scene["coupler"]["length_m"],
-                                      scene["slider"]["offset_m"])[1]
-        rows["case"].append(name)
-        outcome = case.attrs.get("design_outcome", "failed") if case.status == "ok" else "failed"
-        rows["outcome"].append(outcome)
-        rows["model"].append(str(case.attrs.get("design_model", "-")))
-        for key, (_, section, field_name) in INPUTS.items():
-            rows[key].append(float(scene[section][field_name]))
-        for key in MEASURES:
-            dataset = case.datasets.get(f"measures/{key}")
-            rows[key].append(float(np.asarray(dataset.data)) if dataset is not None else np.nan)
-        rows["valid"].append(float(rows["deployment_complete"][-1] == 1
-                                   and rows["final_crank_angle"][-1] < fold))
-    return {key: np.asarray(values, dtype=object if key in ("case", "outcome", "model")
-                            else float) for key, values in rows.items()}
-
-
-def table_datasets(rows: Mapping[str, np.ndarray]) -> dict[str, Dataset]:
-    """The table as ``table/<column>`` datasets with units."""
-    units = {**{k: (u, f"case input: {s}.{f}") for k, (u, s, f) in INPUTS.items()},
-             **MEASURES, "case": ("1", "case name"),
-             "outcome": ("1", "simulated, or refused by auto (near buckling)"),
-             "model": ("1", "the coupler model auto chose"),
-             "valid": ("1", "1: comes to rest before the folded dead centre")}
-    return {f"table/{key}": Dataset(values, *units[key]) for key, values in rows.items()}
-
-
-def rows_of(rows: Mapping[str, np.ndarray], names: list[str]) -> dict[str, np.ndarray]:
-    """The table restricted to ``names`` (in that order)."""
-    index = {name: i for i, name in enumerate(rows["case"])}
-    keep = np.array([index[name] for name in names if name in index], dtype=int)
-    return {key: np.asarray(values)[keep] for key, values in rows.items()}
-
-
-# ------------------------------------------------------------------------------------------
-# extrema along a line, and the thesis claim
-# ------------------------------------------------------------------------------------------
-def vertex(x: np.ndarray, y: np.ndarray, i: int) -> tuple[float, float]:
-    """The extremum of the parabola through points i-1, i, i+1 (``(x[i], y[i])`` at an end)."""
-    if i <= 0 or i >= len(x) - 1:
-        return float(x[i]), float(y[i])
-    a, b, c = np.polyfit(x[i - 1:i + 2], y[i - 1:i + 2], 2)
-    if a == 0:
-        return float(x[i]), float(y[i])
-    at = -b / (2 * a)
-    return float(at), float(np.polyval([a, b, c], at))
-
-
-def extrema(x: Any, y: Any) -> dict[str, float]:
-    """Largest and smallest of ``y(x)`` (finite points, x ascending), each refined by a
-    parabola through its neighbours; ``*_interior`` 1 when not at an end of the range."""
-    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-    ok = np.isfinite(y)
-    x, y = x[ok], y[ok]
-    out: dict[str, float] = {}
-    for kind, index in (("max", int(np.argmax(y))), ("min", int(np.argmin(y)))):
-        out[f"{kind}_x"], out[f"{kind}_y"] = vertex(x, y, index)
-        out[f"{kind}_interior"] = float(0 < index < len(x) - 1)
-    return out
-
-
-def line(rows: Mapping[str, np.ndarray], names: list[str], select: Mapping[str, float]
-         ) -> dict[str, np.ndarray]:
-    """The rows of ``names`` whose inputs equal ``select`` (relative 1e-6), sorted by angle."""
-    part = rows_of(rows, names)
-    keep = np.ones(len(part["case"]), dtype=bool)
-    for key, value in select.items():
-        keep &= np.isclose(part[key], value, rtol=1e-6, atol=0)
-    order = np.argsort(part["angle_deg"][keep])
-    return {key: values[keep][order] for key, values in part.items()}
-
-
-def line_name(family: str, value: float) -> str:
-    """``preload_p22``, ``energy_k3000``: a line's name from its family and fixed value."""
-    if family == "angle_preload":
-        return f"preload_p{value * 1e3:.4g}".replace(".", "p")
-    return f"energy_k{value:.5g}".replace(".", "p")
-
-
-def claim_lines(rows: Mapping[str, np.ndarray], families: Mapping[str, list[str]]
-                ) -> dict[str, dict[str, np.ndarray]]:
-    """The lines of measures against initial angle: ``preload_p<mm>`` (the spring as given,
-    one preload: fixed preload = fixed stored energy = fixed slider travel 2 delta at that
-    rate), ``energy_k<N/m>`` (the design point's stored energy with that rate) and
-    ``final_angle`` (rest at the design point's own final angle); lines of 3 points or more."""
-    out = {"final_angle": line(rows, families["final_angle"], {})}
-    for family, key in (("angle_preload", "preload_m"), ("angle_rate", "rate_N_per_m")):
-        for value in sorted(set(rows_of(rows, families[family])[key])):
-            out[line_name(family, value)] = line(rows, families[family], {key: value})
-    return {name: part for name, part in out.items() if np.sum(part["valid"] == 1) >= 3}
-
-
-def claim_verdict(part: Mapping[str, np.ndarray], point: DesignPoint,
-                  measure: str = "peak_crank_speed") -> dict[str, float]:
-    """Where ``measure`` peaks and dips along one line, its value at the design angle, and
-    ``design_is_max`` (1 when the interior maximum lies within half a grid step of the design
-    angle)."""
-    x, y = part["angle_deg"], np.where(part["valid"] == 1, part[measure], np.nan)
-    found = extrema(x, y)
-    at = float(np.interp(point.angle_deg, x, part[measure]))
-    step = float(np.median(np.diff(x))) if len(x) > 1 else math.inf
-    found.update(design_value=at, design_angle=point.angle_deg,
-                 design_is_max=float(bool(found["max_interior"])
-                                     and abs(found["max_x"] - point.angle_deg) <= step / 2),
-                 design_is_min=float(bool(found["min_interior"])
-                                     and abs(found["min_x"] - point.angle_deg) <= step / 2),
-                 gain_over_design=found["max_y"] / at - 1)
-    return found
-
-
-# ------------------------------------------------------------------------------------------
-# mechanism checks from the scene
-# ------------------------------------------------------------------------------------------
-def topology(scene: Scene) -> tuple[list[str], list[Joint]]:
-    """Bodies (with the frame) and joints of the scene's mechanism (docs/model.md): revolute
-    A, B, C, prismatic P; a welded wing adds a body and weld W. The drive is an input, not a
-    joint (a constant-speed crank is a driving constraint that takes the one freedom)."""
-    bodies = ["frame", "crank", "coupler", "slider"]
-    joints = [Joint("A", ("frame", "crank"), "revolute"),
-              Joint("B", ("crank", "coupler"), "revolute"),
-              Joint("C", ("coupler", "slider"), "revolute"),
-              Joint("P", ("slider", "frame"), "prismatic")]
-    if scene.get("wing", {}).get("enabled", False):
-        bodies.append("wing")
-        joints.append(Joint("W", ("crank", "wing"), "weld"))
-    return bodies, joints
-
-
-def jacobian_along(scene: Scene, crank_angles_rad: np.ndarray) -> dict[str, np.ndarray]:
-    """The reference DAE's constraint Jacobian (:class:`flex.dynamics.reference.SliderCrankDAE`,
-    9 coordinates) at the closed-form configuration of each crank angle: its rank, smallest
-    singular value, and the smallest singular value of the square Jacobian of the other
-    coordinates with the slider position as the input (0 at a dead centre)."""
-    from flex.dynamics.reference import SliderCrankDAE
-
-    dae = SliderCrankDAE(scene)
-    ranks, smallest, slider_input = [], [], []
-    for theta in np.asarray(crank_angles_rad, dtype=float):
-        dae.initial_crank_angle_rad = theta
-        q, _ = dae.initial_state()
-        jac = dae.jacobian(q)
-        found = jacobian_mobility(jac)
-        ranks.append(found["rank"])
-        smallest.append(float(found["singular_values"].min()))
-        slider_input.append(smallest_singular_value(np.delete(jac, 6, axis=1)[:8]))
-    return {"rank": np.asarray(ranks), "smallest_singular_value": np.asarray(smallest),
-            "slider_input_smallest_singular_value": np.asarray(slider_input),
-            "rows": np.asarray(dae.n_constraints), "coordinates": np.asarray(9)}
-
-
-def mechanism_checks(scene: Scene, deployment_angles_rad: np.ndarray) -> dict[str, Dataset]:
-    """Mobility by Gruebler and Kutzbach from the scene's bodies and joints, by the rank of
-    the constraint Jacobian along the deployment and over a full turn, the dead centres and
-    the transmission angle over a full turn: ``mechanism/*`` datasets."""
-    bodies, joints = topology(scene)
-    counted = counted_mobility(bodies, joints)
-    turn = np.radians(np.arange(0.0, 360.0, 1.0))
-    along = jacobian_along(scene, deployment_angles_rad)
-    full = jacobian_along(scene, turn)
-    coupler = slider_crank(scene["crank"]["length_m"], scene["coupler"]["length_m"], turn,
-                           offset_m=scene["slider"]["offset_m"]).coupler_angle_rad
-    dead = dead_centre_angles_rad(scene["crank"]["length_m"], scene["coupler"]["length_m"],
-                                  scene["slider"]["offset_m"])
-    return {
-        "mechanism/bodies": Dataset(np.array(bodies, dtype=object), "1", "bodies with frame"),
-        "mechanism/joints": Dataset(np.array([f"{j.name}:{j.kind}" for j in joints],
-                                             dtype=object), "1", "joints and kinds"),
-        "mechanism/gruebler_mobility": Dataset(counted["gruebler"], "1", "thesis Eq. 1"),
-        "mechanism/kutzbach_mobility": Dataset(counted["kutzbach"], "1", "thesis Eq. 2"),
-        "mechanism/jacobian_rows": Dataset(along["rows"], "1", "reference DAE constraints"),
-        "mechanism/jacobian_rank_min": Dataset(int(min(along["rank"].min(), full["rank"].min())),
-                                               "1", "smallest rank, deployment and full turn"),
-        "mechanism/jacobian_mobility": Dataset(int(9 - along["rank"].min()), "1",
-                                               "9 coordinates - rank (deployment)"),
-        "mechanism/redundant_constraints": Dataset(int(along["rows"] - along["rank"].min()), "1",
-                                                   "constraint rows - rank"),
-        "mechanism/dead_centre_angles": Dataset(np.degrees(dead), "deg",
-                                                "extended and folded dead centres"),
-        "mechanism/turn_angle": Dataset(np.degrees(turn), "deg", "crank angle, full turn"),
-        "mechanism/turn_transmission_angle": Dataset(
-            np.degrees(transmission_angle_rad(turn, coupler)), "deg", "transmission angle"),
-        "mechanism/turn_slider_input_singular_value": Dataset(
-            full["slider_input_smallest_singular_value"], "1",
-            "smallest singular value, Jacobian with the slider as input"),
-        "mechanism/deployment_angle": Dataset(np.degrees(deployment_angles_rad), "deg",
-                                              "crank angle over the design deployment"),
-        "mechanism/deployment_slider_input_singular_value": Dataset(
-            along["slider_input_smallest_singular_value"], "1",
-            "smallest singular value along the design deployment")}
-
-
-# ------------------------------------------------------------------------------------------
 # the independent reference DAE at a few points
 # ------------------------------------------------------------------------------------------
 def reference_check(case: CaseResult) -> dict[str, tuple[float, str]]:
@@ -578,67 +370,10 @@ def reference_check(case: CaseResult) -> dict[str, tuple[float, str]]:
     return deviations
 
 
-# ------------------------------------------------------------------------------------------
-# the study's summary
-# ------------------------------------------------------------------------------------------
 def design_case_name(scene: Scene) -> str:
     """The case name of the design point itself."""
     d = DesignPoint.of(scene)
     return case_name(_rounded(d.angle_deg, d.preload_m, d.rate_N_per_m, d.thickness_m))
-
-
-def _line_datasets(name: str, part: Mapping[str, np.ndarray], point: DesignPoint
-                   ) -> dict[str, Dataset]:
-    out = {f"lines/{name}/{key}": Dataset(part[key], MEASURES[key][0] if key in MEASURES
-                                          else INPUTS.get(key, ("1",))[0], f"along line {name}")
-           for key in ("angle_deg", "preload_m", "rate_N_per_m", "peak_crank_speed",
-                       "deployment_time", "peak_joint_force", "peak_coupler_stress",
-                       "min_transmission_angle", "valid")}
-    for measure, unit in (("peak_crank_speed", "rad/s"), ("deployment_time", "s")):
-        verdict = claim_verdict(part, point, measure)
-        for key, value in verdict.items():
-            kind = unit if key.endswith("_y") or key == "design_value" else (
-                "deg" if key.endswith("_x") or key == "design_angle" else "1")
-            out[f"lines/{name}/{measure}_{key}"] = Dataset(value, kind, f"{measure}: {key}")
-    return out
-
-
-def summary_datasets(scene: Scene, grid: Grid, results: Mapping[str, CaseResult],
-                     references: Mapping[str, Mapping[str, tuple[float, str]]]
-                     ) -> dict[str, Dataset]:
-    """Everything the report and the figures read: the table, the families, the lines with
-    their extrema, the mechanism checks along the design deployment, the reference checks
-    (``references``: :func:`reference_check` by case) and the design inputs."""
-    rows = table(results)
-    _, families = plan(scene, grid)
-    point = DesignPoint.of(scene)
-    out = table_datasets(rows)
-    out.update({f"families/{name}": Dataset(np.array(names, dtype=object), "1",
-                                            f"cases of family {name}")
-                for name, names in families.items()})
-    for name, part in claim_lines(rows, families).items():
-        out.update(_line_datasets(name, part, point))
-    design = results.get(design_case_name(scene))
-    if design is not None and design.status == "ok" and "curves/crank/angle" in design.datasets:
-        angles = np.asarray(design.datasets["curves/crank/angle"].data)
-        stop = first_maximum_index(angles)
-        out.update(mechanism_checks(tomllib.loads(design.scene_toml), angles[:None if stop is None
-                                                                             else stop + 1]))
-    for name, values in references.items():
-        out.update({f"reference/{name}/{key}": Dataset(value, unit, "against the reference DAE")
-                    for key, (value, unit) in values.items()})
-    out.update({
-        "design/point": Dataset(np.array([point.angle_deg, point.preload_m, point.rate_N_per_m,
-                                          point.thickness_m]), "deg, m, N/m, m",
-                                "design point: initial angle, preload, rate, thickness"),
-        "design/stored_energy": Dataset(point.energy_J, "J", "design point spring energy"),
-        "design/rest_angle": Dataset(math.degrees(rest_angle_rad(scene)), "deg",
-                                     "closed-form rest angle of the design point"),
-        "design/tolerance": Dataset(float(scene["fidelity"]["tolerance"]), "1",
-                                    "auto's tolerance"),
-        "design/allowable_stress": Dataset(A36_YIELD_STRESS_PA, "Pa", "ASTM A36 yield"),
-        "design/design_case": Dataset(design_case_name(scene), "1", "the design point's case")})
-    return out
 
 
 def reference_names(scene: Scene, grid: Grid, angles_deg: tuple[float, ...]) -> list[str]:

@@ -42,12 +42,12 @@ from flex.base.thesis import (
 )
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, to_toml, validate
-from flex.experiments.tradeoff import (
+from flex.experiments.workprecision.convergence import converged_reference
+from flex.experiments.workprecision.measurement import (
     Observables,
     ReductionPool,
     Reference,
     Setting,
-    converged_reference,
 )
 from flex.fidelity.caseloop import Progress, run_each
 from flex.fidelity.simulation import simulate_case

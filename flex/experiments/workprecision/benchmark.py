@@ -28,7 +28,8 @@ same run. :func:`run_bench` runs the six parts of a :class:`BenchPlan` in order,
 The run-time switches ``nonlinear`` and ``make_all`` and the reduction cache folder
 ``cache_dir`` are arguments of :func:`run_bench`; the command line reads the environment.
 
-:mod:`flex.experiments.benchmark_report` turns the notes into the table and the figures.
+:mod:`flex.experiments.workprecision.benchmark_report` turns the notes into the table and the
+figures.
 """
 
 from __future__ import annotations
@@ -50,23 +51,21 @@ import numpy as np
 from flex.base.errors import FlexError
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
-from flex.experiments.reference_plans import ReferencePlan, build_reference
-from flex.experiments.tradeoff import (
+from flex.experiments.workprecision.measurement import (
     Measurement,
+    Progress,
     ReductionPool,
     Reference,
     Setting,
-    fastest,
     measure,
-    run_once,
-    scene_for,
-)
-from flex.experiments.workprecision import (
-    Progress,
     measurement_attrs,
     measurement_case,
     nonlinear_available,
+    run_once,
+    scene_for,
 )
+from flex.experiments.workprecision.pareto import fastest
+from flex.experiments.workprecision.reference_plans import ReferencePlan, build_reference
 
 Say = Callable[[str], None]
 
@@ -175,8 +174,9 @@ def profile(scene: Scene, pool: ReductionPool) -> dict[str, float]:
 # ------------------------------------------------------------------------------------------
 def bench_case(name: str, scene: Scene, m: Measurement, extra: dict[str, Any] | None = None
                ) -> CaseResult:
-    """A timed configuration's case (:func:`flex.experiments.workprecision.measurement_case`; attrs
-    knobs, label, errors and ``extra``)."""
+    """A timed configuration's case
+    (:func:`flex.experiments.workprecision.measurement.measurement_case`; attrs knobs, label,
+    errors and ``extra``)."""
     return measurement_case(name, scene, m, measurement_attrs(m, group=False) | (extra or {}))
 
 
@@ -365,14 +365,14 @@ def _newton_variants(scene: Scene, plan: StepCostPlan, repeats: int, pool: Reduc
 
 def bench_plates(scene: Scene, plan: PlatesPlan, repeats: int, pool: ReductionPool, say: Say,
                  notes: dict[str, Any]) -> dict[str, CaseResult]:
-    """Per plate: the converged reference of :mod:`flex.experiments.calibration` (its
+    """Per plate: the converged reference of :mod:`flex.experiments.fitting.calibration` (its
     accuracy certifies a level only within a third of it), then per tolerance flex's own
     choice (every solver and link key ``"auto"``: :mod:`flex.config.ffrf_rule`, or the
     visible fallback) timed and measured against it. ``notes["plates"]``: one row each."""
     from flex.config.settings import AUTO_OVERRIDES, resolve_solver_settings
     from flex.data.scene import apply_overrides
-    from flex.experiments.calibration import scene_reference
-    from flex.experiments.tradeoff import certifies
+    from flex.experiments.fitting.calibration import scene_reference
+    from flex.experiments.workprecision.measurement import certifies
 
     rows, out = [], {}
     for name, overrides in plan.plates.items():

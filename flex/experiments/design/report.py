@@ -1,5 +1,5 @@
 """The design study's report and charts, read from its summary datasets only
-(:func:`flex.experiments.design.summary_datasets`): so ``flex report results/design.h5``
+(:func:`flex.experiments.design.summary.summary_datasets`): so ``flex report results/design.h5``
 and the figures say what the file holds.
 
 Figures (``results/figures/design-*.png``): one contour map per family of two inputs

@@ -3,8 +3,8 @@
 The ``kfit`` (coupler) and ``crank`` studies run the same steps (thesis sec. 6.2, Eq. 64-65):
 
 1. **fit cases**: scenes of the link over a range of n = delta_t / T, each run with the link
-   rigid and flexible (what is measured is the link's own: :mod:`flex.experiments.couplerfit`,
-   :mod:`flex.experiments.crankfit`);
+   rigid and flexible (what is measured is the link's own: :mod:`flex.experiments.fitting.kfit`,
+   :mod:`flex.experiments.fitting.crank`);
 2. **fit table -> laws**: one row per fit case (n, dimensionless errors); power laws
    ``e = floor + c n^-p`` per damping ratio, delta_t definition and measure
    (:func:`fit_laws`, by :func:`flex.fidelity.criteria.fit_error_law`);

@@ -46,6 +46,7 @@ from flex.base.kinematics import constant_speed_motion
 from flex.base.physics import euler_buckling_load_N, pinned_pinned_omega
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, derived_scenes
+from flex.data.tables import table_datasets
 from flex.dynamics import ivp_crank
 from flex.dynamics.ivp_crank import (
     PUBLISHED_AT_0P1S,
@@ -476,24 +477,23 @@ def _ffrf_explained(results: dict[str, CaseResult], solutions: dict[str, CrankSo
                 "ffrf_explained/first_mode_geometric_stiffness_tangent_frame": Dataset(
                     tangent, "1/m", "the same with the strain linear in a frame tangent at B "
                     "(flex's FFRF rod)")}
-    for column in _EXPLAINED_COLUMNS:
-        datasets[f"ffrf_explained/{column}"] = Dataset(
-            np.array([row[column] for row in table.values()]),
-            "m" if column == "chord_change_max" else "1", _EXPLAINED_COLUMNS[column])
+    datasets.update(table_datasets(table.values(), _EXPLAINED_COLUMNS, "ffrf_explained"))
     datasets["ffrf_explained/run"] = Dataset(np.array(list(table), dtype=object), "1", "run")
     return lines, datasets
 
 
 _EXPLAINED_COLUMNS = {
-    "rms_beam": f"RMS deflection difference from {BEST_BEAM} / its peak |deflection|",
-    "rms_fe": "RMS deflection difference from the nonlinear FE rod / its peak |deflection|",
-    "rms_ffrf": f"RMS deflection difference from {FFRF_DEFAULT} / its peak |deflection|",
-    "rms_ffrf_linear": f"RMS deflection difference from {FFRF_LINEAR} / its peak "
-                       "|deflection|",
-    "peak_over_beam": f"peak |deflection| / that of {BEST_BEAM} - 1",
-    "first_window": f"as rms_beam over the first {WINDOW_S} s",
-    "last_window": f"as rms_beam over the last {WINDOW_S} s",
-    "chord_change_max": "largest change of the distance B-C"}
+    "rms_beam": ("1", f"RMS deflection difference from {BEST_BEAM} / its peak |deflection|"),
+    "rms_fe": ("1", "RMS deflection difference from the nonlinear FE rod / its peak "
+                    "|deflection|"),
+    "rms_ffrf": ("1", f"RMS deflection difference from {FFRF_DEFAULT} / its peak "
+                      "|deflection|"),
+    "rms_ffrf_linear": ("1", f"RMS deflection difference from {FFRF_LINEAR} / its peak "
+                             "|deflection|"),
+    "peak_over_beam": ("1", f"peak |deflection| / that of {BEST_BEAM} - 1"),
+    "first_window": ("1", f"as rms_beam over the first {WINDOW_S} s"),
+    "last_window": ("1", f"as rms_beam over the last {WINDOW_S} s"),
+    "chord_change_max": ("m", "largest change of the distance B-C")}
 
 
 def _explained_table(runs: dict[str, Any], fe: CaseResult

@@ -1,20 +1,18 @@
 """The crank's rigid-or-flexible law (study ``crank``): its cases, fit and summary.
 
-The link-specific half of the :mod:`flex.experiments.lawfit` pipeline for a plate crank. The
-coupler's
-law under-predicts the error of a rigid crank that carries the wing (measured about 2x at
-equal n: the wing makes the crank a cantilever under a larger quasi-static load), so the
-crank gets its own, with n = delta_t / T and T the period of the crank's first in-plane
-elastic mode in the assembled mechanism (:func:`flex.fidelity.auto.crank_elastic_omega`).
+The link-specific half of the :mod:`flex.experiments.fitting.lawfit` pipeline for a plate crank. The
+coupler's law under-predicts the error of a rigid crank that carries the wing (measured about 2x at
+equal n: the wing makes the crank a cantilever under a larger quasi-static load), so the crank gets
+its own, with n = delta_t / T and T the period of the crank's first in-plane elastic mode in the
+assembled mechanism (:func:`flex.fidelity.auto.crank_elastic_omega`).
 
 Cases (:func:`cases`): each fit scene (with the wing: the harder case, so the law is
 conservative for cranks without one) as ``<name>__rigid`` and ``<name>__full`` (an FFRF
-crank with :data:`flex.experiments.lawfit.FULL_MODES` modes); each validation scene as
-``<name>__auto``
-(``crank.model = "auto"`` with the law just fitted) and ``<name>__full``. Errors, of rigid
-or auto against the full model over its deployment, are
-:func:`flex.fidelity.criteria.errors_against_full` with the crank's midpoint deflection / L1; the
-governing one is fitted and held against the tolerance.
+crank with :data:`flex.experiments.fitting.lawfit.FULL_MODES` modes); each validation scene as
+``<name>__auto`` (``crank.model = "auto"`` with the law just fitted) and ``<name>__full``.
+Errors, of rigid or auto against the full model over its deployment, are
+:func:`flex.fidelity.criteria.errors_against_full` with the crank's midpoint deflection / L1;
+the governing one is fitted and held against the tolerance.
 """
 
 from __future__ import annotations
@@ -26,8 +24,8 @@ import numpy as np
 
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides
-from flex.experiments import lawfit
-from flex.experiments.lawfit import REPORT_TOLERANCES, Validation, case_data
+from flex.experiments.fitting import lawfit
+from flex.experiments.fitting.lawfit import REPORT_TOLERANCES, Validation, case_data
 from flex.fidelity.auto import crank_elastic_omega
 from flex.fidelity.criteria import (
     DELTA_T_DEFINITIONS,
@@ -75,7 +73,7 @@ def analyse(scenes: dict[str, Scene], results: dict[str, CaseResult],
     """Fit table (per fit scene with both runs ok: n = delta_t of the rigid run x the
     crank's in-mechanism frequency / 2 pi, the errors of the rigid crank against the full
     one) and the governing law over it (``fits``, keyed as
-    :func:`flex.experiments.lawfit.fit_laws`). ``cache_dir``: the reduction cache folder of
+    :func:`flex.experiments.fitting.lawfit.fit_laws`). ``cache_dir``: the reduction cache folder of
     the frequency analyses (None: built in memory, no disk cache)."""
     rows = {}
     for name, scene in scenes.items():
@@ -112,7 +110,7 @@ def criterion_toml(analysis: dict[str, Any], provenance: bool = False) -> str:
 def fit_then_validate(scenes: dict[str, Scene], runner: lawfit.CaseRunner, path: Path,
                       cache_dir: Path | None = None
                       ) -> tuple[dict[str, CaseResult], dict[str, Any]]:
-    """The :mod:`flex.experiments.lawfit` pipeline for the crank: fit cases, :func:`analyse`
+    """The :mod:`flex.experiments.fitting.lawfit` pipeline for the crank: fit cases, :func:`analyse`
     (its reductions in the reduction cache folder ``cache_dir``, None: in memory), the
     criterion at ``path``, the validation cases."""
     fit = {n: s for n, s in scenes.items() if n.startswith("fit_")}

@@ -1,8 +1,8 @@
 """Report, summary datasets and figures of the FFRF rule's calibration (``make calibrate``).
 
 :func:`calibration_summary` fits the rule on the calibration scenes
-(:func:`flex.experiments.calibration.fit_levels`), validates it on the others
-(:func:`flex.experiments.calibration.validate`) and returns the datasets stored under
+(:func:`flex.experiments.fitting.calibration.fit_levels`), validates it on the others
+(:func:`flex.experiments.fitting.calibration.validate`) and returns the datasets stored under
 ``/summary`` (``rule/toml``: the constants to install, ``levels/*``, ``validation/*``) and
 the report text; :func:`draw_calibration` draws one work-precision panel per scene with the
 rule's picks marked on the Pareto front of the grid.
@@ -28,7 +28,8 @@ from flex.config.ffrf_rule import (
 )
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
-from flex.experiments.calibration import (
+from flex.data.tables import table_datasets
+from flex.experiments.fitting.calibration import (
     LEVELS,
     MARGIN,
     SLOWDOWN_LIMIT,
@@ -42,8 +43,8 @@ from flex.experiments.calibration import (
     rule_toml,
     validate,
 )
-from flex.experiments.rule_designs import TWIN_CLOSENESS, design_frontier, near_twins
-from flex.experiments.tradeoff import pareto_front
+from flex.experiments.fitting.rule_designs import TWIN_CLOSENESS, design_frontier, near_twins
+from flex.experiments.workprecision.pareto import pareto_front
 
 
 def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[str, Scene],
@@ -107,7 +108,7 @@ def _within_family(results: Mapping[str, CaseResult], scenes: Mapping[str, Scene
             if name in results and inside(scene)}
 
 
-#: the columns of the rule designs' comparison (flex.experiments.rule_designs)
+#: the columns of the rule designs' comparison (flex.experiments.fitting.rule_designs)
 DESIGN_COLUMNS = (("judged", "pairs"), ("no_pick", "no pick"),
                   ("over_level", "over the level"), ("not_robust", "not robustly within"),
                   ("slower", f"robust, > {SLOWDOWN_LIMIT:g}x slower"),
@@ -115,31 +116,26 @@ DESIGN_COLUMNS = (("judged", "pairs"), ("no_pick", "no pick"),
 
 
 def _design_datasets(designs: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]:
-    """:func:`flex.experiments.rule_designs.design_frontier`'s tallies as
+    """:func:`flex.experiments.fitting.rule_designs.design_frontier`'s tallies as
     ``design_frontier/*``."""
-    out = {f"design_frontier/{key}": Dataset(np.array([row[key] for row in designs]), "1",
-                                             f"(scene, level) pairs: {text}")
-           for key, text in DESIGN_COLUMNS}
-    out["design_frontier/design"] = Dataset(np.array([row["design"] for row in designs],
-                                                     dtype=object), "1", "rule design")
-    out["design_frontier/worst_ratio"] = Dataset(
-        np.array([row["worst_ratio"] for row in designs]), "1",
-        "largest certified error of a pick / its level")
-    return out
+    columns = {key: ("1", f"(scene, level) pairs: {text}") for key, text in DESIGN_COLUMNS}
+    columns |= {"design": ("1", "rule design", object),
+                "worst_ratio": ("1", "largest certified error of a pick / its level")}
+    return table_datasets(designs, columns, "design_frontier")
+
+
+#: ``near_twins/<column>``: one row per pair of near twins (:func:`_twin_datasets`)
+TWIN_COLUMNS = {"scene_a": ("1", "first scene of the pair", object),
+                "scene_b": ("1", "second scene", object),
+                "tolerance": ("1", "level"),
+                "slowdown": ("1", "least worse-of-the-two modelled slowdown of a grid pair "
+                                  "robust on both (inf: none)")}
 
 
 def _twin_datasets(twins: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]:
-    """:func:`flex.experiments.rule_designs.near_twins`' rows as ``near_twins/*``."""
-    return {
-        "near_twins/scene_a": Dataset(np.array([row["scenes"][0] for row in twins],
-                                               dtype=object), "1", "first scene of the pair"),
-        "near_twins/scene_b": Dataset(np.array([row["scenes"][1] for row in twins],
-                                               dtype=object), "1", "second scene"),
-        "near_twins/tolerance": Dataset(np.array([row["tolerance"] for row in twins]), "1",
-                                        "level"),
-        "near_twins/slowdown": Dataset(np.array([row["slowdown"] for row in twins]), "1",
-                                       "least worse-of-the-two modelled slowdown of a grid "
-                                       "pair robust on both (inf: none)")}
+    """:func:`flex.experiments.fitting.rule_designs.near_twins`' rows as ``near_twins/*``."""
+    return table_datasets(({"scene_a": row["scenes"][0], "scene_b": row["scenes"][1], **row}
+                           for row in twins), TWIN_COLUMNS, "near_twins")
 
 
 def _twin_lines(twins: Sequence[Mapping[str, Any]]) -> list[str]:
@@ -168,7 +164,7 @@ def _design_lines(designs: Sequence[Mapping[str, Any]]) -> list[str]:
     scenes = {row["scene"] for row in designs[0]["rows"]}
     lines = ["", "## Rule designs compared (leave-one-out over every measured scene)", "",
              "Each calibration and validation scene in turn is left out, and each design, "
-             "built from the others, picks its settings (`flex.experiments.rule_designs`). "
+             "built from the others, picks its settings (`flex.experiments.fitting.rule_designs`). "
              f"Every design is judged on the same {len(designs[0]['rows'])} (scene, level) "
              f"pairs, from {len(scenes)} scenes. The validation scenes are spent here only "
              "for comparing designs, not for choosing the installed one. A design with no "
@@ -195,21 +191,21 @@ def _design_lines(designs: Sequence[Mapping[str, Any]]) -> list[str]:
     return lines
 
 
+#: ``<group>/<column>``: one row per judged (scene, level) pair (:func:`_row_datasets`)
+JUDGED_COLUMNS = {"rule_error": ("1", "certified error of the rule's pick"),
+                  "rule_time_s": ("s", "time of the rule's pick"),
+                  "best_time_s": ("s", "fastest grid pair within the level"),
+                  "slowdown": ("1", "rule / fastest"),
+                  "tolerance": ("1", "level"),
+                  "certifiable": ("1", "the scene's reference can certify the level"),
+                  "meets": ("1", "within the level and the slowdown limit"),
+                  "scene": ("1", "scene", object)}
+
+
 def _row_datasets(group: str, rows: Sequence[Mapping[str, Any]]) -> dict[str, Dataset]:
-    """The judged rows of :func:`flex.experiments.calibration.validate` as ``group/*``."""
+    """The judged rows of :func:`flex.experiments.fitting.calibration.validate` as ``group/*``."""
     judged = [row for row in rows if "failed" not in row and "outside" not in row]
-    out = {f"{group}/{key}": Dataset(np.array([row[key] for row in judged]), units, text)
-           for key, units, text in (
-               ("rule_error", "1", "certified error of the rule's pick"),
-               ("rule_time_s", "s", "time of the rule's pick"),
-               ("best_time_s", "s", "fastest grid pair within the level"),
-               ("slowdown", "1", "rule / fastest"),
-               ("tolerance", "1", "level"),
-               ("certifiable", "1", "the scene's reference can certify the level"),
-               ("meets", "1", "within the level and the slowdown limit"))}
-    out[f"{group}/scene"] = Dataset(np.array([row["scene"] for row in judged], dtype=object),
-                                    "1", "scene")
-    return out
+    return table_datasets(judged, JUDGED_COLUMNS, group)
 
 
 def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any]],
@@ -274,7 +270,7 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
 
 
 def _certifiable_rows(rows: Sequence[Mapping[str, Any]]) -> list[Mapping[str, Any]]:
-    """The judged rows of :func:`flex.experiments.calibration.validate` whose reference can
+    """The judged rows of :func:`flex.experiments.fitting.calibration.validate` whose reference can
     certify their level."""
     return [row for row in rows if "failed" not in row and "outside" not in row
             and row["certifiable"]]
@@ -323,7 +319,7 @@ def _target_lines(rows: Sequence[Mapping[str, Any]]) -> list[str]:
 
 def _beyond_text(level: Mapping[str, Any]) -> str:
     """The level's certifiable scenes outside its n range (no grid pair meets one of them,
-    :func:`flex.experiments.calibration.reachable_run`)."""
+    :func:`flex.experiments.fitting.calibration.reachable_run`)."""
     beyond = level.get("beyond_grid") or []
     return (f"; left out, the grid cannot meet the level on, or beyond, "
             f"{', '.join(beyond)}" if beyond else "")
@@ -461,7 +457,7 @@ if __name__ == "__main__":
     from flex.base.errors import FlexError
 
     if len(sys.argv) != 3:
-        print("usage: python -m flex.experiments.calibration_report RESULT.h5 RULE.toml "
+        print("usage: python -m flex.experiments.fitting.calibration_report RESULT.h5 RULE.toml "
               "(install a calibrate run's fitted FFRF rule)", file=sys.stderr)
         raise SystemExit(2)
     try:

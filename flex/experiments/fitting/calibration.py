@@ -7,8 +7,8 @@ and materials, springs and drives) :func:`measure_scene` runs
   32, at least :data:`REFERENCE_MESH_FLOOR_M`) and a step that resolves the 12th mode
   (:data:`REFERENCE_STEPS_PER_TOP_PERIOD` steps per period, at most T1 / 400), with the
   evidence of three one-level coarsenings (8 modes, twice the step, 1.5 x the mesh; their
-  changes summed are the reference's accuracy, :func:`flex.experiments.tradeoff.
-  converged_reference`);
+  changes summed are the reference's accuracy,
+  :func:`flex.experiments.workprecision.convergence.converged_reference`);
 - the **grid**: every pair of :data:`GRID_MODES` and :data:`GRID_STEPS_PER_PERIOD` (step T1 /
   N) on the rule's mesh, each timed as a user runs it (whole ``simulate``, warm reduction
   cache, median of ``repeats``) and measured against the reference (relative error of the
@@ -51,13 +51,14 @@ from flex.config.ffrf_rule import (
 )
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
+from flex.data.tables import table_datasets
 from flex.dynamics.solver import FFRF_DEFLECTION_LIMIT
-from flex.experiments.tradeoff import (
+from flex.experiments.workprecision.convergence import converged_reference
+from flex.experiments.workprecision.measurement import (
     ReductionPool,
     Reference,
     Setting,
     certifies,
-    converged_reference,
     measure,
     scene_for,
 )
@@ -176,34 +177,34 @@ def measure_case(name: str, scene: Scene, *, repeats: int = 3, cache_dir: Path |
 measure_case.case_version = 3  # type: ignore[attr-defined]
 
 
+#: ``grid/<column>``: one row per grid pair (modes, steps per first period) of a scene
+GRID_COLUMNS = {
+    "modes": ("1", "in-plane fixed-interface eigenmodes", float),
+    "steps_per_first_period": ("1", "step = first bending period / this", float),
+    "step": ("s", "time step", float),
+    "peak_deflection_error": ("1", "relative error of the peak midpoint deflection against the "
+                                   "reference (NaN: failed)", float),
+    "crank_angle_error": ("1", "largest crank angle error / its swing", float),
+    "slider_position_error": ("1", "largest slider error / its travel", float),
+    "total_time": ("s", "median time of the whole run (warm reduction cache)", float),
+    "newton_per_step": ("1", "Newton iterations per step", float),
+}
+
+
 def _datasets(reference: Reference, rows: Sequence[tuple[int, float, Any]]
               ) -> dict[str, Dataset]:
-    def column(values: Sequence[Any], units: str, text: str) -> Dataset:
-        return Dataset(np.array(values, dtype=float), units, text)
-
     def error(m: Any, key: str) -> float:
         return m.errors.get(key, math.nan) if m.ok else math.nan
 
-    out = {
-        "grid/modes": column([r[0] for r in rows], "1", "in-plane fixed-interface eigenmodes"),
-        "grid/steps_per_first_period": column([r[1] for r in rows], "1",
-                                              "step = first bending period / this"),
-        "grid/step": column([dict(r[2].setting.overrides)["simulation.step_s"] for r in rows],
-                            "s", "time step"),
-        "grid/peak_deflection_error": column([error(r[2], "peak_deflection_relative")
-                                              for r in rows], "1",
-                                             "relative error of the peak midpoint deflection "
-                                             "against the reference (NaN: failed)"),
-        "grid/crank_angle_error": column([error(r[2], "crank_angle_relative") for r in rows],
-                                         "1", "largest crank angle error / its swing"),
-        "grid/slider_position_error": column([error(r[2], "slider_position_relative")
-                                              for r in rows], "1",
-                                             "largest slider error / its travel"),
-        "grid/total_time": column([r[2].total_time_s for r in rows], "s",
-                                  "median time of the whole run (warm reduction cache)"),
-        "grid/newton_per_step": column([r[2].newton_iterations / max(r[2].steps, 1)
-                                        for r in rows], "1", "Newton iterations per step"),
-    }
+    grid = [{"modes": modes, "steps_per_first_period": per,
+             "step": dict(m.setting.overrides)["simulation.step_s"],
+             "peak_deflection_error": error(m, "peak_deflection_relative"),
+             "crank_angle_error": error(m, "crank_angle_relative"),
+             "slider_position_error": error(m, "slider_position_relative"),
+             "total_time": m.total_time_s,
+             "newton_per_step": m.newton_iterations / max(m.steps, 1)}
+            for modes, per, m in rows]
+    out = table_datasets(grid, GRID_COLUMNS, "grid")
     for knob, evidence in reference.evidence.items():
         safe = knob.replace(" ", "_").replace(">", "").replace("-", "to")
         out[f"reference/evidence/{safe}"] = Dataset(
@@ -250,7 +251,7 @@ def within_linear_validity(case: CaseResult) -> bool:
 def certifiable(case: CaseResult, level: float) -> bool:
     """Whether the case can certify ``level``: its reference within the linear FFRF validity
     (:func:`within_linear_validity`) and accurate to at most 1 / REFERENCE_MARGIN of the
-    level (:data:`flex.experiments.tradeoff.REFERENCE_MARGIN`)."""
+    level (:data:`flex.experiments.workprecision.measurement.REFERENCE_MARGIN`)."""
     return (case.status == "ok" and within_linear_validity(case)
             and certifies(case.attrs["reference_accuracy"], level))
 

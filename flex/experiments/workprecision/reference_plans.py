@@ -2,9 +2,9 @@
 
 A :class:`ReferencePlan` names the finest setting, its one-level coarsenings, the relative
 accuracy it claims, a description, the three-level knob sequences
-(:class:`flex.experiments.tradeoff.Refinement`) and the anchor of the check that the knobs' errors
-add up;
-:func:`build_reference` runs it (:func:`flex.experiments.tradeoff.converged_reference`).
+(:class:`flex.experiments.workprecision.convergence.Refinement`) and the anchor of the check
+that the knobs' errors add up; :func:`build_reference` runs it
+(:func:`flex.experiments.workprecision.convergence.converged_reference`).
 :func:`reference_plan` gives the work-precision study's plans: the scipy reference DAE for the
 rigid coupler, and flex's FFRF model for the 1 mm and 10 mm steel plates
 (:data:`FFRF_REFERENCE`), refined in step, mesh and modes (and Newton tolerance).
@@ -16,13 +16,8 @@ from collections.abc import Callable, Sequence
 from typing import Any, NamedTuple
 
 from flex.data.scene import Scene
-from flex.experiments.tradeoff import (
-    ReductionPool,
-    Reference,
-    Refinement,
-    Setting,
-    converged_reference,
-)
+from flex.experiments.workprecision.convergence import Refinement, converged_reference
+from flex.experiments.workprecision.measurement import ReductionPool, Reference, Setting
 
 S = Setting.of
 
@@ -170,7 +165,8 @@ def through_reference(plan: dict[str, Any]) -> bool:
 def build_reference(base: Scene, label: str, plan: ReferencePlan,
                     pool: ReductionPool | None = None,
                     progress: Callable[[str], None] | None = None) -> Reference:
-    """Run ``plan`` on ``base`` (:func:`flex.experiments.tradeoff.converged_reference`); raises
+    """Run ``plan`` on ``base``
+    (:func:`flex.experiments.workprecision.convergence.converged_reference`); raises
     :class:`~flex.base.errors.FlexError` if the finest run fails."""
     return converged_reference(base, label, plan.finest, plan.coarsenings, plan.tolerance,
                                pool, plan.description, progress, plan.refinements,

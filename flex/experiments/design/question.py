@@ -4,7 +4,7 @@ A :class:`Question` varies one input (``thickness`` of the coupler, initial cran
 spring ``preload`` or ``rate``) to meet one target (``peak_speed`` at least, ``deployment_time``
 at most, ``final_angle`` at least) while the peak coupler stress times the safety factor stays
 below the allowable stress, every case simulated with ``coupler.model = "auto"``
-(:func:`flex.experiments.design.design_case`). The answer is the feasible value nearest the
+(:func:`flex.experiments.design.cases.design_case`). The answer is the feasible value nearest the
 preferred end: the smallest thickness (the lightest coupler), preload and rate, and for the
 angle the one nearest the scene's own.
 
@@ -31,7 +31,9 @@ from scipy.optimize import brentq
 from flex.base.errors import FlexError
 from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import Scene, apply_overrides, to_toml, validate
-from flex.experiments import design
+from flex.experiments.design.cases import A36_YIELD_STRESS_PA, design_case
+from flex.experiments.design.summary import table, table_datasets
+from flex.experiments.fitting.kfit import mesh_size_m
 
 #: variable -> (scene section, key, default range, unit, log-spaced scan, prefer)
 VARIABLES = {
@@ -58,7 +60,7 @@ class Question:
     vary: str
     target: str
     value: float
-    allowable_stress_Pa: float = design.A36_YIELD_STRESS_PA
+    allowable_stress_Pa: float = A36_YIELD_STRESS_PA
     safety_factor: float = 1.5
     bounds: tuple[float, float] | None = None
 
@@ -132,14 +134,14 @@ def scene_for(scene: Scene, vary: str, value: float) -> Scene:
     section, key = VARIABLES[vary][:2]
     overrides = [f"{section}.{key}={float(value)!r}"]
     if vary == "thickness":
-        overrides.append(f"coupler.mesh_size_m={design.mesh_size_m(value)!r}")
+        overrides.append(f"coupler.mesh_size_m={mesh_size_m(value)!r}")
     changed = apply_overrides(scene, overrides)
     validate(changed)
     return changed
 
 
 def evaluator(scene: Scene, question: Question, cache_dir: Path | None,
-              simulate: Callable[..., CaseResult] = design.design_case,
+              simulate: Callable[..., CaseResult] = design_case,
               say: Callable[[str], None] | None = None
               ) -> tuple[Callable[[float], Evaluation], dict[float, Evaluation]]:
     """A memoised function value -> :class:`Evaluation`, and the memo it fills (in order).
@@ -195,7 +197,7 @@ def boundary(evaluate: Callable[[float], Evaluation], infeasible: float, feasibl
 
 
 def answer(scene: Scene, question: Question, cache_dir: Path | None = None,
-           simulate: Callable[..., CaseResult] = design.design_case) -> Answer:
+           simulate: Callable[..., CaseResult] = design_case) -> Answer:
     """Answer ``question`` about ``scene`` (module doc); FlexError for an unreachable target."""
     question.check()
     check_scene(scene, question)
@@ -300,8 +302,8 @@ def answer_text(result: Answer) -> str:
 def write_answer(result: Answer, scene: Scene, path: Path) -> Path:
     """The evidence cases and the answer in an HDF5 result file (study ``design``)."""
     q = result.question
-    rows = design.table({e.case.name: e.case for e in result.evidence})
-    summary = design.table_datasets(rows)
+    rows = table({e.case.name: e.case for e in result.evidence})
+    summary = table_datasets(rows)
     unit = VARIABLES[q.vary][3]
     summary.update({
         "question/vary": Dataset(q.vary, "1", "the input varied"),

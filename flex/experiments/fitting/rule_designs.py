@@ -1,13 +1,12 @@
 """How close can a rule get to each scene's fastest setting? Rule designs judged side by side.
 
 Issue 15's validation target asks the rule's pick to be within its tolerance and at most
-:data:`flex.experiments.calibration.SLOWDOWN_LIMIT` x slower than the fastest grid pair
-robustly within it, on scenes the rule never saw. The installed design is one law per
-damping class, safe on every calibration scene (:func:`flex.experiments.calibration.
-fit_levels`); a scene's needed steps and modes scatter around any smooth law, and the law
-keeps that scatter as margin. :func:`design_frontier` measures the trade this forces, by
-leave-one-out over the measured scenes, for the installed design and for a local one that
-keeps no global law:
+:data:`flex.experiments.fitting.calibration.SLOWDOWN_LIMIT` x slower than the fastest grid pair
+robustly within it, on scenes the rule never saw. The installed design is one law per damping class,
+safe on every calibration scene (:func:`flex.experiments.fitting.calibration.fit_levels`); a scene's
+needed steps and modes scatter around any smooth law, and the law keeps that scatter as margin.
+:func:`design_frontier` measures the trade this forces, by leave-one-out over the measured scenes,
+for the installed design and for a local one that keeps no global law:
 
 - **nearest neighbours** (:func:`neighbour_pick`): the grid pair robustly within ``margin`` x
   the level on the ``k`` scenes of the same damping class nearest in (ln n, ln L / t), the
@@ -36,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from flex.data.results import CaseResult
-from flex.experiments.calibration import (
+from flex.experiments.fitting.calibration import (
     LEVELS,
     SLOWDOWN_LIMIT,
     certifiable,
@@ -69,10 +68,10 @@ def scene_features(case: CaseResult) -> tuple[float, float]:
 def neighbour_pick(held: CaseResult, others: Mapping[str, CaseResult], level: float, k: int,
                    margin: float) -> int | None:
     """Index of the grid pair the local design picks for ``held`` at ``level``: robustly
-    within ``margin`` x ``level`` (:func:`flex.experiments.calibration.robustly_within`) on
+    within ``margin`` x ``level`` (:func:`flex.experiments.fitting.calibration.robustly_within`) on
     the ``k`` scenes of ``others`` nearest to it (:func:`scene_features`; same damping class,
     a reference that can certify the level and some grid pair within it), with the least
-    worst modelled slowdown (:func:`flex.experiments.calibration.modelled_time_s`) on them.
+    worst modelled slowdown (:func:`flex.experiments.fitting.calibration.modelled_time_s`) on them.
     None if fewer than ``k`` such scenes exist or they share no such pair."""
     x = np.array(scene_features(held))
     candidates = []
@@ -101,7 +100,7 @@ def design_frontier(cases: Mapping[str, CaseResult], levels: Sequence[float] = L
     module doc). Rows: ``design``, ``judged``, ``no_pick`` (the neighbours share no pair),
     ``over_level``, ``not_robust``, ``slower`` (robustly within, more than the slowdown
     limit slower), ``meets``, ``worst_ratio`` (largest certified error / level), ``rows``
-    (the per-pair rows of :func:`flex.experiments.calibration.validate`)."""
+    (the per-pair rows of :func:`flex.experiments.fitting.calibration.validate`)."""
     installed = [row for row in cross_validate(cases, levels)
                  if "rule_pair" in row and row["certifiable"]]
     out = [_tally(INSTALLED, installed)]

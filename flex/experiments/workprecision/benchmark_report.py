@@ -1,12 +1,11 @@
 """What the benchmark reports: its table and its bar charts.
 
-:func:`bench_summary` turns the notes of :func:`flex.experiments.benchmark.run_bench` into datasets
---
-``rigid/...``, ``ffrf_1mm/...`` (times [s], errors, ratios, each run's profile),
-``step_cost/...``, ``reduction/...``, ``make_all/...`` -- and the printed table
-(``table/what``, ``table/value``, ``table/detail``). :func:`bench_figures` draws the
-integration times at equal accuracy, the Exudyn CPU shares of the untuned and tuned runs,
-and the FFRF cost per step against mesh and modes (before and after the cheap joint markers).
+:func:`bench_summary` turns the notes of :func:`flex.experiments.workprecision.benchmark.run_bench`
+into datasets -- ``rigid/...``, ``ffrf_1mm/...`` (times [s], errors, ratios, each run's profile),
+``step_cost/...``, ``reduction/...``, ``make_all/...`` -- and the printed table (``table/what``,
+``table/value``, ``table/detail``). :func:`bench_figures` draws the integration times at equal
+accuracy, the Exudyn CPU shares of the untuned and tuned runs, and the FFRF cost per step against
+mesh and modes (before and after the cheap joint markers).
 """
 
 from __future__ import annotations
@@ -19,7 +18,7 @@ import numpy as np
 
 from flex.base.plotting import figure
 from flex.data.results import Dataset
-from flex.experiments.benchmark import BenchPlan
+from flex.experiments.workprecision.benchmark import BenchPlan
 
 Row = tuple[str, str, str]
 

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from flex.bodies import spring as sp
+from flex.data import tables
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, validate
 from flex.fidelity.criteria import first_maximum_index, fit_error_law
@@ -138,8 +139,8 @@ def wing_spring_mass_kg(rate_N_per_m: float) -> float:
 
 def wing_spring_scene(scene: Scene) -> Scene:
     """``scene`` with the wing welded on and the wing study's fitted spring
-    (:func:`flex.experiments.wing.fit_spring`), its mass from :func:`wing_spring_mass_kg`."""
-    from flex.experiments.wing import fit_spring
+    (:func:`flex.experiments.thesis.wing.fit_spring`), its mass from :func:`wing_spring_mass_kg`."""
+    from flex.experiments.thesis.wing import fit_spring
 
     fitted, values = fit_spring(apply_overrides(scene, ["wing.enabled=true"]))
     return apply_overrides(fitted, [
@@ -247,12 +248,8 @@ def deployment_table(results: Mapping[str, CaseResult]) -> dict[str, dict[str, f
 
 def table_datasets(table: Mapping[str, Mapping[str, float]]) -> dict[str, Dataset]:
     """The table as ``deployment/case`` (names) and ``deployment/<quantity>`` datasets."""
-    names = list(table)
-    out = {"deployment/case": Dataset(np.array(names, dtype=object), "1", "case")}
-    for key, (unit, meaning) in QUANTITIES.items():
-        out[f"deployment/{key}"] = Dataset(np.array([table[n][key] for n in names]), unit,
-                                           meaning)
-    return out
+    return {"deployment/case": Dataset(np.array(list(table), dtype=object), "1", "case"),
+            **tables.table_datasets(table.values(), QUANTITIES, "deployment")}
 
 
 def convergence_datasets(rows: list[ConvergenceRow], prefix: str) -> dict[str, Dataset]:
@@ -427,19 +424,21 @@ def massless_predictions(cases: Mapping[str, Scene], table: Mapping[str, Mapping
     return out
 
 
+#: ``prediction/<column>``: one row per case with a massless spring (:func:`prediction_datasets`)
+PREDICTION_COLUMNS = {
+    "case": ("1", "case", object),
+    "predicted": ("1", "the massless spring's governing error predicted from the rigid probe",
+                  float),
+    "measured": ("1", "its governing error against the finest chain", float),
+    "mass_ratio": ("1", "m_s / M_min, M_min the smallest mass reduced to the slider", float)}
+
+
 def prediction_datasets(predictions: Mapping[str, tuple[float, float, float]]
                         ) -> dict[str, Dataset]:
     """:func:`massless_predictions` as ``prediction/case|predicted|measured|mass_ratio``."""
-    names = list(predictions)
-    columns = zip(*predictions.values(), strict=True) if names else ((), (), ())
-    predicted, measured, ratio = (np.array(c, dtype=float) for c in columns)
-    return {"prediction/case": Dataset(np.array(names, dtype=object), "1", "case"),
-            "prediction/predicted": Dataset(predicted, "1", "the massless spring's governing "
-                                            "error predicted from the rigid probe"),
-            "prediction/measured": Dataset(measured, "1", "its governing error against the "
-                                           "finest chain"),
-            "prediction/mass_ratio": Dataset(ratio, "1", "m_s / M_min, M_min the smallest "
-                                             "mass reduced to the slider")}
+    rows = ({"case": name, "predicted": predicted, "measured": measured, "mass_ratio": ratio}
+            for name, (predicted, measured, ratio) in predictions.items())
+    return tables.table_datasets(rows, PREDICTION_COLUMNS, "prediction")
 
 
 def prediction_lines(predictions: Mapping[str, tuple[float, float, float]]) -> list[str]:
