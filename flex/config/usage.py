@@ -137,7 +137,7 @@ def _link_unused(link: str, scene: Scene, link_models: Mapping[str, Any]) -> dic
                                      f"with model = {used_with(rigid=False, damped=True)}")
     elif model == AUTO:
         mark(("modes",), f'{link}.model = "auto" chooses the modes itself; used with '
-                         f'model = "ffrf"')
+                         f"model = {quoted(model_names(link, link_models, modal=True))}")
         if geometry == "lumped":  # an auto crank: analysed as the plate of its mass
             mark(("thickness_m",), f'{link}.model = "auto" with geometry = "lumped" analyses '
                                    f"the plate of the {link}'s mass_kg (its thickness follows "
