@@ -8,6 +8,7 @@ scenes). The sketch of the mechanism and the choice of build are in
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -17,6 +18,7 @@ from flex.base.errors import SceneError
 from flex.base.kinematics import crank_pin, slider_crank
 from flex.base.physics import cuboid_inertia_kgm2, cuboid_mass_kg
 from flex.data.scene import Scene, plate_mass_properties
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel, entries
 
 os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
 
@@ -233,8 +235,8 @@ class _Builder:
     #: index of the rotation about z among a rigid-body node's coordinates (x y z rx ry rz)
     rotation_coordinate = 5
 
-    def __init__(self, scene: Scene, models: dict[str, Any], link_models: Any,
-                 ffrf_joint_markers: str = "fewest") -> None:
+    def __init__(self, scene: Scene, ffrf_joint_markers: str = "fewest", *,
+                 link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> None:
         import exudyn as exu
         import exudyn.itemInterface as eii
 
@@ -244,9 +246,10 @@ class _Builder:
         self.init = initial_configuration(scene)
         system_container = exu.SystemContainer()
         self.mbs = system_container.AddSystem()
-        self.mech = Mechanism(system_container, self.mbs, scene, self.init, models=models,
-                              link_models=link_models)
-        self.models = models
+        #: the entry of each link's model (:mod:`flex.dynamics.link_models`)
+        self.models = entries(scene, link_models)
+        self.mech = Mechanism(system_container, self.mbs, scene, self.init,
+                              models=self.models, link_models=link_models)
         self.ground = self.mbs.CreateGround()
         self.markers: dict[str, int] = {}
         self.crank_body: dict | None = None

@@ -14,10 +14,11 @@ import numpy as np
 from flex.data.results import Dataset
 from flex.dynamics import planar
 from flex.dynamics.builder import Mechanism
-
-
-def _sensor(mech: Mechanism, name: str) -> np.ndarray:
-    return np.asarray(mech.mbs.GetSensorStoredData(mech.sensors[name]))
+from flex.dynamics.link_models import (  # noqa: F401 - stress_window_m: re-exported
+    _elastic_datasets,
+    _sensor,
+    stress_window_m,
+)
 
 
 def collect(mech: Mechanism) -> dict[str, Dataset]:
@@ -199,68 +200,6 @@ def _spring_chain_energy(mech: Mechanism, slider_displacement_m: np.ndarray
     kinetic = 0.5 * chain.inner_mass_kg * np.sum(np.square(speeds), axis=0) if speeds \
         else np.zeros_like(slider_displacement_m)
     return kinetic, potential
-
-
-def _elastic_datasets(mech: Mechanism, link: str, start_marker: str, end_marker: str,
-                      chord_name: str, time_s: np.ndarray) -> dict[str, Dataset]:
-    """Midpoint motion and elastic response of a flexible ``link`` (FFRF or nonlinear FE).
-
-    From its joint markers (``start_marker``, ``end_marker``: sensor names) and its midpoint
-    marker; an FFRF link adds its modal coordinates and bending stress.
-    """
-    from flex.bodies.reduction import bending_stress_history, midpoint_deflection
-    from flex.bodies.stress import peak_datasets
-
-    position_start = _sensor(mech, f"{start_marker}.Position")[:, 1:4]
-    position_end = _sensor(mech, f"{end_marker}.Position")[:, 1:4]
-    position_mid = _sensor(mech, f"marker_{link}_mid.Position")[:, 1:4]
-    velocity_mid = _sensor(mech, f"marker_{link}_mid.Velocity")[:, 1:3]
-    deflection = midpoint_deflection(position_start, position_end, position_mid)
-    out: dict[str, Dataset] = {}
-    out[f"{link}/midpoint_position"] = Dataset(position_mid[:, :2], "m",
-                                               f"{link} midpoint x, y")
-    # the superelement marker reports no acceleration: differentiate its velocity (2nd order)
-    out[f"{link}/midpoint_acceleration"] = Dataset(
-        np.gradient(velocity_mid, time_s, axis=0), "m/s^2",
-        f"{link} midpoint acceleration x, y (thesis figs. 35-42), from the marker velocity")
-    out[f"{link}/midpoint_deflection"] = Dataset(
-        deflection.transverse_m, "m",
-        f"transverse elastic deflection of the midpoint from the chord {chord_name}, 0 at t = 0")
-    out[f"{link}/chord_change"] = Dataset(deflection.chord_change_m, "m",
-                                          f"change of the distance {chord_name} (axial strain "
-                                          "x length)")
-    body = mech.crank if link == "crank" else mech.coupler
-    if "reduction" not in body:  # nonlinear FE: nodal coordinates, no modes, no stress yet
-        return out
-    modal = _sensor(mech, f"{link}.modal_coordinates")[:, 1:]
-    out[f"{link}/modal_coordinates"] = Dataset(
-        modal, "1", "elastic coordinates: the static modes, then the fixed-interface eigenmodes")
-    reduction = body["reduction"]
-    if reduction.has_stress_modes:
-        out[f"{link}/peak_bending_stress"] = Dataset(
-            bending_stress_history(reduction, modal, stress_window_m(reduction)), "Pa",
-            "largest |sigma_xx| away from the end faces (bending + membrane)")
-        out.update(peak_datasets(link, reduction, modal))
-    out.update(_frame_datasets(mech, link))
-    return out
-
-
-def _frame_datasets(mech: Mechanism, link: str) -> dict[str, Dataset]:
-    """The pose of an FFRF link's floating frame (what :mod:`flex.tools.export` places the
-    nodal field with): origin x, y [m] and angle about z [rad]."""
-    origin = _sensor(mech, f"{link}.frame_Position")[:, 1:3]
-    angle = np.unwrap(_sensor(mech, f"{link}.frame_Rotation")[:, 3])
-    return {f"{link}/frame_position": Dataset(origin, "m", "floating frame origin x, y"),
-            f"{link}/frame_angle": Dataset(angle, "rad", "floating frame angle from +x")}
-
-
-def stress_window_m(reduction: Any) -> tuple[float, float]:
-    """Where a link's peak bending stress is read [m along it]: one thickness from each end
-    face (Saint-Venant), but never narrower than one element about the midpoint, so a plate
-    as thick as half its length (the stubbiest accepted) still has mesh nodes in it."""
-    length, half = reduction.length_m, 0.5 * reduction.length_m - reduction.thickness_m
-    half = max(half, 0.5 * min(reduction.mesh_size_m, length))
-    return (0.5 * length - half, 0.5 * length + half)
 
 
 def _wing_datasets(mech: Mechanism) -> dict[str, Dataset]:

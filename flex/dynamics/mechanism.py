@@ -61,13 +61,13 @@ def build_mechanism(scene: Scene, reduction: Any = None, crank_reduction: Any = 
     (:mod:`flex.dynamics.link_models`; each adds itself, point 5 of its contract). Returns a
     :class:`Mechanism`.
     """
-    models = entries(scene, link_models)  # SceneError for "auto" or an unknown model
+    entries(scene, link_models)  # SceneError for "auto" or an unknown model, first
     if planar and not is_planar(scene, link_models):
         raise SceneError("a planar build needs rigid crank and coupler and an implicit "
                          "integrator (simulation.integrator != \"explicit_penalty\")")
     use_planar = is_planar(scene, link_models) if planar is None else planar
-    builder = (PlanarBuilder(scene, models, link_models) if use_planar
-               else _Builder(scene, models, link_models, ffrf_joint_markers))
+    builder = (PlanarBuilder(scene, link_models=link_models) if use_planar
+               else _Builder(scene, ffrf_joint_markers, link_models=link_models))
     builder.add_crank_and_slider(crank_reduction)
     builder.add_coupler(reduction)
     builder.add_joints()

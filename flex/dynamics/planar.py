@@ -28,11 +28,12 @@ from typing import Any
 
 import numpy as np
 
-from flex.data.scene import BUILTIN_LINK_SCHEMAS, LINKS, Scene, link_model
+from flex.data.scene import LINKS, Scene, link_model
 from flex.dynamics.builder import Mechanism, _Builder, slider_mass_kg
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 
 
-def is_planar(scene: Scene, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> bool:
+def is_planar(scene: Scene, link_models: Mapping[str, Any] = BUILTIN_LINK_MODELS) -> bool:
     """Whether ``scene`` can be built with 2D items and give the 3D model's results.
 
     Needs rigid crank and coupler (the FFRF and nonlinear FE bodies are 3D meshes) and an
@@ -50,8 +51,9 @@ class PlanarBuilder(_Builder):
     #: index of the angle among a 2D rigid-body node's coordinates (x y angle)
     rotation_coordinate = 2
 
-    def __init__(self, scene: Scene, models: dict[str, Any], link_models: Any) -> None:
-        super().__init__(scene, models, link_models)
+    def __init__(self, scene: Scene, *,
+                 link_models: Mapping[str, Any] = BUILTIN_LINK_MODELS) -> None:
+        super().__init__(scene, link_models=link_models)
         self.mech.planar = True
         self.wing_angle_joint: int | None = None
 
