@@ -52,8 +52,11 @@ Capability flags the callers read: ``rigid``, ``meshed``, ``modal``, ``damped`` 
 ``linear_elastic``: its results are trusted only for small elastic deflections and loads
 below buckling (validity warnings, :func:`flex.dynamics.advice.validity_warning`);
 ``reference``: an accuracy reference the others are compared with (named in advice);
-``auto_choice``: ``model = "auto"`` may pick it (:mod:`flex.fidelity.auto`); ``label``: its
-name in reports.
+``auto_choice``: ``model = "auto"`` may pick it (:mod:`flex.fidelity.auto`, whose fitted laws
+decide among the built-in models only); ``label``: its name in reports. A model of one's own
+is an entry built the same way (``dataclasses.replace`` of a built-in one, or
+:meth:`LinkModel.extending` a :class:`~flex.data.scene.LinkSchema`): tests/test_link_models.py
+runs such a toy through :func:`flex.simulate`.
 """
 
 from __future__ import annotations
@@ -98,6 +101,10 @@ def _free(values: dict[str, Any], modes: int | None) -> float:
     return 0.0
 
 
+def _no_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
+    return {}
+
+
 @dataclass(frozen=True)
 class LinkModel(LinkSchema):
     """One link model: its scene-level part (:class:`flex.data.scene.LinkSchema`, points 1-3)
@@ -118,7 +125,7 @@ class LinkModel(LinkSchema):
     #: (6) ``sensors(builder, link)``, ``datasets(mech, link, time_s)``, known energy,
     #: ``recorder(mech, link, settings)``
     sensors: Callable[[Any, str], None] = _nothing
-    datasets: Callable[[Any, str, np.ndarray], dict[str, Dataset]] = lambda *args: {}
+    datasets: Callable[[Any, str, np.ndarray], dict[str, Dataset]] = _no_datasets
     energy: bool = True
     recorder: Callable[[Any, str, dict[str, Any]], Any] = _nothing
     #: (7) ``time_scale(link, values, prepared)`` -> (omega [rad/s], what) or None;
