@@ -2,7 +2,8 @@
 build returns, and the 3D builder (:class:`_Builder`) that :func:`flex.dynamics.mechanism.
 build_mechanism` drives (:mod:`flex.dynamics.planar` extends it with 2D items for rigid
 scenes). The sketch of the mechanism and the choice of build are in
-:mod:`flex.dynamics.mechanism`.
+:mod:`flex.dynamics.mechanism`; the crank's and the coupler's bodies are added by their link
+models (:mod:`flex.dynamics.link_models`, point 5 of its contract).
 """
 
 from __future__ import annotations

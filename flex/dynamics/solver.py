@@ -23,6 +23,11 @@ Newton (or a Jacobian once per step), or an explicit Runge-Kutta method with pen
 always at a fixed step (a Newton failure is reported, not retried with a smaller step). Step
 N covers t = (N - 1) h ... N h: a Newton failure names the step and its start time, a
 non-finite or exploding output the step that produced it and its end time.
+
+Each link's model (``link_models``, :mod:`flex.dynamics.link_models`) prepares, builds, senses
+and adjusts the solver for itself; the datasets are collected by :mod:`flex.dynamics.collect`,
+the validity warnings, time scales and divergence advice are :mod:`flex.dynamics.advice`'s
+(their names are importable from here too).
 """
 
 from __future__ import annotations
