@@ -118,7 +118,8 @@ def _flat(overrides: Mapping[str, Any]) -> list[tuple[str, Any]]:
     return pairs
 
 
-def load_scene(source: str | Path | None = None, overrides: Overrides | None = None) -> Scene:
+def load_scene(source: str | Path | None = None, overrides: Overrides | None = None, *,
+               link_models: Mapping[str, Any] | None = None) -> Scene:
     """Read a scene: a TOML file or a bundled parameter set, with overrides, validated.
 
     Inputs:
@@ -126,6 +127,10 @@ def load_scene(source: str | Path | None = None, overrides: Overrides | None = N
             thesis's ``"cavezza2012"``, ``flex/scenes/cavezza2012.toml``). A file needs only
             the keys it changes; the rest come from the bundled set.
         overrides: ``"section.key=value"`` strings or a dict (module doc), applied on top.
+        link_models: the link models ``crank.model`` and ``coupler.model`` may name, by name
+            (None: the built-in ones, :data:`flex.dynamics.link_models.BUILTIN_LINK_MODELS`;
+            a registry of one's own adds models, module doc of
+            :mod:`flex.dynamics.link_models`).
     Output:
         the validated scene (a new nested dict; values in the units their keys name).
         ``"auto"`` values (``coupler.model``, ``simulation.step_s``, ...) are kept as
@@ -138,10 +143,12 @@ def load_scene(source: str | Path | None = None, overrides: Overrides | None = N
     """
     from flex.data.scene import load_scene as _load
 
-    return _load(_source(source), override_strings(overrides))
+    return _load(_source(source), override_strings(overrides),
+                 link_models=_link_models(link_models, run=False))
 
 
-def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
+def derive_scene(scene: Scene, overrides: Overrides, *,
+                 link_models: Mapping[str, Any] | None = None) -> Scene:
     """A new scene: ``scene`` with ``overrides`` applied, validated as a whole.
 
     The one way to edit a scene in a script: the same parsing as ``--set``
@@ -155,6 +162,7 @@ def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
         overrides: ``"section.key=value"`` strings or a dict (module doc), e.g.
             ``{"drive.spring_preload_m": 0.011}`` [m] or ``["coupler.model=ffrf",
             "coupler.geometry=plate", "coupler.thickness_m=0.003"]``.
+        link_models: the link models a scene may name (as :func:`load_scene`).
     Output:
         the derived scene (a deep copy; ``"auto"`` values kept as written).
     Errors:
@@ -165,12 +173,30 @@ def derive_scene(scene: Scene, overrides: Overrides) -> Scene:
     from flex.data.scene import apply_overrides, validate
 
     derived = apply_overrides(_plain_scene(scene), override_strings(overrides))
-    validate(derived)
+    validate(derived, _link_models(link_models, run=False))
     return derived
 
 
+def _link_models(given: Mapping[str, Any] | None, run: bool = True) -> Mapping[str, Any]:
+    """The registry of link models: ``given``, or the built-in one (to check a scene, its
+    scene-level part: nothing heavy is imported; ``run``: the entries)."""
+    if given is not None:
+        if not isinstance(given, Mapping):
+            raise ArgumentError(f"link_models = {_shown(given)}: must be a mapping of link "
+                                "model names to flex.dynamics.link_models.LinkModel entries "
+                                f"(got {_kind(given)})")
+        return given
+    if not run:
+        from flex.data.scene import BUILTIN_LINK_SCHEMAS
+
+        return BUILTIN_LINK_SCHEMAS
+    from flex.dynamics.link_models import BUILTIN_LINK_MODELS
+
+    return BUILTIN_LINK_MODELS
+
+
 def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None = None,
-             **options: Any) -> CaseResult:
+             link_models: Mapping[str, Any] | None = None, **options: Any) -> CaseResult:
     """Simulate one scene in memory and return its curves (nothing is written to disk
     except the reduction cache).
 
@@ -186,6 +212,8 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
         name: the case name stored with the result (default ``"case"``).
         cache_dir: the reduction cache folder (default: the user's, read from the
             environment at this call; module doc).
+        link_models: the link models the scene may name (as :func:`load_scene`; None: the
+            built-in ones).
         options: passed on to :func:`flex.fidelity.simulation.simulate` (``reduction=``,
             ``crank_reduction=``: prebuilt reductions; ``criterion=``, ``crank_criterion=``:
             another fitted law for ``auto``, :func:`flex.fidelity.criteria.load_criterion`); not
@@ -211,7 +239,8 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
     from flex.fidelity.simulation import simulate as simulate_scene
     from flex.study import check_cases, load_study
 
-    scene = checked_scene(scene)
+    models = _link_models(link_models)
+    scene = checked_scene(scene, link_models=models)
     _check_case_name(name)
     _check_options(options, {"reduction": "a flex.bodies.reduction.Reduction",
                              "crank_reduction": "a flex.bodies.reduction.Reduction",
@@ -219,8 +248,8 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
                              "crank_criterion": "a flex.fidelity.criteria.Criterion"},
                    "simulate")
     folder = _cache_dir(cache_dir)
-    check_cases(load_study("simulate"), {name: scene}, given_keys(scene))
-    return simulate_scene(scene, name, cache_dir=folder, **options)
+    check_cases(load_study("simulate"), {name: scene}, given_keys(scene), link_models=models)
+    return simulate_scene(scene, name, cache_dir=folder, link_models=models, **options)
 
 
 def _cache_dir(given: str | Path | None) -> Path:
@@ -252,6 +281,8 @@ def run_study(name: str, source: str | Path | None = None, overrides: Overrides 
         quiet: print nothing on success (failed cases still go to stderr).
         cache_dir: the reduction cache folder (default: the user's, read from the
             environment at this call; module doc).
+        link_models: the link models the scene may name (as :func:`load_scene`; None: the
+            built-in ones).
         options: passed on to :func:`flex.study.run_study` (e.g. ``sweep=``, a
             :class:`flex.sweep.SweepSettings` saying where a sweep study's cases run;
             ``environment=``, the values of the variables the study declares in
@@ -390,14 +421,18 @@ def _plain_scene(scene: Any, argument: str = "scene") -> dict[str, dict[str, Any
     return plain
 
 
-def checked_scene(scene: Any, argument: str = "scene") -> Scene:
+def checked_scene(scene: Any, argument: str = "scene", *,
+                  link_models: Mapping[str, Any] | None = None) -> Scene:
     """A validated copy of a scene a caller hands over (:func:`_plain_scene`, then
     :func:`flex.data.scene.validate`: the checks ``--scene`` and ``--set`` get); raises
     :class:`~flex.base.errors.ArgumentError` or :class:`~flex.base.errors.SceneError`."""
     from flex.data.scene import validate
 
     plain = _plain_scene(scene, argument)
-    validate(plain)
+    if link_models is None:
+        validate(plain)
+    else:
+        validate(plain, link_models)
     return plain
 
 

@@ -45,6 +45,7 @@ from flex.data.outputs import (
 )
 from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import Scene, load_scene, to_toml
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.fidelity.auto import check
 from flex.fidelity.caseloop import run_each
 from flex.fidelity.simulation import simulate_case
@@ -215,15 +216,16 @@ def check_outputs(path: Path, figures: bool) -> None:
 
 
 def check_cases(module: ModuleType, scenes: dict[str, Scene],
-                given: dict[str, object] | None = None) -> None:
+                given: dict[str, object] | None = None, *,
+                link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> None:
     """Refuse (:class:`SceneError`), before any case runs, a case scene that cannot run or
     would mean nothing (:func:`flex.fidelity.auto.check`), and a value the user gave
     (``given``: ``{"section.key": value}``, :func:`flex.config.usage.explicit_keys`) that no case
     uses: one the study sets itself in each case, or one no case's models read
     (:func:`flex.config.usage.unused_keys`, minus the keys the study declares it reads itself in
-    ``READS``)."""
+    ``READS``). ``link_models``: the registry of the scenes' link models."""
     for scene in scenes.values():
-        check(scene)
+        check(scene, link_models)
     reads = set(getattr(module, "READS", ()))
     for name, value in (given or {}).items():
         if name in reads:
@@ -236,7 +238,8 @@ def check_cases(module: ModuleType, scenes: dict[str, Scene],
             raise SceneError(f"{name} = {value!r}: study '{module.NAME}' sets this key itself "
                              f"in each of its cases ({shown}), so the value given would be "
                              f"ignored; use 'flex run simulate' to run a scene of your own")
-        reasons = [unused_keys(case).get(name) for case in scenes.values()]
+        reasons = [unused_keys(case, link_models=link_models).get(name)
+                   for case in scenes.values()]
         if all(reasons):
             why = reasons[0] if reasons else f"study '{module.NAME}' runs no simulation"
             raise SceneError(f"{name} = {value!r} would be ignored: {why}")

@@ -213,9 +213,9 @@ def test_one_simulate_resolves_each_scene_once(monkeypatch, reduction_cache):
         seen["resolve"] += 1
         return real_resolve(*args, **kwargs)
 
-    def counting_solver(scene):
+    def counting_solver(scene, **kwargs):
         seen["solver"].append(to_toml(scene))
-        return real_solver(scene)
+        return real_solver(scene, **kwargs)
 
     def counting_links(scene):
         seen["links"].append(to_toml(scene))

@@ -34,6 +34,7 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cache
 from importlib import resources
@@ -41,7 +42,16 @@ from typing import Any
 
 from flex.base.errors import SceneError
 from flex.config.ffrf_rule import LINK_KEYS, RulePick, fill_link_keys, pick
-from flex.data.scene import Scene, check_drive_steps, check_meshed_plate, check_steps
+from flex.data.scene import (
+    BUILTIN_LINK_SCHEMAS,
+    Scene,
+    check_drive_steps,
+    check_meshed_plate,
+    check_steps,
+    link_model,
+    meshes,
+    model_names,
+)
 
 #: the ``[simulation]`` keys that may be ``"auto"``
 AUTO_KEYS = ("step_s", "spectral_radius", "newton", "newton_relative_tolerance")
@@ -106,16 +116,19 @@ def resolve_link_keys(scene: Scene) -> tuple[Scene, dict[str, Any]]:
     return resolved, filled
 
 
-def choose_entry(scene: Scene) -> tuple[str, str, RulePick | None]:
+def choose_entry(scene: Scene, *, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
+                 ) -> tuple[str, str, RulePick | None]:
     """The entry (``"rigid"``, ``"ffrf_rule"`` or ``"flexible_fallback"``) for ``scene``,
-    the reason, and the rule's pick (``ffrf_rule`` only)."""
-    crank, coupler = scene["crank"]["model"], scene["coupler"]["model"]
-    if AUTO in (crank, coupler):
+    the reason, and the rule's pick (``ffrf_rule`` only). ``link_models``: the registry of
+    the scene's link models (their ``rigid`` and ``modal`` flags choose)."""
+    if AUTO in (scene["crank"]["model"], scene["coupler"]["model"]):
         raise ValueError('resolve model = "auto" links before the solver settings')
-    if crank == "rigid" and coupler == "rigid":
+    crank, coupler = (link_model(link, scene[link], link_models) for link in ("crank",
+                                                                              "coupler"))
+    if crank.rigid and coupler.rigid:
         return "rigid", "rigid links", None
-    if coupler != "ffrf" or crank != "rigid":
-        what = ("an FFRF crank" if crank == "ffrf" else f'coupler.model = "{coupler}"')
+    if not (coupler.modal and crank.rigid):  # the rule: a modal (FFRF) coupler, rigid crank
+        what = ("an FFRF crank" if crank.modal else f'coupler.model = "{coupler.name}"')
         return "flexible_fallback", f"no calibrated rule for {what}: {FALLBACK}", None
     tolerance = float(scene["fidelity"]["tolerance"])
     chosen = pick(scene, tolerance)
@@ -143,24 +156,27 @@ def finest_certified_accuracy() -> tuple[float, str]:
     return min(found)
 
 
-def reads_tolerance(scene: Scene) -> bool:
+def reads_tolerance(scene: Scene, *, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> bool:
     """Whether ``fidelity.tolerance`` is read: by an ``auto`` link or spring model (validated:
     only with a spring drive), or by ``"auto"`` solver keys choosing the FFRF coupler's entry
     (:func:`choose_entry`)."""
-    crank, coupler = scene["crank"]["model"], scene["coupler"]["model"]
-    if AUTO in (crank, coupler) or scene["drive"]["spring_model"] == AUTO:
+    if AUTO in (scene["crank"]["model"], scene["coupler"]["model"]) \
+            or scene["drive"]["spring_model"] == AUTO:
         return True
-    return has_auto(scene) and coupler == "ffrf" and crank == "rigid"
+    return (has_auto(scene) and link_model("coupler", scene["coupler"], link_models).modal
+            and link_model("crank", scene["crank"], link_models).rigid)
 
 
-def tolerance_beyond_reach(scene: Scene) -> str:
+def tolerance_beyond_reach(scene: Scene, *,
+                           link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> str:
     """Why ``fidelity.tolerance`` asks for more than flex can certify ("" if it does not, or
     if no ``auto`` choice reads it): a tolerance below :func:`finest_certified_accuracy`
     is met by no model flex has measured (``auto`` then takes its most accurate model, up to
     the nonlinear FE coupler, whose own error is not known to be that small)."""
     tolerance = float(scene["fidelity"]["tolerance"])
     finest, source = finest_certified_accuracy()
-    if tolerance >= finest * (1 - 1e-9) or not reads_tolerance(scene):
+    if tolerance >= finest * (1 - 1e-9) or not reads_tolerance(scene,
+                                                                link_models=link_models):
         return ""
     return (f"fidelity.tolerance = {tolerance:g} is beyond reach: no model's settings are "
             f"certified finer than {finest:g} ({source}); \"auto\" takes its most accurate "
@@ -175,12 +191,14 @@ def whole_steps_s(step_s: float, end_time_s: float, multiple: int) -> float:
     return end_time_s / (multiple * groups)
 
 
-def resolve_solver_settings(scene: Scene) -> tuple[Scene, SolverChoice | None]:
-    """``scene`` with its ``"auto"`` solver and link keys filled in (see module doc)."""
+def resolve_solver_settings(scene: Scene, *, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
+                            ) -> tuple[Scene, SolverChoice | None]:
+    """``scene`` with its ``"auto"`` solver and link keys filled in (see module doc);
+    ``link_models``: the registry of its link models."""
     if not (has_auto(scene) or has_auto_link_keys(scene)):
         return scene, None
     resolved, filled = resolve_link_keys(scene)
-    name, reason, chosen = choose_entry(resolved)
+    name, reason, chosen = choose_entry(resolved, link_models=link_models)
     entry = solver_defaults()[name]
     values = dict(entry)
     accuracy = entry["accuracy"]
@@ -204,7 +222,8 @@ def resolve_solver_settings(scene: Scene) -> tuple[Scene, SolverChoice | None]:
     return resolved, SolverChoice(name, accuracy, filled, reason)
 
 
-def resolved_simulation(scene: Scene) -> dict[str, Any]:
+def resolved_simulation(scene: Scene, *,
+                        link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> dict[str, Any]:
     """The ``[simulation]`` section of ``scene`` with ``"auto"`` keys filled in.
 
     For code that needs the step before a run (its links must be concrete; an ``"auto"``
@@ -215,8 +234,8 @@ def resolved_simulation(scene: Scene) -> dict[str, Any]:
     probe = copy.deepcopy(scene)
     for link in ("crank", "coupler"):
         if probe[link]["model"] == AUTO:
-            probe[link]["model"] = "rigid"
-    return resolve_solver_settings(probe)[0]["simulation"]
+            probe[link]["model"] = model_names(link, link_models, rigid=True)[0]
+    return resolve_solver_settings(probe, link_models=link_models)[0]["simulation"]
 
 
 #: the coupler's modes and mesh size the bundled scene had before they became "auto" (6
@@ -238,7 +257,8 @@ def pinned_overrides(entry: str = "rigid") -> list[str]:
         PINNED_COUPLER_DISCRETIZATION)
 
 
-def check_concrete(scene: Scene, choice: SolverChoice | None = None) -> None:
+def check_concrete(scene: Scene, choice: SolverChoice | None = None, *,
+                   link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> None:
     """Refuse, before anything is built, meshed or simulated, a concrete scene (no
     ``"auto"`` left: :func:`flex.fidelity.auto.resolve`) that cannot run or whose result
     would mean nothing; return None when it can run. Takes milliseconds. ``choice``: the
@@ -253,13 +273,12 @@ def check_concrete(scene: Scene, choice: SolverChoice | None = None) -> None:
     """
     for link in ("crank", "coupler"):
         values = scene[link]
-        meshed = values["model"] in ("ffrf", "nonlinear_fe")  # a lumped or rigid link
-        # keeps its unused "auto" modes and mesh (never read)
-        if values["model"] == AUTO or (meshed and AUTO in (values.get(key)
-                                                          for key in LINK_KEYS)):
+        if values["model"] == AUTO or (meshes(link, values, link_models)  # a lumped or
+                                       and AUTO in (values.get(key)  # rigid link keeps its
+                                                    for key in LINK_KEYS)):  # unused "auto"s
             raise ValueError(f"{link}: resolve its \"auto\" values first "
                              f"(flex.fidelity.auto.resolve)")
-        check_meshed_plate(link, values)
+        check_meshed_plate(link, values, link_models)
     if has_auto(scene) or scene["drive"]["spring_model"] == AUTO:
         raise ValueError('[simulation] or drive.spring_model: resolve its "auto" values first '
                          "(flex.fidelity.auto.resolve)")

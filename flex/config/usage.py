@@ -15,12 +15,21 @@ A key the user gave that no case of a study uses (and that the study does not re
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from flex.config.settings import reads_tolerance
-from flex.data.scene import Scene, default_scene, parse_override, read_source
+from flex.data.scene import (
+    BUILTIN_LINK_SCHEMAS,
+    Scene,
+    default_scene,
+    link_model,
+    model_names,
+    parse_override,
+    quoted,
+    read_source,
+)
 
 AUTO = "auto"
 #: plate keys of a link beyond the mass-giving ones
@@ -35,18 +44,21 @@ _SPRING_CHAIN = ("spring_mass_kg", "spring_segments")
 _WING = ("span_m", "chord_m", "thickness_m", "density_kg_per_m3", "youngs_modulus_Pa")
 
 
-def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset()) -> dict[str, str]:
+def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset(), *,
+                link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> dict[str, str]:
     """The keys of ``scene`` that its models do not read: ``{"section.key": reason}``.
 
     Contract: ``scene`` is a validated scene (link models and solver keys may be
     ``"auto"``: a key that ``auto`` may read counts as used; ``modes`` of an ``auto`` link
     does not, ``auto`` chooses them). ``read_by_study``: ``"section.key"`` names a study
     reads itself (e.g. the modal study's plate keys of rigid links); they are never
-    reported. The reason names what would read the key. Pure: reads nothing but ``scene``.
+    reported. The reason names what would read the key. ``link_models``: the registry of
+    the link models (a model's flags say which of its link's keys it reads). Pure: reads
+    nothing but its arguments.
     """
     unused: dict[str, str] = {}
     for link in ("crank", "coupler"):
-        unused.update(_link_unused(link, scene))
+        unused.update(_link_unused(link, scene, link_models))
     wing = scene["wing"]
     if not wing["enabled"]:
         for key in _WING:
@@ -82,7 +94,7 @@ def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset()) -> dic
         for key in _SOLVER_EXPLICIT:
             unused[f"simulation.{key}"] = ('simulation.integrator = "generalized_alpha": used '
                                            'with integrator = "explicit_penalty"')
-    if not reads_tolerance(scene):
+    if not reads_tolerance(scene, link_models=link_models):
         unused["fidelity.tolerance"] = ('no "auto" choice reads it: used by model = "auto" '
                                         'links, and by "auto" solver keys of an FFRF coupler '
                                         "on a rigid crank")
@@ -91,12 +103,14 @@ def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset()) -> dic
     return unused
 
 
-def _link_unused(link: str, scene: Scene) -> dict[str, str]:
+def _link_unused(link: str, scene: Scene, link_models: Mapping[str, Any]) -> dict[str, str]:
     values = scene[link]
     model, geometry = values["model"], values["geometry"]
+    entry = None if model == AUTO else link_model(link, values, link_models)
     unused: dict[str, str] = {}
-    elastic = ('"ffrf", "nonlinear_fe" or "auto"' if link == "coupler"
-               else '"ffrf" or "auto"')
+
+    def used_with(**flags: bool) -> str:  # the models reading a key, and "auto"
+        return quoted([*model_names(link, link_models, **flags), AUTO])
 
     def mark(keys: Iterable[str], reason: str) -> None:
         for key in keys:
@@ -106,30 +120,33 @@ def _link_unused(link: str, scene: Scene) -> dict[str, str]:
         mark(("mass_kg", "inertia_kgm2"),
              f'{link}.geometry = "plate": mass and inertia come from the plate (thickness_m, '
              f'width_m, density_kg_per_m3); used with geometry = "lumped"')
-    if model == "rigid":
+    if entry is not None and entry.rigid:
         if geometry == "lumped":
             mark(_PLATE_MASS + _PLATE_ELASTIC,
                  f'{link}.geometry = "lumped": the {link} is its mass_kg and inertia_kgm2; '
                  f'used with geometry = "plate"')
-        mark(_PLATE_ELASTIC, f'{link}.model = "rigid": a rigid link has no elasticity; used '
-                             f"with model = {elastic}")
-    elif model == "nonlinear_fe":
-        mark(("modes", "mode_selection"), f'{link}.model = "nonlinear_fe" moves every mesh '
-                                          f'node (no modes); used with model = "ffrf"')
-        mark(("damping_ratio",), f'{link}.model = "nonlinear_fe" has no damping model; used '
-                                 f'with model = "ffrf" or "auto"')
+        mark(_PLATE_ELASTIC, f'{link}.model = "{model}": a rigid link has no elasticity; used '
+                             f"with model = {used_with(rigid=False)}")
+    elif entry is not None:
+        if not entry.modal:
+            mark(("modes", "mode_selection"),
+                 f'{link}.model = "{model}" moves every mesh node (no modes); used with '
+                 f"model = {quoted(model_names(link, link_models, modal=True))}")
+        if not entry.damped:
+            mark(("damping_ratio",), f'{link}.model = "{model}" has no damping model; used '
+                                     f"with model = {used_with(rigid=False, damped=True)}")
     elif model == AUTO:
         mark(("modes",), f'{link}.model = "auto" chooses the modes itself; used with '
-                         f'model = "ffrf"')
+                         f"model = {quoted(model_names(link, link_models, modal=True))}")
         if geometry == "lumped":  # an auto crank: analysed as the plate of its mass
             mark(("thickness_m",), f'{link}.model = "auto" with geometry = "lumped" analyses '
                                    f"the plate of the {link}'s mass_kg (its thickness follows "
                                    f'from it); used with geometry = "plate"')
-    if model not in ("ffrf", AUTO):
+    if entry is not None and not entry.modal:
         mark(("geometric_stiffness",),
              f'{link}.model = "{model}": only an FFRF body takes the geometric stiffness of '
-             f'its axial force (the nonlinear FE body has it exactly); used with model = '
-             f'"ffrf" or "auto"')
+             f"its axial force (the nonlinear FE body has it exactly); used with model = "
+             f"{used_with(modal=True)}")
     return unused
 
 

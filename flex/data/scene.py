@@ -7,6 +7,13 @@ parameter sets live in ``flex/scenes/``, e.g. ``cavezza2012``), changed by ``--s
 section.key=value`` overrides, and checked by :func:`validate`, which refuses an unknown key,
 a wrong type, a non-finite or out-of-range number, and a linkage that cannot assemble, with
 one message naming the key and the accepted range.
+
+The link models a scene may name (``crank.model``, ``coupler.model``) are an argument,
+``link_models``, of every function here that checks a scene: a mapping from a model's name to
+its entry, of which this layer reads only the scene-level part, :class:`LinkSchema` (links,
+flags, extra check). Its default, :data:`BUILTIN_LINK_SCHEMAS`, names the built-in models once;
+their full entries (how they build, sense, advise) are
+:data:`flex.dynamics.link_models.BUILTIN_LINK_MODELS`, whose keys a test ties to these.
 """
 
 from __future__ import annotations
@@ -14,18 +21,117 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
-from collections.abc import Mapping
-from dataclasses import dataclass
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, replace
 from importlib import resources
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import tomli_w
 
 from flex.base.errors import SceneError
-from flex.base.progress import duration_text
+from flex.data.plates import (  # noqa: F401 - the names callers import from here
+    ESTIMATE_MODES,
+    MESH_ASPECT_LIMIT,
+    MESH_MEMORY_LIMIT_BYTES,
+    PLATE_SLENDERNESS_LIMIT,
+    PLATE_STUBBINESS_LIMIT,
+    MeshEstimate,
+    estimate_mesh,
+    modes_cost_factor,
+    plate_mass_properties,
+)
+from flex.data.plates import check_meshed_plate as _check_meshed_plate
+from flex.data.plates import meshed_plate as _meshed_plate
+from flex.data.steps import (  # noqa: F401 - the names callers import from here
+    MAX_CRANK_TURN_PER_SAMPLE_RAD,
+    MAX_CRANK_TURN_PER_STEP_RAD,
+    MAX_STEPS,
+    check_drive_steps,
+    check_steps,
+)
 
 Scene = dict[str, dict[str, Any]]
+#: the links whose model a scene chooses
+LINKS = ("crank", "coupler")
+AUTO = "auto"
+
+
+@dataclass(frozen=True)
+class LinkSchema:
+    """The scene-level part of a link model's entry (points 1-3 of the contract in
+    :mod:`flex.dynamics.link_models`): what validation, the usage of keys and the solver
+    defaults read. Every flag is a fact about the keys of ``[crank]``/``[coupler]`` it reads.
+    """
+
+    #: (1) the value of ``<link>.model`` that selects it
+    name: str
+    #: the links it may model (``"crank"``, ``"coupler"``)
+    links: tuple[str, ...]
+    #: (2) a rigid body: reads the link's mass keys only (``mass_kg``/``inertia_kgm2`` or the
+    #: plate's mass); builds planar; runs with the explicit integrators
+    rigid: bool = False
+    #: (2) meshes the link's plate: needs ``geometry = "plate"``, reads the elastic plate keys
+    #: and ``mesh_size_m`` (the plate checks of :func:`flex.data.plates.check_meshed_plate`)
+    meshed: bool = False
+    #: (2) a modal reduction: reads ``modes``, ``mode_selection``, ``geometric_stiffness``
+    modal: bool = False
+    #: (2) reads ``damping_ratio`` (False: it has no damping model, the key must be 0)
+    damped: bool = True
+    #: (3) its own checks on the scene's keys beyond the flags' (raise SceneError), or None
+    check: Callable[[str, Scene], None] | None = None
+
+
+#: the built-in link models' scene-level part, by name, in the order messages list them
+BUILTIN_LINK_SCHEMAS: Mapping[str, LinkSchema] = MappingProxyType({
+    "rigid": LinkSchema("rigid", LINKS, rigid=True),
+    "ffrf": LinkSchema("ffrf", LINKS, meshed=True, modal=True),
+    "nonlinear_fe": LinkSchema("nonlinear_fe", ("coupler",), meshed=True, damped=False),
+})
+
+
+def model_names(link: str, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS,
+                **flags: bool) -> list[str]:
+    """The names of the models of ``link`` in ``link_models`` whose flags have the given values
+    (``rigid=True``: the rigid ones), in the registry's order."""
+    return [name for name, entry in link_models.items() if link in entry.links
+            and all(getattr(entry, flag) == value for flag, value in flags.items())]
+
+
+def quoted(names: list[str]) -> str:
+    """``"a"``, ``"a" or "b"``, ``"a", "b" or "c"``: names as a message lists them."""
+    words = [f'"{name}"' for name in names]
+    return " or ".join(filter(None, [", ".join(words[:-1]), words[-1]])) if words else ""
+
+
+def link_model(link: str, values: dict[str, Any], link_models: Mapping[str, Any]) -> Any:
+    """The entry of ``link``'s model (``values["model"]``, not ``"auto"``) in ``link_models``;
+    SceneError naming the accepted models if it has none or it does not model ``link``."""
+    model = values["model"]
+    names = model_names(link, link_models)
+    if not isinstance(model, str) or model not in names:
+        raise SceneError(f"{link}.model = {_show(model)}: must be one of "
+                         + ", ".join(f'"{name}"' for name in [*names, AUTO]))
+    return link_models[model]
+
+
+def meshes(link: str, values: dict[str, Any], link_models: Mapping[str, Any]) -> bool:
+    """Whether ``link``'s concrete model meshes its plate (False for ``"auto"``)."""
+    return values["model"] != AUTO and link_model(link, values, link_models).meshed
+
+
+def check_meshed_plate(link: str, values: dict[str, Any],
+                       link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> None:
+    """:func:`flex.data.plates.check_meshed_plate` for ``link``'s model in ``link_models``."""
+    _check_meshed_plate(link, values, meshes(link, values, link_models))
+
+
+def meshed_plate(link: str, values: dict[str, Any],
+                 link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
+                 ) -> tuple[float, str, str] | None:
+    """:func:`flex.data.plates.meshed_plate` for ``link``'s model in ``link_models``."""
+    return _meshed_plate(link, values, meshes(link, values, link_models))
 
 
 @dataclass(frozen=True)
@@ -109,7 +215,7 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "inertia_kgm2": Field(doc="crank inertia about its centre of mass (lumped)", **_POS),
         "initial_angle_deg": Field(float, "crank angle at t = 0, from the slide line",
                                    minimum=-360.0, maximum=360.0),
-        "model": Field(("rigid", "ffrf", "auto"),
+        "model": Field((*model_names("crank"), AUTO),
                        "rigid body or floating-frame flexible body (plate geometry); auto: "
                        "rigid or ffrf (and modes) from the fitted criterion and "
                        "fidelity.tolerance"),
@@ -119,7 +225,7 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "length_m": Field(doc="coupler length L2 between joints B and C", **_POS),
         "mass_kg": Field(doc="coupler mass (geometry = lumped)", **_POS),
         "inertia_kgm2": Field(doc="coupler inertia about its centre of mass (lumped)", **_POS),
-        "model": Field(("rigid", "ffrf", "nonlinear_fe", "auto"),
+        "model": Field((*model_names("coupler"), AUTO),
                        "rigid body, floating-frame flexible body, or fully nonlinear FE body "
                        "(accuracy reference, ~50x slower per step); auto: rigid or "
                        "ffrf (and modes) from the fitted criterion and fidelity.tolerance"),
@@ -206,14 +312,16 @@ def bundled_scenes() -> list[str]:
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
-def load_scene(source: str | Path | None = None, overrides: list[str] | None = None) -> Scene:
+def load_scene(source: str | Path | None = None, overrides: list[str] | None = None, *,
+               link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> Scene:
     """Load, override and validate a scene.
 
     ``source`` is a TOML file path or the name of a bundled parameter set (default
     ``cavezza2012``). Sections and keys missing from a file are taken from the default
     parameter set, so a user scene needs to state only what it changes. ``overrides`` are
     ``"section.key=value"`` strings, the value in TOML syntax (``1e-3``, ``"ffrf"``,
-    ``true``); a bare word is read as a string. Returns the validated scene.
+    ``true``); a bare word is read as a string. ``link_models``: the link models a scene
+    may name (:func:`validate`). Returns the validated scene.
     """
     scene = default_scene()
     user = read_source(source)
@@ -221,7 +329,7 @@ def load_scene(source: str | Path | None = None, overrides: list[str] | None = N
         scene = merge(scene, user)
     if overrides:
         scene = apply_overrides(scene, overrides)
-    validate(scene)
+    validate(scene, link_models)
     return scene
 
 
@@ -297,13 +405,14 @@ def apply_overrides(scene: Scene, overrides: list[str]) -> Scene:
     return merge(scene, changes)
 
 
-def derived_scenes(scene: Scene, overrides_by_name: Mapping[str, list[str]]) -> dict[str, Scene]:
+def derived_scenes(scene: Scene, overrides_by_name: Mapping[str, list[str]], *,
+                   link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> dict[str, Scene]:
     """One validated scene per name: ``scene`` with that name's overrides (a study's cases
     declared as data); raises SceneError naming the first that does not validate."""
     out = {name: apply_overrides(scene, overrides)
            for name, overrides in overrides_by_name.items()}
     for derived in out.values():
-        validate(derived)
+        validate(derived, link_models)
     return out
 
 
@@ -325,7 +434,7 @@ def _parse_value(text: str) -> Any:
         return text
 
 
-def validate(scene: Scene) -> None:
+def validate(scene: Scene, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> None:
     """Raise :class:`SceneError` naming the first problem; return ``None`` if valid.
 
     Checks: known sections and keys, every key present, types, finiteness, ranges, and the
@@ -333,7 +442,9 @@ def validate(scene: Scene) -> None:
     consistent (an explicit step: :func:`check_steps`, :func:`check_drive_steps`; an
     ``"auto"`` one is checked once resolved, :func:`flex.fidelity.auto.check`), FFRF
     couplers need plate geometry, and plates that will be meshed must make sense and fit
-    this machine (:func:`check_meshed_plate`).
+    this machine (:func:`check_meshed_plate`). ``link_models``: the models ``crank.model``
+    and ``coupler.model`` may name, by name (entries with the fields of :class:`LinkSchema`:
+    their flags and own checks apply; default: the built-in ones).
     """
     for section, table in scene.items():
         if section not in SCHEMA:
@@ -344,12 +455,15 @@ def validate(scene: Scene) -> None:
                 raise SceneError(f"unknown key {_name(section)}.{_name(key)}; accepted keys in "
                                  f"[{section}]: "
                                  f"{', '.join(SCHEMA[section])}")
-            _check_value(f"{section}.{key}", SCHEMA[section][key], value)
+            field = SCHEMA[section][key]
+            if section in LINKS and key == "model":  # the models of the registry given
+                field = replace(field, kind=(*model_names(section, link_models), AUTO))
+            _check_value(f"{section}.{key}", field, value)
     for section, fields in SCHEMA.items():
         for key in fields:
             if key not in scene.get(section, {}):
                 raise SceneError(f"missing key {section}.{key} ({fields[key].doc})")
-    _check_geometry(scene)
+    _check_geometry(scene, link_models)
 
 
 def _check_value(name: str, field: Field, value: Any) -> None:
@@ -397,7 +511,7 @@ def _name(text: str, limit: int = 60) -> str:
     return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
-def _check_geometry(scene: Scene) -> None:
+def _check_geometry(scene: Scene, link_models: Mapping[str, Any]) -> None:
     crank_m = scene["crank"]["length_m"]
     coupler_m = scene["coupler"]["length_m"]
     offset_m = scene["slider"]["offset_m"]
@@ -411,109 +525,51 @@ def _check_geometry(scene: Scene) -> None:
                          f"{coupler_m - crank_m:g}")
     check_steps(scene["simulation"])
     check_drive_steps(scene)
-    for link in ("crank", "coupler"):
-        _check_link(link, scene[link])
-    if scene["crank"]["model"] == "ffrf" and scene["drive"]["kind"] == "constant_speed":
-        raise SceneError('crank.model = "ffrf" needs drive.kind = "spring": the constant-speed '
-                         "drive constrains the rotation coordinate of a rigid crank, which a "
-                         'flexible crank\'s floating frame does not have; accepted: "rigid"')
-    if scene["crank"]["model"] == "auto" and scene["drive"]["kind"] != "spring":
+    for link in LINKS:
+        _check_link(link, scene[link], link_models)
+    entries = {link: None if scene[link]["model"] == AUTO
+               else link_models[scene[link]["model"]] for link in LINKS}
+    rigid_cranks = quoted(model_names("crank", link_models, rigid=True))
+    crank_model = scene["crank"]["model"]
+    if (entries["crank"] is not None and not entries["crank"].rigid
+            and scene["drive"]["kind"] == "constant_speed"):
+        raise SceneError(f'crank.model = "{crank_model}" needs drive.kind = "spring": the '
+                         "constant-speed drive constrains the rotation coordinate of a rigid "
+                         "crank, which a flexible crank's floating frame does not have; "
+                         f"accepted: {rigid_cranks}")
+    if crank_model == AUTO and scene["drive"]["kind"] != "spring":
         raise SceneError('crank.model = "auto" needs drive.kind = "spring": auto analyses the '
                          "crank as a flexible plate in the mechanism, and a flexible crank needs "
-                         'the spring drive; accepted with a constant-speed drive: "rigid"')
+                         f"the spring drive; accepted with a constant-speed drive: {rigid_cranks}")
     if scene["drive"]["spring_model"] == "auto" and scene["drive"]["kind"] != "spring":
         raise SceneError('drive.spring_model = "auto" needs drive.kind = "spring" (a '
                          "constant-speed drive has no spring to choose a model for); "
                          'accepted: "massless" or "chain"')
-    coupler = scene["coupler"]
-    if coupler["model"] == "nonlinear_fe" and coupler["damping_ratio"] != 0:
-        raise SceneError(f"coupler.damping_ratio = {coupler['damping_ratio']:g}: "
-                         'coupler.model = "nonlinear_fe" has no damping model; accepted: 0')
+    for link, entry in entries.items():
+        values = scene[link]
+        if entry is not None and not entry.damped and values["damping_ratio"] != 0:
+            raise SceneError(f"{link}.damping_ratio = {values['damping_ratio']:g}: "
+                             f'{link}.model = "{values["model"]}" has no damping model; '
+                             "accepted: 0")
     if scene["simulation"]["integrator"] == "explicit_penalty" and (
-            coupler["model"] != "rigid" or scene["crank"]["model"] != "rigid"
+            not all(entry is not None and entry.rigid for entry in entries.values())
             or scene["drive"]["kind"] != "spring"):
         raise SceneError('simulation.integrator = "explicit_penalty" needs crank.model and '
                          'coupler.model = "rigid" and drive.kind = "spring" (Exudyn\'s explicit '
                          "solvers take no algebraic constraints: the flexible bodies' "
                          "Euler-parameter frames and the crank-speed constraint have them); "
                          'accepted: "generalized_alpha"')
+    for link, entry in entries.items():
+        if entry is not None and entry.check is not None:
+            entry.check(link, scene)
 
 
-#: most integration steps of one run: ~25 min of the rigid model (0.03 ms per step), days of
-#: an FFRF one, and 5e7 samples x ~40 datasets is ~16 GB of output at output_step_s = 0
-MAX_STEPS = 5e7
-#: largest crank rotation per integration step of the constant-speed drive [rad]: 63 steps
-#: per crank turn, 31 per period of the slider's second harmonic (the largest after the
-#: first for L1 / L2 = 1/2), where the generalized-alpha period error (omega h)^2 / 12 is
-#: 3e-3. At 10 rad per step (1e6 rad/s, 1e-5 s) the motion is aliased: the crank turns
-#: 1.6 times between steps. The studies reach 6.3e-3 rad (100 turns per second, 1e-5 s).
-MAX_CRANK_TURN_PER_STEP_RAD = 0.1
-#: largest crank rotation between stored samples [rad]: the stored slider curve is sampled
-#: at least 4 times per period of its second harmonic (Nyquist: 2; the studies store at
-#: 6.3e-3 rad per sample)
-MAX_CRANK_TURN_PER_SAMPLE_RAD = math.pi / 4
-
-
-def check_steps(sim: dict[str, Any]) -> None:
-    """Step, output interval and step count; an ``"auto"`` step is checked once resolved.
-
-    The output interval must be 0 (every step) or an integer multiple of the step: Exudyn
-    stores a sample at the first step at or after each interval, so another interval gives
-    irregularly spaced samples (e.g. 2.5e-5 s at 1e-5 s: 3e-5, 5e-5, 8e-5, ...).
-    """
-    if sim["step_s"] == "auto":
-        return
-    step, output = sim["step_s"], sim["output_step_s"]
-    if step > sim["end_time_s"]:
-        raise SceneError(f"simulation.step_s = {step:g} must be <= "
-                         f"simulation.end_time_s = {sim['end_time_s']:g}")
-    if 0 < output < step * (1 - 1e-9):
-        raise SceneError(f"simulation.output_step_s = {output:g} must be >= "
-                         f"simulation.step_s = {step:g} (or 0: every step)")
-    steps = sim["end_time_s"] / step
-    if steps > MAX_STEPS:
-        raise SceneError(f"simulation.end_time_s = {sim['end_time_s']:g} at simulation.step_s "
-                         f"= {step:g} needs {steps:.3g} steps; accepted: at most "
-                         f"{MAX_STEPS:g} steps (end_time_s <= {MAX_STEPS * step:.3g} at this "
-                         f"step)")
-    if output > 0:
-        ratio = output / step
-        if abs(ratio - round(ratio)) > 1e-6 + 1e-9 * ratio:  # float noise only
-            below, above = math.floor(ratio) * step, math.ceil(ratio) * step
-            raise SceneError(f"simulation.output_step_s = {output:g} must be an integer "
-                             f"multiple of simulation.step_s = {step:g} (it is {ratio:.6g} "
-                             f"steps: the samples would be irregular); nearest valid: "
-                             f"{below:.6g} or {above:.6g} (or 0: every step)")
-
-
-def check_drive_steps(scene: Scene) -> None:
-    """A constant-speed crank must turn at most :data:`MAX_CRANK_TURN_PER_STEP_RAD` per step
-    and :data:`MAX_CRANK_TURN_PER_SAMPLE_RAD` between stored samples (an ``"auto"`` step is
-    checked once resolved)."""
-    sim, drive = scene["simulation"], scene["drive"]
-    if drive["kind"] != "constant_speed" or sim["step_s"] == "auto":
-        return
-    speed = abs(drive["crank_speed_rad_per_s"])
-    step, sample = sim["step_s"], sim["output_step_s"] or sim["step_s"]
-    for interval, limit, what, key, aliased, extra in (
-            (step, MAX_CRANK_TURN_PER_STEP_RAD, "per step", "simulation.step_s", "motion is",
-             ""),
-            (sample, MAX_CRANK_TURN_PER_SAMPLE_RAD, "between stored samples",
-             "simulation.output_step_s", "stored curves are", " (or 0: every step)")):
-        if speed * interval > limit * (1 + 1e-9):
-            raise SceneError(f"drive.crank_speed_rad_per_s = {drive['crank_speed_rad_per_s']:g} "
-                             f"turns the crank {speed * interval:.3g} rad {what} ({key} = "
-                             f"{interval:g} s): the {aliased} aliased; accepted: at most "
-                             f"{limit:.3g} rad {what}, i.e. |crank_speed_rad_per_s| <= "
-                             f"{limit / interval:.4g}, or {key} <= {limit / speed:.3g}{extra}")
-
-
-def _check_link(link: str, values: dict[str, Any]) -> None:
+def _check_link(link: str, values: dict[str, Any], link_models: Mapping[str, Any]) -> None:
     """A flexible (or auto) link needs plate geometry, and the plate must fit its length;
     a plate that will be meshed must make sense as a meshed link (:func:`check_meshed_plate`).
     """
     model = values["model"]
-    if model in ("ffrf", "nonlinear_fe") and values["geometry"] != "plate":
+    if meshes(link, values, link_models) and values["geometry"] != "plate":
         raise SceneError(f'{link}.model = "{model}" needs {link}.geometry = "plate" (the '
                          "flexible body is meshed from the plate's dimensions)")
     if model == "auto" and values["geometry"] != "plate" and link == "coupler":
@@ -523,209 +579,9 @@ def _check_link(link: str, values: dict[str, Any]) -> None:
     if values["geometry"] == "plate" and values["thickness_m"] >= values["length_m"]:
         raise SceneError(f"{link}.thickness_m = {values['thickness_m']:g} must be smaller "
                          f"than {link}.length_m = {values['length_m']:g}")
-    check_meshed_plate(link, values)
-
-
-# ------------------------------------------------------------------------------------------
-# meshed plates: what makes sense, and what this machine can mesh
-# ------------------------------------------------------------------------------------------
-#: largest mesh_size_m / min(thickness_m, width_m) of a meshed plate. Quadratic tetrahedra
-#: bend well with one element across the thickness while the elements are not much longer
-#: than thick: measured first pinned-pinned bending frequency against Euler-Bernoulli
-#: (80 x 10 mm steel plates): ratio 2 (1 mm, 2 mm elements) +0.08 %; ratio 20: +1.8 %
-#: (0.1 mm, 2 mm) and +6.4 % (0.3 mm, 6 mm: also only 13 elements along the length); ratio
-#: 50: +13 %; ratio 100: +14 %; ratio 200: +20 %. The studies mesh at ratios 2-20.
-MESH_ASPECT_LIMIT = 20.0
-#: largest length_m / thickness_m of a meshed plate link (smallest thickness: L / 1000).
-#: Slenderness L / r = 3464 (r = t / sqrt(12)): Euler buckling at pi^2 E / (L/r)^2 =
-#: 8e-7 E, e.g. 0.16 MPa in steel; such a strip is a foil that buckles under any load the
-#: mechanism carries, not a link the linear FFRF body (or a solid mesh) describes. The studies
-#: reach L / t = 267 (0.3 mm coupler).
-PLATE_SLENDERNESS_LIMIT = 1000.0
-#: smallest length_m / thickness_m of a meshed plate link: the rigid joint faces disturb
-#: the plate over about one thickness from each end (Saint-Venant), so below 2 no part of the
-#: link is free of them: its midpoint deflection and bending stress (evaluated away from
-#: the end faces, one thickness from each) would mean nothing. The studies reach 4 (20 mm).
-PLATE_STUBBINESS_LIMIT = 2.0
-#: largest estimated memory of a plate reduction (or nonlinear FE body) [bytes]: two thirds
-#: of this machine's 24 GiB, the rest for the simulation, the operating system and the
-#: other process of a 2-core run (about 870k DOF by :func:`estimate_mesh`, ~30 min to build).
-MESH_MEMORY_LIMIT_BYTES = 16 * 2**30
-
-
-@dataclass(frozen=True)
-class MeshEstimate:
-    """Estimated size and cost of meshing and reducing one plate (before any meshing).
-
-    Calibrated on netgen meshes of steel plates 80 mm long (second-order tetrahedra, as
-    :mod:`flex.bodies.reduction` builds them), one process, 2-core machine:
-
-    ==========================  ========  =======  ======  ===========  =========
-    t x w, maxh [mm]            elements  DOF      est.    build [s]    peak RSS
-    ==========================  ========  =======  ======  ===========  =========
-    1 x 10, 2                   1463      9627     10.7k   2.6          0.24 GB
-    1 x 10, 1                   5711      35805    42.9k   13.7         0.50 GB
-    1 x 10, 0.5                 23403     143670   177k    77.5         1.56 GB
-    3 x 10, 0.7                 36065     175212   194k    154          2.07 GB
-    2 x 10, 0.3 (mesh only)     333045    --       --      23 (mesh)    --
-    1 x 100, 2 (mesh only)      13895     --       --      2.3 (mesh)   --
-    ==========================  ========  =======  ======  ===========  =========
-
-    Elements: ``max(5.6 V / h^3, 3.65 S / h^2)`` (V volume, S surface area, h = maxh):
-    netgen fills a plate thicker than h with ~5.6 elements per h^3 and meshes a thinner one
-    from its two large faces (~3.65 elements per h^2 of surface), within +-25 % on the
-    meshes above (1.5x high on the 1 mm, 0.5 mm mesh). Nodes of the quadratic mesh: 2.2
-    per element when the surface term dominates, 1.65 when the volume does; DOF = 3 x
-    nodes. Memory: 0.15 GB + 11.5 kB per DOF, the sparse factorisation's share growing as
-    DOF^(1/3) beyond the largest mesh measured (175k DOF); build time: 154 s x (DOF /
-    175k)^1.5 (Craig-Bampton eigenmodes dominate). Estimates: within a factor 2 of what a
-    build takes.
-    """
-
-    elements: float
-    dof: float
-    memory_bytes: float
-    build_time_s: float
-
-    def text(self) -> str:
-        """One-line description, e.g. ``~1.5e+03 elements, ~1.1e+04 DOF, ~0.26 GiB, ~2 s``."""
-        return (f"~{self.elements:.2g} quadratic tetrahedra, ~{self.dof:.2g} DOF, "
-                f"~{self.memory_bytes / 2**30:.2g} GiB, ~{duration_text(self.build_time_s)} to "
-                f"mesh and reduce")
-
-
-#: the Craig-Bampton modes the build times of :class:`MeshEstimate` were measured with
-ESTIMATE_MODES = 6
-
-
-def modes_cost_factor(modes: int) -> float:
-    """Build time of a reduction to ``modes`` in-plane modes relative to one to
-    :data:`ESTIMATE_MODES`: the eigen-solve computes about 2 x modes + 4 eigenmodes (more
-    when the in-plane ones are not all among them) and its orthogonalisation grows with
-    their square. Measured on a 1 mm plate, 2 mm mesh (9.6k DOF, one process on a 2-core
-    machine loaded by others): 7.6 / 20 / 53 / 216 s at 2 / 6 / 24 / 40 modes;
-    ``1 + 0.3 m + 4e-4 m^3`` follows those ratios within a factor 1.5."""
-    def grow(count: float) -> float:
-        return 1.0 + 0.3 * count + 4e-4 * count**3
-
-    return grow(float(modes)) / grow(ESTIMATE_MODES)
-
-
-def estimate_mesh(length_m: float, thickness_m: float, width_m: float,
-                  mesh_size_m: float, modes: int | None = None) -> MeshEstimate:
-    """Elements, DOF, memory and build time of a plate mesh before meshing (see
-    :class:`MeshEstimate` for the calibration); ``modes``: the reduction's mode count,
-    which scales the build time (:func:`modes_cost_factor`; None: the calibration's).
-    Pure arithmetic: never meshes."""
-    h = mesh_size_m
-    volume = length_m * thickness_m * width_m
-    surface = 2.0 * (length_m * thickness_m + length_m * width_m + thickness_m * width_m)
-    from_volume, from_surface = 5.6 * volume / h**3, 3.65 * surface / h**2
-    elements = max(from_volume, from_surface, 6.0)
-    nodes = elements * (2.2 if from_surface >= from_volume else 1.65)
-    dof = 3.0 * nodes
-    memory = 0.15e9 + 11.5e3 * dof * max(1.0, dof / 175e3) ** (1.0 / 3.0)
-    build = 154.0 * (dof / 175e3) ** 1.5
-    if modes is not None:
-        build *= modes_cost_factor(modes)
-    return MeshEstimate(elements, dof, memory, build)
-
-
-def meshed_plate(link: str, values: dict[str, Any]) -> tuple[float, str, str] | None:
-    """Whether the scene meshes ``link``'s plate: ``(thickness_m meshed, its name, why)`` or
-    None.
-
-    ``ffrf`` and ``nonlinear_fe`` links are meshed; an ``auto`` crank always is (its
-    frequency is computed on the mesh; a lumped crank as the plate of its mass, of thickness
-    mass / (density x length x width), as :func:`flex.fidelity.auto.equivalent_crank_plate`); an
-    ``auto`` coupler is when the criterion chooses ``ffrf``.
-    """
-    model = values["model"]
-    name = f"{link}.thickness_m"
-    if model in ("ffrf", "nonlinear_fe"):
-        return values["thickness_m"], name, f'{link}.model = "{model}"'
-    if model != "auto":
-        return None
-    if link == "crank" and values["geometry"] == "lumped":
-        from flex.base.physics import plate_thickness_for_mass_m
-
-        thickness = plate_thickness_for_mass_m(values["mass_kg"], values["length_m"],
-                                               values["width_m"], values["density_kg_per_m3"])
-        return (thickness, "the thickness of the plate of crank.mass_kg (mass / (density_kg_"
-                "per_m3 x length_m x width_m))", 'crank.model = "auto" meshes a lumped crank '
-                "as the plate of its mass")
-    if link == "crank":
-        return values["thickness_m"], name, 'crank.model = "auto" meshes the crank plate'
-    return (values["thickness_m"], name,
-            'coupler.model = "auto" meshes the plate if it chooses "ffrf"')
-
-
-def check_meshed_plate(link: str, values: dict[str, Any]) -> None:
-    """Refuse a plate that will be meshed but cannot mean anything, or that this machine
-    cannot mesh (the estimate is in the message); nothing is meshed here."""
-    meshed = meshed_plate(link, values)
-    if meshed is None:
-        return
-    thickness, name, why = meshed
-    length, width, mesh = values["length_m"], values["width_m"], values["mesh_size_m"]
-
-    def as_mass(relation: str, bound: float) -> str:  # a lumped auto crank: on its mass_kg
-        if values["geometry"] != "lumped":
-            return ""
-        mass = bound * values["density_kg_per_m3"] * length * width
-        return (f"; i.e. {link}.mass_kg {relation} {mass:g} kg at its density_kg_per_m3, "
-                f"length_m and width_m")
-
-    for word, ratio, relation, outside, meaning in (
-            ("least", PLATE_SLENDERNESS_LIMIT, ">=", -1,
-             "thinner, it is a foil that buckles under any load the mechanism carries"),
-            ("most", PLATE_STUBBINESS_LIMIT, "<=", 1,
-             "thicker, the rigid joint faces reach its midpoint (Saint-Venant) and its "
-             "deflection and stress mean nothing")):
-        bound = length / ratio
-        if outside * (thickness - bound * (1 + outside * 1e-9)) > 0:
-            raise SceneError(f"{name} = {thickness:g}: a meshed plate link must be at "
-                             f"{word} {link}.length_m / {ratio:g} = {bound:g} m thick "
-                             f"({why}){as_mass(relation, bound)}; {meaning}")
-    if mesh == "auto":  # checked once resolved (flex.fidelity.auto.check)
-        return
-    if mesh > length * (1 + 1e-9):
-        raise SceneError(f"{link}.mesh_size_m = {mesh:g} must be <= {link}.length_m = "
-                         f"{length:g} ({why}); about 1-2 x thickness_m is accurate")
-    smallest = min(thickness, width)
-    limit = MESH_ASPECT_LIMIT * smallest
-    if mesh > limit * (1 + 1e-9):
-        side = name if thickness <= width else f"{link}.width_m"
-        raise SceneError(f"{link}.mesh_size_m = {mesh:g} must be <= {MESH_ASPECT_LIMIT:g} x "
-                         f"{side} = {limit:g} ({why}): longer elements than that make "
-                         f"the plate too stiff in bending (+13 % at 50 x); about 1-2 x "
-                         f"thickness is accurate")
-    estimate = estimate_mesh(length, thickness, width, mesh)
-    if estimate.memory_bytes > MESH_MEMORY_LIMIT_BYTES:
-        raise SceneError(f"{link}.mesh_size_m = {mesh:g} on a {length:g} x {thickness:g} x "
-                         f"{width:g} m plate needs {estimate.text()} (estimate); this machine "
-                         f"takes at most {MESH_MEMORY_LIMIT_BYTES / 2**30:g} GiB ({why}): use "
-                         f"a coarser mesh_size_m or a smaller plate")
+    check_meshed_plate(link, values, link_models)
 
 
 def to_toml(scene: Scene) -> str:
     """The fully resolved scene as TOML text (what ``python -m flex scene`` prints)."""
     return tomli_w.dumps(scene)
-
-
-def plate_mass_properties(scene: Scene, link: str = "coupler") -> tuple[float, float]:
-    """Mass [kg] and in-plane inertia about the centre of mass [kg m^2] of a link.
-
-    ``link`` is ``"coupler"`` or ``"crank"``. Lumped geometry returns the scene's
-    ``mass_kg`` and ``inertia_kgm2``; plate geometry computes them from length x thickness x
-    width and density (a cuboid: m (L^2 + t^2)/12).
-    """
-    from flex.base.physics import cuboid_inertia_kgm2, cuboid_mass_kg
-
-    values = scene[link]
-    if values["geometry"] == "lumped":
-        return values["mass_kg"], values["inertia_kgm2"]
-    length_m, thickness_m = values["length_m"], values["thickness_m"]
-    mass_kg = cuboid_mass_kg(length_m, thickness_m, values["width_m"],
-                             values["density_kg_per_m3"])
-    return mass_kg, cuboid_inertia_kgm2(mass_kg, length_m, thickness_m)

@@ -2,12 +2,14 @@
 build returns, and the 3D builder (:class:`_Builder`) that :func:`flex.dynamics.mechanism.
 build_mechanism` drives (:mod:`flex.dynamics.planar` extends it with 2D items for rigid
 scenes). The sketch of the mechanism and the choice of build are in
-:mod:`flex.dynamics.mechanism`.
+:mod:`flex.dynamics.mechanism`; the crank's and the coupler's bodies are added by their link
+models (:mod:`flex.dynamics.link_models`, point 5 of its contract).
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -17,6 +19,7 @@ from flex.base.errors import SceneError
 from flex.base.kinematics import crank_pin, slider_crank
 from flex.base.physics import cuboid_inertia_kgm2, cuboid_mass_kg
 from flex.data.scene import Scene, plate_mass_properties
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel, entries
 
 os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
 
@@ -80,6 +83,10 @@ class Mechanism:
     #: ``drive.spring_model = "chain"``: ``{"chain": SpringChain, "nodes": [inner nodes,
     #: slider side first]}`` (collect reads their sensors ``spring_chain.<i>.<output>``)
     spring_chain: dict[str, Any] = field(default_factory=dict)
+    #: the entry of each link's model, by link (:mod:`flex.dynamics.link_models`), and the
+    #: registry they come from
+    models: dict[str, Any] = field(default_factory=dict)
+    link_models: Any = None
 
 
 @dataclass(frozen=True)
@@ -229,7 +236,8 @@ class _Builder:
     #: index of the rotation about z among a rigid-body node's coordinates (x y z rx ry rz)
     rotation_coordinate = 5
 
-    def __init__(self, scene: Scene, ffrf_joint_markers: str = "fewest") -> None:
+    def __init__(self, scene: Scene, ffrf_joint_markers: str = "fewest", *,
+                 link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> None:
         import exudyn as exu
         import exudyn.itemInterface as eii
 
@@ -239,7 +247,10 @@ class _Builder:
         self.init = initial_configuration(scene)
         system_container = exu.SystemContainer()
         self.mbs = system_container.AddSystem()
-        self.mech = Mechanism(system_container, self.mbs, scene, self.init)
+        #: the entry of each link's model (:mod:`flex.dynamics.link_models`)
+        self.models = entries(scene, link_models)
+        self.mech = Mechanism(system_container, self.mbs, scene, self.init,
+                              models=self.models, link_models=link_models)
         self.ground = self.mbs.CreateGround()
         self.markers: dict[str, int] = {}
         self.crank_body: dict | None = None
@@ -273,16 +284,14 @@ class _Builder:
         return self.mbs.AddMarker(self.eii.MarkerBodyRigid(bodyNumber=body["bodyNumber"],
                                                            localPosition=list(local)))
 
-    def add_crank_and_slider(self, crank_reduction: Any) -> None:
-        """The crank (rigid body or FFRF plate), the slider, the ground markers at A and C,
-        and the wing welded at A when enabled."""
+    def add_crank_and_slider(self, crank_prepared: Any) -> None:
+        """The crank (its model's: a rigid body before the slider, any other after the
+        ground markers), the slider, the ground markers at A and C, and the wing welded at A
+        when enabled."""
         scene, init, mbs, eii = self.scene, self.init, self.mbs, self.eii
-        crank = scene["crank"]
-        if crank["model"] == "rigid":
-            self.crank_body = self.rigid_body(
-                "crank", *plate_mass_properties(scene, "crank"), init.joint_B_m / 2,
-                init.crank_angle_rad, init.joint_B_velocity_m_per_s / 2,
-                init.crank_speed_rad_per_s)
+        crank_model = self.models["crank"]
+        if crank_model.rigid:  # the order numbers the coordinates: kept as it always was
+            crank_model.add(self, "crank", crank_prepared)
         self.slider_body = self.add_slider()
         m = self.markers
         m["ground_A"] = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=self.ground,
@@ -293,7 +302,7 @@ class _Builder:
             m["crank_A"] = self.body_marker(self.crank_body, [0.0, 0.0, 0.0])
             m["crank_B"] = self.body_marker(self.crank_body, init.joint_B_m)
         else:
-            self._add_flexible_crank(crank_reduction)
+            crank_model.add(self, "crank", crank_prepared)
         m["slider_C"] = self.body_marker(self.slider_body, init.joint_C_m)
         if scene["wing"]["enabled"]:
             wing_root = _add_wing(self.mech, self.rigid_body, self.body_marker)
@@ -320,8 +329,9 @@ class _Builder:
         from flex.bodies.reduction import add_ffrf_link
 
         if crank_reduction is None:
-            raise SceneError('crank.model = "ffrf" needs its reduction (flex.fidelity.simulation.'
-                             "simulate builds it from the scene)")
+            raise SceneError(f'crank.model = "{self.scene["crank"]["model"]}" needs its '
+                             "reduction (flex.fidelity.simulation.simulate builds it from the "
+                             "scene)")
         # the plate's end_a face is the pivot A (the floating frame), end_b the joint B
         flexible_crank = add_ffrf_link(
             self.mbs, crank_reduction, [0.0, 0.0, 0.0], self.init.crank_angle_rad,
@@ -333,41 +343,9 @@ class _Builder:
         self.markers["crank_B"] = flexible_crank["marker_C"]
         self.mech.crank = dict(flexible_crank, reduction=crank_reduction)
 
-    def add_coupler(self, reduction: Any) -> None:
-        """The coupler B-C: FFRF body, nonlinear FE body or rigid body."""
-        scene, init, mbs = self.scene, self.init, self.mbs
-        model = scene["coupler"]["model"]
-        if model == "ffrf":
-            from flex.bodies.reduction import add_ffrf_link
-
-            self.coupler = add_ffrf_link(
-                mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
-                damping_ratio=scene["coupler"]["damping_ratio"],
-                initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
-                initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s,
-                joint_markers=self.ffrf_joint_markers,
-                end_a_rotation=False,  # the pin at B is free about z
-                end_b_rotation=False)  # the pin at C constrains x and y only
-            self.mech.coupler = dict(self.coupler, reduction=reduction)
-        elif model == "nonlinear_fe":
-            from flex.bodies.nonlinear import add_nonlinear_fe_coupler, nonlinear_plate_for_scene
-
-            plate = reduction if reduction is not None else nonlinear_plate_for_scene(scene)
-            self.coupler = add_nonlinear_fe_coupler(
-                mbs, plate, list(init.joint_B_m), init.coupler_angle_rad,
-                initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
-                initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
-            self.mech.coupler = dict(self.coupler, plate=plate)
-        else:
-            mass_kg, inertia_kgm2 = plate_mass_properties(scene)
-            body = self.rigid_body(
-                "coupler", mass_kg, inertia_kgm2, (init.joint_B_m + init.joint_C_m) / 2,
-                init.coupler_angle_rad,
-                (init.joint_B_velocity_m_per_s + init.joint_C_velocity_m_per_s) / 2,
-                init.coupler_speed_rad_per_s)
-            self.coupler = {"marker_B": self.body_marker(body, init.joint_B_m),
-                            "marker_C": self.body_marker(body, init.joint_C_m)}
-            self.mech.coupler = {"body": body["bodyNumber"], "node": body["nodeNumber"]}
+    def add_coupler(self, prepared: Any) -> None:
+        """The coupler B-C, as its model adds it (:mod:`flex.dynamics.link_models`, point 5)."""
+        self.models["coupler"].add(self, "coupler", prepared)
         self.markers["coupler_B"] = self.coupler["marker_B"]
         self.markers["coupler_C"] = self.coupler["marker_C"]
 
@@ -382,7 +360,7 @@ class _Builder:
 
         for name, link in (("coupler", self.mech.coupler), ("crank", self.mech.crank)):
             values = self.scene[name]
-            if values["model"] == "ffrf" and values["geometric_stiffness"]:
+            if self.models[name].modal and values["geometric_stiffness"]:
                 link["geometric_data"] = geometric_stiffness(link["reduction"])
                 link["geometric_stiffness"] = add_geometric_stiffness(
                     self.mbs, link["node_modal"], link["geometric_data"], name)
@@ -496,12 +474,8 @@ class _Builder:
         for name, body in (("crank", self.crank_body), ("slider", self.slider_body)):
             if body is not None:  # None: a flexible crank, its markers below
                 self._add_body_sensors(name, body)
-        if self.scene["coupler"]["model"] == "rigid":
-            # the centre of mass is the coupler's midpoint
-            for output in ("Position", "Velocity", "Acceleration", "Rotation",
-                           "AngularVelocity"):
-                self.add(f"coupler.{output}",
-                         self.sensor("Node", output, nodeNumber=self.mech.coupler["node"]))
+        for link, model in self.models.items():  # the link model's own (point 6)
+            model.sensors(self, link)
         self._add_joint_sensors()
         self._add_marker_sensors()
         self._add_flexible_sensors()
@@ -540,8 +514,7 @@ class _Builder:
                                        ("coupler_C", "slider_C")]
 
     def _add_flexible_sensors(self) -> None:
-        model = self.scene["coupler"]["model"]
-        flexible = {"coupler": self.coupler} if model in ("ffrf", "nonlinear_fe") else {}
+        flexible = {} if self.models["coupler"].rigid else {"coupler": self.coupler}
         if self.mech.crank:
             flexible["crank"] = self.mech.crank
             for name in ("crank_A", "crank_B"):

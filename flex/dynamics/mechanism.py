@@ -25,6 +25,7 @@ compressed by ``spring_preload_m`` at t = 0 and attached throughout, released fr
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 from flex.base.errors import SceneError
@@ -37,12 +38,13 @@ from flex.dynamics.builder import (  # noqa: F401 - the names callers import fro
     initial_configuration,
     wing_mass_properties,
 )
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel, entries
 from flex.dynamics.planar import PlanarBuilder, is_planar
 
 
 def build_mechanism(scene: Scene, reduction: Any = None, crank_reduction: Any = None, *,
-                    ffrf_joint_markers: str = "fewest", planar: bool | None = None
-                    ) -> Mechanism:
+                    ffrf_joint_markers: str = "fewest", planar: bool | None = None,
+                    link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> Mechanism:
     """Build and assemble the slider-crank of ``scene`` in a new Exudyn system.
 
     ``reduction`` is the Craig-Bampton reduction (:func:`flex.bodies.reduction.build_reduction`)
@@ -55,18 +57,17 @@ def build_mechanism(scene: Scene, reduction: Any = None, crank_reduction: Any = 
     (:mod:`flex.dynamics.planar`: the same datasets at a quarter of the cost per step);
     None: wherever the scene allows it (:func:`flex.dynamics.planar.is_planar`); False:
     always 3D (for callers that read 3D coordinates, e.g. the out-of-plane modes); True:
-    planar or SceneError. Returns a :class:`Mechanism`.
+    planar or SceneError. ``link_models``: the registry the links' models come from
+    (:mod:`flex.dynamics.link_models`; each adds itself, point 5 of its contract). Returns a
+    :class:`Mechanism`.
     """
-    for link in ("crank", "coupler"):
-        if scene[link]["model"] == "auto":
-            raise SceneError('model = "auto" must be resolved before building '
-                             "(flex.fidelity.simulation.simulate does it with "
-                             "flex.fidelity.auto.resolve)")
-    if planar and not is_planar(scene):
+    entries(scene, link_models)  # SceneError for "auto" or an unknown model, first
+    if planar and not is_planar(scene, link_models):
         raise SceneError("a planar build needs rigid crank and coupler and an implicit "
                          "integrator (simulation.integrator != \"explicit_penalty\")")
-    use_planar = is_planar(scene) if planar is None else planar
-    builder = PlanarBuilder(scene) if use_planar else _Builder(scene, ffrf_joint_markers)
+    use_planar = is_planar(scene, link_models) if planar is None else planar
+    builder = (PlanarBuilder(scene, link_models=link_models) if use_planar
+               else _Builder(scene, ffrf_joint_markers, link_models=link_models))
     builder.add_crank_and_slider(crank_reduction)
     builder.add_coupler(reduction)
     builder.add_joints()

@@ -23,20 +23,25 @@ read by their own rules (:func:`joint_forces`, :func:`weld_loads`), so that
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from typing import Any
+
 import numpy as np
 
-from flex.data.scene import Scene
+from flex.data.scene import LINKS, Scene, link_model
 from flex.dynamics.builder import Mechanism, _Builder, slider_mass_kg
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 
 
-def is_planar(scene: Scene) -> bool:
+def is_planar(scene: Scene, link_models: Mapping[str, Any] = BUILTIN_LINK_MODELS) -> bool:
     """Whether ``scene`` can be built with 2D items and give the 3D model's results.
 
     Needs rigid crank and coupler (the FFRF and nonlinear FE bodies are 3D meshes) and an
     implicit integrator (``explicit_penalty`` keeps its 3D penalty joints, whose out-of-plane
     coordinate constraints the explicit solvers eliminate).
     """
-    return (scene["crank"]["model"] == "rigid" and scene["coupler"]["model"] == "rigid"
+    return (all(scene[link]["model"] != "auto"
+                and link_model(link, scene[link], link_models).rigid for link in LINKS)
             and scene["simulation"]["integrator"] != "explicit_penalty")
 
 
@@ -46,8 +51,9 @@ class PlanarBuilder(_Builder):
     #: index of the angle among a 2D rigid-body node's coordinates (x y angle)
     rotation_coordinate = 2
 
-    def __init__(self, scene: Scene) -> None:
-        super().__init__(scene)
+    def __init__(self, scene: Scene, *,
+                 link_models: Mapping[str, Any] = BUILTIN_LINK_MODELS) -> None:
+        super().__init__(scene, link_models=link_models)
         self.mech.planar = True
         self.wing_angle_joint: int | None = None
 

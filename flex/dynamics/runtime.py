@@ -13,48 +13,48 @@ from __future__ import annotations
 import io
 import re
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from flex.base.progress import Progress, duration_text
-from flex.data.scene import Scene, estimate_mesh
+from flex.data.scene import Scene
+from flex.dynamics.link_models import (  # noqa: F401 - the names callers import from here
+    BUILTIN_LINK_MODELS,
+    STEP_COST_FFRF_S,
+    STEP_COST_NONLINEAR_FE_PER_DOF_S,
+    LinkModel,
+    entries,
+)
 
 #: an integration whose estimated wall time exceeds this is announced on stderr first [s]
 ANNOUNCE_RUN_S = 30.0
 #: wall time per step [s] of the integration, rough (2-core machine, shared; within ~3x):
-#: the rigid model (planar, full Newton: 12-30 us measured), an FFRF link per modal
-#: coordinate beyond its frame (1 mm plate, 2 mm mesh, 1e-5 s, modified Newton: 0.25 ms at
-#: 2 modes, 0.38 at 6, 0.99 at 20, 2.5 at 40), and the nonlinear FE coupler per DOF of its
-#: mesh (40 ms per step at ~5.6k DOF, 80 x 3 x 10 mm plate, 4 mm mesh)
+#: the rigid model (planar, full Newton: 12-30 us measured); each flexible link model adds
+#: its own (:mod:`flex.dynamics.link_models`: an FFRF link per modal coordinate, the
+#: nonlinear FE coupler per DOF of its mesh)
 STEP_COST_RIGID_S = 3e-5
-STEP_COST_FFRF_S = (1.5e-4, 5e-5)  # (per FFRF link, per mode)
-STEP_COST_NONLINEAR_FE_PER_DOF_S = 7e-6
 
 
-def estimated_run_time_s(scene: Scene, modes: dict[str, int] | None = None) -> float:
+def estimated_run_time_s(scene: Scene, modes: dict[str, int] | None = None,
+                         link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> float:
     """Rough wall time [s] of integrating a concrete scene (solver keys resolved) once:
-    steps x an estimated cost per step (:data:`STEP_COST_RIGID_S`, ...). ``modes``: the
-    modes of built reductions by link (default: the scene's)."""
+    steps x an estimated cost per step (:data:`STEP_COST_RIGID_S` and each link model's
+    ``step_cost_s``). ``modes``: the modes of built reductions by link (default: the
+    scene's)."""
     steps = scene["simulation"]["end_time_s"] / scene["simulation"]["step_s"]
     per_step = STEP_COST_RIGID_S
-    for link in ("crank", "coupler"):
-        values = scene[link]
-        if values["model"] == "ffrf":
-            count = (modes or {}).get(link) or values["modes"]
-            per_step += STEP_COST_FFRF_S[0] + STEP_COST_FFRF_S[1] * float(count)
-        elif values["model"] == "nonlinear_fe":
-            dof = estimate_mesh(values["length_m"], values["thickness_m"], values["width_m"],
-                                values["mesh_size_m"]).dof
-            per_step += STEP_COST_NONLINEAR_FE_PER_DOF_S * dof
+    for link, model in entries(scene, link_models).items():
+        per_step += model.step_cost_s(scene[link], (modes or {}).get(link))
     return steps * per_step
 
 
-def announce_integration(scene: Scene, name: str, reductions: dict[str, Any]) -> None:
+def announce_integration(scene: Scene, name: str, reductions: dict[str, Any],
+                         link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> None:
     """Say on stderr, before it starts, what a long integration will cost (estimate)."""
     # a nonlinear FE coupler's plate has no modes: its cost comes from its mesh
     modes = {link: built.modes for link, built in reductions.items()
              if getattr(built, "modes", None) is not None}
-    estimate = estimated_run_time_s(scene, modes)
+    estimate = estimated_run_time_s(scene, modes, link_models)
     if estimate > ANNOUNCE_RUN_S:
         sim = scene["simulation"]
         print(f"flex: integrating {name}: {sim['end_time_s'] / sim['step_s']:.3g} steps of "

@@ -52,7 +52,14 @@ from flex.config.settings import (
     resolve_link_keys,
     resolve_solver_settings,
 )
-from flex.data.scene import Scene, check_meshed_plate, to_toml
+from flex.data.scene import Scene, check_meshed_plate, model_names, to_toml
+from flex.dynamics.link_models import (
+    BUILTIN_LINK_MODELS,
+    FFRF,
+    NONLINEAR_FE,
+    RIGID,
+    LinkModel,
+)
 from flex.fidelity.criteria import (
     DEFAULT_CRANK_CRITERION,
     EULER_LOAD_LIMIT,
@@ -96,12 +103,15 @@ def has_auto_models(scene: Mapping[str, Mapping[str, Any]]) -> bool:
             or scene["drive"]["spring_model"] == AUTO)
 
 
-def candidates(scene: Scene) -> list[Scene]:
+def candidates(scene: Scene, link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
+               ) -> list[Scene]:
     """The concrete-model scenes ``"auto"`` link models may turn ``scene`` into (itself if
     none): a link ``"auto"`` may become rigid or FFRF (the nonlinear FE coupler, past them,
     runs at the rigid step too), a lumped crank or one with a constant-speed drive only
     rigid (a flexible verdict is refused there); an ``"auto"`` spring is taken massless (the
-    checks do not depend on it)."""
+    checks do not depend on it). What ``"auto"`` may become: the models of ``link_models``
+    ``auto`` may pick (``auto_choice``) short of the reference (which runs at the rigid
+    step too), rigid ones only where a flexible verdict is refused."""
     if scene["drive"]["spring_model"] == AUTO:
         scene = copy.deepcopy(scene)
         scene["drive"]["spring_model"] = "massless"
@@ -112,9 +122,9 @@ def candidates(scene: Scene) -> list[Scene]:
             choices.append([values["model"]])
         elif link == "crank" and (values["geometry"] != "plate"
                                   or scene["drive"]["kind"] != "spring"):
-            choices.append(["rigid"])
+            choices.append(model_names(link, link_models, auto_choice=True, rigid=True))
         else:
-            choices.append(["rigid", "ffrf"])
+            choices.append(model_names(link, link_models, auto_choice=True, reference=False))
     if all(len(options) == 1 and options[0] == scene[link]["model"]
            for options, link in zip(choices, LINKS, strict=True)):
         return [scene]
@@ -126,7 +136,8 @@ def candidates(scene: Scene) -> list[Scene]:
     return out
 
 
-def check(scene: Scene) -> dict[str, tuple[Scene, SolverChoice | None]]:
+def check(scene: Scene, link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
+          ) -> dict[str, tuple[Scene, SolverChoice | None]]:
     """Refuse, before anything is built, meshed or simulated, a scene none of whose
     resolutions can run (:class:`SceneError`, one line naming the key and the accepted
     range): every candidate (:func:`candidates`) resolved and checked
@@ -134,17 +145,18 @@ def check(scene: Scene) -> dict[str, tuple[Scene, SolverChoice | None]]:
     check that fails for only some choices is left to the run, which then stores a failed
     case naming it); with ``"auto"`` models, the rigid probe must fit the step limit
     (:func:`flex.fidelity.probe.probe_scene`). Returns the candidates that passed, resolved,
-    by their TOML (what :func:`resolve` reuses). Takes milliseconds."""
+    by their TOML (what :func:`resolve` reuses). Takes milliseconds. ``link_models``: the
+    registry of the scene's link models."""
     linked, _ = resolve_link_keys(scene)  # an "auto" link's plate too: what it may mesh
     for link in LINKS:
-        check_meshed_plate(link, linked[link])
-    options = candidates(scene)
+        check_meshed_plate(link, linked[link], link_models)
+    options = candidates(scene, link_models)
     passed: dict[str, tuple[Scene, SolverChoice | None]] = {}
     errors: list[SceneError] = []
     for candidate in options:
         try:
-            resolved, choice = resolve_solver_settings(candidate)
-            check_concrete(resolved, choice)
+            resolved, choice = resolve_solver_settings(candidate, link_models=link_models)
+            check_concrete(resolved, choice, link_models=link_models)
             passed[to_toml(candidate)] = (resolved, choice)
         except SceneError as exc:
             errors.append(exc)
@@ -159,13 +171,15 @@ def check(scene: Scene) -> dict[str, tuple[Scene, SolverChoice | None]]:
 
 def resolve(scene: Scene, criterion: Criterion | None = None,
             crank_criterion: Criterion | None = None, *, cache_dir: Path | None = None,
-            quiet: bool = False) -> Resolution:
+            quiet: bool = False,
+            link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> Resolution:
     """Decide every ``"auto"`` of a validated scene (see the module doc); raises
     :class:`SceneError` for a scene that cannot run or an ``auto`` that refuses.
     ``criterion`` / ``crank_criterion``: the coupler's and the crank's fitted laws (None: the
     installed ones); ``cache_dir``: the reduction cache folder of the crank's frequency
-    analysis (None: in memory)."""
-    passed = check(scene)
+    analysis (None: in memory); ``link_models``: the registry of the scene's link models
+    (``auto`` itself decides among the built-in ones, whose laws are fitted)."""
+    passed = check(scene, link_models)
     decisions: list[FidelityDecision] = []
     concrete = scene
     if concrete["drive"]["spring_model"] == AUTO:
@@ -176,9 +190,10 @@ def resolve(scene: Scene, criterion: Criterion | None = None,
                                        cache_dir=cache_dir)
         decisions += links
     reused = passed.get(to_toml(concrete))
-    resolved, choice = reused if reused is not None else resolve_solver_settings(concrete)
+    resolved, choice = (reused if reused is not None
+                        else resolve_solver_settings(concrete, link_models=link_models))
     if reused is None:
-        check_concrete(resolved, choice)
+        check_concrete(resolved, choice, link_models=link_models)
     if not quiet:
         for decision in decisions:
             modes = f" ({decision.modes} modes)" if decision.modes else ""
@@ -229,7 +244,7 @@ def _decide(link: str, omega: float, delta_t_s: float, how: str, tolerance: floa
     predicted = float(law.band(n["physical"], "physical", kind="prediction")[1])
     extrapolated = law.extrapolated(n["physical"])
     rigid = n["physical"] >= k_phys
-    verdict = "rigid" if rigid else "ffrf"
+    verdict = RIGID if rigid else FFRF
     reason = (f"{link}: n = delta_t/T = {n['physical']:.4g} (T = 2 pi/omega; thesis "
               f"convention delta_t*omega = {n['thesis']:.4g}) {'>=' if rigid else '<'} "
               f"k = {k_phys:.4g} ({k_phys * TWO_PI:.4g} thesis) for tolerance "
@@ -287,7 +302,7 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]], *,
     from flex.dynamics.solver import reduction_for_scene
 
     analysis = copy.deepcopy({k: dict(v) for k, v in scene.items()})
-    analysis["coupler"]["model"] = "rigid"
+    analysis["coupler"]["model"] = RIGID
     crank = analysis["crank"]
     estimates = clamped_plate_frequencies(crank["length_m"], crank["thickness_m"],
                                           crank["width_m"], crank["youngs_modulus_Pa"],
@@ -298,7 +313,7 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]], *,
     def in_plane_omegas(model: str) -> np.ndarray:
         crank["model"] = model
         reduction = (reduction_for_scene(analysis, "crank", cache_dir=cache_dir)
-                     if model == "ffrf" else None)
+                     if BUILTIN_LINK_MODELS[model].modal else None)
         # 3D for both models: the modes are sorted by their out-of-plane coordinates
         mech = build_mechanism(analysis, None, reduction, planar=False)
         values, vectors = mech.mbs.ComputeODE2Eigenvalues(useAbsoluteValues=True)
@@ -310,8 +325,8 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]], *,
         out_of_plane = np.sqrt(block[2] ** 2 + (arm * block[3]) ** 2 + (arm * block[4]) ** 2)
         return np.sort(np.sqrt(values[in_plane > out_of_plane]))
 
-    rigid = in_plane_omegas("rigid")
-    flexible = in_plane_omegas("ffrf")
+    rigid = in_plane_omegas(RIGID)
+    flexible = in_plane_omegas(FFRF)
     if len(rigid) != 1 or len(flexible) < 2:
         raise SceneError(f"crank frequency analysis: expected one in-plane rigid-body mode and "
                          f"at least one elastic mode, found {len(rigid)} and "
@@ -409,17 +424,17 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
             f'coupler.model = "auto": the coupler carries {ratio:.3g} x its Euler '
             f"buckling load (pi^2 E I / L^2) during the deployment; the criterion is "
             f"fitted up to {EULER_LOAD_LIMIT:g} x, and near buckling the error depends on "
-            f'that ratio, not on n (the linear "ffrf" model does not represent buckling '
-            f'either): use a thicker coupler, or coupler.model = "nonlinear_fe"')
+            f'that ratio, not on n (the linear "{FFRF}" model does not represent buckling '
+            f'either): use a thicker coupler, or coupler.model = "{NONLINEAR_FE}"')
     how += f"; compressive load {ratio:.3g} x Euler load"
     decision, k_phys = _decide("coupler", omega, delta_t_s, how, tolerance, criterion,
                                float(coupler["damping_ratio"]))
     _decide_by_loads(decision, predict_deflection(probe, coupler).relative_error(
         coupler["length_m"]), tolerance)
-    if decision.model == "ffrf":
+    if not BUILTIN_LINK_MODELS[decision.model].rigid:
         _climb(decision, coupler, ratio, tolerance)
     coupler["model"] = decision.model
-    if decision.model == "ffrf":
+    if BUILTIN_LINK_MODELS[decision.model].modal:
         _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s)
     return decision, how
 
@@ -435,12 +450,12 @@ def _climb(decision: FidelityDecision, coupler: dict[str, Any], load_ratio: floa
     decision.reason += (f"; ladder: {rung} ({body} model error {relative:.3g} of the "
                         f"deflection, make ladder's measured bound, "
                         f"{'<=' if rung == 'ffrf' else '>'} tolerance {tolerance:g})")
-    if rung == "nonlinear_fe":
+    if BUILTIN_LINK_MODELS[rung].reference:
         if coupler["damping_ratio"] != 0:
             raise SceneError(f'coupler.model = "auto": {decision.reason}; the nonlinear FE '
                              f"coupler has no damping model: set coupler.damping_ratio = 0, "
                              f"or a larger fidelity.tolerance")
-        decision.model = "nonlinear_fe"
+        decision.model = rung
 
 
 def _decide_by_loads(decision: FidelityDecision, predicted_rigid_error: float,
@@ -452,7 +467,7 @@ def _decide_by_loads(decision: FidelityDecision, predicted_rigid_error: float,
     bound = predicted_rigid_error * PREDICTION_MARGIN
     rigid = bound <= tolerance
     baseline = decision.model
-    decision.model = "rigid" if rigid else "ffrf"
+    decision.model = RIGID if rigid else FFRF
     decision.reason = (
         f"{decision.link}: the rigid run's loads predict a deflection error of "
         f"{predicted_rigid_error:.3g} (x {PREDICTION_MARGIN:g} margin: {bound:.3g} "
@@ -483,17 +498,17 @@ def _decide_crank(resolved: dict[str, dict[str, Any]], probe: dict[str, np.ndarr
                   "Exudyn eigenvalues at t = 0")
     _crank_by_loads(decision, probe, plate, omega, tolerance,
                     bool(resolved.get("wing", {}).get("enabled", False)))
-    if decision.model == "ffrf":
+    if not BUILTIN_LINK_MODELS[decision.model].rigid:
         if lumped:
             raise SceneError(f'crank.model = "auto": the criterion says the crank is '
                              f"flexible ({decision.reason}); a flexible crank is meshed "
                              f'from a plate: set crank.geometry = "plate" (and its '
-                             f'thickness_m, width_m, material), or crank.model = "rigid" '
+                             f'thickness_m, width_m, material), or crank.model = "{RIGID}" '
                              f"to accept the error")
         if resolved["drive"]["kind"] != "spring":
             raise SceneError(f'crank.model = "auto": the criterion says the crank is '
                              f"flexible ({decision.reason}), but a flexible crank needs "
-                             f'drive.kind = "spring"; set crank.model = "rigid" to accept '
+                             f'drive.kind = "spring"; set crank.model = "{RIGID}" to accept '
                              f"the error")
         _mode_cut(decision, resolved, "crank", k_phys, delta_t_s)
     decision.reason += ("; crank law from "

@@ -56,6 +56,7 @@ from flex.base.thesis import (  # noqa: F401 - part of this module's face
     THESIS_K,  # thesis sec. 6.2, in the thesis convention (n = delta_t * omega)
     THESIS_YOUNGS_MODULUS_PA,
 )
+from flex.dynamics.link_models import FFRF, NONLINEAR_FE
 from flex.fidelity.predictor import PREDICTION_MARGIN
 
 CRITERION_FORMAT = "flex-criterion/1"
@@ -229,7 +230,7 @@ def flexible_rung(load_ratio: float, tolerance: float, geometric_stiffness: bool
     ``"nonlinear_fe"``; and the FFRF rung's relative model error. All dimensionless."""
     relative = (GEOMETRIC_FFRF_ERROR if geometric_stiffness
                 else LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio)
-    return ("ffrf" if relative <= tolerance else "nonlinear_fe"), relative
+    return (FFRF if relative <= tolerance else NONLINEAR_FE), relative
 
 
 def euler_load_ratio(force_B_N: np.ndarray, force_C_N: np.ndarray,

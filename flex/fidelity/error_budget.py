@@ -41,13 +41,14 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 from flex.base.errors import FlexError
 from flex.data.results import CaseResult
-from flex.data.scene import Scene, apply_overrides
+from flex.data.scene import Scene, apply_overrides, model_names
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.fidelity.criteria import FFRF_MOTION_ERROR_FRACTION, GEOMETRIC_FFRF_ERROR
 from flex.fidelity.error_estimate import (
     HEADLINES,
@@ -122,10 +123,11 @@ def combined(terms: Any) -> float:
 OWN = ("_peak_deflection_m", "_peak_bending_stress_Pa", "_peak_von_mises_Pa")
 
 
-def _flexible(scene: Scene, model: str | None = None) -> list[str]:
+def _links(scene: Scene, link_models: Mapping[str, LinkModel], **flags: bool) -> list[str]:
+    """The links whose models have the given flags (``modal=True``: the FFRF links)."""
     return [link for link in LINKS
-            if scene[link]["model"] == (model or "ffrf")
-            or (model is None and scene[link]["model"] == "nonlinear_fe")]
+            if all(getattr(link_models[scene[link]["model"]], flag) == value
+                   for flag, value in flags.items())]
 
 
 def _companion(scene: Scene, overrides: list[str]) -> Scene:
@@ -165,9 +167,9 @@ class _Companions:
             self.wall_time_s += time.perf_counter() - start
 
 
-def _modes_term(scene: Scene, result: CaseResult, companions: _Companions
-                ) -> tuple[dict[str, float], str]:
-    ffrf = _flexible(scene, "ffrf")
+def _modes_term(scene: Scene, result: CaseResult, companions: _Companions,
+                link_models: Mapping[str, LinkModel]) -> tuple[dict[str, float], str]:
+    ffrf = _links(scene, link_models, modal=True)
     if not ffrf:
         return {}, "no FFRF link (no modes)"
     changes = {link: richer_modes(int(scene[link]["modes"])) for link in ffrf}
@@ -178,9 +180,10 @@ def _modes_term(scene: Scene, result: CaseResult, companions: _Companions
     return _differences(result, richer), f"difference to a companion with more modes ({how})"
 
 
-def _mesh_term(scene: Scene, result: CaseResult, companions: _Companions
-               ) -> tuple[dict[str, float], str]:
-    meshed = [link for link in _flexible(scene) if scene[link]["geometry"] == "plate"]
+def _mesh_term(scene: Scene, result: CaseResult, companions: _Companions,
+               link_models: Mapping[str, LinkModel]) -> tuple[dict[str, float], str]:
+    meshed = [link for link in _links(scene, link_models, meshed=True)
+              if scene[link]["geometry"] == "plate"]
     if not meshed:
         return {}, "no meshed link"
     sizes = {link: min(MESH_FACTOR * float(scene[link]["mesh_size_m"]),
@@ -194,12 +197,15 @@ def _mesh_term(scene: Scene, result: CaseResult, companions: _Companions
 
 
 def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
-                leaves_out: list[str]) -> tuple[dict[str, float], str]:
-    ffrf = _flexible(scene, "ffrf")
+                leaves_out: list[str], link_models: Mapping[str, LinkModel]
+                ) -> tuple[dict[str, float], str]:
+    # the measured model error of the linear-elastic (FFRF) links: make ladder, make flexible
+    ffrf = _links(scene, link_models, linear_elastic=True)
     sentences, terms = [], {}
     if ffrf:
         twin = companions.run("model", _companion(
-            scene, [f'{link}.model="rigid"' for link in ffrf]
+            scene, [f'{link}.model="{model_names(link, link_models, rigid=True)[0]}"'
+                    for link in ffrf]
             + [f'{link}.geometry="plate"' for link in ffrf]))
         elastic = _differences(result, twin)
         terms = {name: (GEOMETRIC_FFRF_ERROR if name.endswith(OWN)
@@ -218,10 +224,10 @@ def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
                 terms[name] = terms.get(name, 0.0) + value
             sentences.append(f"linear FFRF ({', '.join(linear)}): plus the difference to a "
                              f"companion with geometric stiffness")
-    if _flexible(scene, "nonlinear_fe"):
+    if _links(scene, link_models, reference=True):
         leaves_out.append("the nonlinear FE coupler's own model error (the top rung: "
                           "St. Venant-Kirchhoff continuum, deformable joint faces)")
-    rigid = [link for link in LINKS if scene[link]["model"] == "rigid"]
+    rigid = _links(scene, link_models, rigid=True)
     if rigid:
         leaves_out.append(f"the elasticity of the rigid {' and '.join(rigid)} (predicted by "
                           f"model = \"auto\", fidelity_* attributes)")
@@ -230,19 +236,21 @@ def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
 
 def error_budget(scene: Scene, result: CaseResult,
                  run_companion: Callable[[Scene], CaseResult],
-                 time_scales: list[tuple[float, float, str]]) -> ErrorBudget:
+                 time_scales: list[tuple[float, float, str]],
+                 link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> ErrorBudget:
     """The error budget of ``result``, the run of ``scene`` (concrete models, solver keys
     resolved), from companion runs made by ``run_companion`` (see the module doc);
-    ``time_scales``: the scene's (:func:`flex.dynamics.solver.time_scales`)."""
+    ``time_scales``: the scene's (:func:`flex.dynamics.solver.time_scales`);
+    ``link_models``: the registry of its link models (their flags choose the terms)."""
     values = {name: read(result.datasets) for name, (_, _, read) in HEADLINES.items()}
     values = {name: value for name, value in values.items() if value is not None}
     step = estimate_step_error(scene, result, run_companion, time_scales)
     companions = _Companions(run_companion)
     leaves_out = ["the spring's and joints' idealizations (massless spring unless chained, "
                   "ideal pins)"]
-    modes, modes_how = _modes_term(scene, result, companions)
-    mesh, mesh_how = _mesh_term(scene, result, companions)
-    model, model_how = _model_term(scene, result, companions, leaves_out)
+    modes, modes_how = _modes_term(scene, result, companions, link_models)
+    mesh, mesh_how = _mesh_term(scene, result, companions, link_models)
+    model, model_how = _model_term(scene, result, companions, leaves_out, link_models)
     failed = {failure.split(":")[0] for failure in companions.failures}
     if not step.values:
         failed.add("step")

@@ -22,6 +22,7 @@ import numpy as np
 from flex.base.errors import SceneError
 from flex.config.settings import solver_defaults
 from flex.data.scene import MAX_STEPS
+from flex.dynamics.link_models import RIGID
 from flex.fidelity.criteria import PRIMARY_DELTA_T, deployment_times
 
 #: the probe's step: at most this [s], and at most end time / PROBE_SAMPLES
@@ -73,7 +74,7 @@ def probe_scene(scene: Mapping[str, Mapping[str, Any]], end_time_s: float | None
     sample stored. Raises :class:`SceneError` for a constant-speed drive at rest (no half
     turn to probe) and for a probe over the step limit."""
     rigid = copy.deepcopy({k: dict(v) for k, v in scene.items()})
-    rigid["coupler"]["model"] = rigid["crank"]["model"] = "rigid"
+    rigid["coupler"]["model"] = rigid["crank"]["model"] = RIGID
     end = float(rigid["simulation"]["end_time_s"] if end_time_s is None else end_time_s)
     drive = scene["drive"]
     if drive["kind"] == "constant_speed":

@@ -21,6 +21,7 @@ import numpy as np
 from flex.base.kinematics import chord_components
 from flex.base.physics import euler_buckling_load_N
 from flex.data.results import CaseResult, Dataset
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, RIGID
 
 
 def coupler_compression_N(data: dict[str, np.ndarray], samples: int | None = None
@@ -57,10 +58,9 @@ def first_peak_index(deflection: np.ndarray) -> int:
 
 Values = dict[str, tuple[Any, str, str]]  # key -> (value, units, description)
 
-#: what each compared model is called in reports
-LABELS = {"ffrf": "FFRF (flex's default: geometric stiffness)",
-          "linear": "linear FFRF (geometric_stiffness = false)",
-          "rigid": "rigid twin", "nonlinear_fe": "nonlinear FE (reference)"}
+#: what each compared model (a case named after it) is called in reports
+LABELS = {**{name: model.label for name, model in BUILTIN_LINK_MODELS.items()},
+          "linear": "linear FFRF (geometric_stiffness = false)"}
 
 
 def _model_values(data: dict[str, np.ndarray], reference: dict[str, np.ndarray],
@@ -144,8 +144,8 @@ def compare_with_reference(label: str, cases: dict[str, CaseResult], reference: 
             continue
         found[name] = _model_values(data, ref, samples, LABELS.get(name, name))
     compression = (float(coupler_compression_N(
-        {k: v.data for k, v in cases["ffrf"].datasets.items()}, samples).max())
-        if "ffrf" in found else float("nan"))
+        {k: v.data for k, v in cases[FFRF].datasets.items()}, samples).max())
+        if FFRF in found else float("nan"))
     common: Values = {
         "span_end_time": (float(ref["time"][-1]), "s", "runs compared over 0 .. this time"),
         "reference_peak_deflection": (float(np.abs(ref["coupler/midpoint_deflection"]).max()),
@@ -174,10 +174,10 @@ def compare_with_reference(label: str, cases: dict[str, CaseResult], reference: 
                      f"({_error_text(v['peak_error'])}), first peak "
                      f"{_error_text(v['first_peak_error'])}, curves "
                      f"{v['max_curve_difference_over_peak']:.1%} of the peak apart")
-    if "ffrf" in found and "rigid" in found:
+    if FFRF in found and RIGID in found:
         fractions = motion_error_fractions(
-            {k: v.data for k, v in cases["ffrf"].datasets.items()},
-            {k: v.data for k, v in cases["rigid"].datasets.items()}, ref, samples)
+            {k: v.data for k, v in cases[FFRF].datasets.items()},
+            {k: v.data for k, v in cases[RIGID].datasets.items()}, ref, samples)
         datasets.update({f"{prefix}/ffrf/motion_error_fraction/{name.replace(' ', '_')}":
                          Dataset(value, "1", f"|FFRF - reference| / |FFRF - rigid twin|, "
                                  f"{name} over the span") for name, value in fractions.items()})

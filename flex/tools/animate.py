@@ -30,7 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from flex.base.errors import FlexError
-from flex.tools.motion import Body, CaseMotion, case_motion, top_faces
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS
+from flex.tools.motion import Body, CaseMotion, case_motion, model_entry, top_faces
 
 #: frame size [px] (even, as H.264 in yuv420p needs) at :data:`DPI`
 SIZE_PX = (960, 540)
@@ -230,7 +231,7 @@ def _render(motion: CaseMotion, frames: list[_Frame], magnification: float):
             artists = []
             for body in motion.bodies:
                 xy = frame.shapes[body.name][:, :2]
-                if body.model == "rigid":
+                if model_entry(body.model).rigid:
                     artists += axes.fill(*_outline(xy).T, color="0.7", ec="0.2", lw=1.0)
                     continue
                 shape = _drawn(body, frame.shapes[body.name], magnification)
@@ -319,7 +320,9 @@ def animate_results(result: str | Path, *, cache_dir: Path | None = None,
             if attrs.get("status") != "ok":
                 continue
             scene = case_scene(attrs, f"{result} case {name}")
-            if any(scene[link]["model"] != "rigid" for link in ("crank", "coupler")):
+            if any(scene[link]["model"] not in BUILTIN_LINK_MODELS
+                   or not BUILTIN_LINK_MODELS[scene[link]["model"]].rigid
+                   for link in ("crank", "coupler")):
                 chosen.append(name)
     return [animate_case(result, name, default_animation_path(result, name), frames=frames,
                          cache_dir=cache_dir) for name in chosen]

@@ -37,6 +37,7 @@ import numpy as np
 from flex.base.errors import FlexError
 from flex.data.results import case_names, reading
 from flex.data.scene import Scene, default_scene, merge
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, NONLINEAR_FE, RIGID, LinkModel
 
 #: VTK/XDMF order of a quadratic tetrahedron's mid-edge nodes (corner pairs)
 TET10_EDGES = ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
@@ -51,7 +52,7 @@ class Body:
     ``corners`` (cells, 4) their corner nodes."""
 
     name: str
-    model: str  #: "ffrf", "nonlinear_fe" or "rigid"
+    model: str  #: the name of its link model (the slider: the rigid model's)
     reference_m: np.ndarray
     cells: np.ndarray
     corners: np.ndarray
@@ -95,7 +96,7 @@ class CaseMotion:
     @property
     def flexible(self) -> list[Body]:
         """The flexible bodies."""
-        return [body for body in self.bodies if body.model != "rigid"]
+        return [body for body in self.bodies if not model_entry(body.model).rigid]
 
     def crank_angle_rad(self, index: int) -> float:
         """The crank angle (chord A-B for a flexible crank) at motion sample ``index``."""
@@ -119,7 +120,8 @@ class CaseMotion:
 
     def _state(self, body: Body, index: int) -> BodyState:
         d, s = self._data, self.sample[index]
-        if body.model == "ffrf":
+        entry = model_entry(body.model)
+        if entry.modal:  # a reduction's modal coordinates in its floating frame
             reduction = self._extra[body.name]
             from flex.bodies.stress import nodal_displacement, nodal_stress
 
@@ -129,7 +131,7 @@ class CaseMotion:
                               d[f"{body.name}/frame_angle"][s])
             stress = nodal_stress(reduction, q) if body.has_stress else None
             return BodyState(position, elastic, stress)
-        if body.model == "nonlinear_fe":
+        if entry.meshed:  # every node of the mesh (the nonlinear FE coupler)
             position = np.asarray(d["coupler/nodal/position"][index], dtype=float)
             plate = self._extra[body.name]
             b = plate.weights_end_a @ position[plate.nodes_end_a]
@@ -262,6 +264,15 @@ def case_scene(attrs: dict[str, Any], where: str) -> Scene:
         raise FlexError(f"{where}: its scene_toml is not a readable scene ({exc})") from None
 
 
+def model_entry(name: str, where: str = "") -> LinkModel:
+    """The built-in link model ``name`` (its flags say how its stored motion is read): a
+    model that is not built in has no stored-motion reader here (FlexError)."""
+    if name not in BUILTIN_LINK_MODELS:
+        raise FlexError(f"{where or 'a body'}: link model {name!r} has no stored-motion "
+                        f"reader; accepted: {', '.join(BUILTIN_LINK_MODELS)}")
+    return BUILTIN_LINK_MODELS[name]
+
+
 def case_motion(path: str | Path, case: str | None = None, *,
                 cache_dir: Path | None = None) -> CaseMotion:
     """The :class:`CaseMotion` of ``case`` (None: the file's only case) of result file
@@ -275,15 +286,16 @@ def case_motion(path: str | Path, case: str | None = None, *,
     if attrs.get("status") != "ok":
         raise FlexError(f"{where} failed ({attrs.get('message', '')}): nothing to export")
     scene = case_scene(attrs, where)
-    models = {link: scene[link]["model"] for link in ("crank", "coupler")}
-    if all(model == "rigid" for model in models.values()):
+    models = {link: model_entry(scene[link]["model"], where)
+              for link in ("crank", "coupler")}
+    if all(model.rigid for model in models.values()):
         raise FlexError(f"{where} has no flexible link (crank and coupler rigid): flex export "
                         f"and animate show FFRF and nonlinear FE links")
     bodies, extra = [], {}
     for link, model in models.items():
-        if model == "ffrf":
+        if model.modal:
             body, extra[link] = _ffrf_body(link, scene, data, attrs, where, cache_dir)
-        elif model == "nonlinear_fe":
+        elif model.meshed:
             body, extra[link] = _nonlinear_body(scene, data, where)
         else:
             body = _rigid_body(link, scene)
@@ -308,7 +320,7 @@ def _ffrf_body(link: str, scene: Scene, data: dict[str, np.ndarray], attrs: dict
         raise FlexError(f"{where}: {problem}")
     positions = reduction.fem.GetNodePositionsAsArray()
     corners = np.asarray(reduction.fem.elements[0]["Tet4"], dtype=np.int64)
-    body = Body(link, "ffrf", positions, tet10_cells(corners, positions), corners,
+    body = Body(link, FFRF, positions, tet10_cells(corners, positions), corners,
                 has_stress=reduction.has_stress_modes,
                 facts={"reduction_key": reduction.key, "from_cache": reduction.from_cache})
     return body, reduction
@@ -330,7 +342,7 @@ def _nonlinear_body(scene: Scene, data: dict[str, np.ndarray], where: str
     corners = np.array([[v.nr - 1 for v in element.vertices]
                         for element in plate.mesh.ngmesh.Elements3D()], dtype=np.int64)
     positions = plate.node_positions_m
-    return Body("coupler", "nonlinear_fe", positions, tet10_cells(corners, positions),
+    return Body("coupler", NONLINEAR_FE, positions, tet10_cells(corners, positions),
                 corners), plate
 
 
@@ -338,14 +350,14 @@ def _rigid_body(link: str, scene: Scene) -> Body:
     values = scene[link]
     points, cells, corners = _quadratic_box(values["length_m"], values["thickness_m"],
                                             values["width_m"], centred=False)
-    return Body(link, "rigid", points, cells, corners)
+    return Body(link, RIGID, points, cells, corners)
 
 
 def _slider_body(scene: Scene) -> Body:
     length = scene["coupler"]["length_m"]
     points, cells, corners = _quadratic_box(SLIDER_BLOCK[0] * length, SLIDER_BLOCK[1] * length,
                                             scene["coupler"]["width_m"], centred=True)
-    return Body("slider", "rigid", points, cells, corners)
+    return Body("slider", RIGID, points, cells, corners)
 
 
 def sample_indices(count: int, every: int) -> np.ndarray:

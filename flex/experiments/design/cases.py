@@ -57,6 +57,7 @@ from flex.base.mechanism_checks import (
 from flex.base.thesis import THESIS_ANGLE_MAX_TIME_S, THESIS_SPRING_RATE_N_PER_M
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, validate
+from flex.dynamics.link_models import RIGID
 from flex.experiments.fitting.kfit import mesh_size_m
 from flex.experiments.fitting.lawfit import case_data
 from flex.fidelity.criteria import first_maximum_index, quasi_static_stress
@@ -391,4 +392,4 @@ def run_references(results: Mapping[str, CaseResult], names: list[str]
                    ) -> dict[str, dict[str, tuple[float, str]]]:
     """:func:`reference_check` of each named case that ran with a rigid coupler."""
     return {name: reference_check(results[name]) for name in names
-            if name in results and results[name].attrs.get("design_model") == "rigid"}
+            if name in results and results[name].attrs.get("design_model") == RIGID}

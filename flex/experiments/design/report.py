@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from flex.data.results import Dataset
+from flex.dynamics.link_models import FFRF, RIGID
 
 #: map figure -> (family, x column, x scale and label, y column, y scale and label)
 MAPS = {
@@ -196,7 +197,7 @@ def report_text(datasets: Mapping[str, Dataset], sweep: Mapping[str, Any] | None
     rows = columns(datasets)
     point = _value(datasets, "design/point")
     outcomes = {k: int(np.sum(rows["outcome"] == k)) for k in ("simulated", "refused", "failed")}
-    models = {k: int(np.sum(rows["model"] == k)) for k in ("rigid", "ffrf")}
+    models = {k: int(np.sum(rows["model"] == k)) for k in (RIGID, FFRF)}
     head = [
         "# Design charts and the thesis's optimum initial angle", "",
         f"Design point: initial crank angle {point[0]:g} deg, preload {point[1] * 1e3:g} mm, "
@@ -257,7 +258,7 @@ def _map_panel(ax, fig, rows, names, spec, panel, point, tolerance) -> None:
         ax.contour(xs * xscale, ys * yscale, np.ma.masked_invalid(error), [tolerance],
                    colors="k", linestyles="--")
     _, _, valid = grid_of(rows, names, x, y, "valid")
-    _, _, model = grid_of({**rows, "is_ffrf": (rows["model"] == "ffrf").astype(float)}, names,
+    _, _, model = grid_of({**rows, "is_ffrf": (rows["model"] == FFRF).astype(float)}, names,
                           x, y, "is_ffrf")
     _, _, refused = grid_of({**rows, "is_refused": (rows["outcome"] != "simulated").astype(float)},
                             names, x, y, "is_refused")

@@ -45,6 +45,7 @@ from flex.base.thesis import THESIS_COMPRESSION_M as THESIS_PRELOAD_M  # sec. 6.
 from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M as THESIS_SPRING_N_PER_M  # Table 2
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, to_toml, validate
+from flex.dynamics.link_models import FFRF
 from flex.experiments.fitting import lawfit
 from flex.experiments.fitting.lawfit import case_data
 from flex.fidelity.criteria import (
@@ -213,7 +214,7 @@ def family(name: str) -> str:
 def geometry_key(scene: Scene) -> tuple | None:
     """What a reduction depends on (None for scenes that need none)."""
     c = scene["coupler"]
-    if c["model"] not in ("ffrf", "auto"):
+    if c["model"] not in (FFRF, "auto"):
         return None
     return (c["length_m"], c["thickness_m"], c["width_m"], c["youngs_modulus_Pa"],
             c["density_kg_per_m3"], c["poisson_ratio"], c["mesh_size_m"], c["modes"],

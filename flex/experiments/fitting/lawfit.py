@@ -35,6 +35,7 @@ import numpy as np
 
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
+from flex.dynamics.link_models import FFRF
 from flex.fidelity.criteria import GOVERNING, PRIMARY_DELTA_T, Criterion, ErrorLaw, fit_error_law
 
 #: modes of the full flexible model the validation holds ``auto`` against
@@ -282,7 +283,7 @@ class Validation:
         """``rigid``, or ``ffrf/<modes>``."""
         model = str(self.attrs.get(f"fidelity_{self.link}_model", "?"))
         modes = int(self.attrs.get(f"fidelity_{self.link}_modes", -1))
-        return model + (f"/{modes}" if model == "ffrf" else "")
+        return model + (f"/{modes}" if model == FFRF else "")
 
 
 def against_full(name: str, link: str, tolerance: float, auto: Mapping[str, np.ndarray],

@@ -22,6 +22,7 @@ from flex.base.plotting import (
     wrap,
 )
 from flex.data.results import CaseResult
+from flex.dynamics.link_models import RIGID
 from flex.experiments.fitting.kfit import THESIS_MODELS, label
 from flex.experiments.fitting.kfit_law import PREDICTOR_BAND, predictor_ratios
 from flex.experiments.fitting.lawfit import FULL_MODES, REPORT_TOLERANCES
@@ -279,7 +280,7 @@ def _crank_validation(data: dict[str, Any], scenes: list[str], path: Path) -> Pa
             error = max(float(data[f"{key}/errors/governing"].data), 1e-9)
             tolerance = float(data[f"{key}/tolerance"].data)
             tolerances.add(tolerance)
-            rigid = str(data[f"{key}/choice"].data) == "rigid"
+            rigid = str(data[f"{key}/choice"].data) == RIGID
             ax.loglog([n], [error], "o" if rigid else "s", ms=8,
                       color="C0" if error <= tolerance else "C3")
             numbered.append((scene_label(name), {"marker": f"${len(numbered) + 1}$", "ms": 7}))

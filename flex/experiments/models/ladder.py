@@ -21,16 +21,17 @@ import numpy as np
 from flex.base.physics import pinned_pinned_omega
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, validate
+from flex.dynamics.link_models import FFRF, NONLINEAR_FE
 from flex.fidelity.simulation import simulate_case
 from flex.fidelity.softening import coupler_compression_N, coupler_euler_load_N
 
 #: the three models, cheapest first: name -> coupler overrides
 MODELS = {
-    "linear": ('coupler.model="ffrf"', "coupler.geometric_stiffness=false"),
-    "ffrf": ('coupler.model="ffrf"', "coupler.geometric_stiffness=true"),
-    "nonlinear_fe": ('coupler.model="nonlinear_fe"', "coupler.geometric_stiffness=false"),
+    "linear": (f'coupler.model="{FFRF}"', "coupler.geometric_stiffness=false"),
+    FFRF: (f'coupler.model="{FFRF}"', "coupler.geometric_stiffness=true"),
+    NONLINEAR_FE: (f'coupler.model="{NONLINEAR_FE}"', "coupler.geometric_stiffness=false"),
 }
-REFERENCE = "nonlinear_fe"
+REFERENCE = NONLINEAR_FE
 #: the curves a ladder run keeps
 KEEP = ("time", "crank/angle", "coupler/midpoint_deflection", "coupler/angle",
         "joints/B/force_on_coupler", "joints/C/force_on_coupler")

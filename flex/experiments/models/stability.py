@@ -42,6 +42,7 @@ from flex.base.thesis import (
 )
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, to_toml, validate
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, NONLINEAR_FE
 from flex.experiments.workprecision.convergence import converged_reference
 from flex.experiments.workprecision.measurement import (
     Observables,
@@ -70,7 +71,7 @@ class Extreme:
     expect: str = "within"
 
 
-PLATE = ('coupler.geometry="plate"', 'coupler.model="ffrf"')
+PLATE = ('coupler.geometry="plate"', f'coupler.model="{FFRF}"')
 
 
 def plate_overrides(thickness_mm: float, mesh_mm: float) -> tuple[str, ...]:
@@ -185,9 +186,9 @@ class References:
                 self.tolerance / 10, self.pool,
                 f"flex, same discretization, h = {step:g} s, modified Newton 1e-10 "
                 f"(evidence: h = {2 * step:g} s)")
-        if name == "nonlinear_fe" and value:
+        if name == NONLINEAR_FE and value:
             step = float(value)
-            nonlinear = apply_overrides(scene, ['coupler.model="nonlinear_fe"',
+            nonlinear = apply_overrides(scene, [f'coupler.model="{NONLINEAR_FE}"',
                                                 "simulation.newton_relative_tolerance=1e-8"])
             return converged_reference(
                 nonlinear, "nonlinear FE", _nonlinear_setting(step),
@@ -225,7 +226,7 @@ def run_measures(scene: Scene, data: dict[str, np.ndarray]) -> Verdict:
             # vibration the integrator removed
             out["energy_drift_over_peak_strain"] = float(
                 (energy[-1] - energy[0]) / data["energy/strain"].max())
-    if scene["coupler"]["model"] != "rigid":
+    if not BUILTIN_LINK_MODELS[scene["coupler"]["model"]].rigid:
         deflection = np.abs(data["coupler/midpoint_deflection"])
         tenth = max(1, len(deflection) // 10)
         out["peak_deflection_first_tenth"] = float(deflection[:tenth].max())
@@ -328,7 +329,7 @@ def simulate_extremes(extremes: Sequence[Extreme], scenes: dict[str, Scene],
 
     def run_one(name: str, scene: Scene) -> CaseResult:
         extreme = by_name[name]
-        if extreme.reference.startswith("nonlinear_fe") and not nonlinear:
+        if extreme.reference.startswith(NONLINEAR_FE) and not nonlinear:
             verdicts[name] = {"group": extreme.group, "parameter": extreme.parameter,
                               "status": "failed", "verdict": "pending: no nonlinear FE",
                               "within_tolerance": False, "expect": extreme.expect}

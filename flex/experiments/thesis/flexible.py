@@ -30,6 +30,7 @@ from flex.base.plotting import MICRO, figure, legend_below, panels
 from flex.bodies.nonlinear import nonlinear_plate_for_scene
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, validate
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, NONLINEAR_FE, RIGID
 from flex.dynamics.solver import reduction_for_scene
 from flex.fidelity.caseloop import Progress, run_each
 from flex.fidelity.error_budget import budget_rows
@@ -52,11 +53,11 @@ def _plate_case(scene: Scene, thickness_m: float, mesh_m: float, *more: str) -> 
 
 
 #: the models of each plate (case name suffix -> overrides)
-KINDS = {"ffrf": ['coupler.model="ffrf"'],
-         "linear": ['coupler.model="ffrf"', "coupler.geometric_stiffness=false",
+KINDS = {FFRF: [f'coupler.model="{FFRF}"'],
+         "linear": [f'coupler.model="{FFRF}"', "coupler.geometric_stiffness=false",
                     "simulation.error_estimate=false"],
-         "rigid": ['coupler.model="rigid"'],
-         "nonlinear_fe": ['coupler.model="nonlinear_fe"', "simulation.error_estimate=false"]}
+         RIGID: [f'coupler.model="{RIGID}"'],
+         NONLINEAR_FE: [f'coupler.model="{NONLINEAR_FE}"', "simulation.error_estimate=false"]}
 
 
 def twin_cases(scene: Scene, plates: Plates, reference_spans_s: dict[str, float | None]
@@ -66,11 +67,11 @@ def twin_cases(scene: Scene, plates: Plates, reference_spans_s: dict[str, float 
     plate in ``reference_spans_s``, run to that end time [s] (None: the scene's)."""
     out = {}
     for model, (thickness_m, mesh_m) in plates.items():
-        kinds = [kind for kind in KINDS if kind != "nonlinear_fe"]
+        kinds = [kind for kind in KINDS if kind != NONLINEAR_FE]
         if scene["coupler"]["damping_ratio"] == 0 and model in reference_spans_s:
-            kinds.append("nonlinear_fe")
+            kinds.append(NONLINEAR_FE)
         for kind in kinds:
-            span = reference_spans_s.get(model) if kind == "nonlinear_fe" else None
+            span = reference_spans_s.get(model) if kind == NONLINEAR_FE else None
             out[f"{model}_{kind}"] = _plate_case(
                 scene, thickness_m, mesh_m, *KINDS[kind],
                 *([] if span is None else [f"simulation.end_time_s={span!r}"]))
@@ -81,20 +82,20 @@ def _simulate_one(name: str, scene: Scene, notes: dict[str, Any],
                   cache_dir: Path | None) -> CaseResult:
     """One case with its reduction (FFRF, cached in ``cache_dir``) or mesh (nonlinear FE);
     their facts in attrs, the reduction's in ``notes["reductions"][name]``."""
-    model = scene["coupler"]["model"]
+    entry = BUILTIN_LINK_MODELS[scene["coupler"]["model"]]
     reduction = None
-    if model == "ffrf":
+    if entry.modal:
         reduction = reduction_for_scene(scene, cache_dir=cache_dir)
-    elif model == "nonlinear_fe":
+    elif entry.meshed:
         reduction = nonlinear_plate_for_scene(scene)  # the mesh and its node sets
     case = simulate_case(scene, name, reduction, cache_dir=cache_dir)
-    if model == "ffrf":
+    if entry.modal:
         case.attrs.update(reduction_key=reduction.key,
                           reduction_from_cache=reduction.from_cache,
                           reduction_build_time_s=reduction.build_time_s)
         notes.setdefault("reductions", {})[name] = {
             key: getattr(reduction, key) for key in REDUCTION_FACTS}
-    elif model == "nonlinear_fe":
+    elif entry.meshed:
         case.attrs.update(fe_nodes=reduction.n_nodes, fe_dof=reduction.n_dof,
                           fe_elements=reduction.n_elements,
                           fe_mesh_time_s=reduction.build_time_s)
@@ -190,12 +191,12 @@ def _reference_lines(scene: Scene, results: dict[str, CaseResult], plates: Plate
     (``reference/<model>/...`` added to ``datasets``); the report lines."""
     lines = []
     for model, (thickness_m, _) in plates.items():
-        reference = results.get(f"{model}_nonlinear_fe")
+        reference = results.get(f"{model}_{NONLINEAR_FE}")
         if reference is None:
             continue
         euler_load_N = coupler_euler_load_N({**scene["coupler"], "thickness_m": thickness_m})
         runs = {kind: results[f"{model}_{kind}"] for kind in KINDS
-                if kind != "nonlinear_fe" and f"{model}_{kind}" in results}
+                if kind != NONLINEAR_FE and f"{model}_{kind}" in results}
         found, more = compare_with_reference(model, runs, reference, euler_load_N,
                                              f"reference/{model}")
         datasets.update(found)
@@ -294,14 +295,14 @@ def _reference_figure(ok: dict[str, dict[str, np.ndarray]], models: list[str],
     """One panel per plate with a nonlinear FE run: the midpoint deflection of each model
     over the reference's span (own scale each)."""
     path = folder / "flexible-nonlinear-reference.png"
-    styles = {"ffrf": ("C0", "-", "FFRF (flex's default)"),
+    styles = {FFRF: ("C0", "-", "FFRF (flex's default)"),
               "linear": ("C1", "-.", "linear FFRF"),
-              "nonlinear_fe": ("k", "--", "nonlinear FE (reference)")}
+              NONLINEAR_FE: ("k", "--", "nonlinear FE (reference)")}
     with panels(path, "Midpoint deflection of each coupler model against the nonlinear FE "
                 "reference, one panel per plate (own scale each)", rows=len(models),
                 size=(7.5, 1.6 + 2.0 * len(models)), sharex=True) as (fig, axes):
         for ax, model in zip(axes, models, strict=True):
-            samples = len(ok[f"{model}_nonlinear_fe"]["time"])
+            samples = len(ok[f"{model}_{NONLINEAR_FE}"]["time"])
             for kind, (color, style, label) in styles.items():
                 data = ok.get(f"{model}_{kind}")
                 if data is not None:
@@ -344,7 +345,7 @@ def twin_figures(results: dict[str, CaseResult], summary: dict[str, Dataset], fo
     paths = [_deflection_panels(ok, drawn, folder)] if drawn else []
     paths += [_acceleration_pair(model, ok[f"{model}_ffrf"], ok[f"{model}_rigid"], folder)
               for model in models if f"{model}_ffrf" in ok and f"{model}_rigid" in ok]
-    referenced = [model for model in models if f"{model}_nonlinear_fe" in ok]
+    referenced = [model for model in models if f"{model}_{NONLINEAR_FE}" in ok]
     if referenced:
         paths.append(_reference_figure(ok, referenced, folder))
     found = [model for model in models

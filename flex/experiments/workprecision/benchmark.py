@@ -51,6 +51,7 @@ import numpy as np
 from flex.base.errors import FlexError
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
+from flex.dynamics.link_models import NONLINEAR_FE
 from flex.experiments.workprecision.measurement import (
     Measurement,
     Progress,
@@ -287,7 +288,7 @@ def _bench_nonlinear(scene: Scene, plan: BenchPlan, reference: Reference,
     coarse = measure(scene, coarse_setting, own, 1, pool)
     results["nonlinear"] = {"fine_wall_time_s": own.wall_time_s, "coarse": coarse,
                             "model_difference": own.errors(reference.observables)}
-    return {"nonlinear_fe": bench_case("nonlinear_fe", scene, coarse, {
+    return {NONLINEAR_FE: bench_case(NONLINEAR_FE, scene, coarse, {
         "fine_wall_time_s": own.wall_time_s,
         "note": f"errors against the nonlinear FE run at h = {fine_step} s"})}
 

@@ -41,6 +41,7 @@ from flex.config.settings import resolve_solver_settings
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides
 from flex.data.tables import table_datasets
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, NONLINEAR_FE
 from flex.fidelity.error_estimate import HEADLINES, PREFIX, integrator_order, richardson_error
 from flex.fidelity.simulation import simulate_case
 
@@ -74,10 +75,10 @@ def reference_overrides(scene: Scene) -> tuple[list[str], str]:
     overrides, parts = [], []
     for link in LINKS:
         values = scene[link]
-        if values["model"] != "ffrf":
+        if not BUILTIN_LINK_MODELS[values["model"]].modal:
             continue
         if link == "coupler" and values["damping_ratio"] == 0:
-            overrides.append('coupler.model="nonlinear_fe"')
+            overrides.append(f'coupler.model="{NONLINEAR_FE}"')
             parts.append("the nonlinear FE coupler")
         else:
             overrides.append(f"{link}.modes={REFERENCE_MODES}")
@@ -90,7 +91,7 @@ def _mesh_overrides(scene: Scene, fine: bool) -> list[str]:
     :data:`REFERENCE_MODES` modes, on the run's mesh or one :data:`MESH_REFINEMENT` finer."""
     out = []
     for link in LINKS:
-        if scene[link]["model"] == "ffrf":
+        if BUILTIN_LINK_MODELS[scene[link]["model"]].modal:
             size = float(scene[link]["mesh_size_m"]) / (MESH_REFINEMENT if fine else 1.0)
             out += [f"{link}.modes={REFERENCE_MODES}", f"{link}.mesh_size_m={size!r}"]
     return out
@@ -107,7 +108,7 @@ def check_one(name: str, scene: Scene, cache_dir: Path | None) -> CaseResult:
     lift, what = reference_overrides(resolved)
     quiet = ["simulation.error_estimate=false"]
     runs = {"best": (lift, step / REFINEMENT), "other": (lift, 2 * step / REFINEMENT)}
-    if any(resolved[link]["model"] == "ffrf" for link in LINKS):
+    if any(BUILTIN_LINK_MODELS[resolved[link]["model"]].modal for link in LINKS):
         runs["mesh"] = (_mesh_overrides(resolved, False), step / REFINEMENT)
         runs["mesh_other"] = (_mesh_overrides(resolved, False), 2 * step / REFINEMENT)
         runs["fine_mesh"] = (_mesh_overrides(resolved, True), step / REFINEMENT)

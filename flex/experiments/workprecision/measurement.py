@@ -42,6 +42,7 @@ from flex.base.errors import FlexError, SceneError
 from flex.config.settings import has_auto_link_keys, resolve_link_keys, resolved_simulation
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, to_toml, validate
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 from flex.dynamics.reference import solve_reference
 
 #: a reference certifies an accuracy level only if the level is at least this many times the
@@ -337,7 +338,7 @@ class ReductionPool:
         None. ``"auto"`` modes and mesh size are keyed by what the rule fills in at the
         scene's ``fidelity.tolerance`` (:func:`flex.config.settings.resolve_link_keys`), as
         the run resolves them."""
-        if scene["coupler"]["model"] != "ffrf":
+        if not BUILTIN_LINK_MODELS[scene["coupler"]["model"]].modal:
             return None
         if has_auto_link_keys(scene):
             scene, _ = resolve_link_keys(scene)
@@ -359,7 +360,7 @@ def run_once(scene: Scene, setting: Setting, pool: ReductionPool | None = None
     (``wall_time_s`` = integration only, ``total_time_s``, steps, Newton iterations).
     Raises :class:`~flex.base.errors.FlexError` (SimulationError, SceneError) on failure."""
     start = time.perf_counter()
-    flexible = scene["coupler"]["model"] != "rigid"
+    flexible = not BUILTIN_LINK_MODELS[scene["coupler"]["model"]].rigid
     if setting.engine == "scipy":
         if flexible:
             raise SceneError("the scipy reference DAE models a rigid coupler only")

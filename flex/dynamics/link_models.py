@@ -1,0 +1,482 @@
+"""The link models a scene may name (``crank.model``, ``coupler.model``): a registry of entries
+under a written contract.
+
+:data:`BUILTIN_LINK_MODELS` is an immutable mapping (``types.MappingProxyType``) from a model's
+name to its :class:`LinkModel`, in the order messages list them: ``"rigid"``, ``"ffrf"``,
+``"nonlinear_fe"``. Every function that checks, resolves, builds or runs a scene takes the
+registry as an argument, ``link_models``, with the built-ins as its default; a caller with
+another model builds its own registry (``MappingProxyType({**BUILTIN_LINK_MODELS, "toy":
+toy})``) and passes it along. Nothing here is mutable and nothing registers itself. The layers
+below (:mod:`flex.data`, :mod:`flex.config`) read only an entry's scene-level part,
+:class:`flex.data.scene.LinkSchema` (its fields are :class:`LinkModel`'s first ones), with
+:data:`flex.data.scene.BUILTIN_LINK_SCHEMAS` as their default (a test ties the two).
+
+The contract of an entry -- what a link model declares, point by point:
+
+1. **name**: the value of ``<link>.model`` that selects it (``name``), and the links it may
+   model (``links``). A name not in the registry, or a model of another link, is refused
+   with a :class:`~flex.base.errors.SceneError` naming the accepted models
+   (:func:`flex.data.scene.validate`, :func:`entry_of`).
+2. **scene keys it reads**, as flags on ``[<link>]``: ``rigid`` (mass keys only),
+   ``meshed`` (the plate's elastic keys and ``mesh_size_m``), ``modal`` (``modes``,
+   ``mode_selection``, ``geometric_stiffness``), ``damped`` (``damping_ratio``). A key a
+   model does not read and the user set is refused (:func:`flex.config.usage.unused_keys`).
+3. **checks on those keys** (SceneError, before anything runs): the flags' (a meshed model
+   needs ``geometry = "plate"`` and a plate that can be meshed, an undamped one
+   ``damping_ratio = 0``, a non-rigid crank the spring drive, the explicit integrators rigid
+   links), then its own ``check(link, scene)`` if it has one.
+4. **what it prepares before a run**: ``prepare(scene, link, given, cache_dir)`` returns what
+   its ``add`` needs (the Craig-Bampton reduction of an FFRF link; ``given``: one the caller
+   built; None for models that need nothing).
+5. **how it adds itself to the Exudyn builder**: ``add(builder, link, prepared)`` adds the
+   link's bodies to :class:`flex.dynamics.builder._Builder` and leaves the joint markers in
+   the builder (``crank_body`` for a rigid crank; ``mech.crank`` for a flexible one; the
+   coupler's ``builder.coupler["marker_B"|"marker_C"]``). A rigid crank is added before the
+   slider (the order numbers the coordinates), any other after the ground markers.
+6. **its sensors and datasets**: ``sensors(builder, link)`` adds what its ``datasets(mech,
+   link, time_s)`` reads after the run (the coupler's ``coupler/...`` datasets; a crank's
+   motion is read from its joint markers or rigid body by :mod:`flex.dynamics.collect`);
+   ``energy``: whether its energy is known (else the run has no ``energy/...``);
+   ``recorder(mech, link, settings)``: an extra recorder of the run (nodal coordinates), or
+   None.
+7. **its time scales**: ``time_scale(link, values, prepared)`` -> ``(omega [rad/s], what)``
+   or None: the fastest motion the link adds (the highest retained mode of a reduction, the
+   first bending mode of a nonlinear FE plate), which the step advice must resolve
+   (:func:`flex.dynamics.advice.time_scales`); ``step_cost_s(values, modes)``: its share of
+   the wall time per integration step [s] (:func:`flex.dynamics.runtime.estimated_run_time_s`).
+8. **solver adjustments**: ``adjust_solver(settings)`` changes the integrator settings in
+   place (a sparse solver, a looser absolute tolerance); ``own_progress``: the model prints
+   its own progress during a solve.
+
+Capability flags the callers read: ``rigid``, ``meshed``, ``modal``, ``damped`` (above);
+``linear_elastic``: its results are trusted only for small elastic deflections and loads
+below buckling (validity warnings, :func:`flex.dynamics.advice.validity_warning`);
+``reference``: an accuracy reference the others are compared with (named in advice);
+``auto_choice``: ``model = "auto"`` may pick it (:mod:`flex.fidelity.auto`, whose fitted laws
+decide among the built-in models only); ``label``: its name in reports. A model of one's own
+is an entry built the same way (``dataclasses.replace`` of a built-in one, or
+:meth:`LinkModel.extending` a :class:`~flex.data.scene.LinkSchema`): tests/test_link_models.py
+runs such a toy through :func:`flex.simulate`.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, fields
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+from flex.base.errors import SceneError
+from flex.base.progress import heartbeat
+from flex.data.results import Dataset
+from flex.data.scene import (
+    AUTO,
+    BUILTIN_LINK_SCHEMAS,
+    LINKS,
+    LinkSchema,
+    Scene,
+    check_meshed_plate,
+    estimate_mesh,
+    link_model,
+    plate_mass_properties,
+)
+
+#: the built-in models' names (for code that sets a model in a scene)
+RIGID, FFRF, NONLINEAR_FE = BUILTIN_LINK_SCHEMAS
+
+
+def _nothing(*args: Any) -> None:
+    return None
+
+
+def _given(scene: Scene, link: str, given: Any, cache_dir: Path | None) -> Any:
+    return given
+
+
+def _free(values: dict[str, Any], modes: int | None) -> float:
+    return 0.0
+
+
+def _no_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
+    return {}
+
+
+@dataclass(frozen=True)
+class LinkModel(LinkSchema):
+    """One link model: its scene-level part (:class:`flex.data.scene.LinkSchema`, points 1-3)
+    and what it does in a run (points 4-8 of the module's contract)."""
+
+    #: its name in reports and figures
+    label: str = ""
+    #: an accuracy reference the other models are compared with
+    reference: bool = False
+    #: results trusted only for small elastic deflections, below buckling (validity warnings)
+    linear_elastic: bool = False
+    #: ``model = "auto"`` may pick it
+    auto_choice: bool = False
+    #: (4) ``prepare(scene, link, given, cache_dir)``: what ``add`` needs
+    prepare: Callable[[Scene, str, Any, Path | None], Any] = _given
+    #: (5) ``add(builder, link, prepared)``
+    add: Callable[[Any, str, Any], None] = _nothing
+    #: (6) ``sensors(builder, link)``, ``datasets(mech, link, time_s)``, known energy,
+    #: ``recorder(mech, link, settings)``
+    sensors: Callable[[Any, str], None] = _nothing
+    datasets: Callable[[Any, str, np.ndarray], dict[str, Dataset]] = _no_datasets
+    energy: bool = True
+    recorder: Callable[[Any, str, dict[str, Any]], Any] = _nothing
+    #: (7) ``time_scale(link, values, prepared)`` -> (omega [rad/s], what) or None;
+    #: ``step_cost_s(values, modes)`` [s per step]
+    time_scale: Callable[[str, dict[str, Any], Any], tuple[float, str] | None] = _nothing
+    step_cost_s: Callable[[dict[str, Any], int | None], float] = _free
+    #: (8) ``adjust_solver(settings)`` in place; prints its own progress
+    adjust_solver: Callable[[dict[str, Any]], None] = _nothing
+    own_progress: bool = False
+
+    @classmethod
+    def extending(cls, schema: LinkSchema, **behaviour: Any) -> LinkModel:
+        """The entry of ``schema`` (its scene-level part) with ``behaviour`` (points 4-8)."""
+        return cls(**{f.name: getattr(schema, f.name) for f in fields(LinkSchema)}, **behaviour)
+
+
+def entry_of(link: str, scene: Scene, link_models: Mapping[str, LinkModel]) -> LinkModel:
+    """The entry of ``link``'s concrete model in ``link_models`` (SceneError naming the
+    accepted models otherwise; ``"auto"`` must be resolved first)."""
+    if scene[link]["model"] == AUTO:
+        raise SceneError(f'{link}.model = "auto" must be resolved before building '
+                         "(flex.fidelity.simulation.simulate does it with "
+                         "flex.fidelity.auto.resolve)")
+    return link_model(link, scene[link], link_models)
+
+
+def entries(scene: Scene, link_models: Mapping[str, LinkModel]) -> dict[str, LinkModel]:
+    """The entries of a concrete scene's links, by link."""
+    return {link: entry_of(link, scene, link_models) for link in LINKS}
+
+
+# ------------------------------------------------------------------------------------------
+# what a flexible link's markers and modal coordinates give (FFRF and nonlinear FE)
+# ------------------------------------------------------------------------------------------
+def _sensor(mech: Any, name: str) -> np.ndarray:
+    return np.asarray(mech.mbs.GetSensorStoredData(mech.sensors[name]))
+
+
+def _elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
+                      chord_name: str, time_s: np.ndarray) -> dict[str, Dataset]:
+    """Midpoint motion and elastic response of a flexible ``link`` (FFRF or nonlinear FE).
+
+    From its joint markers (``start_marker``, ``end_marker``: sensor names) and its midpoint
+    marker; an FFRF link adds its modal coordinates and bending stress.
+    """
+    from flex.bodies.reduction import bending_stress_history, midpoint_deflection
+    from flex.bodies.stress import peak_datasets
+
+    position_start = _sensor(mech, f"{start_marker}.Position")[:, 1:4]
+    position_end = _sensor(mech, f"{end_marker}.Position")[:, 1:4]
+    position_mid = _sensor(mech, f"marker_{link}_mid.Position")[:, 1:4]
+    velocity_mid = _sensor(mech, f"marker_{link}_mid.Velocity")[:, 1:3]
+    deflection = midpoint_deflection(position_start, position_end, position_mid)
+    out: dict[str, Dataset] = {}
+    out[f"{link}/midpoint_position"] = Dataset(position_mid[:, :2], "m",
+                                               f"{link} midpoint x, y")
+    # the superelement marker reports no acceleration: differentiate its velocity (2nd order)
+    out[f"{link}/midpoint_acceleration"] = Dataset(
+        np.gradient(velocity_mid, time_s, axis=0), "m/s^2",
+        f"{link} midpoint acceleration x, y (thesis figs. 35-42), from the marker velocity")
+    out[f"{link}/midpoint_deflection"] = Dataset(
+        deflection.transverse_m, "m",
+        f"transverse elastic deflection of the midpoint from the chord {chord_name}, 0 at t = 0")
+    out[f"{link}/chord_change"] = Dataset(deflection.chord_change_m, "m",
+                                          f"change of the distance {chord_name} (axial strain "
+                                          "x length)")
+    body = mech.crank if link == "crank" else mech.coupler
+    if "reduction" not in body:  # nonlinear FE: nodal coordinates, no modes, no stress yet
+        return out
+    modal = _sensor(mech, f"{link}.modal_coordinates")[:, 1:]
+    out[f"{link}/modal_coordinates"] = Dataset(
+        modal, "1", "elastic coordinates: the static modes, then the fixed-interface eigenmodes")
+    reduction = body["reduction"]
+    if reduction.has_stress_modes:
+        out[f"{link}/peak_bending_stress"] = Dataset(
+            bending_stress_history(reduction, modal, stress_window_m(reduction)), "Pa",
+            "largest |sigma_xx| away from the end faces (bending + membrane)")
+        out.update(peak_datasets(link, reduction, modal))
+    out.update(_frame_datasets(mech, link))
+    return out
+
+
+def _frame_datasets(mech: Any, link: str) -> dict[str, Dataset]:
+    """The pose of an FFRF link's floating frame (what :mod:`flex.tools.export` places the
+    nodal field with): origin x, y [m] and angle about z [rad]."""
+    origin = _sensor(mech, f"{link}.frame_Position")[:, 1:3]
+    angle = np.unwrap(_sensor(mech, f"{link}.frame_Rotation")[:, 3])
+    return {f"{link}/frame_position": Dataset(origin, "m", "floating frame origin x, y"),
+            f"{link}/frame_angle": Dataset(angle, "rad", "floating frame angle from +x")}
+
+
+def stress_window_m(reduction: Any) -> tuple[float, float]:
+    """Where a link's peak bending stress is read [m along it]: one thickness from each end
+    face (Saint-Venant), but never narrower than one element about the midpoint, so a plate
+    as thick as half its length (the stubbiest accepted) still has mesh nodes in it."""
+    length, half = reduction.length_m, 0.5 * reduction.length_m - reduction.thickness_m
+    half = max(half, 0.5 * min(reduction.mesh_size_m, length))
+    return (0.5 * length - half, 0.5 * length + half)
+
+
+# ------------------------------------------------------------------------------------------
+# rigid: a rigid body of the link's mass properties
+# ------------------------------------------------------------------------------------------
+def _add_rigid(builder: Any, link: str, prepared: Any) -> None:
+    scene, init = builder.scene, builder.init
+    if link == "crank":
+        builder.crank_body = builder.rigid_body(
+            "crank", *plate_mass_properties(scene, "crank"), init.joint_B_m / 2,
+            init.crank_angle_rad, init.joint_B_velocity_m_per_s / 2, init.crank_speed_rad_per_s)
+        return
+    mass_kg, inertia_kgm2 = plate_mass_properties(scene)
+    body = builder.rigid_body(
+        "coupler", mass_kg, inertia_kgm2, (init.joint_B_m + init.joint_C_m) / 2,
+        init.coupler_angle_rad,
+        (init.joint_B_velocity_m_per_s + init.joint_C_velocity_m_per_s) / 2,
+        init.coupler_speed_rad_per_s)
+    builder.coupler = {"marker_B": builder.body_marker(body, init.joint_B_m),
+                       "marker_C": builder.body_marker(body, init.joint_C_m)}
+    builder.mech.coupler = {"body": body["bodyNumber"], "node": body["nodeNumber"]}
+
+
+def _rigid_sensors(builder: Any, link: str) -> None:
+    """A rigid coupler's node (its centre of mass is the midpoint); a rigid crank's body
+    sensors are the builder's, as every rigid body's."""
+    if link == "coupler":
+        for output in ("Position", "Velocity", "Acceleration", "Rotation", "AngularVelocity"):
+            builder.add(f"coupler.{output}",
+                        builder.sensor("Node", output, nodeNumber=builder.mech.coupler["node"]))
+
+
+def _rigid_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
+    if link != "coupler":
+        return {}
+    return {
+        "coupler/midpoint_position": Dataset(_sensor(mech, "coupler.Position")[:, 1:3], "m",
+                                             "coupler midpoint x, y"),
+        "coupler/midpoint_acceleration": Dataset(
+            _sensor(mech, "coupler.Acceleration")[:, 1:3], "m/s^2",
+            "coupler midpoint acceleration x, y (thesis figs. 35-42)"),
+        "coupler/midpoint_deflection": Dataset(np.zeros_like(time_s), "m",
+                                               "elastic midpoint deflection (rigid: 0)"),
+        "coupler/angle": Dataset(_sensor(mech, "coupler.Rotation")[:, 3], "rad",
+                                 "coupler angle from +x (B to C)")}
+
+
+# ------------------------------------------------------------------------------------------
+# flexible links: the coupler's datasets from its markers
+# ------------------------------------------------------------------------------------------
+def _flexible_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
+    """A flexible coupler's chord angle and elastic response from its B, C and midpoint
+    markers (a flexible crank's are read with its motion, :mod:`flex.dynamics.collect`)."""
+    if link != "coupler":
+        return {}
+    position_b = _sensor(mech, "marker_coupler_B.Position")[:, 1:4]
+    position_c = _sensor(mech, "marker_coupler_C.Position")[:, 1:4]
+    chord = position_c - position_b
+    out = {"coupler/angle": Dataset(np.unwrap(np.arctan2(chord[:, 1], chord[:, 0])), "rad",
+                                    "angle of the chord B-C from +x")}
+    out.update(_elastic_datasets(mech, "coupler", "marker_coupler_B", "marker_coupler_C",
+                                 "B-C", time_s))
+    return out
+
+
+# ------------------------------------------------------------------------------------------
+# FFRF: a Craig-Bampton reduction of the meshed plate in a floating frame
+# ------------------------------------------------------------------------------------------
+#: a mesh whose estimated build takes longer than this is announced on stderr first [s]
+ANNOUNCE_MESH_S = 30.0
+#: wall time per step [s] of an FFRF link, rough (2-core machine, shared; within ~3x), per
+#: link and per modal coordinate beyond its frame (1 mm plate, 2 mm mesh, 1e-5 s, modified
+#: Newton: 0.25 ms at 2 modes, 0.38 at 6, 0.99 at 20, 2.5 at 40)
+STEP_COST_FFRF_S = (1.5e-4, 5e-5)  # (per FFRF link, per mode)
+#: the nonlinear FE coupler's wall time per step per DOF of its mesh [s] (40 ms per step at
+#: ~5.6k DOF, 80 x 3 x 10 mm plate, 4 mm mesh)
+STEP_COST_NONLINEAR_FE_PER_DOF_S = 7e-6
+
+
+def _announce_mesh(link: str, values: dict[str, Any], what: str, modes: int | None = None
+                   ) -> None:
+    """Say on stderr what a long meshing job will cost before it starts (so a big mesh, or
+    a reduction to many modes, is not a silent hang)."""
+    estimate = estimate_mesh(values["length_m"], values["thickness_m"], values["width_m"],
+                             values["mesh_size_m"], modes)
+    if estimate.build_time_s > ANNOUNCE_MESH_S:
+        print(f"flex: meshing the {link} plate for its {what}: {estimate.text()} "
+              f"(estimate)", file=sys.stderr, flush=True)
+
+
+def reduction_for_scene(scene: Scene, link: str = "coupler", *,
+                        cache_dir: Path | None = None):
+    """The Craig-Bampton reduction of the scene's plate ``link`` (coupler or crank).
+
+    ``cache_dir``: the reduction cache folder (loaded from there if present, written there
+    if built; :func:`flex.bodies.reduction.reduction_cache_dir` names the user's), or None to
+    build it in memory without any disk cache.
+    """
+    from flex.bodies.reduction import build_reduction
+
+    c = scene[link]
+    if "auto" in (c["modes"], c["mesh_size_m"]):
+        raise ValueError(f'{link}: resolve its "auto" modes and mesh first '
+                         f"(flex.fidelity.auto.resolve, flex.config.settings.resolve_link_keys)")
+    check_meshed_plate(link, dict(c, model=FFRF))  # refused before any meshing
+    _announce_mesh(link, c, f"reduction with {c['modes']} modes (instant if cached)",
+                   c["modes"])
+    with heartbeat(f"{link} reduction ({c['modes']} modes)"):
+        return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
+                               c["youngs_modulus_Pa"], c["density_kg_per_m3"],
+                               c["poisson_ratio"], c["mesh_size_m"], c["modes"], cache_dir,
+                               mode_selection=c["mode_selection"])
+
+
+def _prepare_reduction(scene: Scene, link: str, given: Any, cache_dir: Path | None) -> Any:
+    return given if given is not None else reduction_for_scene(scene, link,
+                                                               cache_dir=cache_dir)
+
+
+def _add_ffrf(builder: Any, link: str, reduction: Any) -> None:
+    if link == "crank":
+        builder._add_flexible_crank(reduction)
+        return
+    from flex.bodies.reduction import add_ffrf_link
+
+    init = builder.init
+    builder.coupler = add_ffrf_link(
+        builder.mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
+        damping_ratio=builder.scene["coupler"]["damping_ratio"],
+        initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+        initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s,
+        joint_markers=builder.ffrf_joint_markers,
+        end_a_rotation=False,  # the pin at B is free about z
+        end_b_rotation=False)  # the pin at C constrains x and y only
+    builder.mech.coupler = dict(builder.coupler, reduction=reduction)
+
+
+def _highest_retained_omega(values: dict[str, Any]) -> float:
+    """Beam estimate of the highest fixed-interface circular frequency [rad/s] a link's
+    reduction keeps (its ``modes`` lowest of the kinds its ``mode_selection`` keeps)."""
+    from flex.base.physics import clamped_plate_frequencies, in_plane_fixed_interface_omegas
+
+    plate = (values["length_m"], values["thickness_m"], values["width_m"],
+             values["youngs_modulus_Pa"], values["density_kg_per_m3"], values["poisson_ratio"])
+    if values["mode_selection"] == "in_plane":
+        return in_plane_fixed_interface_omegas(*plate, count=values["modes"])[-1]
+    return clamped_plate_frequencies(*plate, count=values["modes"])[-1][0]
+
+
+def _ffrf_time_scale(link: str, values: dict[str, Any], reduction: Any
+                     ) -> tuple[float, str]:
+    if reduction is not None:
+        hertz = float(np.max(reduction.fixed_interface_frequencies_Hz))
+        return 2 * np.pi * hertz, "highest retained mode"
+    return _highest_retained_omega(values), "highest retained mode (beam estimate)"
+
+
+def _ffrf_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
+    return STEP_COST_FFRF_S[0] + STEP_COST_FFRF_S[1] * float(modes or values["modes"])
+
+
+# ------------------------------------------------------------------------------------------
+# nonlinear FE: every node of the meshed plate, large deformation
+# ------------------------------------------------------------------------------------------
+#: nonlinear FE coupler (~10k coordinates): a sparse LU (a dense one would take seconds and
+#: ~1 GB per Newton step), reused while Newton converges -- the Jacobian and its
+#: factorisation dominate a full Newton iteration. Measured on the 1 mm plate, 30 steps:
+#: modified Newton 3 iterations per step and one Jacobian in all, 5x faster than full Newton
+#: (2 iterations per step, each with a new Jacobian)
+NONLINEAR_FE_SOLVER = {"linear_solver": "EigenSparse", "modified_newton": True}
+#: the Newton residual of the nonlinear FE system stalls at ~9e-8 (Exudyn's residual norm,
+#: measured at step 1e-5 s over the deployment): round-off of the face-marker positions
+#: (weighted sums over ~100 nodes), scaled by 1 / step^2 in the index-3 equations. Relative
+#: tolerances cannot reach below it (Newton failed at 6.6 ms with 1e-8 and at 7.9 ms with
+#: 1e-7), so the absolute tolerance is raised above it; 1e-8 and 1e-7 relative gave midpoint
+#: deflections 5e-12 m apart
+NONLINEAR_FE_NEWTON_ABSOLUTE_TOLERANCE = 1e-6
+
+
+def _add_nonlinear_fe(builder: Any, link: str, plate: Any) -> None:
+    from flex.bodies.nonlinear import add_nonlinear_fe_coupler, nonlinear_plate_for_scene
+
+    scene, init = builder.scene, builder.init
+    if plate is None:
+        _announce_mesh(link, scene[link], "nonlinear FE body")
+        plate = nonlinear_plate_for_scene(scene)
+    builder.coupler = add_nonlinear_fe_coupler(
+        builder.mbs, plate, list(init.joint_B_m), init.coupler_angle_rad,
+        initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+        initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
+    builder.mech.coupler = dict(builder.coupler, plate=plate)
+
+
+def _nonlinear_fe_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
+    out = _flexible_datasets(mech, link, time_s)
+    # the face markers' linearised rotation can tilt the faces out of plane (see
+    # flex.bodies.nonlinear): record how far the midpoint leaves the plane
+    position_mid = _sensor(mech, f"marker_{link}_mid.Position")[:, 1:4]
+    out[f"{link}/midpoint_out_of_plane"] = Dataset(
+        position_mid[:, 2] - position_mid[0, 2], "m",
+        "midpoint displacement normal to the mechanism plane (z), 0 at t = 0")
+    return out
+
+
+def _nodal_recorder(mech: Any, link: str, settings: dict[str, Any]) -> Any:
+    """A :class:`flex.bodies.nonlinear.NodalRecorder` of the link's nodes."""
+    from flex.bodies.nonlinear import NodalRecorder
+
+    return NodalRecorder(mech.mbs, mech.coupler["nodes"], settings["step_s"],
+                         settings["output_step_s"], settings["end_time_s"])
+
+
+def _nonlinear_fe_time_scale(link: str, values: dict[str, Any], plate: Any
+                             ) -> tuple[float, str]:
+    from flex.base.physics import pinned_pinned_omega
+
+    return (pinned_pinned_omega(values["length_m"], values["thickness_m"],
+                                values["youngs_modulus_Pa"], values["density_kg_per_m3"]),
+            "first bending mode")
+
+
+def _nonlinear_fe_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
+    dof = estimate_mesh(values["length_m"], values["thickness_m"], values["width_m"],
+                        values["mesh_size_m"]).dof
+    return STEP_COST_NONLINEAR_FE_PER_DOF_S * dof
+
+
+def _nonlinear_fe_solver(settings: dict[str, Any]) -> None:
+    settings.update(NONLINEAR_FE_SOLVER)
+    settings["newton_absolute_tolerance"] = max(settings["newton_absolute_tolerance"],
+                                                NONLINEAR_FE_NEWTON_ABSOLUTE_TOLERANCE)
+
+
+# ------------------------------------------------------------------------------------------
+# the registry
+# ------------------------------------------------------------------------------------------
+#: the built-in link models, by name (immutable; pass another mapping to add models)
+BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
+    RIGID: LinkModel.extending(
+        BUILTIN_LINK_SCHEMAS[RIGID], label="rigid twin", auto_choice=True, add=_add_rigid,
+        sensors=_rigid_sensors, datasets=_rigid_datasets),
+    FFRF: LinkModel.extending(
+        BUILTIN_LINK_SCHEMAS[FFRF], label="FFRF (flex's default: geometric stiffness)",
+        linear_elastic=True, auto_choice=True, prepare=_prepare_reduction, add=_add_ffrf,
+        datasets=_flexible_datasets, time_scale=_ffrf_time_scale,
+        step_cost_s=_ffrf_step_cost_s),
+    NONLINEAR_FE: LinkModel.extending(
+        BUILTIN_LINK_SCHEMAS[NONLINEAR_FE], label="nonlinear FE (reference)", reference=True,
+        auto_choice=True, add=_add_nonlinear_fe, datasets=_nonlinear_fe_datasets,
+        energy=False, recorder=_nodal_recorder, time_scale=_nonlinear_fe_time_scale,
+        step_cost_s=_nonlinear_fe_step_cost_s, adjust_solver=_nonlinear_fe_solver,
+        own_progress=True),
+})
+
+__all__ = ["LinkModel", "BUILTIN_LINK_MODELS", "RIGID", "FFRF", "NONLINEAR_FE", "entry_of",
+           "entries", "reduction_for_scene"]
