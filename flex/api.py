@@ -188,7 +188,7 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
             environment at this call; module doc).
         options: passed on to :func:`flex.fidelity.simulation.simulate` (``reduction=``,
             ``crank_reduction=``: prebuilt reductions; ``criterion=``, ``crank_criterion=``:
-            another fitted law for ``auto``, :func:`flex.fidelity.criteria.load_criterion`); not
+            another fitted law for ``auto``, :func:`flex.fidelity.laws.load_criterion`); not
             needed for ordinary use.
     Output:
         a :class:`flex.data.results.CaseResult`: ``status == "ok"``; ``datasets`` maps paths of
@@ -215,8 +215,8 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
     _check_case_name(name)
     _check_options(options, {"reduction": "a flex.bodies.reduction.Reduction",
                              "crank_reduction": "a flex.bodies.reduction.Reduction",
-                             "criterion": "a flex.fidelity.criteria.Criterion",
-                             "crank_criterion": "a flex.fidelity.criteria.Criterion"},
+                             "criterion": "a flex.fidelity.laws.Criterion",
+                             "crank_criterion": "a flex.fidelity.laws.Criterion"},
                    "simulate")
     folder = _cache_dir(cache_dir)
     check_cases(load_study("simulate"), {name: scene}, given_keys(scene))

@@ -235,7 +235,7 @@ def test_case_hash_follows_the_solver_defaults_of_auto_scenes(monkeypatch):
 def test_case_hash_follows_the_criterion_of_auto_links(tmp_path, monkeypatch):
     import functools
 
-    import flex.fidelity.criteria as criteria
+    import flex.fidelity.laws as criteria
     from flex.fidelity.simulation import simulate_case
     from flex.sweep import case_hash
 

@@ -409,12 +409,13 @@ def _spring_chain_energy(mech: Mechanism, slider_displacement_m: np.ndarray
 
 
 def reduction_for_scene(scene: Scene, link: str = "coupler", *,
-                        cache_dir: Path | None = None):
+                        cache_dir: Path | None = None, mesh_order: int = 2):
     """The Craig-Bampton reduction of the scene's plate ``link`` (coupler or crank).
 
     ``cache_dir``: the reduction cache folder (loaded from there if present, written there
     if built; :func:`flex.bodies.reduction.reduction_cache_dir` names the user's), or None to
-    build it in memory without any disk cache.
+    build it in memory without any disk cache. ``mesh_order``: the tetrahedra's order (2, or
+    1 for the work-precision study's linear ones).
     """
     from flex.bodies.reduction import build_reduction
 
@@ -429,7 +430,7 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
         return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
                                c["youngs_modulus_Pa"], c["density_kg_per_m3"],
                                c["poisson_ratio"], c["mesh_size_m"], c["modes"], cache_dir,
-                               mode_selection=c["mode_selection"])
+                               mode_selection=c["mode_selection"], mesh_order=mesh_order)
 
 
 def scene_reductions(scene: Scene, reduction: Any = None, crank_reduction: Any = None, *,

@@ -54,11 +54,13 @@ from flex.config.settings import (
 )
 from flex.data.scene import Scene, check_meshed_plate, to_toml
 from flex.fidelity.criteria import (
-    DEFAULT_CRANK_CRITERION,
     EULER_LOAD_LIMIT,
-    Criterion,
     euler_load_ratio,
     flexible_rung,
+)
+from flex.fidelity.laws import (
+    DEFAULT_CRANK_CRITERION,
+    Criterion,
     load_criterion,
 )
 from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection

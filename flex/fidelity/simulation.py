@@ -4,7 +4,7 @@ The layer above :mod:`flex.dynamics.solver` (which integrates concrete scenes): 
 ``"auto"`` (link and spring models, modes, mesh, solver keys) is decided by
 :func:`flex.fidelity.auto.resolve`, once per scene; the fitted laws it reads are arguments
 (``None``: the installed criterion files); a study that has just fitted a law passes it as a
-:class:`flex.fidelity.criteria.Criterion`.
+:class:`flex.fidelity.laws.Criterion`.
 
 The reduction cache folder is an argument too (``cache_dir``, keyword): FFRF reductions are
 loaded from it or written to it; ``None`` builds them in memory, with no disk cache. The
@@ -24,8 +24,10 @@ from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
 from flex.dynamics.solver import VALIDITY_WARNING, integrate, scene_reductions, time_scales
 from flex.fidelity.auto import Resolution, resolve
-from flex.fidelity.criteria import Criterion
 from flex.fidelity.error_budget import error_budget
+from flex.fidelity.laws import (
+    Criterion,
+)
 
 
 def simulate(scene: Scene, name: str = "case", reduction: Any = None,

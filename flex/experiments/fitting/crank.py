@@ -11,7 +11,7 @@ conservative for cranks without one) as ``<name>__rigid`` and ``<name>__full`` (
 crank with :data:`flex.experiments.fitting.lawfit.FULL_MODES` modes); each validation scene as
 ``<name>__auto`` (``crank.model = "auto"`` with the law just fitted) and ``<name>__full``.
 Errors, of rigid or auto against the full model over its deployment, are
-:func:`flex.fidelity.criteria.errors_against_full` with the crank's midpoint deflection / L1;
+:func:`flex.fidelity.laws.errors_against_full` with the crank's midpoint deflection / L1;
 the governing one is fitted and held against the tolerance.
 """
 
@@ -31,9 +31,11 @@ from flex.fidelity.criteria import (
     DELTA_T_DEFINITIONS,
     GOVERNING,
     deployment_times,
+    n_values,
+)
+from flex.fidelity.laws import (
     errors_against_full,
     load_criterion,
-    n_values,
 )
 
 HEADER = ("# Fitted rigid-or-flexible law of the crank, read by crank.model = \"auto\".\n"

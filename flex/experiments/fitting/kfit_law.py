@@ -30,6 +30,8 @@ from flex.fidelity.criteria import (
     PRIMARY_DELTA_T,
     THESIS_K,
     TWO_PI,
+)
+from flex.fidelity.laws import (
     ErrorLaw,
 )
 from flex.fidelity.predictor import PREDICTION_MARGIN

@@ -37,7 +37,12 @@ from flex.bodies import spring as sp
 from flex.data import tables
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, apply_overrides, validate
-from flex.fidelity.criteria import first_maximum_index, fit_error_law
+from flex.fidelity.criteria import (
+    first_maximum_index,
+)
+from flex.fidelity.laws import (
+    fit_error_law,
+)
 
 #: chain segment counts of the deployment measurement (rigid links and FFRF coupler)
 MEASURED_SEGMENTS: tuple[int, ...] = (1, 2, 4, 8, 16, 32, 64)
@@ -389,7 +394,7 @@ def massless_errors(cases: Mapping[str, Scene],
 
 def error_law_lines(points: Mapping[str, tuple[float, float]]) -> tuple[list[str], Any]:
     """Report lines of the massless spring's error against n and its fitted law
-    ``e = c n^-p`` (:func:`flex.fidelity.criteria.fit_error_law`); returns them and the law."""
+    ``e = c n^-p`` (:func:`flex.fidelity.laws.fit_error_law`); returns them and the law."""
     n = np.array([v[0] for v in points.values()])
     errors = np.array([v[1] for v in points.values()])
     law = fit_error_law(n, errors)

@@ -27,11 +27,10 @@ Wall times are medians over repeats on a shared machine: compare ratios measured
 
 from __future__ import annotations
 
-import contextlib
 import math
 import statistics
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -297,29 +296,6 @@ def describe(m: Measurement | None) -> str:
             f"{m.steps} steps, {m.newton_iterations} Newton iterations)")
 
 
-@contextlib.contextmanager
-def element_order(order: int) -> Iterator[None]:
-    """Build reductions with tetrahedra of ``order`` (1 or 2) inside the block.
-
-    :mod:`flex.bodies.reduction` fixes quadratic tetrahedra (module constant ``_MESH_ORDER``, part
-    of
-    the cache key); the work-precision study sets it for the duration of one build to show
-    what linear tetrahedra cost in accuracy. Raises SceneError if the constant is gone.
-    """
-    from flex.bodies import reduction
-
-    if order not in (1, 2):
-        raise SceneError(f"element_order = {order!r}: must be 1 or 2")
-    if not hasattr(reduction, "_MESH_ORDER"):
-        raise SceneError("element_order: flex.bodies.reduction no longer exposes _MESH_ORDER")
-    previous = reduction._MESH_ORDER
-    reduction._MESH_ORDER = order
-    try:
-        yield
-    finally:
-        reduction._MESH_ORDER = previous
-
-
 class ReductionPool:
     """Reductions (and their FFRF interfaces) built once per key and shared by all runs.
 
@@ -348,8 +324,8 @@ class ReductionPool:
                                    "density_kg_per_m3", "poisson_ratio", "mesh_size_m",
                                    "modes")) + (order,)
         if key not in self._by_key:
-            with element_order(order):
-                self._by_key[key] = reduction_for_scene(scene, cache_dir=self.cache_dir)
+            self._by_key[key] = reduction_for_scene(scene, cache_dir=self.cache_dir,
+                                                    mesh_order=order)
         return self._by_key[key]
 
 
