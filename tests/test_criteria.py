@@ -227,7 +227,7 @@ def test_criterion_toml_round_trip_and_damping_choice(tmp_path):
 
 
 def test_committed_criterion_loads_and_is_decreasing():
-    criterion = load_criterion(laws.DEFAULT_CRITERION)
+    criterion = load_criterion(laws.DEFAULT_CRITERION)  # the bundled file, by its path
     _, law = criterion.law(0.0)
     assert law.exponent > 1.0
     assert 1.0 < law.k(0.01, bound="upper") < 100.0

@@ -9,19 +9,6 @@ import time
 from dataclasses import dataclass
 
 from flex.base.errors import SceneError
-from flex.base.thesis import (  # noqa: F401 - part of this module's face
-    THESIS_ACTIVE_COILS,
-    THESIS_ANGLE_MAX_TIME_S,
-    THESIS_COMPRESSION_M,
-    THESIS_DELTA_T_S,
-    THESIS_FREE_LENGTH_M,
-    THESIS_K,
-    THESIS_MUSIC_WIRE_DENSITY_KG_PER_M3,
-    THESIS_MUSIC_WIRE_YOUNGS_MODULUS_PA,
-    THESIS_SPRING_DIAMETER_M,
-    THESIS_SPRING_RATE_N_PER_M,
-    THESIS_WIRE_DIAMETER_M,
-)
 from flex.bodies.spring import (
     MUSIC_WIRE_YOUNGS_MODULUS_PA,
     SpringDesign,

@@ -10,8 +10,9 @@ has the measures they are fitted to and the module doc of the whole statement).
   ``upper`` bound uses the upper 95 % prediction band instead of the central fit: a
   conservative k that covers the scatter of the sweep's cases around the law.
 - **the fitted laws** ``auto`` reads (:mod:`flex.fidelity.auto` decides) are read from
-  :data:`DEFAULT_CRITERION` (``flex/fidelity/criteria_fit.toml``, written by ``make kfit``),
-  or passed as a :class:`Criterion`.
+  a calibration (:func:`criterion_of`; the bundled ``flex/config/criteria_fit.toml`` is written
+  by ``make kfit`` and installed by ``make calibration-install``), or passed as a
+  :class:`Criterion`.
 """
 
 from __future__ import annotations
@@ -28,14 +29,18 @@ import numpy as np
 
 from flex.base.errors import FlexError
 from flex.base.physics import TWO_PI
+from flex.config.calibration import BUNDLED_FOLDER, FILES, Calibration, calibration_of
 from flex.fidelity.criteria import GOVERNING, PRIMARY_DELTA_T, convert_n, deployment_times
 from flex.fidelity.predictor import PREDICTION_MARGIN
 
 CRITERION_FORMAT = "flex-criterion/1"
-DEFAULT_CRITERION = Path(__file__).with_name("criteria_fit.toml")
-#: the crank's own law (``make crank``, copied by ``make crank-criterion``): the coupler law
-#: under-predicts a crank carrying a wing (README, "The crank")
-DEFAULT_CRANK_CRITERION = Path(__file__).with_name("crank_criteria_fit.toml")
+#: the bundled coupler law (``make kfit``, installed by ``make calibration-install``)
+DEFAULT_CRITERION = BUNDLED_FOLDER / FILES["coupler_criterion"]
+#: the bundled crank law (``make crank``): the coupler law under-predicts a crank carrying a
+#: wing (README, "The crank")
+DEFAULT_CRANK_CRITERION = BUNDLED_FOLDER / FILES["crank_criterion"]
+#: the parts of a calibration holding each link's law
+CRITERION_PARTS = {"coupler": "coupler_criterion", "crank": "crank_criterion"}
 
 
 def errors_against_full(run: Mapping[str, np.ndarray], full: Mapping[str, np.ndarray],
@@ -329,30 +334,41 @@ class Criterion:
 
 
 def criteria_in_force_text(scene: Mapping[str, Mapping[str, Any]]) -> str:
-    """The text of the installed criterion files ``scene``'s ``model = "auto"`` links read
-    when no law is passed (``""`` for none; a missing file as its path), with the load
-    prediction's margin they are decided by: part of a sweep case's identity."""
-    parts = []
-    for link, path in (("coupler", DEFAULT_CRITERION), ("crank", DEFAULT_CRANK_CRITERION)):
-        if scene.get(link, {}).get("model") == "auto":
-            try:
-                parts.append(f"{link}:{path.read_text('utf-8')}")
-            except OSError:
-                parts.append(f"{link}:missing {path}")
-    if parts:
-        parts.append(f"prediction margin {PREDICTION_MARGIN!r}")
-    return "\n".join(parts)
+    """What ``scene``'s ``model = "auto"`` links are decided by beyond their calibration's
+    laws (:attr:`flex.config.calibration.Calibration.digest` holds those): the load
+    prediction's margin (``""`` without such links); part of a sweep case's identity."""
+    if any(scene.get(link, {}).get("model") == "auto" for link in CRITERION_PARTS):
+        return f"prediction margin {PREDICTION_MARGIN!r}"
+    return ""
+
+
+def criterion_of(calibration: Calibration | None = None, link: str = "coupler") -> Criterion:
+    """The fitted law ``link``'s ``model = "auto"`` reads: ``calibration``'s (None: the
+    bundled calibration's). Raises :class:`FlexError` naming the file if it is not installed
+    or malformed."""
+    calibration = calibration_of(calibration)
+    part = CRITERION_PARTS[link]
+    text = getattr(calibration, f"{part}_toml")
+    path = calibration.path(part)
+    if text is None:
+        study = "kfit" if link == "coupler" else "crank"
+        raise FlexError(f"criterion file '{path}' does not exist; run 'make {study}' and "
+                        f"'make calibration-install' to create it")
+    return parse_criterion(text, str(path))
 
 
 def load_criterion(path: str | Path | None = None) -> Criterion:
-    """Read a criterion file: ``path``, else :data:`DEFAULT_CRITERION`. Raises
-    :class:`FlexError` naming the file if it is missing or malformed."""
-    path = Path(path or DEFAULT_CRITERION)
+    """Read a criterion file: ``path``, else the bundled calibration's coupler law
+    (:func:`criterion_of`). Raises :class:`FlexError` naming the file if it is missing or
+    malformed."""
+    if path is None:
+        return criterion_of()
+    path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise FlexError(f"criterion file '{path}' does not exist; run 'make kfit' and "
-                        f"'make kfit-criterion' to create it") from None
+                        f"'make calibration-install' to create it") from None
     return parse_criterion(text, str(path))
 
 

@@ -34,27 +34,28 @@ def _physics_versions() -> str:
 def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
     """Identity of a case: its resolved scene and the case function's qualified name and
     ``case_version`` attribute (bumped when what the function stores changes: stale case
-    files are then rerun, not resumed), and what its ``"auto"`` values resolve from (the
-    solver defaults table, the fitted criterion files)."""
+    files are then rerun, not resumed), and, for a scene with ``"auto"`` values, what they
+    resolve from: the calibration's digest (:attr:`flex.config.calibration.Calibration.digest`:
+    the fitted laws, the FFRF rule and the solver defaults as one; the case function's bound
+    ``calibration``, else the bundled one) and the load prediction's margin."""
     from flex.config import settings
-    from flex.fidelity.laws import (
-        criteria_in_force_text,
-    )
+    from flex.config.calibration import calibration_of
+    from flex.fidelity.auto import has_auto_models
+    from flex.fidelity.laws import criteria_in_force_text
 
-    function, extra = case_function, ""
+    function, extra, calibration = case_function, "", None
     if isinstance(function, functools.partial):  # bound arguments are part of the identity,
+        calibration = function.keywords.get("calibration")
         keywords = sorted((key, value) for key, value in function.keywords.items()
-                          if key not in LOCATION_ARGUMENTS)  # but not where caches live
+                          if key not in LOCATION_ARGUMENTS  # but not where caches live
+                          and key != "calibration")  # (its digest below)
         if function.args or keywords:
             extra = repr((function.args, keywords))
         function = function.func
-    if settings.has_auto(scene):  # a changed table must not resume stale cases
-        extra += repr(sorted(settings.solver_defaults().items()))
-    if settings.has_auto(scene) or settings.has_auto_link_keys(scene):  # nor a changed rule
-        from flex.config.ffrf_rule import rule_constants
-
-        extra += repr(sorted(rule_constants().items()))
-    extra += criteria_in_force_text(scene)  # a re-fit must not resume stale auto cases
+    if settings.has_auto(scene) or settings.has_auto_link_keys(scene) or has_auto_models(scene):
+        # a changed law, rule or table must not resume stale cases
+        extra += f"#calibration{calibration_of(calibration).digest}"
+    extra += criteria_in_force_text(scene)
     version = getattr(function, "case_version", None)
     if version is not None:
         extra += f"@{version}"

@@ -9,8 +9,8 @@ The ``kfit`` (coupler) and ``crank`` studies run the same steps (thesis sec. 6.2
    ``e = floor + c n^-p`` per damping ratio, delta_t definition and measure
    (:func:`fit_laws`, by :func:`flex.fidelity.laws.fit_error_law`);
 3. **criterion**: the laws of the primary delta_t as criterion TOML (:func:`criterion_toml`,
-   the format of ``flex/criteria_fit.toml``), written to a file for ``make
-   <study>-criterion`` to install;
+   the format of ``flex/config/criteria_fit.toml``), written to a file for ``make
+   calibration-install`` to install;
 4. **in force**: the validation cases get the law just fitted as a
    :class:`flex.fidelity.laws.Criterion` parsed from that text (:func:`simulate_with_law`),
    never the installed file;

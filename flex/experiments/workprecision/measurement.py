@@ -40,7 +40,8 @@ import numpy as np
 from flex.base.errors import FlexError, SceneError
 from flex.config.settings import has_auto_link_keys, resolve_link_keys, resolved_simulation
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene, apply_overrides, to_toml, validate
+from flex.data.scene import Scene, to_toml
+from flex.data.scene_edit import derive_scene
 from flex.dynamics.reference import solve_reference
 
 #: a reference certifies an accuracy level only if the level is at least this many times the
@@ -63,10 +64,10 @@ class Setting:
     """One knob combination.
 
     ``overrides``: scene keys ``"section.key"`` -> value, applied to the scene being studied;
-    ``engine``: ``"exudyn"`` (flex's model, :func:`flex.dynamics.solver.simulate`) or ``"scipy"``
-    (the reference DAE of :mod:`flex.dynamics.reference`, rigid coupler only) with ``method``,
-    ``rtol`` and ``atol`` for ``solve_ivp``; ``group``: which sweep it belongs to (one knob
-    at a time, or a combination), used to colour the diagrams.
+    ``engine``: ``"exudyn"`` (flex's model, :func:`flex.fidelity.simulation.simulate`) or
+    ``"scipy"`` (the reference DAE of :mod:`flex.dynamics.reference`, rigid coupler only)
+    with ``method``, ``rtol`` and ``atol`` for ``solve_ivp``; ``group``: which sweep it belongs
+    to (one knob at a time, or a combination), used to colour the diagrams.
     """
 
     label: str
@@ -99,20 +100,10 @@ class Setting:
         return out
 
 
-def _toml_value(value: Any) -> str:
-    if isinstance(value, str):
-        return f'"{value}"'
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return repr(value)
-
-
 def scene_for(base: Scene, setting: Setting) -> Scene:
-    """``base`` with the setting's overrides, validated (raises SceneError)."""
-    scene = apply_overrides(base, [f"{key}={_toml_value(value)}"
-                                   for key, value in setting.overrides])
-    validate(scene)
-    return scene
+    """``base`` with the setting's overrides, validated (raises SceneError;
+    :func:`flex.data.scene_edit.derive_scene`)."""
+    return derive_scene(base, dict(setting.overrides))
 
 
 # ------------------------------------------------------------------------------------------
@@ -354,7 +345,7 @@ def run_once(scene: Scene, setting: Setting, pool: ReductionPool | None = None
         pool = pool or ReductionPool()
         reduction = pool.for_scene(scene, setting.element_order)
         # timed alone: a companion run for an error estimate would be timed with it
-        untimed = apply_overrides(scene, ["simulation.error_estimate=false"])
+        untimed = derive_scene(scene, {"simulation.error_estimate": False})
         result = simulate(untimed, setting.label, reduction, cache_dir=pool.cache_dir)
         observables = Observables.of_datasets(result.datasets, flexible)
         counters = dict(result.counters)
