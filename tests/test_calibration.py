@@ -3,7 +3,9 @@ defaults loaded as one value, passed as an argument, hashed as one and installed
 
 from __future__ import annotations
 
+import dataclasses
 import os
+import pickle
 import tomllib
 
 import pytest
@@ -38,6 +40,17 @@ def test_the_bundled_calibration_is_the_four_files_of_flex_config():
         assert getattr(bundled, f"{part}_toml") == (BUNDLED_FOLDER / name).read_text("utf-8")
     assert solver_defaults() is bundled.solver_defaults  # None is the bundled one
     assert criterion_of().source == str(BUNDLED_FOLDER / "criteria_fit.toml")
+
+
+def test_a_calibration_is_a_value_that_refuses_changes_and_pickles():
+    bundled = load_calibration()
+    with pytest.raises(TypeError):
+        bundled.solver_defaults["rigid"]["step_s"] = 1.0  # type: ignore[index]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        bundled.ffrf_rule_toml = ""  # type: ignore[misc]
+    again = pickle.loads(pickle.dumps(bundled))
+    assert again == bundled and again.digest == bundled.digest
+    assert dict(again.solver_defaults["rigid"]) == dict(bundled.solver_defaults["rigid"])
 
 
 def test_a_folder_is_a_calibration_and_its_digest_follows_every_file(tmp_path):

@@ -30,6 +30,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 from flex.base.errors import FlexError
@@ -54,7 +55,8 @@ BUNDLED_FOLDER = Path(__file__).parent
 @dataclass(frozen=True)
 class Calibration:
     """The four calibration files of one folder (their text; a criterion file not yet
-    installed is None) and the two tables parsed (read-only: never change them).
+    installed is None) and the two tables parsed, read-only (mappings that refuse changes,
+    tuples for lists). Pickles as its texts (a sweep's worker processes get the same value).
 
     ``source``: ``"bundled"`` or the folder's path; ``folder``: where the files are.
     """
@@ -80,6 +82,29 @@ class Calibration:
     def path(self, part: str) -> Path:
         """The file of ``part`` (a key of :data:`FILES`)."""
         return self.folder / FILES[part]
+
+    def __reduce__(self):
+        return _from_texts, (self.source, self.folder, self.coupler_criterion_toml,
+                             self.crank_criterion_toml, self.ffrf_rule_toml,
+                             self.solver_defaults_toml)
+
+
+def _frozen(value: Any) -> Any:
+    """A parsed TOML value that refuses changes: tables as read-only mappings, arrays as
+    tuples."""
+    if isinstance(value, dict):
+        return MappingProxyType({key: _frozen(item) for key, item in value.items()})
+    if isinstance(value, list):
+        return tuple(_frozen(item) for item in value)
+    return value
+
+
+def _from_texts(source: str, folder: Path, coupler: str | None, crank: str | None,
+                rule: str, defaults: str) -> Calibration:
+    """The calibration of these four texts (``folder`` names them in messages)."""
+    return Calibration(source, folder, coupler, crank, rule, defaults,
+                       ffrf_rule=_frozen(_parse(folder, "ffrf_rule", rule)),
+                       solver_defaults=_frozen(_parse(folder, "solver_defaults", defaults)))
 
 
 def _read(folder: Path, part: str, required: bool) -> str | None:
@@ -127,11 +152,8 @@ def _load(folder: Path, source: str) -> Calibration:
                         f"'{BUNDLED}' or a folder holding {', '.join(FILES.values())})")
     texts = {part: _read(folder, part, required=part in ("ffrf_rule", "solver_defaults"))
              for part in FILES}
-    return Calibration(source, folder, texts["coupler_criterion"], texts["crank_criterion"],
-                       texts["ffrf_rule"], texts["solver_defaults"],
-                       ffrf_rule=_parse(folder, "ffrf_rule", texts["ffrf_rule"]),
-                       solver_defaults=_parse(folder, "solver_defaults",
-                                              texts["solver_defaults"]))
+    return _from_texts(source, folder, texts["coupler_criterion"], texts["crank_criterion"],
+                       texts["ffrf_rule"], texts["solver_defaults"])
 
 
 def calibration_of(calibration: Calibration | None) -> Calibration:
