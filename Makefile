@@ -17,7 +17,7 @@ LONG := tradeoff stability bench estimates calibrate design validation ladder sp
 # A study's result, results/<study>.h5 (and its figures, results/figures/<study>-*.png),
 # is remade only when one of its inputs is newer: its module studies/<study>.py, or one of
 # INPUTS -- the library (flex/**/*.py), its bundled scenes and data files (flex/data/scenes/*.toml;
-# flex/fidelity, flex/config: the fitted criteria and the solver defaults), studies/__init__.py and
+# flex/config: the calibration -- fitted criteria, FFRF rule, solver defaults), studies/__init__.py and
 # pyproject.toml. `make <study>` is an alias of `make results/<study>.h5`. FORCE=1 reruns
 # the studies asked for anyway (`make all FORCE=1`, `make kfit FORCE=1`).
 INPUTS := $(shell find flex -type f \( -name '*.py' -o -name '*.toml' \) \
@@ -27,7 +27,7 @@ LONG_RESULTS := $(LONG:%=results/%.h5)
 MAKEFLAGS += --no-builtin-rules
 .SUFFIXES:
 
-.PHONY: all test test-slow lint setup clean kfit-criterion crank-criterion rule-install \
+.PHONY: all test test-slow lint setup clean calibration-install \
 	$(STUDIES) $(LONG) \
 	force-rerun
 
@@ -78,21 +78,19 @@ results/kfit-criterion.toml results/crank-criterion.toml: results/%-criterion.to
 	@if [ $(<:.h5=.failed.h5) -nt $< ]; then echo "make: the last $* run failed" \
 		"($(<:.h5=.failed.h5)): its law $@ is not installed" >&2; exit 1; fi
 
-# after make kfit: install its fit as the criterion that model = "auto" reads (commit it).
-# Every study reads it: they are all out of date after a new law is installed.
-kfit-criterion: results/kfit-criterion.toml
-	@cmp -s $< flex/fidelity/criteria_fit.toml && echo "flex/fidelity/criteria_fit.toml is already $<" \
-		|| { cp $< flex/fidelity/criteria_fit.toml && echo "cp $< flex/fidelity/criteria_fit.toml"; }
+# calibrate stores its fitted FFRF settings rule in its result file: written out beside it
+results/calibrate-rule.toml: results/calibrate.h5 | $(STAMP)
+	$(PY) -m flex.experiments.fitting.calibration_report $< $@
 
-# after make crank: install the crank's law that crank.model = "auto" reads (commit it)
-crank-criterion: results/crank-criterion.toml
-	@cmp -s $< flex/fidelity/crank_criteria_fit.toml && echo "flex/fidelity/crank_criteria_fit.toml is already $<" \
-		|| { cp $< flex/fidelity/crank_criteria_fit.toml && echo "cp $< flex/fidelity/crank_criteria_fit.toml"; }
-
-# after make calibrate: install its fitted FFRF settings rule (flex/config/ffrf_rule.toml, read
-# by every "auto" modes, mesh and step of an FFRF coupler; commit it). Every study reads it.
-rule-install: results/calibrate.h5 | $(STAMP)
-	$(PY) -m flex.experiments.fitting.calibration_report $< flex/config/ffrf_rule.toml
+# after make kfit, make crank and/or make calibrate: install their fits as the bundled
+# calibration (flex/config/: criteria_fit.toml, crank_criteria_fit.toml, ffrf_rule.toml, what
+# every "auto" reads; commit them), in one step (flex.config.calibration.install_calibration).
+# FITS names which (default: all three; a fit's study runs first if it is out of date). Every
+# study reads the calibration: they are all out of date after an install.
+FITS ?= kfit crank calibrate
+FIT_FILES = $(foreach fit,$(FITS),results/$(fit)-$(if $(filter calibrate,$(fit)),rule,criterion).toml)
+calibration-install: $(FIT_FILES) | $(STAMP)
+	$(PY) -m flex.config.calibration install --into flex/config $^
 
 test: $(STAMP)
 	$(PY) -m pytest -q -n 2
@@ -105,4 +103,5 @@ lint: $(STAMP)
 
 clean:
 	rm -rf results/*.h5 results/.*.h5.before results/figures results/reports .cache \
-		results/kfit-cases results/calibrate-cases results/kfit-criterion.toml results/crank-criterion.toml
+		results/kfit-cases results/calibrate-cases results/kfit-criterion.toml results/crank-criterion.toml \
+		results/calibrate-rule.toml

@@ -84,19 +84,9 @@ def override_strings(overrides: Overrides | None) -> list[str]:
                 raise ArgumentError(f"overrides: expected 'section.key=value' strings, got "
                                     f"{_kind(item)}")
         return items
-    import tomli_w
+    from flex.data.scene_edit import override_text
 
-    strings = []
-    for name, value in _flat(overrides):
-        if hasattr(value, "item") and not isinstance(value, str | bytes):
-            value = value.item()  # numpy scalar -> Python scalar
-        try:
-            text = tomli_w.dumps({"v": value}).strip().removeprefix("v = ")
-        except (TypeError, ValueError):
-            raise SceneError(f"override {name}: {value!r} is not a scene value (a string, "
-                             f"number or boolean)") from None
-        strings.append(f"{name}={text}")
-    return strings
+    return [override_text(name, value) for name, value in _flat(overrides)]
 
 
 def _flat(overrides: Mapping[str, Any]) -> list[tuple[str, Any]]:
@@ -124,7 +114,7 @@ def load_scene(source: str | Path | None = None, overrides: Overrides | None = N
 
     Inputs:
         source: a TOML file path, or the name of a bundled parameter set (``None``: the
-            thesis's ``"cavezza2012"``, ``flex/scenes/cavezza2012.toml``). A file needs only
+            thesis's ``"cavezza2012"``, ``flex/data/scenes/cavezza2012.toml``). A file needs only
             the keys it changes; the rest come from the bundled set.
         overrides: ``"section.key=value"`` strings or a dict (module doc), applied on top.
         link_models: the link models ``crank.model`` and ``coupler.model`` may name, by name
@@ -151,7 +141,8 @@ def derive_scene(scene: Scene, overrides: Overrides, *,
                  link_models: Mapping[str, Any] | None = None) -> Scene:
     """A new scene: ``scene`` with ``overrides`` applied, validated as a whole.
 
-    The one way to edit a scene in a script: the same parsing as ``--set``
+    The one way to edit a scene in a script (:func:`flex.data.scene_edit.derive_scene`, which
+    the library's own edits go through too): the same parsing as ``--set``
     (:func:`flex.data.scene.apply_overrides`) and the same checks as :func:`load_scene`
     (:func:`flex.data.scene.validate`), so a derived scene is exactly what the command line would
     run with ``--set``.
@@ -170,11 +161,10 @@ def derive_scene(scene: Scene, overrides: Overrides, *,
         linkage, ...), or for an override that is not ``section.key=value``;
         :class:`TypeError` when ``overrides`` is neither a list of strings nor a mapping.
     """
-    from flex.data.scene import apply_overrides, validate
+    from flex.data.scene_edit import derive_scene as derive
 
-    derived = apply_overrides(_plain_scene(scene), override_strings(overrides))
-    validate(derived, _link_models(link_models, run=False))
-    return derived
+    return derive(_plain_scene(scene), override_strings(overrides),
+                  link_models=_link_models(link_models, run=False))
 
 
 def _link_models(given: Mapping[str, Any] | None, run: bool = True) -> Mapping[str, Any]:
@@ -202,7 +192,7 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
 
     What runs is exactly the scene: ``model = "auto"`` links are decided first (a rigid probe
     run and the fitted criterion; the choice and its reason are printed to stderr), then
-    ``"auto"`` solver keys are filled by model (``flex/config/solver_defaults.toml``), then the
+    ``"auto"`` solver keys are filled by model (the calibration's solver defaults), then the
     mechanism is built in Exudyn and integrated at a fixed step from t = 0 to
     ``simulation.end_time_s``. A flexible (``ffrf``) link's Craig-Bampton reduction is built
     with NGsolve or read from the reduction cache ``cache_dir``.
@@ -216,8 +206,11 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
             built-in ones).
         options: passed on to :func:`flex.fidelity.simulation.simulate` (``reduction=``,
             ``crank_reduction=``: prebuilt reductions; ``criterion=``, ``crank_criterion=``:
-            another fitted law for ``auto``, :func:`flex.fidelity.criteria.load_criterion`); not
-            needed for ordinary use.
+            another fitted law for ``auto``, :func:`flex.fidelity.laws.load_criterion`;
+            ``calibration=``: the fitted laws, FFRF rule and solver defaults every ``"auto"``
+            resolves from, a :class:`flex.config.calibration.Calibration` or its name,
+            ``"bundled"`` (the default) or a folder, :func:`flex.config.calibration.
+            load_calibration`); not needed for ordinary use.
     Output:
         a :class:`flex.data.results.CaseResult`: ``status == "ok"``; ``datasets`` maps paths of
         the result layout to :class:`flex.data.results.Dataset` (``.data`` a numpy array,
@@ -244,9 +237,15 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
     _check_case_name(name)
     _check_options(options, {"reduction": "a flex.bodies.reduction.Reduction",
                              "crank_reduction": "a flex.bodies.reduction.Reduction",
-                             "criterion": "a flex.fidelity.criteria.Criterion",
-                             "crank_criterion": "a flex.fidelity.criteria.Criterion"},
+                             "criterion": "a flex.fidelity.laws.Criterion",
+                             "crank_criterion": "a flex.fidelity.laws.Criterion",
+                             "calibration": "a flex.config.calibration.Calibration, "
+                                            "'bundled' or a folder"},
                    "simulate")
+    if isinstance(options.get("calibration"), str | Path):
+        from flex.config.calibration import load_calibration
+
+        options["calibration"] = load_calibration(options["calibration"])
     folder = _cache_dir(cache_dir)
     check_cases(load_study("simulate"), {name: scene}, given_keys(scene), link_models=models)
     return simulate_scene(scene, name, cache_dir=folder, link_models=models, **options)

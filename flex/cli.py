@@ -329,7 +329,7 @@ def _auto_note(scene) -> str:
         return ""
     if "auto" in (scene["crank"]["model"], scene["coupler"]["model"]):
         return ('# [simulation] "auto" keys: chosen at run time, once the model = "auto" links '
-                "are decided (flex/settings.py)\n")
+                "are decided (flex/config/settings.py)\n")
     _, choice = resolve_solver_settings(scene)
     keys = ", ".join(f"{key} = {value!r}" for key, value in choice.keys.items())
     return f'# [simulation] "auto" keys -> {keys} ({choice.entry}: {choice.reason})\n'

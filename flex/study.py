@@ -225,7 +225,7 @@ def check_cases(module: ModuleType, scenes: dict[str, Scene],
     (:func:`flex.config.usage.unused_keys`, minus the keys the study declares it reads itself in
     ``READS``). ``link_models``: the registry of the scenes' link models."""
     for scene in scenes.values():
-        check(scene, link_models)
+        check(scene, link_models=link_models)
     reads = set(getattr(module, "READS", ()))
     for name, value in (given or {}).items():
         if name in reads:

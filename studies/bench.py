@@ -103,7 +103,8 @@ PLAN = BenchPlan(
     ffrf_untuned=S("untuned: h=1e-5 mesh=2mm modes=6 full tol=1e-10", step_s=1e-5,
                    coupler__mesh_size_m=0.002, coupler__modes=6, newton="full",
                    newton_relative_tolerance=1e-10, spectral_radius=0.9),
-    # what a user gets: the scene's "auto" solver keys (flex/settings.py) on the 2 mm mesh, 6 modes
+    # what a user gets: the scene's "auto" solver keys (flex/config/settings.py) on the 2 mm
+    # mesh, 6 modes
     ffrf_defaults=Setting("flex defaults (auto)", AUTO_OVERRIDES),
     nonlinear_fine=S("nonlinear FE h=1e-4 mesh=4mm modified tol=1e-8",
                      coupler__model="nonlinear_fe", coupler__mesh_size_m=0.004, step_s=1e-4,

@@ -6,7 +6,7 @@ in-plane modes x steps per first period (:mod:`flex.experiments.fitting.calibrat
 validated on ``VALIDATION`` (the scenes: ``calibrate.toml`` beside this file). Some scenes
 carry 1 % damping: an undamped thick plate's peak is the highest of many crests, which no
 affordable reference pins to 1 %. Stored: a case per scene, ``/summary/rule/toml`` (``make
-rule-install``), ``levels/*``, ``validation/*``, ``cross_validation/*`` and
+calibration-install``), ``levels/*``, ``validation/*``, ``cross_validation/*`` and
 ``design_frontier/*`` (rule designs compared, :mod:`flex.experiments.fitting.rule_designs`).
 """
 

@@ -15,8 +15,8 @@ as the coupler's (:mod:`flex.experiments.fitting.lawfit`, the crank's half in
 (fit): crank thicknesses 0.8-5 mm x two spring rates, all with the wing (the harder case;
 cranks without a wing err less at equal n, so the law is conservative for them), each run
 rigid and as the full model, an FFRF crank with 12 modes; the governing error against n is
-fitted and written to ``results/crank-criterion.toml`` (``make crank-criterion`` installs it
-as ``flex/crank_criteria_fit.toml``, which ``auto`` reads). Phase 2 (validation): scenes not
+fitted and written to ``results/crank-criterion.toml`` (``make calibration-install`` installs it
+as ``flex/config/crank_criteria_fit.toml``, which ``auto`` reads). Phase 2 (validation): scenes not
 in the fit (other thicknesses, with and without the wing, tolerances 1 % and 0.1 %) run
 ``auto`` with the law just fitted and the full model.
 

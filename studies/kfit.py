@@ -32,7 +32,7 @@ with the coupler's cases from :mod:`flex.experiments.fitting.kfit`, its fit and 
 
 Every case's file is ``<sweep folder>/cases/<case>.h5`` (default ``results/kfit-cases``);
 the sweep resumes from them. The fit (``results/kfit-criterion.toml``) is what
-``make kfit-criterion`` copies to ``flex/fidelity/criteria_fit.toml`` for ``auto``. Executor:
+``make calibration-install`` copies to ``flex/config/criteria_fit.toml`` for ``auto``. Executor:
 ``flex run kfit --scheduler ... --folder DIR --retry-failed`` (see :mod:`flex.sweep`).
 """
 

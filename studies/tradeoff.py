@@ -50,7 +50,7 @@ SCENES: dict[str, list[str]] = {
     "ffrf_1mm": PLATE + ["coupler.thickness_m=0.001", "coupler.mesh_size_m=0.002"],
     "ffrf_10mm": PLATE + ["coupler.thickness_m=0.01", "coupler.mesh_size_m=0.005"],
 }
-#: the plate the ``ffrf_coupler`` entry of flex/solver_defaults.toml is for (its bundled 2 mm
+#: the plate the ``ffrf_coupler`` entry of flex/config/solver_defaults.toml is for (its bundled 2 mm
 #: mesh and 6 modes): where the FFRF defaults are checked
 FFRF_DEFAULT_SCENE = "ffrf_1mm"
 

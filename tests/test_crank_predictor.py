@@ -113,7 +113,10 @@ def test_the_pivot_moment_from_statics_is_the_wing_s_weld_moment():
 
 def _strict_criterion():
     """An n-law that calls every crank flexible (e = 1e9 n^-2)."""
-    from flex.fidelity.criteria import Criterion, fit_error_law
+    from flex.fidelity.laws import (
+        Criterion,
+        fit_error_law,
+    )
 
     n = np.geomspace(1.0, 100.0, 20)
     return Criterion({(0.0, "governing"): fit_error_law(n, 1e9 * n**-2.0)})
@@ -137,7 +140,9 @@ def test_without_a_wing_the_loads_decide_the_crank_with_one_the_n_law(reduction_
 
 def _ffrf_deflection_error(scene, reduction_cache) -> dict[str, float]:
     """The crank study's errors of the rigid crank against the full FFRF crank."""
-    from flex.fidelity.criteria import errors_against_full
+    from flex.fidelity.laws import (
+        errors_against_full,
+    )
     from flex.fidelity.simulation import simulate
 
     rigid, full = (simulate(apply_overrides(scene, changes), cache_dir=reduction_cache)

@@ -10,7 +10,7 @@
   the reduction's mesh (nodes at the placed reference positions, quadratic tetrahedra), the
   number of times, the units. The exported midpoint deflection equals the stored
   ``coupler/midpoint_deflection`` when rebuilt by its definition (the mid-length slab's
-  weighted average of :func:`flex.bodies.reduction._mid_set` minus the chord between the
+  weighted average of :func:`flex.bodies.reduction.build._mid_set` minus the chord between the
   joint-face centres, :func:`flex.bodies.reduction.midpoint_deflection`) from the exported
   nodes: within 1e-4 of its peak from the mechanism-frame field (float32 storage of
   positions ~0.1 m), 1e-5 from the link-frame field. The exported peak von Mises away from
@@ -36,7 +36,8 @@ import numpy as np
 import pytest
 
 from flex.api import simulate
-from flex.bodies.reduction import _mid_set, midpoint_deflection
+from flex.bodies.reduction import midpoint_deflection
+from flex.bodies.reduction.build import _mid_set
 from flex.bodies.stress import check_basis_identity, von_mises
 from flex.cli import main
 from flex.config.settings import pinned_overrides

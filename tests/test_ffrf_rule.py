@@ -423,13 +423,13 @@ def test_validation_compares_the_rule_with_the_fastest_robust_pair():
     assert not row["meets"]  # far slower than needed
 
 
-def test_install_refuses_a_foreign_result_file(tmp_path):
+def test_rule_extraction_refuses_a_foreign_result_file(tmp_path):
     from flex.data.results import write_results
-    from flex.experiments.fitting.calibration_report import install_rule
+    from flex.experiments.fitting.calibration_report import extract_rule
 
     path = write_results(tmp_path / "other.h5", "simulate", [], "")
     rule = tmp_path / "rule.toml"
     rule.write_text("kept")
     with pytest.raises(FlexError, match="not calibrate"):
-        install_rule(path, rule)
+        extract_rule(path, rule)
     assert rule.read_text() == "kept"

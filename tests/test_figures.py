@@ -26,7 +26,7 @@ import pytest
 
 from flex.base.plotting import review
 from flex.data.results import CaseResult, Dataset
-from flex.fidelity import criteria
+from flex.fidelity import criteria, laws
 from flex.study import Summary, execute, load_study, study_scene
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -233,7 +233,7 @@ def test_kfit_figures_synthetic(tmp_path, reviewed):
         table[f"measures/{measure}"] = error
         for z in kfit.DAMPING_RATIOS:
             rows = np.isclose(table["parameters/damping_ratio"], z) & table["fitted"]
-            fits[(z, "stop", measure)] = criteria.fit_error_law(n[rows], error[rows],
+            fits[(z, "stop", measure)] = laws.fit_error_law(n[rows], error[rows],
                                                                 floor=floor)
     deflection = table["measures/deflection"]
     table["predictor/deflection"] = deflection * np.exp(rng.normal(0, 0.1, len(n)))

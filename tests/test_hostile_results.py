@@ -1,7 +1,7 @@
 """Hostile result files and arguments for ``inspect``, ``plot`` and ``compare``.
 
 Issue "Nothing lost, nothing silent": every command that reads a result file checks its
-layout (:func:`flex.data.results.check_layout`) and names what is wrong and where (file, HDF5
+layout (:func:`flex.data.result_layout.check_layout`) and names what is wrong and where (file, HDF5
 path, what was expected); no traceback, one ``flex: error:`` line, exit status 2, and no
 input file changed (tests/hostile.py). Each malformed file starts as a valid file written by
 :func:`flex.data.results.write_results` with one thing damaged.
@@ -21,7 +21,8 @@ import pytest
 from hostile import check_refused, run_cli
 
 from flex.base.errors import ResultFileError
-from flex.data.results import CaseResult, Dataset, check_layout, open_results, write_results
+from flex.data.result_layout import check_layout
+from flex.data.results import CaseResult, Dataset, open_results, write_results
 from flex.tools.compare import compare_files
 
 REPO = Path(__file__).resolve().parent.parent

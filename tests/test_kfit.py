@@ -8,7 +8,12 @@ import numpy as np
 import pytest
 
 from flex.experiments.fitting import kfit, kfit_law, lawfit
-from flex.fidelity.criteria import EULER_LOAD_LIMIT, load_criterion
+from flex.fidelity.criteria import (
+    EULER_LOAD_LIMIT,
+)
+from flex.fidelity.laws import (
+    load_criterion,
+)
 from flex.fidelity.predictor import PREDICTION_MARGIN
 from flex.study import study_scene
 from studies import kfit as kfit_study

@@ -2,7 +2,7 @@
 
 Lowest first: ``flex/base``, ``data``, ``config``, ``bodies``, ``dynamics``, ``fidelity``,
 ``experiments``, ``tools``, then the top modules ``flex/study.py``, ``api.py``,
-``sweep.py``, ``cli.py`` (README "Layout" describes each module).
+``sweep`` (a package), ``cli.py`` (README "Layout" describes each module).
 """
 
 from __future__ import annotations

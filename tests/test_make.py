@@ -59,8 +59,8 @@ study=$1
 mkdir -p results
 case "$FAKE_MODE" in
   ok) echo "run $study" > results/$study.h5
-      [ "$study" = kfit ] && echo "fit" > results/kfit-criterion.toml
-      [ "$study" = crank ] && echo "crank fit" > results/crank-criterion.toml
+      [ "$study" = kfit ] && echo "fit = 1" > results/kfit-criterion.toml
+      [ "$study" = crank ] && echo "crank_fit = 1" > results/crank-criterion.toml
       exit 0 ;;
   failed) # flex: a failed run is written beside an earlier result, else in its place
       if [ -e results/$study.h5 ]; then echo failed > results/$study.failed.h5
@@ -120,7 +120,7 @@ def test_each_result_file_depends_on_its_module_the_library_data_and_pyproject(t
     rules = database(tree)
     library = [name for name in _inputs() if name.startswith("flex/")]
     assert any(name.startswith("flex/data/scenes/") and name.endswith(".toml") for name in library)
-    assert "flex/fidelity/criteria_fit.toml" in library
+    assert "flex/config/criteria_fit.toml" in library
     assert "flex/config/solver_defaults.toml" in library
     for study in STUDIES + LONG:
         normal, order = rules[f"results/{study}.h5"]
@@ -160,7 +160,7 @@ def test_touching_a_study_module_makes_only_that_study_out_of_date(tree, study):
 
 
 @pytest.mark.parametrize("name", ["flex/dynamics/solver.py", "flex/data/scenes/cavezza2012.toml",
-                                  "flex/fidelity/criteria_fit.toml",
+                                  "flex/config/criteria_fit.toml",
                                   "flex/config/solver_defaults.toml",
                                   "pyproject.toml"])
 def test_touching_the_library_or_its_data_reruns_every_study(tree, name):
@@ -218,30 +218,47 @@ def test_force_reruns_what_is_asked_for(tree):
     assert runs(tree, "bench") == ["bench"]  # no result yet
 
 
-def test_criterion_targets_install_the_fitted_laws_after_their_study(tree):
+def install(tree: Path, *args: str, mode: str = "ok") -> subprocess.CompletedProcess:
+    """``make calibration-install`` with this interpreter as the .venv's python."""
+    # -P: the installed flex, not the empty module files of the tree
+    return make(tree, f"PY={sys.executable} -P", "calibration-install", *args, mode=mode)
+
+
+def test_calibration_install_installs_the_fitted_laws_after_their_study(tree):
+    config = tree / "flex" / "config"
     for study, installed in (("kfit", "criteria_fit.toml"), ("crank", "crank_criteria_fit.toml")):
         _set_time(tree / "studies" / f"{study}.py", T0 + 30)
-        done = make(tree, f"{study}-criterion")
+        done = install(tree, f"FITS={study}")
         assert done.returncode == 0, done.stderr
-        assert (tree / "flex" / "fidelity" / installed).read_text() == (tree / "results" /
-                                                           f"{study}-criterion.toml").read_text()
+        assert (config / installed).read_text() == (tree / "results" /
+                                                    f"{study}-criterion.toml").read_text()
         assert (tree / "results" / f"{study}.h5").read_text() == f"run {study}\n"
-    stamp = (tree / "flex" / "fidelity" / "criteria_fit.toml").stat().st_mtime
-    again = make(tree, "kfit-criterion", "kfit")
-    assert again.returncode == 0
+    stamp = (config / "criteria_fit.toml").stat().st_mtime
+    again = install(tree, "FITS=kfit crank")
+    assert again.returncode == 0 and "is already" in again.stdout
     # same law: no copy
-    assert (tree / "flex" / "fidelity" / "criteria_fit.toml").stat().st_mtime == stamp
+    assert (config / "criteria_fit.toml").stat().st_mtime == stamp
+
+
+def test_calibration_install_is_one_command_for_every_fit(tree):
+    done = make(tree, "-n", "calibration-install")
+    assert done.returncode == 0, done.stderr
+    installs = [line for line in done.stdout.splitlines() if "flex.config.calibration" in line]
+    assert len(installs) == 1, done.stdout
+    for fit in ("kfit-criterion", "crank-criterion", "calibrate-rule"):
+        assert f"results/{fit}.toml" in installs[0]
 
 
 def test_no_law_is_installed_from_a_run_that_failed(tree):
+    installed = tree / "flex" / "config" / "criteria_fit.toml"
     assert make(tree, "kfit", "FORCE=1", mode="failed").returncode != 0  # earlier kfit.h5 kept
-    before = (tree / "flex" / "fidelity" / "criteria_fit.toml").stat().st_mtime
-    done = make(tree, "kfit-criterion")
+    before = installed.stat().st_mtime
+    done = install(tree, "FITS=kfit")
     assert done.returncode != 0 and "the last kfit run failed" in done.stderr
-    assert (tree / "flex" / "fidelity" / "criteria_fit.toml").stat().st_mtime == before
+    assert installed.stat().st_mtime == before
     assert make(tree, "kfit", "FORCE=1").returncode == 0  # a good run: installed again
-    assert make(tree, "kfit-criterion").returncode == 0
-    assert (tree / "flex" / "fidelity" / "criteria_fit.toml").read_text() == "fit\n"
+    assert install(tree, "FITS=kfit").returncode == 0
+    assert installed.read_text() == "fit = 1\n"
 
 
 def test_clean_removes_results_figures_and_reports(tree):

@@ -127,7 +127,7 @@ def test_second_build_is_a_fast_identical_cache_hit(reduction, cache_dir):
 
 
 def test_key_depends_on_every_argument(reduction, tmp_path):
-    from flex.bodies.reduction import _cache_key
+    from flex.bodies.reduction.cache import _cache_key
 
     base = {"length_m": LENGTH, "modes": MODES}
     assert _cache_key(base) == _cache_key(dict(base))
@@ -361,7 +361,7 @@ def test_thesis_plates_pinned_pinned_frequency(thickness, mesh_size, low, high, 
 # joint markers: as cheap as the basis allows, the same motion as on every face node
 # ------------------------------------------------------------------------------------------
 def test_joint_markers_use_the_frame_node_and_four_corners_of_the_rigid_face(reduction):
-    from flex.bodies.reduction import _face_corners, _rigid_face_motions
+    from flex.bodies.reduction.body import _face_corners, _rigid_face_motions
 
     basis = reduction.fem.modeBasis["matrix"]
     basis = basis.reshape(-1, 3, basis.shape[1])
@@ -419,7 +419,7 @@ def test_in_plane_selection_keeps_the_in_plane_modes_of_the_full_basis(reduction
     any kind computed with enough modes: the same fixed-interface frequencies (to the
     eigensolver's accuracy: a fixed 40-step PINVIT, measured within 1e-5) and the 3 in-plane
     static modes of end_b."""
-    from flex.bodies.reduction import _mirror_antisymmetry
+    from flex.bodies.reduction.basis import _mirror_antisymmetry
 
     full = build_reduction(*ARGS[:-1], 3 * MODES + 4, None, mode_selection="all")
     score = _mirror_antisymmetry(full.fem.GetNodePositionsAsArray(),
@@ -440,7 +440,7 @@ def test_mirror_comparison_falls_back_when_exact_pairs_miss_a_mode():
     subspace's eigenproblem."""
     from scipy.linalg import eigh
 
-    from flex.bodies.reduction import _mirror_antisymmetry, _mirror_parts
+    from flex.bodies.reduction.basis import _mirror_antisymmetry, _mirror_parts
 
     rng = np.random.default_rng(1)
     pairs = rng.uniform(-1, 1, (20, 3)) * [0.04, 0.001, 0.005]

@@ -1,4 +1,4 @@
-"""Solver settings by model: the bundled scene's "auto" keys (flex/settings.py)."""
+"""Solver settings by model: the bundled scene's "auto" keys (flex/config/settings.py)."""
 
 from __future__ import annotations
 
@@ -213,13 +213,13 @@ def test_one_simulate_resolves_each_scene_once(monkeypatch, reduction_cache):
         seen["resolve"] += 1
         return real_resolve(*args, **kwargs)
 
-    def counting_solver(scene, **kwargs):
+    def counting_solver(scene, calibration=None, **kwargs):
         seen["solver"].append(to_toml(scene))
-        return real_solver(scene, **kwargs)
+        return real_solver(scene, calibration, **kwargs)
 
-    def counting_links(scene):
+    def counting_links(scene, calibration=None):
         seen["links"].append(to_toml(scene))
-        return real_links(scene)
+        return real_links(scene, calibration)
 
     monkeypatch.setattr("flex.fidelity.simulation.resolve", counting_resolve)
     monkeypatch.setattr("flex.fidelity.auto.resolve_solver_settings", counting_solver)

@@ -11,7 +11,7 @@ import math
 import pytest
 
 from flex.base.errors import SceneError
-from flex.bodies import spring
+from flex.bodies import spring, spring_fe
 
 INCH_M = 0.0254
 LBF_N = 4.4482216152605
@@ -202,7 +202,7 @@ def test_surge_check_of_the_consistent_design():
     lambda v: spring.rigid_or_flexible_ratio(v, 60.0, "physical"),
     lambda v: spring.spring_stress_check(spring.CONSISTENT_THESIS_SPRING, v),
     lambda v: spring.SpringDesign(v, 0.09, 3, 0.043),
-    lambda v: spring.fe_helix_segment_stress(spring.CONSISTENT_THESIS_SPRING, v),
+    lambda v: spring_fe.fe_helix_segment_stress(spring.CONSISTENT_THESIS_SPRING, v),
 ])
 def test_non_positive_inputs_raise_scene_error(call, bad):
     with pytest.raises(SceneError, match="must be"):
@@ -219,13 +219,13 @@ def test_other_invalid_inputs_raise_scene_error():
     with pytest.raises(SceneError, match="index C > 1"):
         spring.SpringDesign(0.0044, 0.004, 3, 0.043)
     with pytest.raises(SceneError, match=r"\(0, 1\]"):
-        spring.fe_helix_segment_stress(spring.CONSISTENT_THESIS_SPRING, 33.0, segment_turns=2)
+        spring_fe.fe_helix_segment_stress(spring.CONSISTENT_THESIS_SPRING, 33.0, segment_turns=2)
 
 
 # --- finite-element check ---------------------------------------------------------------------
 
 def test_fe_helix_segment_matches_wahl_coarse():
-    result = spring.fe_helix_segment_stress(spring.CONSISTENT_THESIS_SPRING, 33.0)
+    result = spring_fe.fe_helix_segment_stress(spring.CONSISTENT_THESIS_SPRING, 33.0)
     assert result.peak_angle_deg == pytest.approx(0.0, abs=20.0)  # inner fibre
     assert result.fe_over_wahl == pytest.approx(1.0, abs=0.02)
     assert result.fe_over_bergstrasser == pytest.approx(1.0, abs=0.02)
@@ -238,7 +238,7 @@ def test_fe_helix_segment_matches_wahl_coarse():
 @pytest.mark.parametrize(("segment_turns", "mesh_size_m"), [(0.125, 0.0008), (0.5, 0.0022)])
 def test_fe_helix_refined_and_longer(segment_turns, mesh_size_m):
     # finer mesh (converged within 0.1 %) and a longer segment (end effects): same answer
-    result = spring.fe_helix_segment_stress(spring.CONSISTENT_THESIS_SPRING, 33.0,
+    result = spring_fe.fe_helix_segment_stress(spring.CONSISTENT_THESIS_SPRING, 33.0,
                                             segment_turns=segment_turns, mesh_size_m=mesh_size_m)
     assert result.fe_over_wahl == pytest.approx(0.995, abs=0.006)
     assert result.fe_over_bergstrasser == pytest.approx(1.0, abs=0.006)

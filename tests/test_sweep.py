@@ -217,39 +217,60 @@ def test_case_hash_follows_the_case_function_s_version(monkeypatch):
     assert case_hash(scene, bound) != before
 
 
-def test_case_hash_follows_the_solver_defaults_of_auto_scenes(monkeypatch):
-    # a resumed sweep must not reuse cases run with another flex/config/solver_defaults.toml
+def _calibration_copy(folder, **changed):
+    """A calibration folder: the bundled files, ``changed`` ones (part -> text) replaced."""
+    from flex.config.calibration import BUNDLED_FOLDER, FILES, load_calibration
+
+    folder.mkdir(exist_ok=True)
+    for part, name in FILES.items():
+        text = changed.get(part, (BUNDLED_FOLDER / name).read_text(encoding="utf-8"))
+        (folder / name).write_text(text, encoding="utf-8")
+    return load_calibration(folder)
+
+
+def test_case_hash_follows_the_calibration_of_auto_scenes(tmp_path):
+    # a resumed sweep must not reuse cases run with other solver defaults (or rule, or law):
+    # the calibration is one argument of the case function, hashed as one
+    import functools
+
     import flex.config.settings as settings
+    from flex.config.calibration import BUNDLED_FOLDER, load_calibration
     from flex.fidelity.simulation import simulate_case
     from flex.sweep import case_hash
 
     auto = load_scene()
     pinned = load_scene(None, settings.pinned_overrides())
+    bundled = functools.partial(simulate_case, calibration=load_calibration("bundled"))
     before = case_hash(auto, simulate_case), case_hash(pinned, simulate_case)
-    monkeypatch.setattr(settings, "solver_defaults",
-                        lambda: {"rigid": {"step_s": 2e-5}, "ffrf_coupler": {}})
-    assert case_hash(auto, simulate_case) != before[0]
-    assert case_hash(pinned, simulate_case) == before[1]  # nothing of it is "auto"
+    assert case_hash(auto, bundled) == before[0]  # None is the bundled calibration
+    same = _calibration_copy(tmp_path / "same")
+    assert case_hash(auto, functools.partial(simulate_case, calibration=same)) == before[0]
+    defaults = (BUNDLED_FOLDER / "solver_defaults.toml").read_text(encoding="utf-8")
+    other = _calibration_copy(tmp_path / "other",
+                              solver_defaults=defaults.replace("1.0e-5", "2.0e-5"))
+    assert other.digest != same.digest
+    with_other = functools.partial(simulate_case, calibration=other)
+    assert case_hash(auto, with_other) != before[0]
+    assert case_hash(pinned, with_other) == before[1]  # nothing of it is "auto"
 
 
-def test_case_hash_follows_the_criterion_of_auto_links(tmp_path, monkeypatch):
+def test_case_hash_follows_the_criterion_of_auto_links(tmp_path):
     import functools
 
-    import flex.fidelity.criteria as criteria
+    import flex.config.settings as settings
+    from flex.fidelity.laws import criterion_of
     from flex.fidelity.simulation import simulate_case
     from flex.sweep import case_hash
 
     auto = load_scene(None, ['coupler.geometry="plate"', 'coupler.model="auto"'])
-    rigid = load_scene(None, ['coupler.geometry="plate"'])
+    # nothing "auto": no calibration read (the bundled scene's solver keys are "auto")
+    rigid = load_scene(None, ['coupler.geometry="plate"', *settings.pinned_overrides()])
     before = case_hash(auto, simulate_case), case_hash(rigid, simulate_case)
-    # a re-fit installed as the default criterion file
-    refit = tmp_path / "criterion.toml"
-    refit.write_text("# another fit\n")
-    monkeypatch.setattr(criteria, "DEFAULT_CRITERION", refit)
-    assert case_hash(auto, simulate_case) != before[0]
-    assert case_hash(rigid, simulate_case) == before[1]
+    # a re-fit installed as the calibration's criterion file
+    refit = _calibration_copy(tmp_path / "refit", coupler_criterion="# another fit\n")
+    with_refit = functools.partial(simulate_case, calibration=refit)
+    assert case_hash(auto, with_refit) != before[0]
+    assert case_hash(rigid, with_refit) == before[1]
     # a law passed as an argument is part of the case function's identity
-    installed = criteria.Path(criteria.__file__).with_name("criteria_fit.toml")
-    law = criteria.load_criterion(installed)
-    with_law = functools.partial(simulate_case, criterion=law)
+    with_law = functools.partial(simulate_case, criterion=criterion_of())
     assert case_hash(auto, with_law) != case_hash(auto, simulate_case)

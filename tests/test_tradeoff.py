@@ -250,7 +250,8 @@ def test_knob_values_are_validated_with_the_accepted_range(overrides, words):
 
 @pytest.mark.slow
 def test_bundled_defaults_are_the_fastest_setting_within_the_default_tolerance():
-    # the tradeoff study's rule (flex/defaults_check.py: DEFAULT_TOLERANCE): crank angle 1e-6
+    # the tradeoff study's rule (flex/experiments/workprecision/defaults_check.py:
+    # DEFAULT_TOLERANCE): crank angle 1e-6
     # rad, slider 1e-7 m, step <= 1e-5 s (the thesis table's output grid); over the Newton
     # knobs at the largest step allowed, the defaults must be within the study's timing tie of
     # its pick (full and modified Newton at 1e-8 both take one iteration per step and swap
@@ -283,7 +284,7 @@ def test_bundled_defaults_are_the_fastest_setting_within_the_default_tolerance()
 @pytest.mark.slow
 def test_ffrf_default_reaches_the_scene_tolerance_much_faster_than_the_scene_settings(
         reduction_cache):
-    # README "Defaults": the bundled "auto" solver keys on the 1 mm plate (flex/settings.py:
+    # README "Defaults": the bundled "auto" solver keys on the 1 mm plate (flex/config/settings.py:
     # the tradeoff study's certified 1 % pick) against a finer FFRF run (h = 5e-6 s, 1.5 mm,
     # 12 modes: within 1.2e-3 of the study's reference, which is itself estimated accurate to
     # ~2e-3); the margin keeps the check about the default, not the test's reference

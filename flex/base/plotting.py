@@ -11,7 +11,7 @@ House style (what every study figure follows; :func:`review` checks the mechanic
   scale of their magnitude; a conserved quantity is shown as its relative drift
   (:func:`relative_drift`) on its own axis, never on a scale that hides it;
 - in a legend one style means one thing: colour for one dimension (the case), line style
-  or marker for another (the measure), explained by proxy entries (:func:`style_legend`)
+  or marker for another (the measure), explained by proxy entries (:func:`legend_below`)
   rather than by a caption in the title; abbreviations are spelt out.
 """
 
@@ -138,20 +138,6 @@ def log_ticks(ax, axis: str = "x") -> None:
     target.set_minor_locator(LogLocator(base=10, subs=np.arange(2, 10)))
     target.set_minor_formatter(NullFormatter())
     target.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
-
-
-def style_legend(ax, entries: Sequence[tuple[str, dict]], title: str | None = None,
-                 **kwargs):
-    """A legend of proxy entries ``(label, line style kwargs)`` -- to explain what a marker,
-    colour or line style means -- kept beside the axes' own legend (if any)."""
-    handles = [Line2D([], [], **({"color": "k", "linestyle": "none"} | style))
-               for _, style in entries]
-    previous = ax.get_legend()
-    legend = ax.legend(handles, [label for label, _ in entries], title=title,
-                       fontsize="small", title_fontsize="small", **kwargs)
-    if previous is not None:
-        ax.add_artist(previous)
-    return legend
 
 
 def legend_below(fig, entries: Sequence[tuple[str, dict]] = (), ncol: int | None = None,

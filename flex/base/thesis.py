@@ -6,7 +6,7 @@ its own figures are marked "approx." as it marks them. The library and the studi
 them from here (:mod:`flex.fidelity.criteria`, :mod:`flex.experiments.thesis.modal` and
 :mod:`flex.bodies.spring` re-export
 the ones they have always exposed); the closed forms that use them are in
-:mod:`flex.base.physics`. The bundled scene ``flex/scenes/cavezza2012.toml`` is the thesis's
+:mod:`flex.base.physics`. The bundled scene ``flex/data/scenes/cavezza2012.toml`` is the thesis's
 mechanism as an input file (data, with its own citations).
 
 SI units, in the names. No flex imports.

@@ -62,14 +62,8 @@ import numpy as np
 
 from flex.base.errors import SceneError
 from flex.bodies.plate import PlateLink, plate_mesh
-from flex.bodies.reduction import (
-    END_A,
-    END_B,
-    _mid_set,
-    _ngsolve_thread_count,
-    add_plate_markers,
-    as_vector3,
-)
+from flex.bodies.reduction.body import add_plate_markers, as_vector3
+from flex.bodies.reduction.build import END_A, END_B, _mid_set, _ngsolve_thread_count
 from flex.data.results import Dataset
 
 _MESH_ORDER = 2  # as the reduction: linear tets lock in bending

@@ -1,1 +1,2 @@
-"""What a scene resolves to: the "auto" solver settings and which keys a run uses."""
+"""What a scene resolves to: the calibration (fitted laws, FFRF rule, solver defaults), the
+"auto" solver settings and which keys a run uses."""

@@ -23,7 +23,8 @@ most demanding headline quantity), the rule chooses for an FFRF coupler on a rig
 
 The mode cut-off ratio, ``C`` and ``B`` are calibrated per tolerance level and per damping class
 (:func:`damping_class`) by ``make calibrate`` (:mod:`flex.experiments.fitting.calibration`) over a
-family of plates, materials, springs and drives, and live in ``flex/config/ffrf_rule.toml``
+family of plates, materials, springs and drives, and live in ``ffrf_rule.toml`` of a calibration
+(:mod:`flex.config.calibration`: the bundled ``flex/config/ffrf_rule.toml``, or one passed in)
 with the family's bounds and the worst calibration error. A tolerance between levels uses
 the next finer level. Outside the calibrated family (slenderness, a tolerance finer than the
 finest level of the class, an ``n`` that would need more steps than the grid, an FFRF crank,
@@ -36,14 +37,12 @@ Contract: pure functions of the scene's values; nothing is meshed or run.
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
-from functools import cache
-from importlib import resources
 from typing import Any
 
 from flex.base.physics import in_plane_fixed_interface_omegas, pinned_pinned_omega
+from flex.config.calibration import Calibration, calibration_of
 from flex.data.scene import MESH_ASPECT_LIMIT, plate_mass_properties
 
 #: steps per first bending period the rule chooses from (make calibrate's grid)
@@ -55,11 +54,10 @@ LINK_KEYS = ("modes", "mesh_size_m")
 AUTO = "auto"
 
 
-@cache
-def rule_constants() -> dict[str, Any]:
-    """The calibrated constants (``flex/config/ffrf_rule.toml``, read once)."""
-    text = resources.files("flex.config").joinpath("ffrf_rule.toml").read_text("utf-8")
-    return tomllib.loads(text)
+def rule_constants(calibration: Calibration | None = None) -> Mapping[str, Any]:
+    """The calibrated constants of ``calibration``'s rule (``ffrf_rule.toml``; None: the
+    bundled calibration's, :mod:`flex.config.calibration`)."""
+    return calibration_of(calibration).ffrf_rule
 
 
 @dataclass(frozen=True)
@@ -83,24 +81,25 @@ def first_period_s(link: Mapping[str, Any]) -> float:
     return 2.0 * math.pi / omega
 
 
-def rule_mesh_size_m(link: Mapping[str, Any], mesh: Mapping[str, float] | None = None
-                     ) -> float:
+def rule_mesh_size_m(link: Mapping[str, Any], mesh: Mapping[str, float] | None = None,
+                     calibration: Calibration | None = None) -> float:
     """Element size [m] the rule gives a plate link: ``min(MESH_PER_THICKNESS t, L /
     MESH_PER_LENGTH)``, and at most :data:`flex.data.scene.MESH_ASPECT_LIMIT` x the plate's
     smaller side (the elements' aspect limit the scene checks). ``mesh``: the constants
-    ``per_thickness`` and ``per_length`` (default: the installed ones)."""
-    mesh = rule_constants()["mesh"] if mesh is None else mesh
+    ``per_thickness`` and ``per_length`` (default: ``calibration``'s)."""
+    mesh = rule_constants(calibration)["mesh"] if mesh is None else mesh
     size = min(mesh["per_thickness"] * link["thickness_m"],
                link["length_m"] / mesh["per_length"])
     return float(min(size, MESH_ASPECT_LIMIT * min(link["thickness_m"], link["width_m"])))
 
 
-def outside_family(link: Mapping[str, Any], tolerance: float) -> str:
+def outside_family(link: Mapping[str, Any], tolerance: float,
+                   calibration: Calibration | None = None) -> str:
     """Why a plate link and tolerance lie outside the calibrated family ("" if inside)."""
-    family = rule_constants()["family"]
+    family = rule_constants(calibration)["family"]
     slenderness = link["length_m"] / link["thickness_m"]
-    damping = damping_class(link)
-    levels = _levels(damping)
+    damping = damping_class(link, calibration)
+    levels = _levels(damping, calibration)
     if not levels:
         return f"no level is calibrated for {damping} links"
     finest = levels[0]["tolerance"]
@@ -113,7 +112,7 @@ def outside_family(link: Mapping[str, Any], tolerance: float) -> str:
     return ""
 
 
-def damping_class(link: Mapping[str, Any]) -> str:
+def damping_class(link: Mapping[str, Any], calibration: Calibration | None = None) -> str:
     """``"damped"`` if the link's ``damping_ratio`` reaches the calibrated damped class's
     (``family.damped_ratio_min``), else ``"undamped"``.
 
@@ -123,21 +122,22 @@ def damping_class(link: Mapping[str, Any]) -> str:
     undamped, the peak is the highest of many crests over the whole run, and the step must
     keep the first mode's phase and the retained modes' ringing over every period of it.
     """
-    minimum = rule_constants()["family"].get("damped_ratio_min", math.inf)
+    minimum = rule_constants(calibration)["family"].get("damped_ratio_min", math.inf)
     return "damped" if link.get("damping_ratio", 0.0) >= minimum * (1 - 1e-9) else "undamped"
 
 
-def _levels(damping: str) -> list[dict[str, Any]]:
-    return sorted((level for level in rule_constants()["levels"]
+def _levels(damping: str, calibration: Calibration | None = None) -> list[dict[str, Any]]:
+    return sorted((level for level in rule_constants(calibration)["levels"]
                    if level.get("damping", damping) == damping),
                   key=lambda level: level["tolerance"])
 
 
-def level_for(tolerance: float, damping: str = "undamped") -> dict[str, Any]:
+def level_for(tolerance: float, damping: str = "undamped",
+              calibration: Calibration | None = None) -> dict[str, Any]:
     """The calibrated level of the ``damping`` class (:func:`damping_class`) that serves
     ``tolerance``: the coarsest level at or below it (the finest level when ``tolerance``
     is finer than every level)."""
-    levels = _levels(damping)
+    levels = _levels(damping, calibration)
     within = [level for level in levels if level["tolerance"] <= tolerance * (1 + 1e-9)]
     return within[-1] if within else levels[0]
 
@@ -214,20 +214,22 @@ def steps_per_first_period(level: Mapping[str, Any], n_load: float,
     return next((float(n) for n in STEP_GRID if n >= wanted * (1 - 1e-9)), None)
 
 
-def pick(scene: Mapping[str, Mapping[str, Any]], tolerance: float, link: str = "coupler"
-         ) -> RulePick:
-    """The rule's settings for the FFRF plate ``link`` of ``scene`` at ``tolerance``."""
+def pick(scene: Mapping[str, Mapping[str, Any]], tolerance: float, link: str = "coupler",
+         calibration: Calibration | None = None) -> RulePick:
+    """The rule's settings for the FFRF plate ``link`` of ``scene`` at ``tolerance``
+    (``calibration``'s rule; None: the bundled one)."""
     values = scene[link]
-    damping = damping_class(values)
-    mesh = rule_mesh_size_m(values)
-    outside = outside_family(values, tolerance)
+    damping = damping_class(values, calibration)
+    mesh = rule_mesh_size_m(values, calibration=calibration)
+    outside = outside_family(values, tolerance, calibration)
     period = first_period_s(values)
     n_load = load_time_scale_s(scene) / period
     if outside:  # the modes of the class's first level at this load, not the ratio alone
-        levels = _levels(damping) or _levels("undamped") or rule_constants()["levels"]
+        levels = (_levels(damping, calibration) or _levels("undamped", calibration)
+                  or rule_constants(calibration)["levels"])
         return RulePick(None, level_modes(levels[0], values, n_load), mesh, None,
                         f"outside the calibrated family ({outside})")
-    level = level_for(tolerance, damping)
+    level = level_for(tolerance, damping, calibration)
     if not holds_at(level, n_load):
         return RulePick(None, level_modes(level, values, n_load), mesh, None, (
             f"outside the calibrated family (n = t_load / T1 = {n_load:.3g} is outside the "
@@ -245,12 +247,12 @@ def pick(scene: Mapping[str, Mapping[str, Any]], tolerance: float, link: str = "
         f"worst calibration error {level['worst_error']:.2g}): n = t_load / T1 = "
         f"{n_load:.3g} (load time scale {load_time_scale_s(scene):.3g} s), step T1 / {per:g} "
         f"= {step:.3g} s (first bending period T1 = {period:.4g} s), {modes} "
-        f"in-plane modes ({_modes_text(level, n_load)}), mesh {_mesh_text()} = "
+        f"in-plane modes ({_modes_text(level, n_load)}), mesh {_mesh_text(calibration)} = "
         f"{mesh * 1e3:.3g} mm"))
 
 
-def _mesh_text() -> str:
-    mesh = rule_constants()["mesh"]
+def _mesh_text(calibration: Calibration | None) -> str:
+    mesh = rule_constants(calibration)["mesh"]
     return f"min({mesh['per_thickness']:g} t, L / {mesh['per_length']:g})"
 
 
@@ -264,17 +266,17 @@ def _modes_text(level: Mapping[str, Any], n_load: float) -> str:
     return text
 
 
-def fill_link_keys(scene: dict[str, dict[str, Any]], link: str, tolerance: float
-                   ) -> dict[str, Any]:
-    """Fill the ``"auto"`` modes and mesh size of ``scene[link]`` in place with the rule's;
-    return what was filled (key -> value)."""
+def fill_link_keys(scene: dict[str, dict[str, Any]], link: str, tolerance: float,
+                   calibration: Calibration | None = None) -> dict[str, Any]:
+    """Fill the ``"auto"`` modes and mesh size of ``scene[link]`` in place with the rule's
+    (``calibration``'s; None: the bundled one); return what was filled (key -> value)."""
     values = scene[link]
     wanted = [key for key in LINK_KEYS if values.get(key) == AUTO]
     if not wanted:
         return {}
     if values.get("geometry") != "plate":  # never meshed: left "auto"
         return {}
-    chosen = pick(scene, tolerance, link)
+    chosen = pick(scene, tolerance, link, calibration)
     chosen_modes, chosen_mesh = chosen.modes, chosen.mesh_size_m
     choice = {"modes": chosen_modes, "mesh_size_m": chosen_mesh}
     filled = {key: choice[key] for key in wanted}

@@ -3,8 +3,9 @@
 The bundled scene leaves ``simulation.step_s``, ``spectral_radius``, ``newton`` and
 ``newton_relative_tolerance`` to flex (``"auto"``); a number (or choice) written in a scene
 or given with ``--set`` always wins. :func:`resolve_solver_settings` fills the ``"auto"`` keys
-from ``flex/config/solver_defaults.toml``, the settings ``make tradeoff`` measured as fastest within
-a certified accuracy:
+from ``solver_defaults.toml`` of a calibration (:mod:`flex.config.calibration`: the bundled
+``flex/config/solver_defaults.toml``, or one passed in), the settings ``make tradeoff``
+measured as fastest within a certified accuracy:
 
 - ``ffrf_coupler`` (h = 4e-4 s, modified Newton): an FFRF coupler on a rigid crank, when the
   scene's ``fidelity.tolerance`` is at least the entry's certified ``accuracy`` (1 %) and the
@@ -33,15 +34,13 @@ from __future__ import annotations
 
 import copy
 import math
-import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass
-from functools import cache
-from importlib import resources
 from typing import Any
 
 from flex.base.errors import SceneError
-from flex.config.ffrf_rule import LINK_KEYS, RulePick, fill_link_keys, pick
+from flex.config.calibration import Calibration, calibration_of
+from flex.config.ffrf_rule import LINK_KEYS, RulePick, fill_link_keys, pick, rule_constants
 from flex.data.scene import (
     BUILTIN_LINK_SCHEMAS,
     Scene,
@@ -65,7 +64,8 @@ FALLBACK = ("the flexible fallback (the rigid model's 40x smaller step with modi
 
 @dataclass(frozen=True)
 class SolverChoice:
-    """Which entry of ``flex/config/solver_defaults.toml`` filled the ``"auto"`` keys, and why.
+    """Which entry of the solver defaults (``solver_defaults.toml``) filled the ``"auto"``
+    keys, and why.
 
     ``entry``: ``"rigid"`` or ``"ffrf_coupler"``; ``accuracy``: the relative error the entry
     is certified to on the model it was measured on (dimensionless); ``keys``: the keys it
@@ -85,11 +85,10 @@ class SolverChoice:
                 "solver_defaults_reason": self.reason}
 
 
-@cache
-def solver_defaults() -> dict[str, dict[str, Any]]:
-    """The entries of ``flex/config/solver_defaults.toml`` (read once)."""
-    text = resources.files("flex.config").joinpath("solver_defaults.toml").read_text("utf-8")
-    return tomllib.loads(text)
+def solver_defaults(calibration: Calibration | None = None) -> Mapping[str, Mapping[str, Any]]:
+    """The entries of ``calibration``'s ``solver_defaults.toml`` (None: the bundled
+    calibration's, ``flex/config/solver_defaults.toml``; :mod:`flex.config.calibration`)."""
+    return calibration_of(calibration).solver_defaults
 
 
 def has_auto(scene: Scene) -> bool:
@@ -103,20 +102,22 @@ def has_auto_link_keys(scene: Scene) -> bool:
                for key in LINK_KEYS)
 
 
-def resolve_link_keys(scene: Scene) -> tuple[Scene, dict[str, Any]]:
+def resolve_link_keys(scene: Scene, calibration: Calibration | None = None
+                      ) -> tuple[Scene, dict[str, Any]]:
     """``scene`` (a copy) with the links' ``"auto"`` modes and mesh size filled by the rule
-    (:func:`flex.config.ffrf_rule.fill_link_keys` at ``fidelity.tolerance``), and what was
-    filled (``"coupler.modes"`` -> value)."""
+    (:func:`flex.config.ffrf_rule.fill_link_keys` at ``fidelity.tolerance``, ``calibration``'s
+    rule; None: the bundled one), and what was filled (``"coupler.modes"`` -> value)."""
     resolved = copy.deepcopy(scene)
     filled: dict[str, Any] = {}
     tolerance = float(scene["fidelity"]["tolerance"])
     for link in ("crank", "coupler"):
-        for key, value in fill_link_keys(resolved, link, tolerance).items():
+        for key, value in fill_link_keys(resolved, link, tolerance, calibration).items():
             filled[f"{link}.{key}"] = value
     return resolved, filled
 
 
-def choose_entry(scene: Scene, *, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
+def choose_entry(scene: Scene, calibration: Calibration | None = None, *,
+                 link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
                  ) -> tuple[str, str, RulePick | None]:
     """The entry (``"rigid"``, ``"ffrf_rule"`` or ``"flexible_fallback"``) for ``scene``,
     the reason, and the rule's pick (``ffrf_rule`` only). ``link_models``: the registry of
@@ -131,7 +132,7 @@ def choose_entry(scene: Scene, *, link_models: Mapping[str, Any] = BUILTIN_LINK_
         what = ("an FFRF crank" if crank.modal else f'coupler.model = "{coupler.name}"')
         return "flexible_fallback", f"no calibrated rule for {what}: {FALLBACK}", None
     tolerance = float(scene["fidelity"]["tolerance"])
-    chosen = pick(scene, tolerance)
+    chosen = pick(scene, tolerance, calibration=calibration)
     if chosen.step_s is None:
         return "flexible_fallback", f"FFRF coupler {chosen.reason}: {FALLBACK}", None
     reason = f"FFRF coupler on a rigid crank at fidelity.tolerance = {tolerance:g}: {chosen.reason}"
@@ -142,17 +143,16 @@ def choose_entry(scene: Scene, *, link_models: Mapping[str, Any] = BUILTIN_LINK_
     return "ffrf_rule", reason, chosen
 
 
-def finest_certified_accuracy() -> tuple[float, str]:
+def finest_certified_accuracy(calibration: Calibration | None = None) -> tuple[float, str]:
     """The smallest relative error any model's settings are certified to (the solver
     defaults' ``accuracy`` and the FFRF rule's calibrated levels), and where it comes from."""
-    from flex.config.ffrf_rule import rule_constants
 
     # the fallback's and the rule entry's "accuracy" are placeholders, not certifications
     found = [(float(entry["accuracy"]), f"solver defaults entry '{name}'")
-             for name, entry in solver_defaults().items()
+             for name, entry in solver_defaults(calibration).items()
              if "accuracy" in entry and name not in ("flexible_fallback", "ffrf_rule")]
     found += [(float(level["tolerance"]), "the FFRF settings rule's finest level")
-              for level in rule_constants()["levels"]]
+              for level in rule_constants(calibration)["levels"]]
     return min(found)
 
 
@@ -167,14 +167,14 @@ def reads_tolerance(scene: Scene, *, link_models: Mapping[str, Any] = BUILTIN_LI
             and link_model("crank", scene["crank"], link_models).rigid)
 
 
-def tolerance_beyond_reach(scene: Scene, *,
+def tolerance_beyond_reach(scene: Scene, calibration: Calibration | None = None, *,
                            link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> str:
     """Why ``fidelity.tolerance`` asks for more than flex can certify ("" if it does not, or
     if no ``auto`` choice reads it): a tolerance below :func:`finest_certified_accuracy`
     is met by no model flex has measured (``auto`` then takes its most accurate model, up to
     the nonlinear FE coupler, whose own error is not known to be that small)."""
     tolerance = float(scene["fidelity"]["tolerance"])
-    finest, source = finest_certified_accuracy()
+    finest, source = finest_certified_accuracy(calibration)
     if tolerance >= finest * (1 - 1e-9) or not reads_tolerance(scene,
                                                                 link_models=link_models):
         return ""
@@ -191,15 +191,17 @@ def whole_steps_s(step_s: float, end_time_s: float, multiple: int) -> float:
     return end_time_s / (multiple * groups)
 
 
-def resolve_solver_settings(scene: Scene, *, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
+def resolve_solver_settings(scene: Scene, calibration: Calibration | None = None, *,
+                            link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
                             ) -> tuple[Scene, SolverChoice | None]:
-    """``scene`` with its ``"auto"`` solver and link keys filled in (see module doc);
+    """``scene`` with its ``"auto"`` solver and link keys filled in (see module doc), from
+    ``calibration``'s solver defaults and rule (None: the bundled calibration);
     ``link_models``: the registry of its link models."""
     if not (has_auto(scene) or has_auto_link_keys(scene)):
         return scene, None
-    resolved, filled = resolve_link_keys(scene)
-    name, reason, chosen = choose_entry(resolved, link_models=link_models)
-    entry = solver_defaults()[name]
+    resolved, filled = resolve_link_keys(scene, calibration)
+    name, reason, chosen = choose_entry(resolved, calibration, link_models=link_models)
+    entry = solver_defaults(calibration)[name]
     values = dict(entry)
     accuracy = entry["accuracy"]
     if chosen is not None:  # the end time a whole number of 4 steps: the error estimate's
@@ -222,8 +224,9 @@ def resolve_solver_settings(scene: Scene, *, link_models: Mapping[str, Any] = BU
     return resolved, SolverChoice(name, accuracy, filled, reason)
 
 
-def resolved_simulation(scene: Scene, *,
-                        link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> dict[str, Any]:
+def resolved_simulation(scene: Scene, calibration: Calibration | None = None, *,
+                        link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
+                        ) -> dict[str, Any]:
     """The ``[simulation]`` section of ``scene`` with ``"auto"`` keys filled in.
 
     For code that needs the step before a run (its links must be concrete; an ``"auto"``
@@ -235,7 +238,8 @@ def resolved_simulation(scene: Scene, *,
     for link in ("crank", "coupler"):
         if probe[link]["model"] == AUTO:
             probe[link]["model"] = model_names(link, link_models, rigid=True)[0]
-    return resolve_solver_settings(probe, link_models=link_models)[0]["simulation"]
+    return resolve_solver_settings(probe, calibration,
+                                   link_models=link_models)[0]["simulation"]
 
 
 #: the coupler's modes and mesh size the bundled scene had before they became "auto" (6
@@ -244,14 +248,15 @@ def resolved_simulation(scene: Scene, *,
 PINNED_COUPLER_DISCRETIZATION = ("coupler.modes=6", "coupler.mesh_size_m=0.002")
 
 
-def pinned_overrides(entry: str = "rigid") -> list[str]:
+def pinned_overrides(entry: str = "rigid", calibration: Calibration | None = None
+                     ) -> list[str]:
     """``--set`` overrides that fix the solver keys to an entry's values (and the coupler's
     modes and mesh size to :data:`PINNED_COUPLER_DISCRETIZATION`).
 
     For studies whose numbers must not move with the defaults (a knob study varies one
     setting around a fixed base; a thesis figure needs the 1e-5 s grid).
     """
-    values = solver_defaults()[entry]
+    values = solver_defaults(calibration)[entry]
     return [f"simulation.{key}={values[key]!r}" if not isinstance(values[key], str)
             else f'simulation.{key}="{values[key]}"' for key in AUTO_KEYS] + list(
         PINNED_COUPLER_DISCRETIZATION)

@@ -315,12 +315,13 @@ def _announce_mesh(link: str, values: dict[str, Any], what: str, modes: int | No
 
 
 def reduction_for_scene(scene: Scene, link: str = "coupler", *,
-                        cache_dir: Path | None = None):
+                        cache_dir: Path | None = None, mesh_order: int = 2):
     """The Craig-Bampton reduction of the scene's plate ``link`` (coupler or crank).
 
     ``cache_dir``: the reduction cache folder (loaded from there if present, written there
     if built; :func:`flex.bodies.reduction.reduction_cache_dir` names the user's), or None to
-    build it in memory without any disk cache.
+    build it in memory without any disk cache. ``mesh_order``: the tetrahedra's order (2, or
+    1 for the work-precision study's linear ones).
     """
     from flex.bodies.reduction import build_reduction
 
@@ -335,7 +336,7 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
         return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
                                c["youngs_modulus_Pa"], c["density_kg_per_m3"],
                                c["poisson_ratio"], c["mesh_size_m"], c["modes"], cache_dir,
-                               mode_selection=c["mode_selection"])
+                               mode_selection=c["mode_selection"], mesh_order=mesh_order)
 
 
 def _prepare_reduction(scene: Scene, link: str, given: Any, cache_dir: Path | None) -> Any:

@@ -45,6 +45,7 @@ from flex.base.physics import (
     pinned_pinned_omega,
     plate_thickness_for_mass_m,
 )
+from flex.config.calibration import Calibration
 from flex.config.settings import (
     AUTO,
     SolverChoice,
@@ -61,13 +62,11 @@ from flex.dynamics.link_models import (
     LinkModel,
 )
 from flex.fidelity.criteria import (
-    DEFAULT_CRANK_CRITERION,
     EULER_LOAD_LIMIT,
-    Criterion,
     euler_load_ratio,
     flexible_rung,
-    load_criterion,
 )
+from flex.fidelity.laws import Criterion, criterion_of
 from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection
 from flex.fidelity.probe import FidelityDecision, deployment_probe, probe_scene
 from flex.fidelity.spring_choice import decide_spring
@@ -136,7 +135,8 @@ def candidates(scene: Scene, link_models: Mapping[str, LinkModel] = BUILTIN_LINK
     return out
 
 
-def check(scene: Scene, link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
+def check(scene: Scene, calibration: Calibration | None = None, *,
+          link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
           ) -> dict[str, tuple[Scene, SolverChoice | None]]:
     """Refuse, before anything is built, meshed or simulated, a scene none of whose
     resolutions can run (:class:`SceneError`, one line naming the key and the accepted
@@ -145,9 +145,11 @@ def check(scene: Scene, link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODE
     check that fails for only some choices is left to the run, which then stores a failed
     case naming it); with ``"auto"`` models, the rigid probe must fit the step limit
     (:func:`flex.fidelity.probe.probe_scene`). Returns the candidates that passed, resolved,
-    by their TOML (what :func:`resolve` reuses). Takes milliseconds. ``link_models``: the
+    by their TOML (what :func:`resolve` reuses). Takes milliseconds. ``calibration``: what
+    the ``"auto"`` values resolve from (None: the bundled calibration); ``link_models``: the
     registry of the scene's link models."""
-    linked, _ = resolve_link_keys(scene)  # an "auto" link's plate too: what it may mesh
+    # an "auto" link's plate too: what it may mesh
+    linked, _ = resolve_link_keys(scene, calibration)
     for link in LINKS:
         check_meshed_plate(link, linked[link], link_models)
     options = candidates(scene, link_models)
@@ -155,7 +157,8 @@ def check(scene: Scene, link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODE
     errors: list[SceneError] = []
     for candidate in options:
         try:
-            resolved, choice = resolve_solver_settings(candidate, link_models=link_models)
+            resolved, choice = resolve_solver_settings(candidate, calibration,
+                                                       link_models=link_models)
             check_concrete(resolved, choice, link_models=link_models)
             passed[to_toml(candidate)] = (resolved, choice)
         except SceneError as exc:
@@ -165,21 +168,23 @@ def check(scene: Scene, link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODE
             raise errors[0]
         raise SceneError(f'{errors[0]} (for every model "auto" may choose)')
     if len(options) > 1 or AUTO in (scene["crank"]["model"], scene["coupler"]["model"]):
-        probe_scene(scene)
+        probe_scene(scene, calibration=calibration)
     return passed
 
 
 def resolve(scene: Scene, criterion: Criterion | None = None,
             crank_criterion: Criterion | None = None, *, cache_dir: Path | None = None,
-            quiet: bool = False,
+            quiet: bool = False, calibration: Calibration | None = None,
             link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> Resolution:
     """Decide every ``"auto"`` of a validated scene (see the module doc); raises
     :class:`SceneError` for a scene that cannot run or an ``auto`` that refuses.
-    ``criterion`` / ``crank_criterion``: the coupler's and the crank's fitted laws (None: the
-    installed ones); ``cache_dir``: the reduction cache folder of the crank's frequency
-    analysis (None: in memory); ``link_models``: the registry of the scene's link models
-    (``auto`` itself decides among the built-in ones, whose laws are fitted)."""
-    passed = check(scene, link_models)
+    ``criterion`` / ``crank_criterion``: the coupler's and the crank's fitted laws (None:
+    ``calibration``'s); ``cache_dir``: the reduction cache folder of the crank's frequency
+    analysis (None: in memory); ``calibration``: the laws, FFRF rule and solver defaults the
+    ``"auto"`` values resolve from (:mod:`flex.config.calibration`; None: the bundled one);
+    ``link_models``: the registry of the scene's link models (``auto`` itself decides among
+    the built-in ones, whose laws are fitted)."""
+    passed = check(scene, calibration, link_models=link_models)
     decisions: list[FidelityDecision] = []
     concrete = scene
     if concrete["drive"]["spring_model"] == AUTO:
@@ -187,11 +192,12 @@ def resolve(scene: Scene, criterion: Criterion | None = None,
         decisions.append(decide_spring(concrete))
     if AUTO in (concrete["crank"]["model"], concrete["coupler"]["model"]):
         concrete, links = decide_links(concrete, criterion, crank_criterion,
-                                       cache_dir=cache_dir)
+                                       cache_dir=cache_dir, calibration=calibration)
         decisions += links
     reused = passed.get(to_toml(concrete))
     resolved, choice = (reused if reused is not None
-                        else resolve_solver_settings(concrete, link_models=link_models))
+                        else resolve_solver_settings(concrete, calibration,
+                                                     link_models=link_models))
     if reused is None:
         check_concrete(resolved, choice, link_models=link_models)
     if not quiet:
@@ -338,7 +344,7 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]], *,
 def decide_links(scene: Mapping[str, Mapping[str, Any]],
                      criterion: Criterion | None = None,
                      crank_criterion: Criterion | None = None, *,
-                     cache_dir: Path | None = None,
+                     cache_dir: Path | None = None, calibration: Calibration | None = None,
                      ) -> tuple[dict[str, dict[str, Any]], list[FidelityDecision]]:
     """Replace ``"auto"`` link models by concrete ones; return the scene and the decisions.
 
@@ -351,15 +357,14 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
     (rigid when n >= k(tolerance), conservative k, :meth:`ErrorLaw.k` ``upper``) stays in the
     reason and the attributes as the baseline.
     ``crank.model = "auto"`` is decided the same way, with the crank's own law
-    (``crank_criterion``, default
-    :data:`DEFAULT_CRANK_CRITERION`) and its first in-plane elastic frequency in the
-    assembled mechanism (:func:`crank_elastic_omega`; a lumped crank is
-    analysed as a plate of its mass, :func:`equivalent_crank_plate`), and its deflection
-    error predicted from the probe's loads (deciding without a wing, stored beside the
-    n-law's verdict with one: :func:`_crank_by_loads`): ``"rigid"``, or
-    ``"ffrf"`` with its modes for a plate crank; a lumped crank the criterion calls flexible,
-    or a flexible one with a constant-speed drive, is refused with a :class:`SceneError`. A
-    coupler loaded beyond :data:`EULER_LOAD_LIMIT` of its
+    (``crank_criterion``, default ``calibration``'s, :func:`flex.fidelity.laws.criterion_of`)
+    and its first in-plane elastic frequency in the assembled mechanism
+    (:func:`crank_elastic_omega`; a lumped crank is analysed as a plate of its mass,
+    :func:`equivalent_crank_plate`), and its deflection error predicted from the probe's loads
+    (deciding without a wing, stored beside the n-law's verdict with one:
+    :func:`_crank_by_loads`): ``"rigid"``, or ``"ffrf"`` with its modes for a plate crank; a
+    lumped crank the criterion calls flexible, or a flexible one with a constant-speed drive, is
+    refused with a :class:`SceneError`. A coupler loaded beyond :data:`EULER_LOAD_LIMIT` of its
     Euler load is refused too (outside the fit). ``drive.spring_model = "auto"`` must be
     resolved before (:func:`resolve` does it first, with
     :func:`flex.fidelity.spring_choice.decide_spring`). Scenes without ``auto`` are returned
@@ -375,28 +380,30 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
     decisions: list[FidelityDecision] = []
     if not (wants_coupler or wants_crank):
         return resolved, decisions
-    criterion = criterion or load_criterion()
+    criterion = criterion or criterion_of(calibration, "coupler")
     tolerance = float(resolved["fidelity"]["tolerance"])
-    delta_t_s, how, probe = deployment_probe(resolved)
+    delta_t_s, how, probe = deployment_probe(resolved, calibration)
     if wants_coupler:
-        decision, how = _decide_coupler(resolved, probe, delta_t_s, how, tolerance, criterion)
+        decision, how = _decide_coupler(resolved, probe, delta_t_s, how, tolerance, criterion,
+                                        calibration)
         decisions.append(decision)
     if wants_crank:
         decisions.append(_decide_crank(resolved, probe, delta_t_s, how, tolerance,
-                                       crank_criterion or load_criterion(
-                                           DEFAULT_CRANK_CRITERION), cache_dir))
+                                       crank_criterion or criterion_of(calibration, "crank"),
+                                       cache_dir, calibration))
     return resolved, decisions
 
 
 def _mode_cut(decision: FidelityDecision, resolved: dict[str, dict[str, Any]], link: str,
-              k_phys: float, delta_t_s: float) -> None:
+              k_phys: float, delta_t_s: float, calibration: Calibration | None = None) -> None:
     """An ``ffrf`` decision keeps every estimated mode below omega_cut = k / delta_t; a link
     whose ``modes`` is ``"auto"`` gets the tolerance rule's instead (:mod:`flex.config.
     ffrf_rule`, with the mesh and the step)."""
     if resolved[link]["modes"] == "auto":
         from flex.config.ffrf_rule import fill_link_keys
 
-        decision.modes = fill_link_keys(resolved, link, decision.tolerance)["modes"]
+        decision.modes = fill_link_keys(resolved, link, decision.tolerance,
+                                        calibration)["modes"]
         decision.reason += (f"; modes = {decision.modes}: the tolerance rule's "
                             f"(flex.config.ffrf_rule)")
         return
@@ -408,8 +415,8 @@ def _mode_cut(decision: FidelityDecision, resolved: dict[str, dict[str, Any]], l
 
 
 def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.ndarray],
-                    delta_t_s: float, how: str, tolerance: float, criterion: Criterion
-                    ) -> tuple[FidelityDecision, str]:
+                    delta_t_s: float, how: str, tolerance: float, criterion: Criterion,
+                    calibration: Calibration | None = None) -> tuple[FidelityDecision, str]:
     """The coupler's decision (refused near buckling); returns it and ``how`` with the
     compressive load added."""
     coupler = resolved["coupler"]
@@ -435,7 +442,7 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
         _climb(decision, coupler, ratio, tolerance)
     coupler["model"] = decision.model
     if BUILTIN_LINK_MODELS[decision.model].modal:
-        _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s)
+        _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s, calibration)
     return decision, how
 
 
@@ -478,7 +485,8 @@ def _decide_by_loads(decision: FidelityDecision, predicted_rigid_error: float,
 
 def _decide_crank(resolved: dict[str, dict[str, Any]], probe: dict[str, np.ndarray],
                   delta_t_s: float, how: str, tolerance: float, crank_criterion: Criterion,
-                  cache_dir: Path | None = None) -> FidelityDecision:
+                  cache_dir: Path | None = None, calibration: Calibration | None = None
+                  ) -> FidelityDecision:
     """The crank's decision from its own law and its in-mechanism frequency (its reduction
     cached in ``cache_dir``, None: in memory), then from the ``probe``'s loads
     (:func:`_crank_by_loads`); a flexible verdict for a lumped crank or with a
@@ -510,7 +518,7 @@ def _decide_crank(resolved: dict[str, dict[str, Any]], probe: dict[str, np.ndarr
                              f"flexible ({decision.reason}), but a flexible crank needs "
                              f'drive.kind = "spring"; set crank.model = "{RIGID}" to accept '
                              f"the error")
-        _mode_cut(decision, resolved, "crank", k_phys, delta_t_s)
+        _mode_cut(decision, resolved, "crank", k_phys, delta_t_s, calibration)
     decision.reason += ("; crank law from "
                         + (Path(crank_criterion.source).name or "(in memory)"))
     crank["model"] = decision.model

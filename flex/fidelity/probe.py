@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
+from flex.config.calibration import Calibration
 from flex.config.settings import solver_defaults
 from flex.data.scene import MAX_STEPS
 from flex.dynamics.link_models import RIGID
@@ -67,10 +68,11 @@ class FidelityDecision:
 
 
 
-def probe_scene(scene: Mapping[str, Mapping[str, Any]], end_time_s: float | None = None
-                ) -> dict[str, dict[str, Any]]:
+def probe_scene(scene: Mapping[str, Mapping[str, Any]], end_time_s: float | None = None,
+                calibration: Calibration | None = None) -> dict[str, dict[str, Any]]:
     """The rigid probe run of ``scene`` (see the module doc) over ``end_time_s`` [s] (None:
-    the scene's): a concrete scene, every link rigid, its step and end time set, every
+    the scene's), with ``calibration``'s rigid solver defaults (None: the bundled ones): a
+    concrete scene, every link rigid, its step and end time set, every
     sample stored. Raises :class:`SceneError` for a constant-speed drive at rest (no half
     turn to probe) and for a probe over the step limit."""
     rigid = copy.deepcopy({k: dict(v) for k, v in scene.items()})
@@ -84,7 +86,7 @@ def probe_scene(scene: Mapping[str, Mapping[str, Any]], end_time_s: float | None
                              "drive.crank_speed_rad_per_s != 0 (the criterion uses half a "
                              "crank turn as the deployment time)")
         end = min(end, math.pi / speed)
-    rigid_entry = solver_defaults()["rigid"]
+    rigid_entry = solver_defaults(calibration)["rigid"]
     step = scene["simulation"]["step_s"]
     step = min(float(rigid_entry["step_s"] if step == "auto" else step), PROBE_MAX_STEP_S,
                end / PROBE_SAMPLES)
@@ -102,6 +104,7 @@ def probe_scene(scene: Mapping[str, Mapping[str, Any]], end_time_s: float | None
 
 
 def deployment_probe(scene: Mapping[str, Mapping[str, Any]],
+                     calibration: Calibration | None = None,
                      ) -> tuple[float, str, dict[str, np.ndarray]]:
     """Deployment time [s] of a scene for the criterion, how it was obtained, and the rigid
     probe run's data (result paths -> arrays).
@@ -117,7 +120,7 @@ def deployment_probe(scene: Mapping[str, Mapping[str, Any]],
     end = float(scene["simulation"]["end_time_s"])
     drive = scene["drive"]
     for _ in range(4):
-        result = integrate(probe_scene(scene, end), "fidelity_probe")
+        result = integrate(probe_scene(scene, end, calibration), "fidelity_probe")
         data = {k: np.asarray(v.data) for k, v in result.datasets.items()}
         if drive["kind"] == "constant_speed":
             return (math.pi / abs(drive["crank_speed_rad_per_s"]),

@@ -208,7 +208,7 @@ class SpringDecision(FidelityDecision):
 def decide_spring(resolved: dict[str, dict[str, Any]]) -> SpringDecision:
     """Resolve ``drive.spring_model = "auto"`` in ``resolved`` (in place: ``"massless"``, or
     ``"chain"`` with ``spring_segments``) from a rigid massless probe run
-    (:func:`flex.fidelity.criteria.deployment_probe`) and ``fidelity.tolerance``; return the
+    (:func:`flex.fidelity.probe.deployment_probe`) and ``fidelity.tolerance``; return the
     decision. SceneError without a spring drive."""
     drive = resolved["drive"]
     if drive["kind"] != "spring":

@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 import tomllib
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -366,10 +365,3 @@ def sample_indices(count: int, every: int) -> np.ndarray:
         raise FlexError(f"--every {every!r}: must be an integer >= 1")
     indices = np.arange(0, count, every)
     return indices if indices[-1] == count - 1 else np.append(indices, count - 1)
-
-
-def iterate_states(motion: CaseMotion, indices: np.ndarray
-                   ) -> Iterator[tuple[int, dict[str, BodyState]]]:
-    """``(index, states)`` for each motion sample index."""
-    for index in indices:
-        yield int(index), motion.states(int(index))

@@ -56,7 +56,8 @@ from flex.base.mechanism_checks import (
 )
 from flex.base.thesis import THESIS_ANGLE_MAX_TIME_S, THESIS_SPRING_RATE_N_PER_M
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene, apply_overrides, validate
+from flex.data.scene import Scene
+from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import RIGID
 from flex.experiments.fitting.kfit import mesh_size_m
 from flex.experiments.fitting.lawfit import case_data
@@ -217,13 +218,12 @@ def point_scene(scene: Scene, point: Point) -> Scene:
     deployment (:data:`END_TIME_FACTOR`)."""
     angle, preload, rate, thickness = point
     end = END_TIME_FACTOR * THESIS_ANGLE_MAX_TIME_S * math.sqrt(THESIS_SPRING_RATE_N_PER_M / rate)
-    case = apply_overrides(scene, [f"crank.initial_angle_deg={angle!r}",
-                                   f"drive.spring_preload_m={preload!r}",
-                                   f"drive.spring_stiffness_N_per_m={rate!r}",
-                                   f"coupler.thickness_m={thickness!r}",
-                                   f"coupler.mesh_size_m={mesh_size_m(thickness)!r}",
-                                   f"simulation.end_time_s={float(f'{end:.3g}')!r}"])
-    validate(case)
+    case = derive_scene(scene, [f"crank.initial_angle_deg={angle!r}",
+                                f"drive.spring_preload_m={preload!r}",
+                                f"drive.spring_stiffness_N_per_m={rate!r}",
+                                f"coupler.thickness_m={thickness!r}",
+                                f"coupler.mesh_size_m={mesh_size_m(thickness)!r}",
+                                f"simulation.end_time_s={float(f'{end:.3g}')!r}"])
     return case
 
 

@@ -30,7 +30,8 @@ from scipy.optimize import brentq
 
 from flex.base.errors import FlexError
 from flex.data.results import CaseResult, Dataset, write_results
-from flex.data.scene import Scene, apply_overrides, to_toml, validate
+from flex.data.scene import Scene, to_toml
+from flex.data.scene_edit import derive_scene
 from flex.experiments.design.cases import A36_YIELD_STRESS_PA, design_case
 from flex.experiments.design.summary import table, table_datasets
 from flex.experiments.fitting.kfit import mesh_size_m
@@ -132,12 +133,10 @@ def check_scene(scene: Scene, question: Question) -> None:
 def scene_for(scene: Scene, vary: str, value: float) -> Scene:
     """``scene`` with the varied input set (a thickness also sets its mesh)."""
     section, key = VARIABLES[vary][:2]
-    overrides = [f"{section}.{key}={float(value)!r}"]
+    overrides = {f"{section}.{key}": float(value)}
     if vary == "thickness":
-        overrides.append(f"coupler.mesh_size_m={mesh_size_m(value)!r}")
-    changed = apply_overrides(scene, overrides)
-    validate(changed)
-    return changed
+        overrides["coupler.mesh_size_m"] = mesh_size_m(value)
+    return derive_scene(scene, overrides)
 
 
 def evaluator(scene: Scene, question: Question, cache_dir: Path | None,

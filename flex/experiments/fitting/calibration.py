@@ -535,5 +535,5 @@ def rule_toml(levels: Sequence[Mapping[str, Any]], bounds: Mapping[str, float],
               for level in levels if level.get("modes") is not None]
     head = ("# Constants of the FFRF settings rule (flex/config/ffrf_rule.py), written by make "
             "calibrate\n# (results/calibrate.h5, dataset /summary/rule/toml) and installed "
-            "by make rule-install.\n")
+            "by make calibration-install.\n")
     return head + tomli_w.dumps({"mesh": dict(mesh), "family": dict(bounds), "levels": fitted})

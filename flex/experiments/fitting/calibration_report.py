@@ -62,7 +62,7 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
     designs = design_frontier(family)
     twins = [{**row, "tolerance": level} for level in LEVELS for row in near_twins(family, level)]
     toml = rule_toml(fitted, bounds, rule_constants()["mesh"])
-    datasets = {"rule/toml": Dataset(toml, "1", "the rule's constants (make rule-install)")}
+    datasets = {"rule/toml": Dataset(toml, "1", "the rule's constants (make calibration-install)")}
     for index, level in enumerate(fitted):
         prefix = f"levels/{index}"
         datasets[f"{prefix}/damping"] = Dataset(level["damping"], "1", "damping class")
@@ -265,7 +265,8 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
                                      for row in in_sample)])
     lines += ["", f"Validation: {_tally(_certifiable_rows(rows))}.",
               *_cross_lines(left_out), *comparison,
-              "", "## Rule constants (make rule-install)", "", "```toml", toml.strip(), "```"]
+              "", "## Rule constants (make calibration-install)", "", "```toml",
+              toml.strip(), "```"]
     return "\n".join(lines)
 
 
@@ -420,10 +421,12 @@ def fitted_levels(datasets: Mapping[str, Dataset]) -> list[dict[str, Any]]:
     return out
 
 
-def install_rule(result_path: Path, rule_path: Path) -> str:
-    """Copy the fitted rule of a ``calibrate`` result file to ``rule_path`` (atomically);
-    return what was done. Raises :class:`flex.base.errors.FlexError` for a file that is not
-    a finished calibrate result or a rule without any calibrated level."""
+def extract_rule(result_path: Path, rule_path: Path) -> str:
+    """Write the fitted rule of a ``calibrate`` result file to ``rule_path`` (atomically;
+    ``results/calibrate-rule.toml``, which ``make calibration-install`` installs:
+    :func:`flex.config.calibration.install_calibration`); return what was done. Raises
+    :class:`flex.base.errors.FlexError` for a file that is not a finished calibrate result or a
+    rule without any calibrated level."""
     import os
     import tempfile
     import tomllib
@@ -448,7 +451,7 @@ def install_rule(result_path: Path, rule_path: Path) -> str:
     with os.fdopen(handle, "w", encoding="utf-8") as stream:
         stream.write(text)
     os.replace(staged, rule_path)
-    return f"installed the rule of {result_path} as {rule_path}"
+    return f"wrote the rule of {result_path} to {rule_path}"
 
 
 if __name__ == "__main__":
@@ -458,10 +461,11 @@ if __name__ == "__main__":
 
     if len(sys.argv) != 3:
         print("usage: python -m flex.experiments.fitting.calibration_report RESULT.h5 RULE.toml "
-              "(install a calibrate run's fitted FFRF rule)", file=sys.stderr)
+              "(write a calibrate run's fitted FFRF rule, for make calibration-install)",
+              file=sys.stderr)
         raise SystemExit(2)
     try:
-        print(install_rule(Path(sys.argv[1]), Path(sys.argv[2])))
+        print(extract_rule(Path(sys.argv[1]), Path(sys.argv[2])))
     except FlexError as exc:
         print(f"flex: {exc}", file=sys.stderr)
         raise SystemExit(2) from None

@@ -30,7 +30,6 @@ there (the 0.5 mm plate at the thesis spring, 0.33 P_E; 1 mm at 15000 N/m, 0.49 
 
 from __future__ import annotations
 
-import copy
 import functools
 import math
 import time
@@ -44,7 +43,8 @@ from flex.base.thesis import THESIS_ANGLE_MAX_TIME_S
 from flex.base.thesis import THESIS_COMPRESSION_M as THESIS_PRELOAD_M  # sec. 6.1
 from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M as THESIS_SPRING_N_PER_M  # Table 2
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene, apply_overrides, to_toml, validate
+from flex.data.scene import Scene, to_toml
+from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import FFRF
 from flex.experiments.fitting import lawfit
 from flex.experiments.fitting.lawfit import case_data
@@ -109,20 +109,20 @@ def tuned(scene: Scene) -> Scene:
     step = min(1e-4, TWO_PI / omega / 40.0, estimate / 400.0)
     step = float(f"{step:.2g}")
     end = float(f"{1.3 * estimate:.3g}")
-    return apply_overrides(scene, [f"coupler.mesh_size_m={mesh_size_m(coupler['thickness_m'])}",
-                                   f"simulation.step_s={step!r}",
-                                   f"simulation.end_time_s={end!r}"])
+    return derive_scene(scene, [f"coupler.mesh_size_m={mesh_size_m(coupler['thickness_m'])}",
+                                f"simulation.step_s={step!r}",
+                                f"simulation.end_time_s={end!r}"])
 
 
 def _plate(scene: Scene, thickness_m: float, zeta: float, spring_N_per_m: float,
            preload_m: float) -> Scene:
-    case = tuned(apply_overrides(scene, [f"coupler.thickness_m={thickness_m!r}",
-                                         f"coupler.damping_ratio={zeta!r}",
-                                         f"drive.spring_stiffness_N_per_m={spring_N_per_m!r}",
-                                         f"drive.spring_preload_m={preload_m!r}",
-                                         "coupler.geometric_stiffness=true"]))
-    validate(case)
-    return case
+    # the mesh with the thickness: every scene on the way is valid (tuned sets it again)
+    return tuned(derive_scene(scene, [f"coupler.thickness_m={thickness_m!r}",
+                                      f"coupler.mesh_size_m={mesh_size_m(thickness_m)!r}",
+                                      f"coupler.damping_ratio={zeta!r}",
+                                      f"drive.spring_stiffness_N_per_m={spring_N_per_m!r}",
+                                      f"drive.spring_preload_m={preload_m!r}",
+                                      "coupler.geometric_stiffness=true"]))
 
 
 def _euler_N(scene: Scene, thickness_m: float) -> float:
@@ -196,9 +196,8 @@ def validation_cases(scene: Scene, validation: dict[str, tuple[list[str], float]
     """``val_*`` scenes (name -> (overrides, tolerance)) with ``coupler.model = "auto"``."""
     out = {}
     for name, (changes, tolerance) in validation.items():
-        case = tuned(apply_overrides(scene, [*changes, 'coupler.model="auto"',
-                                             f"fidelity.tolerance={tolerance!r}"]))
-        validate(case)
+        case = tuned(derive_scene(scene, [*changes, 'coupler.model="auto"',
+                                          f"fidelity.tolerance={tolerance!r}"]))
         out[name] = case
     return out
 
@@ -246,9 +245,9 @@ def prepare_reduction(scene: Scene, *, cache_dir: Path | None = None) -> dict[st
 def full_scene(scene: Scene) -> Scene:
     """The validation reference: the scene's coupler as FFRF (:data:`REFERENCE`: with
     geometric stiffness) with the full model's modes."""
-    return _with(scene, coupler__model=REFERENCE["model"],
-                 coupler__geometric_stiffness=REFERENCE["geometric_stiffness"],
-                 coupler__modes=lawfit.FULL_MODES)
+    return derive_scene(scene, {"coupler.model": REFERENCE["model"],
+                                "coupler.geometric_stiffness": REFERENCE["geometric_stiffness"],
+                                "coupler.modes": lawfit.FULL_MODES})
 
 
 def full_geometry_key(scene: Scene) -> tuple | None:
@@ -262,14 +261,6 @@ def prepare_full_reduction(scene: Scene, *, cache_dir: Path | None = None) -> di
     return prepare_reduction(full_scene(scene), cache_dir=cache_dir)
 
 
-def _with(scene: Scene, **changes: Any) -> Scene:
-    out = copy.deepcopy(scene)
-    for dotted, value in changes.items():
-        section, key = dotted.split("__")
-        out[section][key] = value
-    return out
-
-
 # ------------------------------------------------------------------------------------------
 # one fit case and one validation case (run on a worker)
 # ------------------------------------------------------------------------------------------
@@ -279,7 +270,7 @@ def _run_pair(scene: Scene, reduction: Any, cache_dir: Path | None
     (``cache_dir``: the reduction cache folder of anything else they build)."""
     from flex.fidelity.simulation import simulate
 
-    rigid_scene = _with(scene, coupler__model="rigid")
+    rigid_scene = derive_scene(scene, {"coupler.model": "rigid"})
     for _ in range(3):
         rigid = simulate(rigid_scene, "rigid", cache_dir=cache_dir)
         rigid_data = case_data(rigid)
@@ -289,15 +280,16 @@ def _run_pair(scene: Scene, reduction: Any, cache_dir: Path | None
             break
         except ValueError:
             end = 2 * rigid_scene["simulation"]["end_time_s"]
-            rigid_scene = _with(rigid_scene, simulation__end_time_s=end)
+            rigid_scene = derive_scene(rigid_scene, {"simulation.end_time_s": end})
     else:
         raise ValueError("no crank-angle maximum within 4 x the estimated deployment time")
     step = scene["simulation"]["step_s"]
     end = min(rigid_scene["simulation"]["end_time_s"],
               step * math.ceil(1.02 * times["stop"] / step + 2))
-    ffrf = simulate(_with(scene, coupler__model=REFERENCE["model"],
-                          coupler__geometric_stiffness=REFERENCE["geometric_stiffness"],
-                          simulation__end_time_s=end), "ffrf", reduction, cache_dir=cache_dir)
+    ffrf = simulate(derive_scene(scene, {
+        "coupler.model": REFERENCE["model"],
+        "coupler.geometric_stiffness": REFERENCE["geometric_stiffness"],
+        "simulation.end_time_s": end}), "ffrf", reduction, cache_dir=cache_dir)
     walls = {"rigid": rigid.counters["wall_time_s"], "ffrf": ffrf.counters["wall_time_s"],
              "ffrf_steps": ffrf.counters["steps"], "rigid_steps": rigid.counters["steps"]}
     return rigid_data, case_data(ffrf), times, walls

@@ -7,12 +7,12 @@ The ``kfit`` (coupler) and ``crank`` studies run the same steps (thesis sec. 6.2
    :mod:`flex.experiments.fitting.crank`);
 2. **fit table -> laws**: one row per fit case (n, dimensionless errors); power laws
    ``e = floor + c n^-p`` per damping ratio, delta_t definition and measure
-   (:func:`fit_laws`, by :func:`flex.fidelity.criteria.fit_error_law`);
+   (:func:`fit_laws`, by :func:`flex.fidelity.laws.fit_error_law`);
 3. **criterion**: the laws of the primary delta_t as criterion TOML (:func:`criterion_toml`,
-   the format of ``flex/criteria_fit.toml``), written to a file for ``make
-   <study>-criterion`` to install;
+   the format of ``flex/config/criteria_fit.toml``), written to a file for ``make
+   calibration-install`` to install;
 4. **in force**: the validation cases get the law just fitted as a
-   :class:`flex.fidelity.criteria.Criterion` parsed from that text (:func:`simulate_with_law`),
+   :class:`flex.fidelity.laws.Criterion` parsed from that text (:func:`simulate_with_law`),
    never the installed file;
 5. **validation**: ``auto`` against the full flexible model (:data:`FULL_MODES` modes) on
    scenes outside the fit (:class:`Validation`, :func:`validation_lines`).
@@ -36,7 +36,8 @@ import numpy as np
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.dynamics.link_models import FFRF
-from flex.fidelity.criteria import GOVERNING, PRIMARY_DELTA_T, Criterion, ErrorLaw, fit_error_law
+from flex.fidelity.criteria import GOVERNING, PRIMARY_DELTA_T
+from flex.fidelity.laws import Criterion, ErrorLaw, fit_error_law
 
 #: modes of the full flexible model the validation holds ``auto`` against
 FULL_MODES = 12
@@ -64,7 +65,9 @@ def simulate_with_law(scene: Scene, name: str, link: str, criterion_text: str | 
     (criterion TOML; None: the installed file). ``raising``: a failure raises
     (:func:`flex.fidelity.simulation.simulate`) instead of becoming a failed case.
     ``cache_dir``: the reduction cache folder (None: built in memory, no disk cache)."""
-    from flex.fidelity.criteria import parse_criterion
+    from flex.fidelity.laws import (
+        parse_criterion,
+    )
     from flex.fidelity.simulation import simulate, simulate_case
 
     law = None if criterion_text is None else parse_criterion(criterion_text, source)
@@ -253,7 +256,7 @@ def criterion_toml(fits: Mapping[tuple[float, str, str], ErrorLaw], header: str,
 @dataclass
 class Validation:
     """One validation scene: ``auto``'s choice for ``link`` and its error against the full
-    model. ``errors``: :func:`flex.fidelity.criteria.errors_against_full` (dimensionless, and
+    model. ``errors``: :func:`flex.fidelity.laws.errors_against_full` (dimensionless, and
     ``delta_t`` [s]); ``attrs``: the auto run's ``fidelity_<link>_*`` attributes;
     ``timings``: report column -> wall time [s]."""
 
@@ -291,7 +294,9 @@ def against_full(name: str, link: str, tolerance: float, auto: Mapping[str, np.n
                  timings: dict[str, float] | None = None) -> Validation:
     """The :class:`Validation` of an auto run's series against the full model's, with
     ``link``'s deflection over ``length_m`` [m]."""
-    from flex.fidelity.criteria import errors_against_full
+    from flex.fidelity.laws import (
+        errors_against_full,
+    )
 
     return Validation(name, link, float(tolerance),
                       errors_against_full(auto, full, link, length_m), attrs, timings or {})

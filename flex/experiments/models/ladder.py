@@ -20,7 +20,8 @@ import numpy as np
 
 from flex.base.physics import pinned_pinned_omega
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene, apply_overrides, validate
+from flex.data.scene import Scene
+from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import FFRF, NONLINEAR_FE
 from flex.fidelity.simulation import simulate_case
 from flex.fidelity.softening import coupler_compression_N, coupler_euler_load_N
@@ -75,8 +76,7 @@ def rung_scenes(scene: Scene, thickness_m: float, mesh_size_m: float, step_s: fl
               "simulation.error_estimate=false"]
     out = {}
     for name, overrides in MODELS.items():
-        model_scene = apply_overrides(scene, common + list(overrides))
-        validate(model_scene)
+        model_scene = derive_scene(scene, common + list(overrides))
         out[name] = model_scene
     return out
 

@@ -36,8 +36,14 @@ import numpy as np
 from flex.bodies import spring as sp
 from flex.data import tables
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene, apply_overrides, validate
-from flex.fidelity.criteria import first_maximum_index, fit_error_law
+from flex.data.scene import Scene
+from flex.data.scene_edit import derive_scene
+from flex.fidelity.criteria import (
+    first_maximum_index,
+)
+from flex.fidelity.laws import (
+    fit_error_law,
+)
 
 #: chain segment counts of the deployment measurement (rigid links and FFRF coupler)
 MEASURED_SEGMENTS: tuple[int, ...] = (1, 2, 4, 8, 16, 32, 64)
@@ -142,8 +148,8 @@ def wing_spring_scene(scene: Scene) -> Scene:
     (:func:`flex.experiments.thesis.wing.fit_spring`), its mass from :func:`wing_spring_mass_kg`."""
     from flex.experiments.thesis.wing import fit_spring
 
-    fitted, values = fit_spring(apply_overrides(scene, ["wing.enabled=true"]))
-    return apply_overrides(fitted, [
+    fitted, values = fit_spring(derive_scene(scene, ["wing.enabled=true"]))
+    return derive_scene(fitted, [
         f"drive.spring_mass_kg={wing_spring_mass_kg(values['stiffness_N_per_m'])!r}"])
 
 
@@ -157,16 +163,14 @@ def deployment_cases(scenes: Mapping[str, Scene],
     for name, scene in scenes.items():
         for links, (overrides, counts) in LINKS.items():
             plate = [f"coupler.thickness_m={FFRF_THICKNESS_M.get(name, 0.001)!r}"]
-            base = apply_overrides(scene, [*overrides, *(plate if links == "ffrf" else []),
-                                           "simulation.end_time_s="
-                                           f"{SCENES_END_TIME_S.get(name, 0.05)!r}"])
-            out[f"{name}_{links}_massless"] = apply_overrides(
+            base = derive_scene(scene, [*overrides, *(plate if links == "ffrf" else []),
+                                        "simulation.end_time_s="
+                                        f"{SCENES_END_TIME_S.get(name, 0.05)!r}"])
+            out[f"{name}_{links}_massless"] = derive_scene(
                 base, ['drive.spring_model="massless"'])
             for n in counts if segments is None else segments:
-                out[f"{name}_{links}_chain_{n}"] = apply_overrides(
+                out[f"{name}_{links}_chain_{n}"] = derive_scene(
                     base, ['drive.spring_model="chain"', f"drive.spring_segments={n}"])
-    for case in out.values():
-        validate(case)
     return out
 
 
@@ -357,15 +361,13 @@ def sweep_cases(scene: Scene) -> dict[str, Scene]:
     out: dict[str, Scene] = {}
     for mass_kg in SWEEP_MASSES_KG:
         for slider_kg in SWEEP_SLIDER_MASSES_KG:
-            base = apply_overrides(scene, [f"drive.spring_mass_kg={mass_kg!r}",
-                                           f"slider.mass_kg={slider_kg!r}",
-                                           "simulation.end_time_s=0.1"])
+            base = derive_scene(scene, [f"drive.spring_mass_kg={mass_kg!r}",
+                                        f"slider.mass_kg={slider_kg!r}",
+                                        "simulation.end_time_s=0.1"])
             name = f"sweep_{mass_kg * 1e3:g}g_slider_{slider_kg * 1e3:g}g"
-            out[f"{name}_massless"] = apply_overrides(base, ['drive.spring_model="massless"'])
-            out[f"{name}_chain_{SWEEP_SEGMENTS}"] = apply_overrides(
+            out[f"{name}_massless"] = derive_scene(base, ['drive.spring_model="massless"'])
+            out[f"{name}_chain_{SWEEP_SEGMENTS}"] = derive_scene(
                 base, ['drive.spring_model="chain"', f"drive.spring_segments={SWEEP_SEGMENTS}"])
-    for case in out.values():
-        validate(case)
     return out
 
 
@@ -389,7 +391,7 @@ def massless_errors(cases: Mapping[str, Scene],
 
 def error_law_lines(points: Mapping[str, tuple[float, float]]) -> tuple[list[str], Any]:
     """Report lines of the massless spring's error against n and its fitted law
-    ``e = c n^-p`` (:func:`flex.fidelity.criteria.fit_error_law`); returns them and the law."""
+    ``e = c n^-p`` (:func:`flex.fidelity.laws.fit_error_law`); returns them and the law."""
     n = np.array([v[0] for v in points.values()])
     errors = np.array([v[1] for v in points.values()])
     law = fit_error_law(n, errors)
@@ -409,7 +411,7 @@ def massless_predictions(cases: Mapping[str, Scene], table: Mapping[str, Mapping
     """For every ``*_massless`` case of ``table`` (:func:`deployment_table`; ``cases`` their
     scenes): ``(predicted, measured governing error, m_s / M_min)`` [-], the prediction
     (:func:`flex.fidelity.spring_choice.predict_massless_spring_error`) from the case's
-    rigid probe (:func:`flex.fidelity.criteria.deployment_probe`: an FFRF coupler's rigid
+    rigid probe (:func:`flex.fidelity.probe.deployment_probe`: an FFRF coupler's rigid
     twin), as ``drive.spring_model = "auto"`` makes it."""
     from flex.fidelity.probe import deployment_probe
     from flex.fidelity.spring_choice import predict_massless_spring_error

@@ -41,7 +41,8 @@ from flex.base.thesis import (
     THESIS_YOUNGS_MODULUS_PA,
 )
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene, apply_overrides, to_toml, validate
+from flex.data.scene import Scene, to_toml
+from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, NONLINEAR_FE
 from flex.experiments.workprecision.convergence import converged_reference
 from flex.experiments.workprecision.measurement import (
@@ -49,6 +50,7 @@ from flex.experiments.workprecision.measurement import (
     ReductionPool,
     Reference,
     Setting,
+    nonlinear_available,
 )
 from flex.fidelity.caseloop import Progress, run_each
 from flex.fidelity.simulation import simulate_case
@@ -91,8 +93,7 @@ def extreme_cases(scene: Scene, extremes: Sequence[Extreme]) -> dict[str, Scene]
     """The validated scene of every extreme, by name."""
     out = {}
     for extreme in extremes:
-        case = apply_overrides(scene, list(extreme.overrides))
-        validate(case)
+        case = derive_scene(scene, list(extreme.overrides))
         out[extreme.name] = case
     return out
 
@@ -169,8 +170,8 @@ class References:
         name, _, value = kind.partition(":")
         if name == "scipy":  # sampled every 1e-5 s (1e-4 s beyond 0.1 s), cubic in between
             interval = 1e-5 if scene["simulation"]["end_time_s"] <= 0.1 else 1e-4
-            base = apply_overrides(scene, [f"simulation.output_step_s={interval!r}",
-                                           f"simulation.step_s={interval!r}"])
+            base = derive_scene(scene, [f"simulation.output_step_s={interval!r}",
+                                        f"simulation.step_s={interval!r}"])
             return converged_reference(
                 base, "scipy", Setting("scipy DOP853 rtol=1e-12", engine="scipy", rtol=1e-12,
                                        atol=1e-14),
@@ -188,8 +189,8 @@ class References:
                 f"(evidence: h = {2 * step:g} s)")
         if name == NONLINEAR_FE and value:
             step = float(value)
-            nonlinear = apply_overrides(scene, [f'coupler.model="{NONLINEAR_FE}"',
-                                                "simulation.newton_relative_tolerance=1e-8"])
+            nonlinear = derive_scene(scene, [f'coupler.model="{NONLINEAR_FE}"',
+                                             "simulation.newton_relative_tolerance=1e-8"])
             return converged_reference(
                 nonlinear, "nonlinear FE", _nonlinear_setting(step),
                 {f"step {step:g} -> {2 * step:g}": _nonlinear_setting(2 * step)},
@@ -202,15 +203,6 @@ class References:
 # ------------------------------------------------------------------------------------------
 # judging
 # ------------------------------------------------------------------------------------------
-def nonlinear_available() -> bool:
-    """Whether the nonlinear FE coupler (:mod:`flex.bodies.nonlinear`) can be built here."""
-    try:
-        from flex.bodies.nonlinear import add_nonlinear_fe_coupler  # noqa: F401
-    except ImportError:
-        return False
-    return True
-
-
 def run_measures(scene: Scene, data: dict[str, np.ndarray]) -> Verdict:
     """What a run shows by itself: energy drift and range (relative to E0 and to the largest
     strain energy), |deflection| peaks in the first and last tenth [m] and the largest

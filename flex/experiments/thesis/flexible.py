@@ -29,7 +29,8 @@ from flex.base.physics import n_values
 from flex.base.plotting import MICRO, figure, legend_below, panels
 from flex.bodies.nonlinear import nonlinear_plate_for_scene
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene, apply_overrides, validate
+from flex.data.scene import Scene
+from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, NONLINEAR_FE, RIGID
 from flex.dynamics.solver import reduction_for_scene
 from flex.fidelity.caseloop import Progress, run_each
@@ -46,9 +47,8 @@ REDUCTION_FACTS = ("pinned_pinned_frequency_Hz", "fixed_interface_frequencies_Hz
 def _plate_case(scene: Scene, thickness_m: float, mesh_m: float, *more: str) -> Scene:
     """``scene`` with a plate coupler ``thickness_m`` thick meshed at ``mesh_m`` [m] and the
     overrides ``more`` (its model among them); validated."""
-    case = apply_overrides(scene, [f"coupler.thickness_m={thickness_m}",
-                                   f"coupler.mesh_size_m={mesh_m}", *more])
-    validate(case)
+    case = derive_scene(scene, [f"coupler.thickness_m={thickness_m}",
+                                f"coupler.mesh_size_m={mesh_m}", *more])
     return case
 
 

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from flex.bodies import spring as sp
+from flex.bodies import spring_fe
 from flex.data.results import Dataset
 
 
@@ -77,7 +78,7 @@ def summary(scene: Any) -> tuple[dict[str, Dataset], str]:
     with_slider_Hz = sp.surge_frequency_fixed_end_mass_Hz(design.rate_N_per_m,
                                                           design.active_mass_kg,
                                                           scene["slider"]["mass_kg"])
-    fe = sp.fe_helix_segment_stress(design, at_press.force_N)
+    fe = spring_fe.fe_helix_segment_stress(design, at_press.force_N)
     d = {**rate_datasets(rows), **design_datasets(design), **stress_datasets("press", at_press),
          **stress_datasets("solid", at_solid)}
     d.update({
@@ -104,7 +105,7 @@ def summary(scene: Any) -> tuple[dict[str, Dataset], str]:
 
 
 def _report(design: sp.SpringDesign, press_m: float, at_press: sp.SpringStressCheck,
-            at_solid: sp.SpringStressCheck, fe: sp.HelixSegmentStress, surge: sp.SurgeCheck,
+            at_solid: sp.SpringStressCheck, fe: spring_fe.HelixSegmentStress, surge: sp.SurgeCheck,
             with_slider_Hz: float) -> list[str]:
     """Report lines of the design, the two stress checks, the FE check and the surge."""
     if surge.n_fixed_fixed_physical < 10:

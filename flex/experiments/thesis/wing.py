@@ -27,7 +27,8 @@ from flex.base.thesis import (
 )
 from flex.bodies.beams import Material, timoshenko_bending_rad_per_s
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene, apply_overrides, validate
+from flex.data.scene import Scene
+from flex.data.scene_edit import derive_scene
 from flex.dynamics.reference import crank_mass_properties, solve_reference
 from flex.fidelity.criteria import first_maximum_index
 
@@ -45,12 +46,6 @@ def peak_rate(scene: Scene) -> tuple[float, float]:
     return float(rate[index]), float(reference.time_s[index])
 
 
-def _with_spring(scene: Scene, stiffness_N_per_m: float, preload_m: float) -> Scene:
-    """``scene`` with the spring's stiffness [N/m] and preload [m] replaced (not validated)."""
-    return apply_overrides(scene, [f"drive.spring_stiffness_N_per_m={stiffness_N_per_m}",
-                                   f"drive.spring_preload_m={preload_m}"])
-
-
 def fit_spring(scene: Scene) -> tuple[Scene, dict[str, float]]:
     """Spring stiffness [N/m] and preload [m] reproducing the thesis's peak rate and time:
     the fitted scene (validated) and the values with the fit's relative residuals.
@@ -60,7 +55,10 @@ def fit_spring(scene: Scene) -> tuple[Scene, dict[str, float]]:
     from scipy.optimize import least_squares
 
     def residual(log_values: np.ndarray) -> np.ndarray:
-        rate, time_s = peak_rate(_with_spring(scene, *np.exp(log_values)))
+        stiffness_N_per_m, preload_m = np.exp(log_values)
+        rate, time_s = peak_rate(derive_scene(scene, {
+            "drive.spring_stiffness_N_per_m": stiffness_N_per_m,
+            "drive.spring_preload_m": preload_m}))
         return np.array([rate / THESIS_WING_PEAK_RATE_DEG_PER_S - 1,
                          time_s / THESIS_WING_PEAK_TIME_S - 1])
 
@@ -69,8 +67,8 @@ def fit_spring(scene: Scene) -> tuple[Scene, dict[str, float]]:
     # the peak time moves on the output grid: finite differences need a step above it
     fit = least_squares(residual, start, diff_step=0.02, xtol=1e-6)
     stiffness, preload = np.exp(fit.x)
-    fitted = _with_spring(scene, stiffness, preload)
-    validate(fitted)
+    fitted = derive_scene(scene, {"drive.spring_stiffness_N_per_m": stiffness,
+                                  "drive.spring_preload_m": preload})
     return fitted, {"stiffness_N_per_m": float(stiffness), "preload_m": float(preload),
                     "residual_rate": float(fit.fun[0]), "residual_time": float(fit.fun[1])}
 
@@ -191,15 +189,15 @@ def auto_decisions(scene: Scene, datasets: dict[str, Dataset],
         from flex.fidelity.auto import decide_links
     except ImportError:
         return ["  auto fidelity: no fitted criterion in this installation"]
-    trial = apply_overrides(scene, ['crank.model="auto"'])
+    overrides = ['crank.model="auto"']
     lines = []
     if scene["coupler"]["geometry"] == "plate":
-        trial = apply_overrides(trial, ['coupler.model="auto"'])
+        overrides.append('coupler.model="auto"')
     else:
         lines.append('  auto fidelity: coupler as simulated: lumped (mass and inertia only), '
                      'no stiffness to decide on (auto needs coupler.geometry = "plate")')
     try:
-        validate(trial)
+        trial = derive_scene(scene, overrides)
         _, decisions = decide_links(trial, cache_dir=cache_dir)
     except Exception as exc:  # a refusal is itself the answer worth reporting
         return lines + [f"  auto fidelity (the links as simulated): {exc}"]

@@ -329,9 +329,9 @@ def bench_step_cost(scene: Scene, plan: StepCostPlan, repeats: int, pool: Reduct
 def _step_case(scene: Scene, plan: StepCostPlan, mesh_m: float, modes: int,
                newton: str = "modified", tolerance: float = 1e-8) -> Scene:
     """The plan's short run on ``mesh_m`` with ``modes``, Newton ``newton`` at ``tolerance``."""
-    from flex.data.scene import apply_overrides
+    from flex.data.scene_edit import derive_scene
 
-    return apply_overrides(scene, [
+    return derive_scene(scene, [
         f"coupler.mesh_size_m={mesh_m}", f"coupler.modes={modes}",
         f"simulation.step_s={plan.step_s}", f"simulation.end_time_s={plan.end_time_s}",
         f'simulation.newton="{newton}"', f"simulation.newton_relative_tolerance={tolerance}",
@@ -371,13 +371,13 @@ def bench_plates(scene: Scene, plan: PlatesPlan, repeats: int, pool: ReductionPo
     choice (every solver and link key ``"auto"``: :mod:`flex.config.ffrf_rule`, or the
     visible fallback) timed and measured against it. ``notes["plates"]``: one row each."""
     from flex.config.settings import AUTO_OVERRIDES, resolve_solver_settings
-    from flex.data.scene import apply_overrides
+    from flex.data.scene_edit import derive_scene
     from flex.experiments.fitting.calibration import scene_reference
     from flex.experiments.workprecision.measurement import certifies
 
     rows, out = [], {}
     for name, overrides in plan.plates.items():
-        plate = apply_overrides(scene, list(overrides))
+        plate = derive_scene(scene, list(overrides))
         reference = scene_reference(plate, pool, say)
         say(f"{name}: reference accuracy {reference.accuracy:.1e}")
         for tolerance in plan.tolerances:

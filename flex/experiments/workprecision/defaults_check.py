@@ -3,7 +3,7 @@
 The setting labelled :data:`DEFAULT_LABEL` is what a user gets: the bundled scene's ``"auto"``
 solver keys (:data:`flex.config.settings.AUTO_OVERRIDES`), which :mod:`flex.config.settings` fills
 from
-``flex/solver_defaults.toml`` (README "Defaults"). On the 1 mm FFRF plate (the bundled 2 mm
+``flex/config/solver_defaults.toml`` (README "Defaults"). On the 1 mm FFRF plate (the bundled 2 mm
 mesh and 6 modes) they resolve to its ``ffrf_coupler`` entry, the certified 1 % pick
 h = 4e-4 s, modified Newton 1e-8; on the rigid scene to the ``rigid`` entry.
 :func:`ffrf_defaults_check` and :func:`rigid_defaults_check` store whether a run confirms
@@ -136,7 +136,7 @@ def ffrf_defaults_check(group: str, measurements: Sequence[Measurement],
             f"fastest certified setting within it ({pick.reason or 'certified'})"),
         f"{group}/default/table_setting": Dataset(
             f"{DEFAULT_LABEL}: {resolved.keys if resolved else ''}", "1",
-            "what the bundled scene's solver keys resolve to (flex/solver_defaults.toml)"),
+            "what the bundled scene's solver keys resolve to (flex/config/solver_defaults.toml)"),
         f"{group}/default/matches_table": Dataset(
             matches, "1", f"the defaults are within the tolerance (certified) and at most "
                           f"{DEFAULT_TIE:g} x slower than the pick"),

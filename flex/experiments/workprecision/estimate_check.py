@@ -39,7 +39,8 @@ import numpy as np
 from flex.base.plotting import figure
 from flex.config.settings import resolve_solver_settings
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene, apply_overrides
+from flex.data.scene import Scene
+from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, NONLINEAR_FE
 from flex.fidelity.error_estimate import HEADLINES, PREFIX, integrator_order, richardson_error
@@ -65,7 +66,7 @@ LINKS = ("crank", "coupler")
 
 
 def _run(scene: Scene, name: str, overrides: list[str], cache_dir: Path | None) -> CaseResult:
-    return simulate_case(apply_overrides(scene, [*overrides, "simulation.output_step_s=0.0"]),
+    return simulate_case(derive_scene(scene, [*overrides, "simulation.output_step_s=0.0"]),
                          name, cache_dir=cache_dir)
 
 

@@ -27,11 +27,10 @@ Wall times are medians over repeats on a shared machine: compare ratios measured
 
 from __future__ import annotations
 
-import contextlib
 import math
 import statistics
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -41,7 +40,8 @@ import numpy as np
 from flex.base.errors import FlexError, SceneError
 from flex.config.settings import has_auto_link_keys, resolve_link_keys, resolved_simulation
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene, apply_overrides, to_toml, validate
+from flex.data.scene import Scene, to_toml
+from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 from flex.dynamics.reference import solve_reference
 
@@ -65,10 +65,10 @@ class Setting:
     """One knob combination.
 
     ``overrides``: scene keys ``"section.key"`` -> value, applied to the scene being studied;
-    ``engine``: ``"exudyn"`` (flex's model, :func:`flex.dynamics.solver.simulate`) or ``"scipy"``
-    (the reference DAE of :mod:`flex.dynamics.reference`, rigid coupler only) with ``method``,
-    ``rtol`` and ``atol`` for ``solve_ivp``; ``group``: which sweep it belongs to (one knob
-    at a time, or a combination), used to colour the diagrams.
+    ``engine``: ``"exudyn"`` (flex's model, :func:`flex.fidelity.simulation.simulate`) or
+    ``"scipy"`` (the reference DAE of :mod:`flex.dynamics.reference`, rigid coupler only)
+    with ``method``, ``rtol`` and ``atol`` for ``solve_ivp``; ``group``: which sweep it belongs
+    to (one knob at a time, or a combination), used to colour the diagrams.
     """
 
     label: str
@@ -101,20 +101,10 @@ class Setting:
         return out
 
 
-def _toml_value(value: Any) -> str:
-    if isinstance(value, str):
-        return f'"{value}"'
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    return repr(value)
-
-
 def scene_for(base: Scene, setting: Setting) -> Scene:
-    """``base`` with the setting's overrides, validated (raises SceneError)."""
-    scene = apply_overrides(base, [f"{key}={_toml_value(value)}"
-                                   for key, value in setting.overrides])
-    validate(scene)
-    return scene
+    """``base`` with the setting's overrides, validated (raises SceneError;
+    :func:`flex.data.scene_edit.derive_scene`)."""
+    return derive_scene(base, dict(setting.overrides))
 
 
 # ------------------------------------------------------------------------------------------
@@ -298,29 +288,6 @@ def describe(m: Measurement | None) -> str:
             f"{m.steps} steps, {m.newton_iterations} Newton iterations)")
 
 
-@contextlib.contextmanager
-def element_order(order: int) -> Iterator[None]:
-    """Build reductions with tetrahedra of ``order`` (1 or 2) inside the block.
-
-    :mod:`flex.bodies.reduction` fixes quadratic tetrahedra (module constant ``_MESH_ORDER``, part
-    of
-    the cache key); the work-precision study sets it for the duration of one build to show
-    what linear tetrahedra cost in accuracy. Raises SceneError if the constant is gone.
-    """
-    from flex.bodies import reduction
-
-    if order not in (1, 2):
-        raise SceneError(f"element_order = {order!r}: must be 1 or 2")
-    if not hasattr(reduction, "_MESH_ORDER"):
-        raise SceneError("element_order: flex.bodies.reduction no longer exposes _MESH_ORDER")
-    previous = reduction._MESH_ORDER
-    reduction._MESH_ORDER = order
-    try:
-        yield
-    finally:
-        reduction._MESH_ORDER = previous
-
-
 class ReductionPool:
     """Reductions (and their FFRF interfaces) built once per key and shared by all runs.
 
@@ -349,8 +316,8 @@ class ReductionPool:
                                    "density_kg_per_m3", "poisson_ratio", "mesh_size_m",
                                    "modes")) + (order,)
         if key not in self._by_key:
-            with element_order(order):
-                self._by_key[key] = reduction_for_scene(scene, cache_dir=self.cache_dir)
+            self._by_key[key] = reduction_for_scene(scene, cache_dir=self.cache_dir,
+                                                    mesh_order=order)
         return self._by_key[key]
 
 
@@ -379,7 +346,7 @@ def run_once(scene: Scene, setting: Setting, pool: ReductionPool | None = None
         pool = pool or ReductionPool()
         reduction = pool.for_scene(scene, setting.element_order)
         # timed alone: a companion run for an error estimate would be timed with it
-        untimed = apply_overrides(scene, ["simulation.error_estimate=false"])
+        untimed = derive_scene(scene, {"simulation.error_estimate": False})
         result = simulate(untimed, setting.label, reduction, cache_dir=pool.cache_dir)
         observables = Observables.of_datasets(result.datasets, flexible)
         counters = dict(result.counters)

@@ -41,341 +41,47 @@ environment's
 
 from __future__ import annotations
 
-import functools
-import hashlib
-import os
 import re
 import sys
 import time
-import traceback
-from collections.abc import Callable, Hashable, Iterable, Mapping
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from collections.abc import Callable, Hashable, Mapping
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from flex.base.errors import FlexError, ResultFileError
-from flex.data.cache import SWEEP_CASES, content_digest, folder_problem, say
-from flex.data.results import CaseResult, Dataset, open_results, write_results
+from flex.base.errors import FlexError
+from flex.data.cache import SWEEP_CASES, folder_problem, say
+from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
+from flex.sweep.case_files import (
+    LOCATION_ARGUMENTS,
+    SWEEP_FORMAT,
+    case_content_digest,
+    case_hash,
+    case_path,
+    read_case_file,
+    write_case_file,
+)
+from flex.sweep.executors import (
+    DaskExecutor,
+    Executor,
+    ProcessExecutor,
+    SerialExecutor,
+    _guarded,
+    _prepare_guarded,
+    make_executor,
+    simulate_scene_case,
+)
 
 CaseFunction = Callable[[str, Scene], CaseResult]
-#: keyword arguments of a case function that say where things are kept, not what a case
-#: computes: left out of its identity (:func:`case_hash`), so a moved cache resumes
-LOCATION_ARGUMENTS = frozenset({"cache_dir"})
 _NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.+-]*$")
-#: 2: a content digest of the case (``sweep_content_digest``), checked when a rerun resumes
-SWEEP_FORMAT = "flex-sweep-case/2"
 
-
-# ------------------------------------------------------------------------------------------
-# the default case function
-# ------------------------------------------------------------------------------------------
-def simulate_scene_case(name: str, scene: Scene, *, cache_dir: Path | None = None
-                        ) -> CaseResult:
-    """The default case: :func:`flex.fidelity.simulation.simulate_case` of the scene (never raises
-    for a diverged run: that is a ``failed`` case). ``cache_dir``: the reduction cache folder
-    (None: reductions built in memory, no disk cache); bind it with ``functools.partial``."""
-    from flex.fidelity.simulation import simulate_case
-
-    return simulate_case(scene, name, cache_dir=cache_dir)
-
-
-def _guarded(function: Callable[..., Any], name: str, scene: Scene) -> Any:
-    """Run ``function(name, scene)``; any exception becomes a failed :class:`CaseResult`."""
-    try:
-        result = function(name, scene)
-    except BaseException as exc:  # noqa: BLE001 - a case must never stop the sweep
-        if isinstance(exc, KeyboardInterrupt | SystemExit):
-            raise
-        where = traceback.extract_tb(exc.__traceback__)[-1] if exc.__traceback__ else None
-        origin = f" (at {Path(where.filename).name}:{where.lineno})" if where else ""
-        return CaseResult(name, to_toml(scene), status="failed",
-                          message=f"{type(exc).__name__}: {exc}{origin}")
-    if not isinstance(result, CaseResult):
-        return CaseResult(name, to_toml(scene), status="failed",
-                          message=f"case function returned {type(result).__name__}, "
-                                  f"not CaseResult")
-    result.name = name
-    return result
-
-
-def _prepare_guarded(function: Callable[[Scene], Any], scene: Scene) -> tuple[bool, Any]:
-    try:
-        return True, function(scene)
-    except Exception as exc:  # noqa: BLE001 - recorded on the cases that needed it
-        return False, f"{type(exc).__name__}: {exc}"
-
-
-# ------------------------------------------------------------------------------------------
-# executors
-# ------------------------------------------------------------------------------------------
-class _DoneFuture:
-    """A finished future for the serial executor (``result()`` re-raises like a future)."""
-
-    def __init__(self, function: Callable[..., Any], args: tuple) -> None:
-        self._value: Any = None
-        self._error: BaseException | None = None
-        try:
-            self._value = function(*args)
-        except Exception as exc:  # noqa: BLE001 - delivered by result()
-            self._error = exc
-
-    def result(self) -> Any:
-        if self._error is not None:
-            raise self._error
-        return self._value
-
-    def running(self) -> bool:
-        return False
-
-
-class Executor:
-    """The executor seam: submit a function, wait for the first finished futures, close."""
-
-    description = "executor"
-    workers = 1
-
-    def submit(self, function: Callable[..., Any], *args: Any) -> Any:
-        raise NotImplementedError
-
-    def wait_first(self, futures: Iterable[Any], timeout: float | None = None) -> set:
-        """Futures of ``futures`` that are finished (at least one unless timed out)."""
-        raise NotImplementedError
-
-    def restart(self) -> None:
-        """Replace a broken pool (local processes only)."""
-
-    def isolated(self) -> Executor:
-        """A fresh single-worker executor for re-running a suspect case alone."""
-        return self
-
-    def close(self) -> None:
-        """Release workers (and the cluster, if this executor started one)."""
-
-
-class SerialExecutor(Executor):
-    """Runs every submission at once, in this process."""
-
-    description = "serial (in-process)"
-
-    def submit(self, function: Callable[..., Any], *args: Any) -> _DoneFuture:
-        return _DoneFuture(function, args)
-
-    def wait_first(self, futures: Iterable[Any], timeout: float | None = None) -> set:
-        return set(futures)
-
-
-class ProcessExecutor(Executor):
-    """``concurrent.futures.ProcessPoolExecutor`` with ``workers`` spawned processes."""
-
-    def __init__(self, workers: int | None = None) -> None:
-        import multiprocessing
-
-        self.workers = int(workers or os.cpu_count() or 1)
-        # spawn, not fork: Exudyn and NGsolve hold threads that a fork would copy half-way
-        self._context = multiprocessing.get_context("spawn")
-        self._pool = ProcessPoolExecutor(self.workers, mp_context=self._context)
-        self.description = f"local processes ({self.workers} workers)"
-
-    def submit(self, function: Callable[..., Any], *args: Any) -> Future:
-        return self._pool.submit(function, *args)
-
-    def wait_first(self, futures: Iterable[Any], timeout: float | None = None) -> set:
-        return wait(list(futures), timeout=timeout, return_when=FIRST_COMPLETED)[0]
-
-    def restart(self) -> None:
-        self._pool.shutdown(wait=False, cancel_futures=True)
-        self._pool = ProcessPoolExecutor(self.workers, mp_context=self._context)
-
-    def isolated(self) -> Executor:
-        return ProcessExecutor(1)
-
-    def close(self) -> None:
-        self._pool.shutdown(wait=True, cancel_futures=True)
-
-
-class DaskExecutor(Executor):
-    """A ``dask.distributed.Client``: to ``address``, or to a new loopback ``LocalCluster``.
-
-    The local cluster has ``workers`` single-threaded worker processes (default: all cores)
-    bound to 127.0.0.1 without a dashboard; :meth:`close` stops it. A remote scheduler is
-    used as it is (its workers need ``flex`` installed and, to share reductions, the
-    ``cache_dir`` the case functions get must be a folder they all reach).
-    """
-
-    def __init__(self, address: str | None = None, workers: int | None = None) -> None:
-        try:
-            from distributed import Client, LocalCluster
-        except ImportError:  # pragma: no cover - a declared dependency
-            raise FlexError("scheduler: dask.distributed is not installed "
-                            "(pip install 'dask[distributed]')") from None
-        self._cluster = None
-        if address is None:
-            self.workers = int(workers or os.cpu_count() or 1)
-            self._cluster = LocalCluster(n_workers=self.workers, threads_per_worker=1,
-                                         processes=True, host="127.0.0.1",
-                                         dashboard_address=None, silence_logs=40)
-            self.client = Client(self._cluster)
-            self.description = f"Dask local cluster ({self.workers} workers)"
-        else:
-            try:
-                self.client = Client(address, timeout="20s")
-            except OSError as exc:
-                raise FlexError(f"scheduler {address}: cannot connect ({exc})") from None
-            self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
-            self.description = f"Dask scheduler {address} ({self.workers} workers)"
-
-    def submit(self, function: Callable[..., Any], *args: Any) -> Any:
-        return self.client.submit(function, *args, pure=False)
-
-    def wait_first(self, futures: Iterable[Any], timeout: float | None = None) -> set:
-        from distributed import wait as dask_wait
-        from distributed.client import TimeoutError as DaskTimeout
-
-        futures = list(futures)
-        try:
-            return set(dask_wait(futures, timeout=timeout, return_when="FIRST_COMPLETED").done)
-        except (DaskTimeout, TimeoutError):
-            return {f for f in futures if f.done()}
-
-    def close(self) -> None:
-        self.client.close()
-        if self._cluster is not None:
-            self._cluster.close()
-
-
-def make_executor(scheduler: str | None = None, workers: int | None = None) -> Executor:
-    """The executor for ``scheduler`` (see the module doc); unknown values are refused."""
-    if workers is not None and (not isinstance(workers, int) or workers < 1):
-        raise FlexError(f"workers = {workers!r}: must be an integer >= 1")
-    if scheduler in (None, "", "processes"):
-        return ProcessExecutor(workers)
-    if scheduler == "serial":
-        return SerialExecutor()
-    if scheduler == "local":
-        return DaskExecutor(None, workers)
-    if re.match(r"^(tcp|tls|inproc|ucx|ws|wss)://", scheduler):
-        return DaskExecutor(scheduler, workers)
-    raise FlexError(f"scheduler {scheduler!r}: expected processes (default), serial, local "
-                    f"(Dask on this machine) or a Dask address like tcp://host:8786")
-
-
-# ------------------------------------------------------------------------------------------
-# case files
-# ------------------------------------------------------------------------------------------
-def _physics_versions() -> str:
-    """What a flexible link's physics depends on beyond the scene: the reduction's basis
-    (chord frame since version 2) and its geometric stiffness (a changed body must not
-    resume stale cases)."""
-    from flex.bodies.geometric_stiffness import GEOMETRIC_FORMAT_VERSION
-    from flex.bodies.reduction import CACHE_FORMAT_VERSION
-
-    return f"#reduction{CACHE_FORMAT_VERSION}#geometric{GEOMETRIC_FORMAT_VERSION}"
-
-
-def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
-    """Identity of a case: its resolved scene and the case function's qualified name and
-    ``case_version`` attribute (bumped when what the function stores changes: stale case
-    files are then rerun, not resumed), and what its ``"auto"`` values resolve from (the
-    solver defaults table, the fitted criterion files)."""
-    from flex.config import settings
-    from flex.fidelity.criteria import criteria_in_force_text
-
-    function, extra = case_function, ""
-    if isinstance(function, functools.partial):  # bound arguments are part of the identity,
-        keywords = sorted((key, value) for key, value in function.keywords.items()
-                          if key not in LOCATION_ARGUMENTS)  # but not where caches live
-        if function.args or keywords:
-            extra = repr((function.args, keywords))
-        function = function.func
-    if settings.has_auto(scene):  # a changed table must not resume stale cases
-        extra += repr(sorted(settings.solver_defaults().items()))
-    if settings.has_auto(scene) or settings.has_auto_link_keys(scene):  # nor a changed rule
-        from flex.config.ffrf_rule import rule_constants
-
-        extra += repr(sorted(rule_constants().items()))
-    extra += criteria_in_force_text(scene)  # a re-fit must not resume stale auto cases
-    version = getattr(function, "case_version", None)
-    if version is not None:
-        extra += f"@{version}"
-    extra += _physics_versions()
-    label = f"{function.__module__}.{function.__qualname__}{extra}"
-    return hashlib.sha256((label + "\n" + to_toml(scene)).encode()).hexdigest()[:24]
-
-
-def case_path(folder: str | Path, name: str) -> Path:
-    """``<folder>/cases/<name>.h5``."""
-    return Path(folder) / "cases" / f"{name}.h5"
-
-
-def write_case_file(folder: str | Path, case: CaseResult, digest: str, study: str) -> Path:
-    """Write one case to its own file, atomically (the hash of what it ran and the digest of
-    what it holds, :func:`case_content_digest`, go in the root attributes)."""
-    return write_results(case_path(folder, case.name), study, [case], case.scene_toml,
-                         attrs={"sweep_case_hash": digest, "sweep_format": SWEEP_FORMAT,
-                                "sweep_content_digest": case_content_digest(case)})
-
-
-def case_content_digest(case: CaseResult) -> str:
-    """Digest of everything a case file holds (:func:`flex.data.cache.content_digest`):
-    status, message, scenes, counters, attributes, and every dataset's values, units and
-    description; the same for a case and for the case read back from its file."""
-    parts: list[tuple[str, Any]] = [("name", case.name), ("status", case.status),
-                                    ("message", case.message), ("scene", case.scene_toml),
-                                    ("solver", case.solver_settings_toml)]
-    parts += [(f"counter:{key}", case.counters[key]) for key in sorted(case.counters)]
-    parts += [(f"attr:{key}", case.attrs[key]) for key in sorted(case.attrs)]
-    for name in sorted(case.datasets):
-        dataset = case.datasets[name]
-        parts += [(f"data:{name}", dataset.data), (f"units:{name}", dataset.units),
-                  (f"description:{name}", dataset.description)]
-    return content_digest(parts)
-
-
-def _text(value: Any) -> Any:
-    return value.decode() if isinstance(value, bytes) else value
-
-
-def read_case_file(path: str | Path) -> tuple[CaseResult, str]:
-    """The :class:`CaseResult` stored in a case file and its case hash.
-
-    Raises :class:`flex.base.errors.ResultFileError` for a missing or damaged file.
-    """
-    import h5py
-
-    with open_results(path) as h5:
-        digest = str(_text(h5.attrs.get("sweep_case_hash", "")))
-        content = str(_text(h5.attrs.get("sweep_content_digest", "")))
-        names = list(h5["cases"])
-        if len(names) != 1:
-            raise FlexError(f"case file '{path}' holds {len(names)} cases, expected 1")
-        group = h5["cases"][names[0]]
-        attrs = {k: _text(v) for k, v in group.attrs.items()}
-        datasets: dict[str, Dataset] = {}
-
-        def visit(name: str, obj: Any) -> None:
-            if isinstance(obj, h5py.Dataset):
-                value = obj[()]
-                if isinstance(value, bytes):
-                    value = value.decode()
-                datasets[name] = Dataset(value, str(_text(obj.attrs.get("units", ""))),
-                                         str(_text(obj.attrs.get("description", ""))))
-
-        group.visititems(visit)
-    counters = {k[len("counter_"):]: v for k, v in attrs.items() if k.startswith("counter_")}
-    fixed = ("status", "message", "scene_toml", "solver_settings_toml")
-    extra = {k: v for k, v in attrs.items() if k not in fixed and not k.startswith("counter_")}
-    case = CaseResult(names[0], str(attrs.get("scene_toml", "")), datasets,
-                      status=str(attrs.get("status", "failed")),
-                      message=str(attrs.get("message", "")), counters=counters,
-                      solver_settings_toml=str(attrs.get("solver_settings_toml", "")),
-                      attrs=extra)
-    if content != case_content_digest(case):
-        raise ResultFileError(f"case file '{path}' did not prove its content (its content "
-                              f"digest does not match: damaged, edited or of an older format)")
-    return case, digest
+__all__ = ["LOCATION_ARGUMENTS", "SWEEP_FORMAT", "CaseFunction", "DaskExecutor", "Executor",
+           "ProcessExecutor", "SerialExecutor", "SweepOutcome", "SweepSettings",
+           "case_content_digest", "case_hash", "case_path", "make_executor",
+           "read_case_file", "run_sweep", "settings_from_environment",
+           "simulate_scene_case", "write_case_file"]
 
 
 # ------------------------------------------------------------------------------------------
@@ -755,9 +461,3 @@ def settings_from_environment(environ: Mapping[str, str]) -> SweepSettings:
                          retry_failed=environ.get("FLEX_RETRY_FAILED", "") == "1",
                          progress=environ.get("FLEX_PROGRESS", "1") != "0")
 
-
-if __name__ == "__main__":  # the old entry point: one line saying where it went
-    print("flex: error: python -m flex.sweep is now part of 'flex run': run 'flex run STUDY' "
-          "(or 'python -m flex run STUDY') with --scheduler, --workers, --folder, "
-          "--retry-failed", file=sys.stderr)
-    raise SystemExit(2)

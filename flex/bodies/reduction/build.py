@@ -1,0 +1,379 @@
+"""Plate mesh -> Craig-Bampton reduction (cached): :func:`build_reduction` and its
+:class:`Reduction`."""
+
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import numbers
+import os
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.base.errors import SceneError
+from flex.bodies.plate import PlateLink, plate_mesh
+from flex.bodies.reduction.basis import (
+    _craig_bampton_basis,
+    _fix_eigenmode_signs,
+)
+from flex.bodies.reduction.cache import (
+    CACHE_FORMAT_VERSION,
+    _cache_key,
+    _content_digest,
+    _load_cached,
+    _meta_digest,
+    _say_unproven,
+)
+from flex.data.cache import (
+    REDUCTION_CACHE,
+    store,
+)
+
+END_A = "end_a"  #: mesh boundary name of the joint-B face (x = 0)
+END_B = "end_b"  #: mesh boundary name of the joint-C face (x = length)
+MID = "mid"  #: node-set name of the mid-length cross-section
+
+#: tetrahedra of a reduction's mesh (:func:`build_reduction`): linear tets lock in bending
+#: (notes: first frequency 69-90 % too high)
+MESH_ORDER = 2
+#: which modes a reduction keeps (:func:`build_reduction`)
+MODE_SELECTIONS = ("in_plane", "all")
+
+
+# ------------------------------------------------------------------------------------------
+# result type
+# ------------------------------------------------------------------------------------------
+@dataclass
+class Reduction(PlateLink):
+    """A reduced flexible plate link, ready for :func:`add_ffrf_link`.
+
+    Node index arrays refer to ``fem``'s mesh nodes; weights sum to 1. ``centre_*`` are the
+    weighted reference positions of the node sets in body coordinates [m]: the points the
+    markers of :func:`add_ffrf_link` report.
+    """
+
+    fem: Any  #: exudyn.FEM.FEMinterface holding mesh, M, K, mode basis, stress modes
+    modes: int  #: number of fixed-interface eigenmodes kept (the static modes come on top)
+    mode_selection: str  #: "in_plane" or "all" (:data:`MODE_SELECTIONS`)
+    fixed_interface_frequencies_Hz: np.ndarray  #: both end faces clamped
+    pinned_pinned_frequency_Hz: float  #: first in-plane bending mode, ends pinned about z
+    mass_kg: float  #: [kg]
+    n_nodes: int
+    n_elements: int  #: second-order tetrahedra
+    n_dof: int  #: 3 * n_nodes, unreduced
+    cold_build_time_s: float  #: time of the original (uncached) build
+    build_time_s: float  #: time spent by this call: the build, or the cache load
+    from_cache: bool
+    cache_file: Path | None
+    key: str  #: hash of everything the reduction depends on
+    _ffrf_interface: Any = field(default=None, repr=False, compare=False)
+
+    @property
+    def n_modal_coordinates(self) -> int:
+        """Number of elastic coordinates of the reduced body: the static modes of ``end_b``
+        (6, or its 3 in-plane ones) + ``modes``."""
+        return int(self.fem.modeBasis["matrix"].shape[1])
+
+    @property
+    def has_stress_modes(self) -> bool:
+        """True if the FEMinterface carries stress post-processing modes."""
+        return "matrix" in (self.fem.postProcessingModes or {})
+
+    def ffrf_interface(self):
+        """The ``ObjectFFRFreducedOrderInterface`` of this reduction, made once and reused.
+
+        Its constructor projects the full mass matrix on the basis (the costly part of adding
+        a body), so several systems built from one reduction share it.
+        """
+        if self._ffrf_interface is None:
+            from exudyn.FEM import ObjectFFRFreducedOrderInterface
+
+            self._ffrf_interface = ObjectFFRFreducedOrderInterface(self.fem)
+        return self._ffrf_interface
+
+
+
+# ------------------------------------------------------------------------------------------
+# input checks
+# ------------------------------------------------------------------------------------------
+def _is_number(value: Any) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def _check_inputs(sizes: dict[str, float], poisson_ratio: float, modes: int) -> None:
+    for name, value in sizes.items():
+        if not (_is_number(value) and math.isfinite(value) and value > 0):
+            raise SceneError(f"reduction {name} = {value!r}: must be a finite number > 0")
+    if not (_is_number(poisson_ratio) and 0.0 < poisson_ratio < 0.5):
+        raise SceneError(
+            f"reduction poisson_ratio = {poisson_ratio!r}: must lie in the open range (0, 0.5)")
+    if isinstance(modes, bool) or not isinstance(modes, int | np.integer) or modes < 1:
+        raise SceneError(f"reduction modes = {modes!r}: must be an integer >= 1")
+    if sizes["mesh_size_m"] > sizes["length_m"]:
+        raise SceneError(
+            f"reduction mesh_size_m = {sizes['mesh_size_m']!r}: must be <= length_m "
+            f"({sizes['length_m']!r}); the notes recommend about 1-2 x thickness")
+
+
+# ------------------------------------------------------------------------------------------
+# building
+# ------------------------------------------------------------------------------------------
+def _node_set(fem, name: str) -> dict:
+    for node_set in fem.nodeSets:
+        if node_set["Name"] == name:
+            return node_set
+    raise KeyError(name)
+
+
+def _mid_set(positions: np.ndarray, length_m: float, mesh_size_m: float,
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """Nodes of a thin slab around x = length/2 and weights placing their centre there.
+
+    A tetrahedral mesh has no node plane at mid-length, so the marker averages a slab of
+    half-width mesh_size/4 (widened until it holds >= 8 nodes). Equal weights are corrected by
+    the smallest change that puts the weighted reference centre exactly at (L/2, 0, 0); if that
+    would make a weight non-positive the equal weights are kept (centre then off by << h).
+    The slab average differs from the mid-section value by O((h/L)^2) in the deflection.
+    """
+    distance = np.abs(positions[:, 0] - length_m / 2)
+    half_width = 0.25 * mesh_size_m
+    nodes = np.flatnonzero(distance <= half_width)
+    while len(nodes) < 8:
+        half_width *= 1.5
+        nodes = np.flatnonzero(distance <= half_width)
+    weights = np.full(len(nodes), 1.0 / len(nodes))
+    constraint = np.vstack([np.ones(len(nodes)), positions[nodes].T])  # sum, x, y, z
+    target = np.array([1.0, length_m / 2, 0.0, 0.0])
+    try:
+        correction = constraint.T @ np.linalg.solve(constraint @ constraint.T,
+                                                    target - constraint @ weights)
+        if np.all(weights + correction > 0):
+            weights = weights + correction
+    except np.linalg.LinAlgError:
+        pass
+    return nodes, unit_sum(weights)
+
+
+def unit_sum(weights: np.ndarray) -> np.ndarray:
+    """Marker weights scaled to sum to 1 (Exudyn warns, once per marker and run, when a
+    solve left their sum off 1 by round-off)."""
+    weights = np.asarray(weights, dtype=float)
+    return weights / math.fsum(weights)
+
+
+def _pinned_pinned_frequency_Hz(ffrf_interface, reduction_length_m: float,
+                                thickness_m: float, width_m: float,
+                                nodes_end_a, weights_end_a, nodes_end_b, weights_end_b,
+                                ) -> float:
+    """First bending frequency of the reduced body with both end faces pinned about z.
+
+    Exudyn's constrained eigenvalue solver on the body alone: each end face is held in all
+    translations and in rotation about x and y, rotation about z free (a revolute pin). With
+    the out-of-plane rotations held at both ends, the lowest mode is the in-plane one while
+    thickness < ~2.2 x width (pinned-pinned 9.87 t vs clamped-clamped 22.4 w); beyond that
+    NaN is returned instead of a wrong mode.
+    """
+    if thickness_m > 2.0 * width_m:
+        return float("nan")
+    import exudyn as exu
+    import exudyn.itemInterface as eii
+
+    system_container = exu.SystemContainer()
+    mbs = system_container.AddSystem()
+    body = ffrf_interface.AddObjectFFRFreducedOrder(mbs, positionRef=[0.0, 0.0, 0.0])
+    ground = mbs.AddObject(eii.ObjectGround())
+    for nodes, weights, x in ((nodes_end_a, weights_end_a, 0.0),
+                              (nodes_end_b, weights_end_b, reduction_length_m)):
+        face = mbs.AddMarker(eii.MarkerSuperElementRigid(
+            bodyNumber=body["oFFRFreducedOrder"], meshNodeNumbers=nodes,
+            weightingFactors=weights))
+        support = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground,
+                                                    localPosition=[x, 0.0, 0.0]))
+        mbs.AddObject(eii.GenericJoint(markerNumbers=[support, face],
+                                       constrainedAxes=[1, 1, 1, 1, 1, 0]))
+    mbs.Assemble()
+    eigenvalues, _ = mbs.ComputeODE2Eigenvalues(useAbsoluteValues=True)
+    eigenvalues = np.sort(np.abs(np.asarray(eigenvalues)))
+    # the constraint projection leaves no rigid-body modes; skip round-off zeros anyway
+    eigenvalues = eigenvalues[eigenvalues > 1e-6 * eigenvalues[-1]]
+    return float(np.sqrt(eigenvalues[0]) / (2 * np.pi))
+
+
+@contextlib.contextmanager
+def _ngsolve_thread_count(threads: int | None) -> Iterator[None]:
+    """Run NGsolve's task manager with ``threads`` threads inside the block, then restore."""
+    if threads is None:
+        yield
+        return
+    if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+        raise SceneError(f"ngsolve_threads = {threads!r}: must be an integer >= 1 or None")
+    import ngsolve
+
+    with ngsolve.TaskManager():  # the count in force is only visible inside a task manager
+        previous = ngsolve.GetNumThreads()
+    ngsolve.SetNumThreads(threads)
+    try:
+        yield
+    finally:
+        ngsolve.SetNumThreads(previous)
+
+def build_reduction(length_m: float, thickness_m: float, width_m: float,
+                    youngs_modulus_Pa: float, density_kg_per_m3: float, poisson_ratio: float,
+                    mesh_size_m: float, modes: int,
+                    cache_dir: str | os.PathLike | None, *,
+                    mode_selection: str = "in_plane",
+                    ngsolve_threads: int | None = 1,
+                    mesh_order: int = MESH_ORDER) -> Reduction:
+    """Mesh, reduce and cache a plate link; return the :class:`Reduction`.
+
+    Contract:
+      - sizes in metres, E in Pa, density in kg/m^3; ``mesh_size_m`` is netgen's maxh
+        (recommendation: about the thickness, at most 2 x thickness); ``modes`` >= 1 is the
+        number of fixed-interface (both faces clamped) eigenmodes added to the static modes
+        of ``end_b``. Bad values raise :class:`flex.base.errors.SceneError`.
+      - ``mode_selection``: ``"in_plane"`` (default) keeps only modes symmetric about the
+        mechanism plane z = 0 -- the 3 in-plane static modes of ``end_b`` (x, y, rotation
+        about z) and the lowest ``modes`` in-plane eigenmodes -- since a planar mechanism
+        loads its links in plane and the out-of-plane bending and torsion modes carry
+        nothing (decoupled by symmetry, :func:`_in_plane_eigenmodes`); ``"all"`` keeps the 6
+        static modes and the lowest ``modes`` eigenmodes of any kind.
+      - the mesh uses second-order tetrahedra; stress post-processing modes (local stress,
+        Pa per unit modal coordinate) are always computed.
+      - ``cache_dir``: directory of the cache (created if missing) or None for no caching. The
+        entry is ``<key>.hdf5``, ``key`` hashing every argument except ``cache_dir``, the
+        cache format version and the exudyn and ngsolve versions. A whole entry for the same
+        key is loaded (``from_cache`` True); a missing, truncated, damaged or foreign entry is
+        rebuilt and replaced by an atomic rename.
+      - ``mesh_order``: the tetrahedra's order, 2 (default, :data:`MESH_ORDER`) or 1 (linear:
+        what the work-precision study measures them to cost in accuracy); part of the key.
+      - ``ngsolve_threads``: threads of NGsolve's task manager during a build (restored
+        afterwards; None leaves NGsolve's setting). 1 by default: the task manager spins,
+        and on a shared 2-core machine 2 threads made a 0.6 s build take 12-20 s.
+      - a rebuild reproduces the same reduction up to round-off (threaded assembly and
+        eigensolver); eigenmode signs are normalised so modal coordinates keep their sign.
+    """
+    start = time.perf_counter()
+    sizes = {"length_m": length_m, "thickness_m": thickness_m, "width_m": width_m,
+             "youngs_modulus_Pa": youngs_modulus_Pa, "density_kg_per_m3": density_kg_per_m3,
+             "mesh_size_m": mesh_size_m}
+    _check_inputs(sizes, poisson_ratio, modes)
+    if mode_selection not in MODE_SELECTIONS:
+        raise SceneError(f"reduction mode_selection = {mode_selection!r}: must be one of "
+                         f"{', '.join(MODE_SELECTIONS)}")
+    if mesh_order not in (1, 2) or isinstance(mesh_order, bool):
+        raise SceneError(f"reduction mesh_order = {mesh_order!r}: must be 1 or 2")
+    parameters = {name: float(value) for name, value in sizes.items()}
+    parameters.update(poisson_ratio=float(poisson_ratio), modes=int(modes),
+                      mesh_order=int(mesh_order), stress_modes=True)
+    if mode_selection != "all":  # "all" keeps the keys (and cache entries) it always had
+        parameters["mode_selection"] = mode_selection
+    key = _cache_key(parameters)
+    cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"
+
+    fem = _load_cached(cache_file, key) if cache_file is not None else None
+    from_cache = fem is not None
+    ffrf_interface = None
+    if fem is None:
+        _say_unproven(cache_file)
+        with _ngsolve_thread_count(ngsolve_threads):
+            fem, ffrf_interface = _build_fem(parameters, key)
+        if cache_file is not None and not store(
+                cache_file, lambda temporary: fem.SaveToFile(str(temporary), mode="HDF5"),
+                REDUCTION_CACHE):
+            cache_file = None  # not kept (said): nothing is cached beside it either
+
+    meta = fem.metaData["flex"]
+    end_a, end_b, mid = (_node_set(fem, name) for name in (END_A, END_B, MID))
+    positions = fem.GetNodePositionsAsArray()
+
+    def centre(node_set: dict) -> np.ndarray:
+        return np.asarray(node_set["NodeWeights"]) @ positions[node_set["NodeNumbers"]]
+
+    return Reduction(
+        fem=fem, **sizes, poisson_ratio=float(poisson_ratio), modes=int(modes),
+        mode_selection=mode_selection,
+        nodes_end_a=np.asarray(end_a["NodeNumbers"]),
+        weights_end_a=unit_sum(end_a["NodeWeights"]),
+        nodes_end_b=np.asarray(end_b["NodeNumbers"]),
+        weights_end_b=unit_sum(end_b["NodeWeights"]),
+        nodes_mid=np.asarray(mid["NodeNumbers"]), weights_mid=unit_sum(mid["NodeWeights"]),
+        centre_end_a=centre(end_a), centre_end_b=centre(end_b), centre_mid=centre(mid),
+        fixed_interface_frequencies_Hz=np.sqrt(np.abs(np.asarray(fem.eigenValues))) / (2 * np.pi),
+        pinned_pinned_frequency_Hz=float(meta["pinned_pinned_frequency_Hz"]),
+        mass_kg=float(meta["mass_kg"]), n_nodes=int(fem.NumberOfNodes()),
+        n_elements=int(meta["n_elements"]), n_dof=3 * int(fem.NumberOfNodes()),
+        cold_build_time_s=float(meta["cold_build_time_s"]),
+        build_time_s=time.perf_counter() - start, from_cache=from_cache,
+        cache_file=cache_file, key=key,
+        _ffrf_interface=ffrf_interface,
+    )
+
+
+def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
+    """Mesh + Craig-Bampton + stress modes.
+
+    Returns the FEMinterface (flex's own data in ``metaData['flex']``, the mid-length node set
+    in ``nodeSets``) and its ObjectFFRFreducedOrderInterface.
+    """
+    import exudyn as exu
+    from exudyn.FEM import FEMinterface, KirchhoffMaterial
+
+    start = time.perf_counter()
+    length_m = parameters["length_m"]
+    mesh = plate_mesh(length_m, parameters["thickness_m"], parameters["width_m"],
+                      parameters["mesh_size_m"])
+    fem = FEMinterface()
+    mass_form, stiffness_form, space = fem.ImportMeshFromNGsolve(
+        mesh, density=parameters["density_kg_per_m3"],
+        youngsModulus=parameters["youngs_modulus_Pa"],
+        poissonsRatio=parameters["poisson_ratio"], meshOrder=parameters["mesh_order"],
+        boundaryNamesList=[END_A, END_B])
+    # sorted node numbers and area weights: reproducible files, weighted centre = face centre
+    interfaces = []
+    for name in (END_A, END_B):
+        node_set = _node_set(fem, name)
+        nodes = np.sort(np.asarray(node_set["NodeNumbers"], dtype=np.int64))
+        node_set["NodeNumbers"] = nodes
+        node_set["NodeWeights"] = fem.GetNodeWeightsFromSurfaceAreas(nodes)
+        interfaces.append(nodes)
+    static_modes = _craig_bampton_basis(fem, mass_form, stiffness_form, interfaces,
+                                        parameters["modes"],
+                                        parameters.get("mode_selection", "all"))
+    _fix_eigenmode_signs(fem.modeBasis["matrix"], static_modes)
+    material = KirchhoffMaterial(parameters["youngs_modulus_Pa"], parameters["poisson_ratio"],
+                                 parameters["density_kg_per_m3"])
+    fem.ComputePostProcessingModesNGsolve(space, material=material,
+                                          outputVariableType=exu.OutputVariableType.StressLocal)
+    positions = fem.GetNodePositionsAsArray()
+    mid_nodes, mid_weights = _mid_set(positions, length_m, parameters["mesh_size_m"])
+    fem.nodeSets.append({"Name": MID, "NodeNumbers": mid_nodes, "NodeWeights": mid_weights})
+
+    from exudyn.FEM import ObjectFFRFreducedOrderInterface
+
+    ffrf_interface = ObjectFFRFreducedOrderInterface(fem)
+    end_a, end_b = _node_set(fem, END_A), _node_set(fem, END_B)
+    pinned_pinned = _pinned_pinned_frequency_Hz(
+        ffrf_interface, length_m, parameters["thickness_m"], parameters["width_m"],
+        end_a["NodeNumbers"], end_a["NodeWeights"], end_b["NodeNumbers"], end_b["NodeWeights"])
+    fem.metaData["flex"] = {
+        "key": key,
+        "format_version": CACHE_FORMAT_VERSION,
+        "parameters": json.dumps(parameters, sort_keys=True),
+        "pinned_pinned_frequency_Hz": pinned_pinned,
+        "mass_kg": float(ffrf_interface.totalMass),
+        "n_elements": int(mesh.ne),
+        "cold_build_time_s": time.perf_counter() - start,
+        "digest": _content_digest(fem),
+    }
+    fem.metaData["flex"]["meta_digest"] = _meta_digest(fem.metaData["flex"])
+    # handed to the Reduction (not stored): saves re-projecting on the first add
+    return fem, ffrf_interface
+
+
