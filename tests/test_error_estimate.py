@@ -193,6 +193,37 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
     assert deflection.terms["modes"] > 0 and deflection.terms["mesh"] > 0
     method = result.attrs["estimated_error_method"]
     assert "coupler 2 -> 4" in method and "coupler 0.005 -> 0.01 m" in method
+    # the first crest: a headline of its own, with the whole budget; the peak's crest gap
+    crest = rows["coupler_first_crest_deflection_m"]
+    assert set(crest.terms) == set(TERMS) and 0 < crest.value <= deflection.value
+    assert crest.terms["model"] == pytest.approx(GEOMETRIC_FFRF_ERROR * crest.value, rel=1e-9)
+    gap = result.attrs["crest_gap_coupler_peak_deflection_m"]
+    assert 0 <= gap < deflection.value
+
+
+def test_first_crest_and_crest_gap_of_a_beat_against_closed_forms():
+    """A beat a(t) = sin(w t) (1 + e cos(W t)): the first lobe's crest is near 1 + e (the
+    envelope at t ~ 0), the largest crest 1 + e, and the crests next to the envelope's top
+    lie ~ e (1 - cos(W pi / w)) lower: the crest gap, in closed form, while a series with
+    one crest has no gap."""
+    from flex.data.results import Dataset
+    from flex.fidelity.error_estimate import FIRST_CREST_PATHS, HEADLINES, crest_gap
+
+    omega, beat, depth = 2 * np.pi * 100.0, 2 * np.pi * 3.0, 0.05
+    time_s = np.linspace(0.0, 1.0, 400_001)
+    series = np.sin(omega * time_s) * (1 + depth * np.cos(beat * time_s))
+    read = HEADLINES["coupler_first_crest_deflection_m"][2]
+    first = read({FIRST_CREST_PATHS["coupler_first_crest_deflection_m"]:
+                  Dataset(series, "m", "")})
+    envelope_at_first_crest = 1 + depth * np.cos(beat * np.pi / (2 * omega))
+    assert first == pytest.approx(envelope_at_first_crest, rel=1e-6)
+    # the top crest sits at the envelope's top (t = 0 is no crest: the series starts at 0);
+    # the best next one a half period of the carrier away, on a neighbouring beat maximum
+    crests_t = (np.arange(200) + 0.5) * np.pi / omega
+    crest_heights = np.sort(np.abs(np.sin(omega * crests_t))
+                            * (1 + depth * np.cos(beat * crests_t)))[::-1]
+    assert crest_gap(series) == pytest.approx(crest_heights[0] - crest_heights[1], rel=1e-3)
+    assert crest_gap(np.sin(np.linspace(0.0, np.pi, 101))) is None
 
 
 def test_a_linear_ffrf_run_counts_its_distance_to_the_default_body(reduction_cache):

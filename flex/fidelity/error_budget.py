@@ -52,7 +52,9 @@ from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.fidelity.criteria import FFRF_MOTION_ERROR_FRACTION, GEOMETRIC_FFRF_ERROR
 from flex.fidelity.error_estimate import (
     HEADLINES,
+    PEAK_PATHS,
     PREFIX,
+    crest_gap,
     estimate_step_error,
     headline_difference,
 )
@@ -84,6 +86,8 @@ class ErrorBudget:
     leaves_out: list[str] = field(default_factory=list)
     validity: str = ""
     companion_wall_time_s: float = 0.0
+    #: a peak deflection's crest gap [m]: the second-largest crest's distance below it
+    crest_gaps: dict[str, float] = field(default_factory=dict)
 
     def total(self, quantity: str) -> float:
         """The root-sum-square of the quantity's terms [its units] (module doc)."""
@@ -110,6 +114,8 @@ class ErrorBudget:
                     f"{PREFIX}leaves_out": "; ".join(self.leaves_out) or "nothing flex knows of",
                     f"{PREFIX}validity": self.validity,
                     f"{PREFIX}companion_wall_time_s": self.companion_wall_time_s})
+        out.update({f"{CREST_GAP_PREFIX}{quantity}": gap
+                    for quantity, gap in self.crest_gaps.items()})
         return out
 
 
@@ -120,7 +126,10 @@ def combined(terms: Any) -> float:
 
 #: the headline quantities of a link's own elastic response (their model term is
 #: GEOMETRIC_FFRF_ERROR of the quantity); the others are quantities of the motion
-OWN = ("_peak_deflection_m", "_peak_bending_stress_Pa", "_peak_von_mises_Pa")
+OWN = ("_peak_deflection_m", "_peak_bending_stress_Pa", "_peak_von_mises_Pa",
+       "_first_crest_deflection_m")
+#: case attribute prefix of a peak's crest gap (:func:`flex.fidelity.error_estimate.crest_gap`)
+CREST_GAP_PREFIX = "crest_gap_"
 
 
 def _links(scene: Scene, link_models: Mapping[str, LinkModel], **flags: bool) -> list[str]:
@@ -266,7 +275,20 @@ def error_budget(scene: Scene, result: CaseResult,
     methods = {"step": step.method, "modes": modes_how, "mesh": mesh_how, "model": model_how}
     return ErrorBudget(values, terms, {k: v for k, v in methods.items() if k not in failed},
                        leaves_out, step.validity,
-                       step.companion_wall_time_s + companions.wall_time_s)
+                       step.companion_wall_time_s + companions.wall_time_s,
+                       _crest_gaps(result, values))
+
+
+def _crest_gaps(result: CaseResult, values: dict[str, float]) -> dict[str, float]:
+    """Each peak deflection's crest gap [m] (the peak races between crests when its error
+    exceeds it; the first crest does not)."""
+    out = {}
+    for name in values:
+        if name.endswith("_peak_deflection_m"):
+            gap = crest_gap(result.datasets[PEAK_PATHS[name]].data)
+            if gap is not None:
+                out[name] = gap
+    return out
 
 
 @dataclass(frozen=True)

@@ -67,6 +67,36 @@ def _peak(path: str) -> Callable[[dict[str, Any]], float | None]:
     return read
 
 
+def _first_crest(path: str) -> Callable[[dict[str, Any]], float | None]:
+    """Reader of the first crest of ``|path|``: the largest magnitude of the series' first
+    lobe (:func:`flex.fidelity.softening.first_peak_index`), a peak that does not race: the
+    largest crest of an undamped ringing plate can move from one crest to a neighbour a
+    fraction of a per cent lower when the phase error changes (docs/criterion.md)."""
+    def read(datasets: dict[str, Any]) -> float | None:
+        from flex.fidelity.softening import first_peak_index
+
+        if path not in datasets:
+            return None
+        values = np.asarray(datasets[path].data, dtype=float)
+        if not values.size or not np.any(values):
+            return None
+        return float(abs(values[first_peak_index(values)]))
+    return read
+
+
+def crest_gap(values: np.ndarray) -> float | None:
+    """How far the second-largest crest of ``|values|`` lies below the largest [the series'
+    units]: a peak's crest uncertainty (an error of the run larger than this may have picked
+    another crest as the peak); None with fewer than two crests."""
+    magnitude = np.abs(np.asarray(values, dtype=float))
+    inner = magnitude[1:-1]
+    crests = inner[(inner > magnitude[:-2]) & (inner >= magnitude[2:])]
+    if crests.size < 2:
+        return None
+    top, second = np.sort(crests)[-2:][::-1]
+    return float(top - second)
+
+
 def _deployment_time(datasets: dict[str, Any]) -> float | None:
     """Time of the first maximum of the crank angle [s] (delta_t, docs/criterion.md); None
     when the crank angle has no maximum within the run (a deployment not reached, a
@@ -107,6 +137,9 @@ _PEAK_WHAT = {"coupler_peak_deflection_m": ("m", "peak elastic midpoint deflecti
                                                 "from the joint faces)"),
               **{f"joint_{joint}_peak_force_N": ("N", f"peak force of joint {joint}")
                  for joint in "ABC"}}
+#: the first crests (a link's own quantity that does not race) and their series
+FIRST_CREST_PATHS = {f"{link}_first_crest_deflection_m": f"{link}/midpoint_deflection"
+                     for link in ("coupler", "crank")}
 #: headline quantity -> (units, what, reader of a result's datasets; None: not in this run)
 HEADLINES: dict[str, tuple[str, str, Callable[[dict[str, Any]], float | None]]] = {
     "crank_angle_end_rad": ("rad", "crank angle at the end time", _final("crank/angle")),
@@ -115,6 +148,9 @@ HEADLINES: dict[str, tuple[str, str, Callable[[dict[str, Any]], float | None]]] 
     "deployment_time_s": ("s", "deployment time (first maximum of the crank angle)",
                           _deployment_time),
     **{name: (*_PEAK_WHAT[name], _peak(path)) for name, path in PEAK_PATHS.items()},
+    **{name: ("m", f"first crest of the elastic midpoint deflection of the {name.split('_')[0]}"
+              " (largest |deflection| of the first lobe)", _first_crest(path))
+       for name, path in FIRST_CREST_PATHS.items()},
 }
 
 
@@ -131,6 +167,8 @@ def headline_difference(name: str, run: dict[str, Any], other: dict[str, Any]) -
         if path not in other:
             return read(run)
         return peak_difference(run, other, path)
+    if name in FIRST_CREST_PATHS:  # a rigid twin: no deflection, or none that is not zero
+        return abs(read(run) - (read(other) or 0.0))
     value = read(other)
     return None if value is None else abs(read(run) - value)
 
@@ -328,6 +366,7 @@ def _order(near: float, far: float, order: int) -> float:
     return float(min(max(math.log2(far / near), 1.0), order))
 
 
-__all__ = ["ErrorEstimate", "HEADLINES", "MIN_STEPS_PER_PERIOD", "companion_step_s",
+__all__ = ["FIRST_CREST_PATHS", "ErrorEstimate", "HEADLINES", "MIN_STEPS_PER_PERIOD",
+           "companion_step_s", "crest_gap",
            "estimate_step_error", "integrator_order", "observed_order", "richardson_error",
            "unresolved_time_scales"]

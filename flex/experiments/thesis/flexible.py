@@ -154,6 +154,13 @@ def _pair_values(thickness_m: float, facts: dict[str, Any], flex_case: CaseResul
         "peak_midpoint_deflection_estimated_relative_error": (
             deflection_relative, "1", "that over the peak"),
         "peak_deflection_over_length": (peak / length_m, "1", "peak deflection / L2"),
+        "peak_deflection_crest_gap": (
+            flex_case.attrs.get("crest_gap_coupler_peak_deflection_m", float("nan")), "m",
+            "how far the second-largest crest lies below the peak (the peak races between "
+            "crests when its error exceeds this)"),
+        "first_crest_deflection": (
+            flex_case.attrs.get("headline_coupler_first_crest_deflection_m", float("nan")),
+            "m", "first crest: largest |deflection| of the first lobe (does not race)"),
         "max_crank_angle_deviation": (
             np.abs(flex_data["crank/angle"] - rigid_data["crank/angle"]).max(), "rad",
             "max |FFRF - rigid twin|"),
@@ -232,11 +239,24 @@ def summarize_twins(scene: Scene, results: dict[str, CaseResult], notes: dict[st
         datasets.update({f"models/{model}/{key}": Dataset(value, unit, text)
                          for key, (value, unit, text) in values.items()})
         lines.append(_row(model, {key: value for key, (value, _, _) in values.items()}))
+    lines.append(_crest_line(datasets, plates))
     lines.append("  n thesis = delta_t * omega (thesis Table 5 takes T = 1/omega); "
                  f"n 2pi/w = delta_t / T with the physical period; delta_t = "
                  f"{deployment_time_s:g} s")
     lines += _reference_lines(scene, results, plates, datasets)
     return datasets, "\n".join(lines)
+
+
+def _crest_line(datasets: dict[str, Dataset], plates: Plates) -> str:
+    """Each plate's first crest and its peak's crest gap [um] (and the gap over the peak)."""
+    parts = []
+    for model in plates:
+        if f"models/{model}/first_crest_deflection" not in datasets:
+            continue
+        first, gap, peak = (float(datasets[f"models/{model}/{key}"].data) for key in (
+            "first_crest_deflection", "peak_deflection_crest_gap", "peak_midpoint_deflection"))
+        parts.append(f"{model} {1e6 * first:.4g} / {1e6 * gap:.3g} ({100 * gap / peak:.2g} %)")
+    return "  first crest [um] / crest gap of the peak [um] (% of the peak): " + "; ".join(parts)
 
 
 # ------------------------------------------------------------------------------------------
