@@ -35,7 +35,7 @@ AUTO = "auto"
 #: plate keys of a link beyond the mass-giving ones
 _PLATE_MASS = ("thickness_m", "width_m", "density_kg_per_m3")
 _PLATE_ELASTIC = ("youngs_modulus_Pa", "poisson_ratio", "modes", "mode_selection",
-                  "mesh_size_m", "damping_ratio")
+                  "mesh_size_m", "damping_ratio", "damping_model")
 _SOLVER_ALPHA = ("spectral_radius", "formulation", "newton", "newton_relative_tolerance")
 _SOLVER_EXPLICIT = ("explicit_method", "penalty_stiffness_N_per_m")
 _SPRING = ("spring_stiffness_N_per_m", "spring_preload_m", "spring_damping_Ns_per_m",
@@ -133,8 +133,9 @@ def _link_unused(link: str, scene: Scene, link_models: Mapping[str, Any]) -> dic
                  f'{link}.model = "{model}" moves every mesh node (no modes); used with '
                  f"model = {quoted(model_names(link, link_models, modal=True))}")
         if not entry.damped:
-            mark(("damping_ratio",), f'{link}.model = "{model}" has no damping model; used '
-                                     f"with model = {used_with(rigid=False, damped=True)}")
+            mark(("damping_ratio", "damping_model"),
+                 f'{link}.model = "{model}" has no damping model; used with model = '
+                 f"{used_with(rigid=False, damped=True)}")
     elif model == AUTO:
         mark(("modes",), f'{link}.model = "auto" chooses the modes itself; used with '
                          f"model = {quoted(model_names(link, link_models, modal=True))}")

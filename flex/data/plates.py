@@ -214,3 +214,31 @@ def plate_mass_properties(scene: Scene, link: str = "coupler") -> tuple[float, f
     mass_kg = cuboid_mass_kg(length_m, thickness_m, values["width_m"],
                              values["density_kg_per_m3"])
     return mass_kg, cuboid_inertia_kgm2(mass_kg, length_m, thickness_m)
+
+
+def check_damping_model(link: str, values: dict[str, Any], entry: Any) -> None:
+    """Refuse ``<link>.damping_model = "modal_bands"`` where nothing would read it or it
+    would be ignored: with a model that is not a modal (FFRF) reduction (``entry``: its
+    registry entry, None for ``"auto"``, whose fitted laws know damping ratios only) or with
+    a ``damping_ratio`` (the bands set every ratio)."""
+    if values.get("damping_model", "stiffness_proportional") != "modal_bands":
+        return
+    if entry is None:
+        raise SceneError(f'{link}.damping_model = "modal_bands" with {link}.model = "auto": '
+                         "auto decides with laws fitted per damping ratio; set "
+                         f'{link}.model = "ffrf" or damping_model = "stiffness_proportional"')
+    if not entry.modal:
+        raise SceneError(f'{link}.damping_model = "modal_bands" damps the modes of a reduced '
+                         f'(FFRF) body; {link}.model = "{values["model"]}" has none: set '
+                         f'{link}.model = "ffrf" or damping_model = "stiffness_proportional"')
+    if values["damping_ratio"] != 0:
+        raise SceneError(f"{link}.damping_ratio = {values['damping_ratio']:g} with "
+                         f'damping_model = "modal_bands": the bands set every mode\'s ratio, '
+                         "this one would be ignored; accepted: 0")
+
+
+def is_damped(values: dict[str, Any]) -> bool:
+    """Whether a link's keys damp its elastic motion: a ``damping_ratio`` above 0 or the
+    ``"modal_bands"`` damping model (a reference without damping, the nonlinear FE body,
+    cannot stand in for it)."""
+    return values["damping_ratio"] > 0 or values.get("damping_model") == "modal_bands"

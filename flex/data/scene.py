@@ -38,6 +38,7 @@ from flex.data.plates import (  # noqa: F401 - the names callers import from her
     PLATE_SLENDERNESS_LIMIT,
     PLATE_STUBBINESS_LIMIT,
     MeshEstimate,
+    check_damping_model,
     estimate_mesh,
     modes_cost_factor,
     plate_mass_properties,
@@ -201,6 +202,13 @@ def _plate_fields(link: str) -> dict[str, Field]:
         "mesh_size_m": Field(doc="netgen maximum element size (auto: min(2 t, L / 16), "
                              "flex.config.ffrf_rule)", auto=True, **_POS),
         "damping_ratio": Field(float, "modal damping ratio", minimum=0.0, below=1.0),
+        "damping_model": Field(("stiffness_proportional", "modal_bands"),
+                               "stiffness_proportional: damping_ratio of the first pinned "
+                               "bending mode, higher modes proportionally more; modal_bands: "
+                               "1 % below 100 Hz, 10 % to 1 kHz, 100 % above, every mode of "
+                               "the reduced body (the commercial codes' default; "
+                               "flex.bodies.reduction.damping)",
+                               default="stiffness_proportional"),
         "geometric_stiffness": Field(bool, "model = ffrf: soften the bending modes under the "
                                      "link's own axial force (flex.bodies.geometric_stiffness; "
                                      "false: the linear FFRF body, for comparison)",
@@ -551,6 +559,7 @@ def _check_geometry(scene: Scene, link_models: Mapping[str, Any]) -> None:
             raise SceneError(f"{link}.damping_ratio = {values['damping_ratio']:g}: "
                              f'{link}.model = "{values["model"]}" has no damping model; '
                              "accepted: 0")
+        check_damping_model(link, values, entry)
     if scene["simulation"]["integrator"] == "explicit_penalty" and (
             not all(entry is not None and entry.rigid for entry in entries.values())
             or scene["drive"]["kind"] != "spring"):

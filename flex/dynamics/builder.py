@@ -336,6 +336,7 @@ class _Builder:
         flexible_crank = add_ffrf_link(
             self.mbs, crank_reduction, [0.0, 0.0, 0.0], self.init.crank_angle_rad,
             damping_ratio=self.scene["crank"]["damping_ratio"],
+            damping_model=self.scene["crank"]["damping_model"],
             initial_angular_velocity_rad_per_s=self.init.crank_speed_rad_per_s, name="crank",
             joint_markers=self.ffrf_joint_markers,
             end_a_rotation=bool(self.scene["wing"]["enabled"]))  # the weld turns with A

@@ -354,6 +354,7 @@ def _add_ffrf(builder: Any, link: str, reduction: Any) -> None:
     builder.coupler = add_ffrf_link(
         builder.mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
         damping_ratio=builder.scene["coupler"]["damping_ratio"],
+        damping_model=builder.scene["coupler"]["damping_model"],
         initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
         initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s,
         joint_markers=builder.ffrf_joint_markers,

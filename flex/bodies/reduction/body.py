@@ -33,6 +33,7 @@ def as_vector3(value: Sequence[float], name: str) -> np.ndarray:
 
 def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_rad: float,
                   damping_ratio: float = 0.0,
+                  damping_model: str = "stiffness_proportional",
                   initial_velocity_B_m_per_s: Sequence[float] = (0.0, 0.0, 0.0),
                   initial_angular_velocity_rad_per_s: float = 0.0,
                   name: str = "coupler", joint_markers: str = "fewest",
@@ -63,7 +64,10 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
         ``beta = 2 * damping_ratio / omega_pp`` on the elastic coordinates, with omega_pp the
         reduced body's first pinned-pinned bending frequency [rad/s]. That mode then has
         exactly ``damping_ratio`` of critical damping, higher modes proportionally more;
-        rigid-body motion is never damped.
+        rigid-body motion is never damped. ``damping_model = "modal_bands"`` (with
+        ``damping_ratio`` 0) damps every mode of the reduced body by its frequency band
+        instead (:mod:`flex.bodies.reduction.damping`: 1 % / 10 % / 100 %, the commercial
+        codes' default).
       - initial state: frame origin (point B) velocity [m/s] and angular velocity about z
         [rad/s], elastic coordinates at rest. Give the coupler's rigid-body velocities of
         the starting configuration (e.g. a crank turning at constant speed); default rest.
@@ -76,7 +80,8 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
       :func:`bending_stress_history`), ``marker_B``, ``marker_C``, ``marker_mid``
       (MarkerIndex), ``position_B``, ``position_C``, ``position_mid`` (reference positions
       [m], global), ``rotation_matrix`` (3x3, body to global), ``mass_kg``,
-      ``stiffness_proportional_damping_s`` (beta [s]).
+      ``stiffness_proportional_damping_s`` (beta [s]), ``modal_damping`` (None, or the
+      bands' ``(frequencies [Hz], damping ratios)`` per mode of the reduced body).
     """
     from exudyn.rigidBodyUtilities import RotationMatrixZ
 
@@ -98,6 +103,7 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
         initialAngularVelocity=[0.0, 0.0, float(initial_angular_velocity_rad_per_s)],
         stiffnessProportionalDamping=beta, name=name)
     body = added["oFFRFreducedOrder"]
+    modal_damping = _band_damping(mbs, body, reduction, damping_model, damping_ratio)
     return {
         "object": body,
         "node_frame": added["nRigidBody"],
@@ -107,7 +113,29 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
                             _ffrf_joint_markers(mbs, body, added["nRigidBody"], reduction,
                                                 name, end_b_rotation, end_a_rotation)),
         "stiffness_proportional_damping_s": beta,
+        "modal_damping": modal_damping,
     }
+
+
+def _band_damping(mbs, body, reduction: Reduction, damping_model: str,
+                  damping_ratio: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """Set the body's band damping matrix for ``damping_model = "modal_bands"`` (and return
+    the modes' frequencies [Hz] and ratios); None for stiffness-proportional damping."""
+    from flex.bodies.reduction.damping import DAMPING_MODELS, modal_band_damping_matrix
+
+    if damping_model not in DAMPING_MODELS:
+        raise SceneError(f"damping_model = {damping_model!r}: must be one of "
+                         f"{', '.join(DAMPING_MODELS)}")
+    if damping_model != "modal_bands":
+        return None
+    if damping_ratio != 0:
+        raise SceneError(f"damping_ratio = {damping_ratio!r} with damping_model = "
+                         '"modal_bands": the bands set every ratio; accepted: 0')
+    interface = reduction.ffrf_interface()
+    matrix, frequencies_Hz, ratios = modal_band_damping_matrix(
+        interface.massMatrixReduced, interface.stiffnessMatrixReduced)
+    mbs.SetObjectParameter(body, "dampingMatrixReduced", matrix)
+    return frequencies_Hz, ratios
 
 
 def _stiffness_proportional_damping_s(reduction: Reduction, damping_ratio: float) -> float:

@@ -28,6 +28,7 @@ import numpy as np
 from flex.base.physics import n_values
 from flex.base.plotting import MICRO, figure, legend_below, panels
 from flex.bodies.nonlinear import nonlinear_plate_for_scene
+from flex.data.plates import is_damped
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
@@ -68,7 +69,7 @@ def twin_cases(scene: Scene, plates: Plates, reference_spans_s: dict[str, float 
     out = {}
     for model, (thickness_m, mesh_m) in plates.items():
         kinds = [kind for kind in KINDS if kind != NONLINEAR_FE]
-        if scene["coupler"]["damping_ratio"] == 0 and model in reference_spans_s:
+        if not is_damped(scene["coupler"]) and model in reference_spans_s:
             kinds.append(NONLINEAR_FE)
         for kind in kinds:
             span = reference_spans_s.get(model) if kind == NONLINEAR_FE else None
@@ -208,8 +209,8 @@ def _reference_lines(scene: Scene, results: dict[str, CaseResult], plates: Plate
                                              f"reference/{model}")
         datasets.update(found)
         lines += more
-    if not lines and scene["coupler"]["damping_ratio"] != 0:
-        lines.append("nonlinear FE reference: not run (coupler.damping_ratio > 0; the "
+    if not lines and is_damped(scene["coupler"]):
+        lines.append("nonlinear FE reference: not run (the coupler is damped; the "
                      "nonlinear FE body has no damping model)")
     return lines
 

@@ -38,6 +38,7 @@ import numpy as np
 
 from flex.base.plotting import figure
 from flex.config.settings import resolve_solver_settings
+from flex.data.plates import is_damped
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
@@ -78,7 +79,7 @@ def reference_overrides(scene: Scene) -> tuple[list[str], str]:
         values = scene[link]
         if not BUILTIN_LINK_MODELS[values["model"]].modal:
             continue
-        if link == "coupler" and values["damping_ratio"] == 0:
+        if link == "coupler" and not is_damped(values):
             overrides.append(f'coupler.model="{NONLINEAR_FE}"')
             parts.append("the nonlinear FE coupler")
         else:
