@@ -11,7 +11,8 @@
   modes over 1 kHz" (MSC Adams Solver documentation, FLEX_BODY); Altair MotionSolve's
   flexible bodies offer the same as their "Default Damping" (HyperWorks help, Deformable
   Body - Modes); RecurDyn is said to do the same (not checked here). Offered so that a flex
-  run can be set up as an engineer would set it up in those codes. The thesis's scene stays undamped, as the thesis is.
+  run can be set up as an engineer would set it up in those codes. The thesis's scene stays
+  undamped, as the thesis is.
 
 The modal damping matrix is ``D = M Phi diag(2 zeta_i omega_i) Phi^T M`` with ``Phi`` the
 mass-normalized eigenvectors of the reduced ``(K, M)`` (``Phi^T M Phi = I``), so that
