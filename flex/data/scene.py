@@ -308,6 +308,10 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "tolerance": Field(float, "model = \"auto\": accepted error of the rigid model "
                            "(dimensionless: deflection / L2, crank-angle and slider deviation "
                            "relative to their swing)", positive=True, maximum=0.5),
+        "refine": Field(bool, "refine step, modes, mesh, rung until the flexible links' "
+                        "peak deflection and first crest meet the tolerance (docs/criterion.md)",
+                        default=False),
+        "refine_limit_s": Field(float, "refine: none starts after", positive=True, default=600.0),
     },
 }
 

@@ -15,15 +15,18 @@ command line and :mod:`flex.api` pass the user's folder
 from __future__ import annotations
 
 import sys
+import time
 from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from flex.base.errors import FlexError
+from flex.base.errors import FlexError, SceneError
 from flex.config.calibration import Calibration
 from flex.config.settings import tolerance_beyond_reach
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
+from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.dynamics.solver import VALIDITY_WARNING, integrate, scene_reductions, time_scales
 from flex.fidelity.auto import Resolution, resolve
@@ -62,6 +65,8 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
         print(f"flex: warning: case {name}: {beyond}", file=sys.stderr, flush=True)
     resolution = resolve(scene, criterion, crank_criterion, cache_dir=cache_dir,
                          calibration=calibration, link_models=link_models)
+    if scene["fidelity"]["refine"]:
+        return refine(resolution, name, cache_dir=cache_dir, link_models=link_models)
     return simulate_resolved(resolution, name, reduction, crank_reduction,
                              cache_dir=cache_dir, beyond=beyond, link_models=link_models)
 
@@ -108,6 +113,123 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
                               time_scales(scene, reductions, link_models), link_models)
         result.attrs.update(budget.attrs())
     return result
+
+
+#: the quantities :func:`refine` certifies: each flexible link's own (docs/criterion.md, "What
+#: the tolerance bounds"): its peak deflection and its first crest (which does not race)
+REFINED = ("_peak_deflection_m", "_first_crest_deflection_m")
+#: most attempts of :func:`refine` (each one a run with its whole error budget)
+MAX_ATTEMPTS = 6
+
+
+def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None = None,
+           link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> CaseResult:
+    """``fidelity.refine``: run the resolved scene with its error budget; while a certified
+    quantity (:data:`REFINED`) has a total estimated error above ``fidelity.tolerance``
+    relative to itself, refine the knob whose term dominates it (the step halved, the modes
+    of the modal links raised as the modes companion's, the mesh of the meshed links halved,
+    an FFRF coupler climbed to the nonlinear FE rung) and run again, until every one meets
+    it, ``fidelity.refine_limit_s`` [s] is spent, :data:`MAX_ATTEMPTS` runs are made or no
+    knob can move. Returns the last run, with ``refine_status`` (``met``, or why not),
+    ``refine_attempts`` (one line per run: its settings, the worst quantity, what changed
+    and why) and ``refine_wall_time_s``; a run that did not meet the tolerance says so in
+    one stderr line. The companion runs of one attempt are not reused by the next (a known
+    cost: the refined run equals one of them)."""
+    from flex.fidelity.error_budget import budget_rows
+
+    if not resolution.scene["simulation"]["error_estimate"]:
+        raise SceneError("fidelity.refine = true with simulation.error_estimate = false: "
+                         "refinement follows the error budget; set error_estimate = true or "
+                         "refine = false")
+    start, lines = time.perf_counter(), []
+    tolerance = float(resolution.scene["fidelity"]["tolerance"])
+    current = resolution
+    for attempt in range(1, MAX_ATTEMPTS + 1):
+        scene = current.scene
+        result = simulate_resolved(current, name, cache_dir=cache_dir, link_models=link_models)
+        rows = [row for row in budget_rows(result.attrs) if row.quantity.endswith(REFINED)]
+        over = [row for row in rows if not row.relative <= tolerance]
+        settings = _settings_text(scene, link_models)
+        if not rows:
+            status = "nothing to certify (no flexible link's deflection)"
+            lines.append(f"{attempt}: {settings}: {status}")
+            break
+        worst = max(rows, key=lambda row: row.relative / tolerance)
+        found = (f"{worst.what} {100 * worst.relative:.3g} % of itself (tolerance "
+                 f"{100 * tolerance:g} %)")
+        if not over:
+            status = "met"
+            lines.append(f"{attempt}: {settings}: met; worst {found}")
+            break
+        term = max(worst.terms, key=lambda key: worst.terms[key])
+        change, why = _refined(scene, term, link_models)
+        spent = time.perf_counter() - start
+        if change is None or spent > scene["fidelity"]["refine_limit_s"] \
+                or attempt == MAX_ATTEMPTS:
+            status = (why if change is None else
+                      f"cost limit ({spent:.0f} s of fidelity.refine_limit_s = "
+                      f"{scene['fidelity']['refine_limit_s']:g} s)" if attempt < MAX_ATTEMPTS
+                      else f"{MAX_ATTEMPTS} runs made")
+            lines.append(f"{attempt}: {settings}: {found}, {term} term dominant; stopped: "
+                         f"{status}")
+            break
+        try:  # validated as --set is: a mesh too fine for this machine stops here
+            refined = derive_scene(scene, change, link_models=link_models)
+        except SceneError as refused:
+            status = f"{why}: refused: {refused}"
+            lines.append(f"{attempt}: {settings}: {found}; stopped: {status}")
+            break
+        lines.append(f"{attempt}: {settings}: {found}, {term} term dominant -> {why}")
+        current = replace(current, scene=refined)
+    result.attrs.update({"refine_status": status, "refine_attempts": "\n".join(lines),
+                         "refine_wall_time_s": time.perf_counter() - start})
+    if status != "met":
+        print(f"flex: case {name}: fidelity.tolerance = {tolerance:g} not met by refinement "
+              f"({status}); the last run is stored with its budget", file=sys.stderr,
+              flush=True)
+    return result
+
+
+def _settings_text(scene: Scene, link_models: Mapping[str, LinkModel]) -> str:
+    parts = [f"step {scene['simulation']['step_s']:g} s"]
+    for link in ("crank", "coupler"):
+        values = scene[link]
+        entry = link_models[values["model"]]
+        if entry.meshed:
+            modes = f", {values['modes']} modes" if entry.modal else ""
+            parts.append(f"{link} {values['model']}{modes}, mesh {values['mesh_size_m']:g} m")
+    return "; ".join(parts)
+
+
+def _refined(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
+             ) -> tuple[list[str] | None, str]:
+    """The overrides that refine the knob of ``term`` (step, modes, mesh, model) and what
+    they do; (None, why not) when it cannot move."""
+    from flex.fidelity.error_budget import richer_modes
+
+    links = {link: link_models[scene[link]["model"]] for link in ("crank", "coupler")}
+    if term == "step":
+        step = scene["simulation"]["step_s"] / 2
+        return [f"simulation.step_s={step!r}"], f"step halved to {step:g} s"
+    if term == "modes":
+        modal = [link for link, entry in links.items() if entry.modal
+                 and richer_modes(scene[link]["modes"]) <= 100]
+        return ([f"{link}.modes={richer_modes(scene[link]['modes'])}" for link in modal] or None,
+                "modes raised (" + ", ".join(f"{link} {scene[link]['modes']} -> "
+                                             f"{richer_modes(scene[link]['modes'])}"
+                                             for link in modal) + ")"
+                if modal else "the modes term dominates and no link can take more modes")
+    if term == "mesh":
+        meshed = [link for link, entry in links.items() if entry.meshed]
+        return ([f"{link}.mesh_size_m={scene[link]['mesh_size_m'] / 2!r}" for link in meshed]
+                or None, "mesh halved (" + ", ".join(meshed) + ")" if meshed
+                else "the mesh term dominates and no link is meshed")
+    higher = [name for name, entry in link_models.items() if entry.reference
+              and "coupler" in entry.links]
+    if links["coupler"].linear_elastic and not links["crank"].linear_elastic and higher:
+        return ([f'coupler.model="{higher[0]}"'],
+                f"coupler climbed to the {link_models[higher[0]].label} rung")
+    return None, "the model term dominates and no link has a higher rung"
 
 
 def simulate_case(scene: Scene, name: str = "case", reduction: Any = None,

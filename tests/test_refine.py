@@ -1,0 +1,66 @@
+"""``fidelity.refine``: settings refined until the run's own error budget meets the tolerance
+(flex.fidelity.simulation.refine).
+
+Checked against a reference the refinement never sees: the same FFRF body at a 4x smaller
+step and twice the modes; the refined run's peak deflection must lie within the tolerance
+of it (the budget's model term, against the nonlinear FE coupler, is not part of that check:
+make ladder measures it)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from flex.api import load_scene
+from flex.base.errors import SceneError
+from flex.fidelity.simulation import simulate
+
+PLATE = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "fidelity.tolerance=0.01",
+         "simulation.end_time_s=0.02"]
+
+
+def _peak(result) -> float:
+    return float(np.abs(result.datasets["coupler/midpoint_deflection"].data).max())
+
+
+def test_refinement_meets_the_tolerance_against_a_finer_reference(reduction_cache):
+    refined = simulate(load_scene(overrides=[*PLATE, "fidelity.refine=true"]),
+                       cache_dir=reduction_cache)
+    attempts = refined.attrs["refine_attempts"].splitlines()
+    assert refined.attrs["refine_status"] == "met", refined.attrs["refine_attempts"]
+    assert len(attempts) >= 2 and "dominant ->" in attempts[0]  # the rule's guess was refined
+    assert refined.attrs["estimated_error_coupler_peak_deflection_m_relative"] <= 0.01
+    first = load_scene(overrides=PLATE)  # the first guess, as auto resolves it
+    from flex.fidelity.auto import resolve
+
+    guess = resolve(first, quiet=True).scene
+    reference = simulate(load_scene(overrides=[
+        *PLATE, f"simulation.step_s={guess['simulation']['step_s'] / 8!r}",
+        f"coupler.modes={2 * guess['coupler']['modes'] + 2}",
+        f"coupler.mesh_size_m={guess['coupler']['mesh_size_m']!r}",
+        "simulation.error_estimate=false"]), cache_dir=reduction_cache)
+    assert _peak(refined) == pytest.approx(_peak(reference), rel=0.01)
+
+
+def test_a_refinement_that_cannot_meet_the_tolerance_says_so_and_keeps_its_best(
+        reduction_cache, capsys):
+    """0.1 %: the FFRF body's own model term (0.5 % of the deflection) dominates once the
+    step is fine; with a limit too short to climb, it stops and says so in one line."""
+    result = simulate(load_scene(overrides=[*PLATE[:2], "fidelity.tolerance=0.001",
+                                            "simulation.end_time_s=0.005",
+                                            "fidelity.refine=true",
+                                            "fidelity.refine_limit_s=0.001"]),
+                      cache_dir=reduction_cache)
+    assert result.attrs["refine_status"].startswith("cost limit")
+    assert "estimated_error_coupler_peak_deflection_m" in result.attrs
+    err = capsys.readouterr().err
+    assert "not met by refinement (cost limit" in err
+
+
+def test_a_rigid_scene_has_nothing_to_refine_and_refinement_needs_the_budget():
+    result = simulate(load_scene(overrides=["fidelity.refine=true",
+                                            "simulation.end_time_s=0.005"]))
+    assert result.attrs["refine_status"].startswith("nothing to certify")
+    with pytest.raises(SceneError, match="refinement follows the error budget"):
+        simulate(load_scene(overrides=["fidelity.refine=true",
+                                       "simulation.error_estimate=false"]))
