@@ -75,3 +75,21 @@ def assert_no_traceback(outcome: Outcome) -> None:
     for text in (outcome.stdout, outcome.stderr):
         assert "Traceback" not in text, text
         assert "internal error" not in text, text
+
+
+def earlier_run(folder: Path) -> Path:
+    """An earlier run in ``folder``: its result file (returned), figure and report, for the
+    checks that an error exit changes none of them."""
+    import numpy as np
+
+    from flex.data.results import CaseResult, Dataset, write_results
+
+    path = write_results(folder / "run.h5", "simulate", [CaseResult("case", "", {
+        "time": Dataset(np.linspace(0, 1, 11), "s"), "crank/angle": Dataset(np.zeros(11),
+                                                                            "rad")})])
+    (folder / "figures").mkdir()
+    (folder / "figures" / "run-crank-angle.png").write_bytes(b"yesterday's figure")
+    (folder / "reports").mkdir()
+    (folder / "reports" / "run.md").write_text("yesterday's report\n")
+    return path
+

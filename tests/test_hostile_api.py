@@ -18,12 +18,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hostile import fingerprint, run_cli
+from hostile import earlier_run, fingerprint, run_cli
 from test_hostile_scenes import OUT_OF_RANGE, WRONG_TYPES
 
 import flex
 from flex.base.errors import ArgumentError, CacheError, FlexError, ResultFileError, SceneError
-from flex.data.results import CaseResult, Dataset, write_results
 
 #: (key, TOML text of a value the command line refuses): every key of the schema with a
 #: value of the wrong type, every number out of its range
@@ -249,14 +248,7 @@ def test_simulate_refuses_a_value_the_scene_would_not_use_as_run_simulate_does(b
 @pytest.fixture
 def earlier(tmp_path) -> Path:
     """An existing result file, its figure and report: an error must change none of them."""
-    path = write_results(tmp_path / "run.h5", "simulate", [CaseResult("case", "", {
-        "time": Dataset(np.linspace(0, 1, 11), "s"), "crank/angle": Dataset(np.zeros(11),
-                                                                            "rad")})])
-    (tmp_path / "figures").mkdir()
-    (tmp_path / "figures" / "run-crank-angle.png").write_bytes(b"yesterday")
-    (tmp_path / "reports").mkdir()
-    (tmp_path / "reports" / "run.md").write_text("yesterday's report\n")
-    return path
+    return earlier_run(tmp_path)
 
 
 RUN_STUDY = [

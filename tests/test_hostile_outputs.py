@@ -13,12 +13,10 @@ import errno
 import os
 from pathlib import Path
 
-import numpy as np
 import pytest
-from hostile import check_refused, fingerprint, run_cli
+from hostile import check_refused, earlier_run, fingerprint, run_cli
 
 from flex.base.errors import EXIT_BAD_INPUT, EXIT_OK, EXIT_SIGINT
-from flex.data.results import CaseResult, Dataset, write_results
 
 SHORT = ["--set", "simulation.end_time_s=0.004", "--set", "simulation.error_estimate=false"]
 STUDIES = ["simulate", "kinematics", "dynamics"]
@@ -27,14 +25,7 @@ STUDIES = ["simulate", "kinematics", "dynamics"]
 @pytest.fixture
 def earlier(tmp_path) -> Path:
     """An earlier run's result file, figure and report (all watched)."""
-    path = write_results(tmp_path / "run.h5", "simulate", [CaseResult("case", "", {
-        "time": Dataset(np.linspace(0, 1, 11), "s"), "crank/angle": Dataset(np.zeros(11),
-                                                                            "rad")})])
-    (tmp_path / "figures").mkdir()
-    (tmp_path / "figures" / "run-crank-angle.png").write_bytes(b"yesterday's figure")
-    (tmp_path / "reports").mkdir()
-    (tmp_path / "reports" / "run.md").write_text("yesterday's report\n")
-    return path
+    return earlier_run(tmp_path)
 
 
 def _argv(study: str, out: Path, *extra: str) -> list[str]:
