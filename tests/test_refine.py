@@ -30,6 +30,11 @@ def test_refinement_meets_the_tolerance_against_a_finer_reference(reduction_cach
     assert refined.attrs["refine_status"] == "met", refined.attrs["refine_attempts"]
     assert len(attempts) >= 2 and "dominant ->" in attempts[0]  # the rule's guess was refined
     assert refined.attrs["estimated_error_coupler_peak_deflection_m_relative"] <= 0.01
+    from flex.tools.inspect import _estimate_lines  # what flex inspect prints of the case
+
+    shown = "\n".join(_estimate_lines(refined.attrs))
+    assert "refinement (fidelity.refine): met" in shown and attempts[-1] in shown
+    assert "crest gap of the coupler's peak deflection" in shown
     first = load_scene(overrides=PLATE)  # the first guess, as auto resolves it
     from flex.fidelity.auto import resolve
 

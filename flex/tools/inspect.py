@@ -280,6 +280,13 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
     for key in ("method", "leaves_out", "validity"):
         if attrs.get(PREFIX + key):
             lines.append(f"    {key.replace('_', ' ')}: {attrs[PREFIX + key]}")
+    lines += [f"    crest gap of the {key.removeprefix('crest_gap_').split('_')[0]}'s peak "
+              f"deflection: {float(value):.3g} m (the second-largest crest lies this far "
+              f"below it)" for key, value in attrs.items() if key.startswith("crest_gap_")]
+    if attrs.get("refine_status"):
+        lines.append(f"  refinement (fidelity.refine): {attrs['refine_status']}, "
+                     f"{float(attrs.get('refine_wall_time_s', 0.0)):.3g} s")
+        lines += [f"    {line}" for line in str(attrs.get("refine_attempts", "")).splitlines()]
     return lines
 
 
