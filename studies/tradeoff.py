@@ -1,22 +1,17 @@
 """Study ``tradeoff``: work-precision of every knob, for the rigid and the FFRF coupler.
 
-Three scenes of the thesis deployment (22 mm preload, 0.03 s): the rigid Table 1 model (``rigid``)
-and a steel-plate FFRF coupler 1 mm and 10 mm thick (``ffrf_1mm``, ``ffrf_10mm``). For each, a
-converged reference is run and shown converged
-(:mod:`flex.experiments.workprecision.reference_plans`), then the knobs are varied one at a time
-around a base setting and in combination (:func:`settings`): time step, generalized-alpha spectral
-radius, index-3 versus index-2 (Newmark) constraints, full versus modified Newton and its tolerance,
-explicit Runge-Kutta with penalty joints (rigid), number of modes, mesh size and element order, the
-fully nonlinear FE coupler instead of the FFRF reduction, and the independent scipy reference DAE
-(rigid) at several tolerances.
+Three scenes of the thesis deployment (22 mm preload, 0.03 s): the rigid Table 1 model
+(``rigid``) and steel-plate FFRF couplers 1 and 10 mm thick (``ffrf_1mm``, ``ffrf_10mm``). Each
+gets a converged reference, shown converged (``workprecision.reference_plans``); the knobs vary
+one at a time around a base setting and in combination (:func:`settings`): step, spectral
+radius, index-3 or index-2, Newton variant and tolerance, explicit Runge-Kutta with penalty
+joints (rigid), modes, mesh size and element order, the nonlinear FE coupler, and the scipy
+reference DAE (rigid) at several tolerances.
 
-Stored (:mod:`flex.experiments.workprecision.tradeoff`): a case ``<scene>__<setting>`` per run (a
-diverged run: a ``failed`` case); under ``/summary/<scene>/``
-(:mod:`flex.experiments.workprecision.tradeoff_report`) ``runs/...``, ``reference/...``,
-``recommended/...`` (1 %, 0.1 %, 0.01 %), ``default/...`` and (FFRF) ``rule/...``: the bundled
-"auto" keys and the rule's picks at 1 % and 0.1 % against the runs
-(:mod:`~flex.experiments.workprecision.defaults_check`,
-:mod:`~flex.experiments.workprecision.rule_check`); figures.
+Stored (``workprecision.tradeoff``): a case ``<scene>__<setting>`` per run (a diverged run:
+a ``failed`` case); under ``/summary/<scene>/`` (``workprecision.tradeoff_report``) ``runs``,
+``reference``, ``recommended`` (1 %, 0.1 %, 0.01 %), ``default`` and (FFRF) ``rule``: the
+bundled "auto" keys and the rule's picks against the runs (``defaults_check``, ``rule_check``).
 """
 
 from __future__ import annotations
