@@ -69,3 +69,10 @@ def test_a_rigid_scene_has_nothing_to_refine_and_refinement_needs_the_budget():
     with pytest.raises(SceneError, match="refinement follows the error budget"):
         simulate(load_scene(overrides=["fidelity.refine=true",
                                        "simulation.error_estimate=false"]))
+
+
+def test_a_refine_limit_without_refine_would_be_ignored_and_is_refused():
+    from hostile import check_refused
+
+    check_refused(["run", "simulate", "--set", "fidelity.refine_limit_s=10"],
+                  ["fidelity.refine_limit_s", "fidelity.refine = true"])

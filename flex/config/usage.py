@@ -94,10 +94,13 @@ def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset(), *,
         for key in _SOLVER_EXPLICIT:
             unused[f"simulation.{key}"] = ('simulation.integrator = "generalized_alpha": used '
                                            'with integrator = "explicit_penalty"')
-    if not reads_tolerance(scene, link_models=link_models):
+    refine = scene["fidelity"].get("refine", False)
+    if not refine and not reads_tolerance(scene, link_models=link_models):
         unused["fidelity.tolerance"] = ('no "auto" choice reads it: used by model = "auto" '
-                                        'links, and by "auto" solver keys of an FFRF coupler '
-                                        "on a rigid crank")
+                                        'links, by "auto" solver keys of an FFRF coupler '
+                                        "on a rigid crank, and by fidelity.refine = true")
+    if not refine:
+        unused["fidelity.refine_limit_s"] = "used with fidelity.refine = true"
     for name in read_by_study:
         unused.pop(name, None)
     return unused
