@@ -76,3 +76,17 @@ def test_a_refine_limit_without_refine_would_be_ignored_and_is_refused():
 
     check_refused(["run", "simulate", "--set", "fidelity.refine_limit_s=10"],
                   ["fidelity.refine_limit_s", "fidelity.refine = true"])
+
+
+def test_a_refinement_whose_next_run_would_exceed_the_limit_stops_before_it(reduction_cache):
+    """3 mm at 1 %: the mesh term dominates the peak's budget and does not shrink as the mesh
+    is halved (the peak races, docs/criterion.md); the next halving would mesh and reduce
+    ~2.7e5 DOF twice (flex's mesh estimate, minutes): with a 60 s limit the refinement stops
+    before starting it, and says what it would have cost."""
+    result = simulate(load_scene(overrides=[*PLATE[:2], "coupler.thickness_m=0.003",
+                                            "fidelity.tolerance=0.01", "fidelity.refine=true",
+                                            "fidelity.refine_limit_s=60"]),
+                      cache_dir=reduction_cache)
+    status = result.attrs["refine_status"]
+    assert status.startswith("cost limit: mesh halved") and "(estimate)" in status
+    assert "would take" in status and result.attrs["refine_wall_time_s"] < 60

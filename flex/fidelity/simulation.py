@@ -179,6 +179,13 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
             status = f"{why}: refused: {refused}"
             lines.append(f"{attempt}: {settings}: {found}; stopped: {status}")
             break
+        cost_s = _attempt_cost_s(refined, link_models)
+        if spent + cost_s > scene["fidelity"]["refine_limit_s"]:
+            status = (f"cost limit: {why} would take ~{cost_s:.3g} s with its budget (estimate), "
+                      f"beyond fidelity.refine_limit_s = {scene['fidelity']['refine_limit_s']:g} "
+                      f"s after {spent:.3g} s")
+            lines.append(f"{attempt}: {settings}: {found}; stopped: {status}")
+            break
         lines.append(f"{attempt}: {settings}: {found}, {term} term dominant -> {why}")
         current = replace(current, scene=refined)
     result.attrs.update({"refine_status": status, "refine_attempts": "\n".join(lines),
@@ -188,6 +195,32 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
               f"({status}); the last run is stored with its budget", file=sys.stderr,
               flush=True)
     return result
+
+
+#: runs of an attempt's error budget, in run-equivalents (companions at 2 h and 4 h, more
+#: modes, a coarser mesh, a rigid twin; rough: the coarser ones cost less)
+BUDGET_RUNS = 4.0
+
+
+def _attempt_cost_s(scene: Scene, link_models: Mapping[str, LinkModel]) -> float:
+    """Rough wall time [s] of one attempt on ``scene``: the run and its budget's companions
+    (:data:`BUDGET_RUNS`), plus meshing and reducing each meshed link at its mesh, twice
+    (the run's reduction and the modes companion's), as flex estimates them before meshing."""
+    from flex.data.plates import estimate_mesh
+    from flex.dynamics.runtime import estimated_run_time_s
+    from flex.fidelity.error_budget import richer_modes
+
+    cost = (1.0 + BUDGET_RUNS) * estimated_run_time_s(scene, link_models=link_models)
+    for link in ("crank", "coupler"):
+        values, entry = scene[link], link_models[scene[link]["model"]]
+        if entry.meshed:
+            modes = values["modes"] if entry.modal else None
+            plate = (values["length_m"], values["thickness_m"], values["width_m"],
+                     values["mesh_size_m"])
+            cost += estimate_mesh(*plate, modes).build_time_s
+            if entry.modal:
+                cost += estimate_mesh(*plate, richer_modes(modes)).build_time_s
+    return cost
 
 
 def _settings_text(scene: Scene, link_models: Mapping[str, LinkModel]) -> str:
