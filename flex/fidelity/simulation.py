@@ -129,8 +129,8 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     relative to itself, refine the knob whose term dominates it (the step halved, the modes
     of the modal links raised as the modes companion's, the mesh of the meshed links halved,
     an FFRF coupler climbed to the nonlinear FE rung) and run again, until every one meets
-    it, ``fidelity.refine_limit_s`` [s] is spent, :data:`MAX_ATTEMPTS` runs are made or no
-    knob can move. Returns the last run, with ``refine_status`` (``met``, or why not),
+    it, the next run's estimated cost (:func:`_attempt_cost_s`) would pass
+    ``fidelity.refine_limit_s`` [s], :data:`MAX_ATTEMPTS` runs are made or no knob can move. Returns the last run, with ``refine_status`` (``met``, or why not),
     ``refine_attempts`` (one line per run: its settings, the worst quantity, what changed
     and why) and ``refine_wall_time_s``; a run that did not meet the tolerance says so in
     one stderr line. The companion runs of one attempt are not reused by the next (a known
