@@ -130,7 +130,8 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     of the modal links raised as the modes companion's, the mesh of the meshed links halved,
     an FFRF coupler climbed to the nonlinear FE rung) and run again, until every one meets
     it, the next run's estimated cost (:func:`_attempt_cost_s`) would pass
-    ``fidelity.refine_limit_s`` [s], :data:`MAX_ATTEMPTS` runs are made or no knob can move. Returns the last run, with ``refine_status`` (``met``, or why not),
+    ``fidelity.refine_limit_s`` [s], :data:`MAX_ATTEMPTS` runs are made or no knob can move.
+    Returns the last run, with ``refine_status`` (``met``, or why not),
     ``refine_attempts`` (one line per run: its settings, the worst quantity, what changed
     and why) and ``refine_wall_time_s``; a run that did not meet the tolerance says so in
     one stderr line. The companion runs of one attempt are not reused by the next (a known
