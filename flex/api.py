@@ -210,7 +210,9 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
             ``calibration=``: the fitted laws, FFRF rule and solver defaults every ``"auto"``
             resolves from, a :class:`flex.config.calibration.Calibration` or its name,
             ``"bundled"`` (the default) or a folder, :func:`flex.config.calibration.
-            load_calibration`); not needed for ordinary use.
+            load_calibration`; ``headlines=``: the headline quantities budgeted and
+            certified, a mapping of name to :class:`flex.fidelity.headlines.Headline`,
+            default the built-in ones); not needed for ordinary use.
     Output:
         a :class:`flex.data.results.CaseResult`: ``status == "ok"``; ``datasets`` maps paths of
         the result layout to :class:`flex.data.results.Dataset` (``.data`` a numpy array,
@@ -240,8 +242,11 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
                              "criterion": "a flex.fidelity.laws.Criterion",
                              "crank_criterion": "a flex.fidelity.laws.Criterion",
                              "calibration": "a flex.config.calibration.Calibration, "
-                                            "'bundled' or a folder"},
+                                            "'bundled' or a folder",
+                             "headlines": "a mapping of names to "
+                                          "flex.fidelity.headlines.Headline"},
                    "simulate")
+    _check_headlines(options.get("headlines"))
     if isinstance(options.get("calibration"), str | Path):
         from flex.config.calibration import load_calibration
 
@@ -459,6 +464,17 @@ def _check_options(options: Mapping[str, Any], accepted: Mapping[str, str], func
             listed = "; ".join(f"{name}: {what}" for name, what in accepted.items())
             raise ArgumentError(f"{function}: unknown keyword argument {key!r}; accepted "
                                 f"beside the named ones: {listed}")
+
+
+def _check_headlines(headlines: Any) -> None:
+    from flex.fidelity.headlines import Headline
+
+    if headlines is not None and not (isinstance(headlines, Mapping) and all(
+            isinstance(name, str) and isinstance(entry, Headline) and entry.name == name
+            for name, entry in headlines.items())):
+        raise ArgumentError(f"headlines: expected a mapping of names to "
+                            f"flex.fidelity.headlines.Headline entries of the same names, got "
+                            f"{_kind(headlines)}")
 
 
 def _check_study_options(options: Mapping[str, Any]) -> None:

@@ -207,14 +207,13 @@ def test_first_crest_and_crest_gap_of_a_beat_against_closed_forms():
     lie ~ e (1 - cos(W pi / w)) lower: the crest gap, in closed form, while a series with
     one crest has no gap."""
     from flex.data.results import Dataset
-    from flex.fidelity.error_estimate import FIRST_CREST_PATHS, HEADLINES, crest_gap
+    from flex.fidelity.headlines import BUILTIN_HEADLINES, crest_gap
 
     omega, beat, depth = 2 * np.pi * 100.0, 2 * np.pi * 3.0, 0.05
     time_s = np.linspace(0.0, 1.0, 400_001)
     series = np.sin(omega * time_s) * (1 + depth * np.cos(beat * time_s))
-    read = HEADLINES["coupler_first_crest_deflection_m"][2]
-    first = read({FIRST_CREST_PATHS["coupler_first_crest_deflection_m"]:
-                  Dataset(series, "m", "")})
+    crest = BUILTIN_HEADLINES["coupler_first_crest_deflection_m"]
+    first = crest.read({crest.series: Dataset(series, "m", "")})
     envelope_at_first_crest = 1 + depth * np.cos(beat * np.pi / (2 * omega))
     assert first == pytest.approx(envelope_at_first_crest, rel=1e-6)
     # the top crest sits at the envelope's top (t = 0 is no crest: the series starts at 0);

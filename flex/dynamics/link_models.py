@@ -47,6 +47,12 @@ The contract of an entry -- what a link model declares, point by point:
 8. **solver adjustments**: ``adjust_solver(settings)`` changes the integrator settings in
    place (a sparse solver, a looser absolute tolerance); ``own_progress``: the model prints
    its own progress during a solve.
+9. **its rung on the ladder**: ``rung(values)`` -> a :class:`flex.dynamics.ladder.Rung` (or
+   None: on no rung): what bounds its model error against the rung above, what that leaves
+   out, and whether ``auto`` and the refinement may climb onto it. The error budget,
+   ``auto``'s climb and the refinement read it and name no model.
+10. **how its stored motion is read back** (``flex export``, ``flex animate``):
+    ``stored_motion``, one of :data:`STORED_MOTIONS`.
 
 Capability flags the callers read: ``rigid``, ``meshed``, ``modal``, ``damped`` (above);
 ``linear_elastic``: its results are trusted only for small elastic deflections and loads
@@ -84,6 +90,12 @@ from flex.data.scene import (
     link_model,
     plate_mass_properties,
 )
+from flex.dynamics.ladder import (
+    NONLINEAR_FE_RUNG,
+    RIGID_RUNG,
+    Rung,
+    ffrf_rung,
+)
 
 #: the built-in models' names (for code that sets a model in a scene)
 RIGID, FFRF, NONLINEAR_FE = BUILTIN_LINK_SCHEMAS
@@ -101,8 +113,20 @@ def _free(values: dict[str, Any], modes: int | None) -> float:
     return 0.0
 
 
+def _no_rung(values: Mapping[str, Any]) -> Rung | None:
+    return None
+
+
 def _no_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
     return {}
+
+
+#: how a model's run stores its motion (the contract's point 10): ``"rigid"`` (the link's
+#: angle and joint positions: a box moved with them), ``"modal"`` (``<link>/modal_coordinates``
+#: and the floating frame's pose ``<link>/frame_position``, ``frame_angle``, on the basis of
+#: the link's reduction, rebuilt from the case's scene), ``"nodal"`` (every node's position,
+#: ``<link>/nodal/position`` at ``<link>/nodal/time``, on the link's plate mesh)
+STORED_MOTIONS = ("rigid", "modal", "nodal")
 
 
 @dataclass(frozen=True)
@@ -135,6 +159,16 @@ class LinkModel(LinkSchema):
     #: (8) ``adjust_solver(settings)`` in place; prints its own progress
     adjust_solver: Callable[[dict[str, Any]], None] = _nothing
     own_progress: bool = False
+    #: (9) its rung on the model ladder for a link's scene values (:mod:`flex.dynamics.
+    #: ladder`), or None: a model on no rung (its budget then says its model error is left out)
+    rung: Callable[[Mapping[str, Any]], Rung | None] = _no_rung
+    #: (10) how its stored motion is read back (export, animate): one of STORED_MOTIONS
+    stored_motion: str = "rigid"
+
+    def __post_init__(self) -> None:
+        if self.stored_motion not in STORED_MOTIONS:
+            raise ValueError(f"link model {self.name}: stored_motion {self.stored_motion!r} "
+                             f"is not one of {', '.join(STORED_MOTIONS)}")
 
     @classmethod
     def extending(cls, schema: LinkSchema, **behaviour: Any) -> LinkModel:
@@ -459,6 +493,14 @@ def _nonlinear_fe_solver(settings: dict[str, Any]) -> None:
                                                 NONLINEAR_FE_NEWTON_ABSOLUTE_TOLERANCE)
 
 
+def _rigid_rung(values: Mapping[str, Any]) -> Rung:
+    return RIGID_RUNG
+
+
+def _nonlinear_fe_rung(values: Mapping[str, Any]) -> Rung:
+    return NONLINEAR_FE_RUNG
+
+
 # ------------------------------------------------------------------------------------------
 # the registry
 # ------------------------------------------------------------------------------------------
@@ -466,19 +508,19 @@ def _nonlinear_fe_solver(settings: dict[str, Any]) -> None:
 BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
     RIGID: LinkModel.extending(
         BUILTIN_LINK_SCHEMAS[RIGID], label="rigid twin", auto_choice=True, add=_add_rigid,
-        sensors=_rigid_sensors, datasets=_rigid_datasets),
+        sensors=_rigid_sensors, datasets=_rigid_datasets, rung=_rigid_rung),
     FFRF: LinkModel.extending(
         BUILTIN_LINK_SCHEMAS[FFRF], label="FFRF (flex's default: geometric stiffness)",
         linear_elastic=True, auto_choice=True, prepare=_prepare_reduction, add=_add_ffrf,
         datasets=_flexible_datasets, time_scale=_ffrf_time_scale,
-        step_cost_s=_ffrf_step_cost_s),
+        step_cost_s=_ffrf_step_cost_s, rung=ffrf_rung, stored_motion="modal"),
     NONLINEAR_FE: LinkModel.extending(
         BUILTIN_LINK_SCHEMAS[NONLINEAR_FE], label="nonlinear FE (reference)", reference=True,
         auto_choice=True, add=_add_nonlinear_fe, datasets=_nonlinear_fe_datasets,
         energy=False, recorder=_nodal_recorder, time_scale=_nonlinear_fe_time_scale,
         step_cost_s=_nonlinear_fe_step_cost_s, adjust_solver=_nonlinear_fe_solver,
-        own_progress=True),
+        own_progress=True, rung=_nonlinear_fe_rung, stored_motion="nodal"),
 })
 
-__all__ = ["LinkModel", "BUILTIN_LINK_MODELS", "RIGID", "FFRF", "NONLINEAR_FE", "entry_of",
-           "entries", "reduction_for_scene"]
+__all__ = ["LinkModel", "BUILTIN_LINK_MODELS", "STORED_MOTIONS", "RIGID", "FFRF",
+           "NONLINEAR_FE", "entry_of", "entries", "reduction_for_scene"]

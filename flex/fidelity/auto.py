@@ -6,10 +6,10 @@ the reasons, as one value.
 1. ``drive.spring_model`` (:func:`flex.fidelity.spring_choice.decide_spring`, from the rigid
    probe of :mod:`flex.fidelity.probe`);
 2. the links' ``model`` (:func:`decide_links`): rigid when the deflection the probe's loads
-   predict meets ``fidelity.tolerance`` (relative to the link's length), else the FFRF body
-   when its measured model error meets the tolerance relative to the deflection
-   (:func:`flex.fidelity.criteria.flexible_rung`), else the nonlinear FE coupler; an FFRF
-   link's modes with it;
+   predict meets ``fidelity.tolerance`` (relative to the link's length), else the lowest
+   flexible rung of the ladder whose measured model error meets the tolerance relative to
+   the deflection (:func:`flex.dynamics.ladder.climb`: the FFRF body), else the highest (the
+   nonlinear FE coupler); an FFRF link's modes with it;
 3. the links' ``modes`` and ``mesh_size_m`` and the ``[simulation]`` solver keys
    (:func:`flex.config.settings.resolve_solver_settings`: the FFRF settings rule, the solver
    defaults).
@@ -54,6 +54,7 @@ from flex.config.settings import (
     resolve_solver_settings,
 )
 from flex.data.scene import Scene, check_meshed_plate, model_names, to_toml
+from flex.dynamics.ladder import climb
 from flex.dynamics.link_models import (
     BUILTIN_LINK_MODELS,
     FFRF,
@@ -64,7 +65,6 @@ from flex.dynamics.link_models import (
 from flex.fidelity.criteria import (
     EULER_LOAD_LIMIT,
     euler_load_ratio,
-    flexible_rung,
 )
 from flex.fidelity.laws import Criterion, criterion_of
 from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection
@@ -182,8 +182,8 @@ def resolve(scene: Scene, criterion: Criterion | None = None,
     ``calibration``'s); ``cache_dir``: the reduction cache folder of the crank's frequency
     analysis (None: in memory); ``calibration``: the laws, FFRF rule and solver defaults the
     ``"auto"`` values resolve from (:mod:`flex.config.calibration`; None: the bundled one);
-    ``link_models``: the registry of the scene's link models (``auto`` itself decides among
-    the built-in ones, whose laws are fitted)."""
+    ``link_models``: the registry of the scene's link models (the fitted laws decide rigid
+    or flexible; past rigid, ``auto`` climbs the ladder of ``link_models``' rungs)."""
     passed = check(scene, calibration, link_models=link_models)
     decisions: list[FidelityDecision] = []
     concrete = scene
@@ -192,7 +192,8 @@ def resolve(scene: Scene, criterion: Criterion | None = None,
         decisions.append(decide_spring(concrete))
     if AUTO in (concrete["crank"]["model"], concrete["coupler"]["model"]):
         concrete, links = decide_links(concrete, criterion, crank_criterion,
-                                       cache_dir=cache_dir, calibration=calibration)
+                                       cache_dir=cache_dir, calibration=calibration,
+                                       link_models=link_models)
         decisions += links
     reused = passed.get(to_toml(concrete))
     resolved, choice = (reused if reused is not None
@@ -345,6 +346,7 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
                      criterion: Criterion | None = None,
                      crank_criterion: Criterion | None = None, *,
                      cache_dir: Path | None = None, calibration: Calibration | None = None,
+                     link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
                      ) -> tuple[dict[str, dict[str, Any]], list[FidelityDecision]]:
     """Replace ``"auto"`` link models by concrete ones; return the scene and the decisions.
 
@@ -385,7 +387,7 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
     delta_t_s, how, probe = deployment_probe(resolved, calibration)
     if wants_coupler:
         decision, how = _decide_coupler(resolved, probe, delta_t_s, how, tolerance, criterion,
-                                        calibration)
+                                        calibration, link_models)
         decisions.append(decision)
     if wants_crank:
         decisions.append(_decide_crank(resolved, probe, delta_t_s, how, tolerance,
@@ -416,7 +418,9 @@ def _mode_cut(decision: FidelityDecision, resolved: dict[str, dict[str, Any]], l
 
 def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.ndarray],
                     delta_t_s: float, how: str, tolerance: float, criterion: Criterion,
-                    calibration: Calibration | None = None) -> tuple[FidelityDecision, str]:
+                    calibration: Calibration | None = None,
+                    link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
+                    ) -> tuple[FidelityDecision, str]:
     """The coupler's decision (refused near buckling); returns it and ``how`` with the
     compressive load added."""
     coupler = resolved["coupler"]
@@ -439,30 +443,27 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
     _decide_by_loads(decision, predict_deflection(probe, coupler).relative_error(
         coupler["length_m"]), tolerance)
     if not BUILTIN_LINK_MODELS[decision.model].rigid:
-        _climb(decision, coupler, ratio, tolerance)
+        _climb(decision, coupler, ratio, tolerance, link_models)
     coupler["model"] = decision.model
-    if BUILTIN_LINK_MODELS[decision.model].modal:
+    if link_models[decision.model].modal:
         _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s, calibration)
     return decision, how
 
 
 def _climb(decision: FidelityDecision, coupler: dict[str, Any], load_ratio: float,
-           tolerance: float) -> None:
-    """Past rigid, the FFRF coupler when its measured model error relative to the deflection
-    meets ``tolerance`` (:func:`flexible_rung`), else the nonlinear FE coupler (in place:
-    ``decision.model``; refused for a damped coupler)."""
-    geometric = bool(coupler.get("geometric_stiffness", True))
-    rung, relative = flexible_rung(load_ratio, tolerance, geometric)
-    body = "FFRF" if geometric else "linear FFRF (geometric_stiffness = false)"
-    decision.reason += (f"; ladder: {rung} ({body} model error {relative:.3g} of the "
-                        f"deflection, make ladder's measured bound, "
-                        f"{'<=' if rung == 'ffrf' else '>'} tolerance {tolerance:g})")
-    if BUILTIN_LINK_MODELS[rung].reference:
-        if coupler["damping_ratio"] != 0:
-            raise SceneError(f'coupler.model = "auto": {decision.reason}; the nonlinear FE '
-                             f"coupler has no damping model: set coupler.damping_ratio = 0, "
-                             f"or a larger fidelity.tolerance")
-        decision.model = rung
+           tolerance: float, link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
+           ) -> None:
+    """Past rigid, the lowest rung of the ladder whose measured model error relative to the
+    deflection meets ``tolerance`` (:func:`flex.dynamics.ladder.climb`), else the highest
+    (in place: ``decision.model``; refused when that model has no damping and the coupler
+    is damped)."""
+    chosen = climb("coupler", coupler, load_ratio, tolerance, link_models)
+    decision.reason += f"; ladder: {chosen.model} ({chosen.reason})"
+    if not link_models[chosen.model].damped and coupler["damping_ratio"] != 0:
+        raise SceneError(f'coupler.model = "auto": {decision.reason}; the '
+                         f"{link_models[chosen.model].label} coupler has no damping model: "
+                         f"set coupler.damping_ratio = 0, or a larger fidelity.tolerance")
+    decision.model = chosen.model
 
 
 def _decide_by_loads(decision: FidelityDecision, predicted_rigid_error: float,

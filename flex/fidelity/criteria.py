@@ -40,6 +40,14 @@ from flex.base.thesis import (  # noqa: F401 - part of this module's face
     THESIS_K,  # thesis sec. 6.2, in the thesis convention (n = delta_t * omega)
     THESIS_YOUNGS_MODULUS_PA,
 )
+from flex.dynamics.ladder import (  # noqa: F401 - the measured bounds, part of this face
+    FFRF_MOTION_ERROR_FRACTION,
+    FFRF_RUNG,
+    GEOMETRIC_FFRF_ERROR,
+    LINEAR_FFRF_ERROR_FLOOR,
+    LINEAR_FFRF_ERROR_PER_LOAD,
+    LINEAR_FFRF_RUNG,
+)
 from flex.dynamics.link_models import FFRF, NONLINEAR_FE
 
 CONVENTIONS = ("physical", "thesis")
@@ -176,29 +184,6 @@ undamped) and 0.49 (1 mm, 15000 N/m, undamped) and beyond the Euler load; the fi
 reach 0.24 (the kfit report lists what is left out)."""
 
 
-LINEAR_FFRF_ERROR_FLOOR = 0.005
-LINEAR_FFRF_ERROR_PER_LOAD = 1.0
-GEOMETRIC_FFRF_ERROR = 0.005
-"""The FFRF rungs' model errors relative to the quantity, measured by ``make ladder``
-(thesis deployment, steel plates 0.5-10 mm, peak elastic midpoint deflection against the
-nonlinear FE coupler's, docs/geometric-stiffness.md): the FFRF coupler (chord frame, with
-the geometric stiffness of its axial force, flex's default) stayed within 0.35 % (largest at
-0.5-0.7 mm and at 10 mm, where both FFRF bodies differ alike from the nonlinear FE one: the
-rigid end faces), bounded by ``GEOMETRIC_FFRF_ERROR``; the linear FFRF coupler
-(``geometric_stiffness = false``) below ``LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD
-x`` (x the rigid probe's compression / Euler load, :func:`euler_load_ratio`; measured 0.32 %
-at x = 1e-4, 0.53 % at 0.0076, 3.2 % at 0.049, 13 % at 0.13, 16 % at 0.20, 18 % at 0.33)."""
-
-
-FFRF_MOTION_ERROR_FRACTION = 0.15
-"""The FFRF body's error against the nonlinear FE coupler on the quantities of the motion
-(crank angle and slider position at the end time, peak joint forces, deployment time), as a
-fraction of what the link's elasticity changes in them (the FFRF run against its rigid twin),
-measured by ``make flexible`` (1-10 mm plates over the reference's span; its report prints
-the run's fractions): up to 0.13 on the joint forces' peaks (the axial ringing the reduced
-body represents with one axial mode), up to 0.16 on the crank angle."""
-
-
 def flexible_rung(load_ratio: float, tolerance: float, geometric_stiffness: bool = True
                   ) -> tuple[str, float]:
     """The coupler's flexible rung for ``tolerance`` (relative to the quantity: the peak
@@ -206,8 +191,8 @@ def flexible_rung(load_ratio: float, tolerance: float, geometric_stiffness: bool
     it (:data:`GEOMETRIC_FFRF_ERROR`, or the linear body's bound at ``load_ratio``, the rigid
     probe's compression / Euler load, without ``geometric_stiffness``), else
     ``"nonlinear_fe"``; and the FFRF rung's relative model error. All dimensionless."""
-    relative = (GEOMETRIC_FFRF_ERROR if geometric_stiffness
-                else LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio)
+    rung = FFRF_RUNG if geometric_stiffness else LINEAR_FFRF_RUNG
+    relative = rung.bound(load_ratio)
     return (FFRF if relative <= tolerance else NONLINEAR_FE), relative
 
 

@@ -4,7 +4,7 @@ flex can know, term by term, in the quantity's unit and relative to it.
 Contract of :func:`error_budget`: given a finished run of a concrete scene (links rigid,
 ffrf or nonlinear_fe; ``"auto"`` keys resolved) and a way to run companion scenes, it returns
 an :class:`ErrorBudget` with, for each headline quantity of the run
-(:data:`flex.fidelity.error_estimate.HEADLINES`: crank angle and slider position at the end
+(:data:`flex.fidelity.headlines.BUILTIN_HEADLINES`: crank angle and slider position at the end
 time, deployment time, peak joint forces, each flexible link's peak midpoint deflection and
 peak bending stress), four named terms and their total [the quantity's units]:
 
@@ -16,17 +16,14 @@ peak bending stress), four named terms and their total [the quantity's units]:
 - ``mesh``: the mesh of the FFRF links: the difference to a companion on a mesh
   :data:`MESH_FACTOR` times coarser, taken whole (first order assumed: the peak stress from
   the nodes converges about that slowly, the deflection faster, so the term leans safe);
-- ``model``: the link model against the next rung of flex's ladder (rigid, linear FFRF,
-  FFRF with geometric stiffness, nonlinear FE). An FFRF link with geometric stiffness: its
-  measured error against the nonlinear FE coupler as a fraction of what the elasticity
-  changes in the quantity (the difference to a companion whose flexible links are rigid
-  twins): :data:`flex.fidelity.criteria.GEOMETRIC_FFRF_ERROR` of the link's own peak
-  deflection and stress (``make ladder``), :data:`flex.fidelity.criteria.
-  FFRF_MOTION_ERROR_FRACTION` of the elastic part of the motion and the joint forces (``make
-  flexible``); a linear FFRF link (``geometric_stiffness = false``) adds its difference to
-  a companion with geometric stiffness; a nonlinear FE link is the top rung (no term);
-  rigid links: not estimated here (the ``auto`` decision predicts a rigid link's deflection
-  error, ``fidelity_*``).
+- ``model``: the link model against the next rung of flex's ladder, read from the rung each
+  link's model entry names (:mod:`flex.dynamics.ladder`; no model is named here): a link on
+  a bounded rung (the FFRF bodies) gets its rung's ``own_fraction`` of what its elasticity
+  changes in its own quantities and the ``motion_fraction`` of what it changes in the
+  motion and the joint forces (the difference to a companion whose bounded links are rigid
+  twins), plus the difference to the rung's companion one step up (the linear FFRF body:
+  geometric stiffness on); a rigid link and the top rung add their ``leaves_out`` lines,
+  and a model on no rung says that its model error is left out.
 
 ``total`` is the root-sum-square of the terms: they come from independent directions of
 refinement (step, basis, mesh, model), whose errors add with unknown signs (the practice of
@@ -48,16 +45,10 @@ from typing import Any
 from flex.base.errors import FlexError
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, apply_overrides, model_names
+from flex.dynamics.ladder import Rung
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
-from flex.fidelity.criteria import FFRF_MOTION_ERROR_FRACTION, GEOMETRIC_FFRF_ERROR
-from flex.fidelity.error_estimate import (
-    HEADLINES,
-    PEAK_PATHS,
-    PREFIX,
-    crest_gap,
-    estimate_step_error,
-    headline_difference,
-)
+from flex.fidelity.error_estimate import PREFIX, estimate_step_error, headline_difference
+from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline, crest_gap
 
 #: the named terms of a budget, in the order they are printed
 TERMS = ("step", "modes", "mesh", "model")
@@ -88,6 +79,8 @@ class ErrorBudget:
     companion_wall_time_s: float = 0.0
     #: a peak deflection's crest gap [m]: the second-largest crest's distance below it
     crest_gaps: dict[str, float] = field(default_factory=dict)
+    #: each quantity's (unit, what): stored with the budget, so readers need no registry
+    described: dict[str, tuple[str, str]] = field(default_factory=dict)
 
     def total(self, quantity: str) -> float:
         """The root-sum-square of the quantity's terms [its units] (module doc)."""
@@ -102,7 +95,8 @@ class ErrorBudget:
         """Case attributes: ``headline_<quantity>`` (the run's value, in the unit its name
         ends with), ``estimated_error_<quantity>`` (the total, same unit), ``..._<term>``
         per term, ``..._relative``; ``estimated_error_method`` (one sentence per term),
-        ``_leaves_out``, ``_validity``, ``_companion_wall_time_s``."""
+        ``_leaves_out``, ``_validity``, ``_companion_wall_time_s``; :data:`DESCRIBED`: each
+        quantity's unit and what it is, one line each (tab-separated)."""
         out: dict[str, Any] = {}
         for quantity, terms in self.terms.items():
             out[f"{HEADLINE_PREFIX}{quantity}"] = self.values[quantity]
@@ -116,6 +110,9 @@ class ErrorBudget:
                     f"{PREFIX}companion_wall_time_s": self.companion_wall_time_s})
         out.update({f"{CREST_GAP_PREFIX}{quantity}": gap
                     for quantity, gap in self.crest_gaps.items()})
+        if self.described:
+            out[DESCRIBED] = "\n".join(f"{quantity}\t{unit}\t{what}" for quantity, (unit, what)
+                                       in self.described.items())
         return out
 
 
@@ -124,10 +121,8 @@ def combined(terms: Any) -> float:
     return float(math.sqrt(math.fsum(value * value for value in terms)))
 
 
-#: the headline quantities of a link's own elastic response (their model term is
-#: GEOMETRIC_FFRF_ERROR of the quantity); the others are quantities of the motion
-OWN = ("_peak_deflection_m", "_peak_bending_stress_Pa", "_peak_von_mises_Pa",
-       "_first_crest_deflection_m")
+#: case attribute of a budget's quantities, one ``name<TAB>unit<TAB>what`` line each
+DESCRIBED = "headlines_described"
 #: case attribute prefix of a peak's crest gap (:func:`flex.fidelity.error_estimate.crest_gap`)
 CREST_GAP_PREFIX = "crest_gap_"
 
@@ -144,26 +139,28 @@ def _companion(scene: Scene, overrides: list[str]) -> Scene:
                                    "simulation.error_estimate=false"])
 
 
-def _differences(result: CaseResult, other: CaseResult | None) -> dict[str, float]:
-    """Each headline quantity's difference between ``result`` and ``other`` (0 for a
-    quantity ``other`` lacks where ``result`` has it, e.g. a rigid twin's stress)."""
-    if other is None:
-        return {}
-    out = {}
-    for name in HEADLINES:
-        difference = headline_difference(name, result.datasets, other.datasets)
-        if difference is not None:
-            out[name] = difference
-    return out
-
-
 class _Companions:
-    """Runs companion scenes, timing them and keeping what failed."""
+    """Runs companion scenes, timing them and keeping what failed; ``differences`` compares
+    a companion's headline quantities with the run's."""
 
-    def __init__(self, run_companion: Callable[[Scene], CaseResult]) -> None:
+    def __init__(self, run_companion: Callable[[Scene], CaseResult],
+                 headlines: Mapping[str, Headline]) -> None:
         self.run_companion = run_companion
+        self.headlines = headlines
         self.failures: list[str] = []
         self.wall_time_s = 0.0
+
+    def differences(self, result: CaseResult, other: CaseResult | None) -> dict[str, float]:
+        """Each headline quantity's difference between ``result`` and ``other`` (0 for a
+        quantity ``other`` lacks where ``result`` has it, e.g. a rigid twin's stress)."""
+        if other is None:
+            return {}
+        out = {}
+        for name, headline in self.headlines.items():
+            difference = headline_difference(headline, result.datasets, other.datasets)
+            if difference is not None:
+                out[name] = difference
+        return out
 
     def run(self, what: str, scene: Scene) -> CaseResult | None:
         start = time.perf_counter()
@@ -186,7 +183,8 @@ def _modes_term(scene: Scene, result: CaseResult, companions: _Companions,
                                                         in changes.items()]))
     how = ", ".join(f"{link} {scene[link]['modes']} -> {modes}" for link, modes in
                     changes.items())
-    return _differences(result, richer), f"difference to a companion with more modes ({how})"
+    return (companions.differences(result, richer),
+            f"difference to a companion with more modes ({how})")
 
 
 def _mesh_term(scene: Scene, result: CaseResult, companions: _Companions,
@@ -201,60 +199,73 @@ def _mesh_term(scene: Scene, result: CaseResult, companions: _Companions,
         scene, [f"{link}.mesh_size_m={size!r}" for link, size in sizes.items()]))
     how = ", ".join(f"{link} {scene[link]['mesh_size_m']:g} -> {size:g} m"
                     for link, size in sizes.items())
-    return _differences(result, coarser), (f"difference to a companion on a {MESH_FACTOR:g}x "
-                                           f"coarser mesh ({how}), taken whole")
+    return companions.differences(result, coarser), (
+        f"difference to a companion on a {MESH_FACTOR:g}x coarser mesh ({how}), taken whole")
+
+
+def _rungs(scene: Scene, link_models: Mapping[str, LinkModel]) -> dict[str, Rung | None]:
+    """Each link's rung on the ladder (None: its model is on no rung)."""
+    return {link: link_models[scene[link]["model"]].rung(scene[link]) for link in LINKS}
+
+
+def _grouped(links: dict[str, Rung], text: str, joiner: str = " and ") -> list[str]:
+    """The rungs' field ``text``, once per distinct line, with ``{links}`` its links."""
+    out: dict[str, list[str]] = {}
+    for link, rung in links.items():
+        out.setdefault(getattr(rung, text), []).append(link)
+    return [line.format(links=joiner.join(names)) for line, names in out.items() if line]
 
 
 def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
                 leaves_out: list[str], link_models: Mapping[str, LinkModel]
                 ) -> tuple[dict[str, float], str]:
-    # the measured model error of the linear-elastic (FFRF) links: make ladder, make flexible
-    ffrf = _links(scene, link_models, linear_elastic=True)
-    sentences, terms = [], {}
-    if ffrf:
+    """The links' model errors from their rungs (:mod:`flex.dynamics.ladder`): a bounded
+    rung's fractions of what the elasticity changes (the difference to rigid twins), plus
+    its companion's difference; every rung's ``leaves_out`` line, highest first."""
+    rungs = _rungs(scene, link_models)
+    bounded = {link: rung for link, rung in rungs.items() if rung is not None and rung.bounded}
+    terms: dict[str, float] = {}
+    sentences: list[str] = []
+    if bounded:
         twin = companions.run("model", _companion(
             scene, [f'{link}.model="{model_names(link, link_models, rigid=True)[0]}"'
-                    for link in ffrf]
-            + [f'{link}.geometry="plate"' for link in ffrf]))
-        elastic = _differences(result, twin)
-        terms = {name: (GEOMETRIC_FFRF_ERROR if name.endswith(OWN)
-                        else FFRF_MOTION_ERROR_FRACTION) * value
-                 for name, value in elastic.items()}
-        sentences.append(f"FFRF with geometric stiffness against the nonlinear FE coupler: "
-                         f"{GEOMETRIC_FFRF_ERROR:g} of a link's own peak deflection and "
-                         f"stress (make ladder), {FFRF_MOTION_ERROR_FRACTION:g} of what the "
-                         f"elasticity changes in the motion and the joint forces (make "
-                         f"flexible; the difference to rigid twins)")
-        linear = [link for link in ffrf if not scene[link]["geometric_stiffness"]]
-        if linear:
-            stiffened = companions.run("model", _companion(
-                scene, [f"{link}.geometric_stiffness=true" for link in linear]))
-            for name, value in _differences(result, stiffened).items():
+                    for link in bounded] + [f'{link}.geometry="plate"' for link in bounded]))
+        motion = max(rung.motion_fraction for rung in bounded.values())
+        for name, value in companions.differences(result, twin).items():
+            owner = companions.headlines[name].link
+            terms[name] = value * (bounded[owner].own_fraction if owner in bounded else motion)
+        sentences += _grouped(bounded, "measured_by")
+        steps_up = {link: rung for link, rung in bounded.items() if rung.companion}
+        if steps_up:
+            above = companions.run("model", _companion(scene, [
+                override.format(link=link) for link, rung in steps_up.items()
+                for override in rung.companion]))
+            for name, value in companions.differences(result, above).items():
                 terms[name] = terms.get(name, 0.0) + value
-            sentences.append(f"linear FFRF ({', '.join(linear)}): plus the difference to a "
-                             f"companion with geometric stiffness")
-    if _links(scene, link_models, reference=True):
-        leaves_out.append("the nonlinear FE coupler's own model error (the top rung: "
-                          "St. Venant-Kirchhoff continuum, deformable joint faces)")
-    rigid = _links(scene, link_models, rigid=True)
-    if rigid:
-        leaves_out.append(f"the elasticity of the rigid {' and '.join(rigid)} (predicted by "
-                          f"model = \"auto\", fidelity_* attributes)")
+            sentences += _grouped(steps_up, "companion_text", ", ")
+    placed = {link: rung for link, rung in rungs.items() if rung is not None}
+    leaves_out += _grouped(dict(sorted(placed.items(), key=lambda item: -item[1].level)),
+                           "leaves_out")
+    leaves_out += [f"the {link_models[scene[link]['model']].label or scene[link]['model']} "
+                   f"{link}'s model error (its model stands on no rung of the ladder)"
+                   for link, rung in rungs.items() if rung is None]
     return terms, "; ".join(sentences) or "no flexible link below the top rung"
 
 
 def error_budget(scene: Scene, result: CaseResult,
                  run_companion: Callable[[Scene], CaseResult],
                  time_scales: list[tuple[float, float, str]],
-                 link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> ErrorBudget:
+                 link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
+                 headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> ErrorBudget:
     """The error budget of ``result``, the run of ``scene`` (concrete models, solver keys
     resolved), from companion runs made by ``run_companion`` (see the module doc);
     ``time_scales``: the scene's (:func:`flex.dynamics.solver.time_scales`);
-    ``link_models``: the registry of its link models (their flags choose the terms)."""
-    values = {name: read(result.datasets) for name, (_, _, read) in HEADLINES.items()}
+    ``link_models``: the registry of its link models (their flags and rungs choose the
+    terms); ``headlines``: the quantities budgeted (:mod:`flex.fidelity.headlines`)."""
+    values = {name: headline.read(result.datasets) for name, headline in headlines.items()}
     values = {name: value for name, value in values.items() if value is not None}
-    step = estimate_step_error(scene, result, run_companion, time_scales)
-    companions = _Companions(run_companion)
+    step = estimate_step_error(scene, result, run_companion, time_scales, headlines)
+    companions = _Companions(run_companion, headlines)
     leaves_out = ["the spring's and joints' idealizations (massless spring unless chained, "
                   "ideal pins)"]
     modes, modes_how = _modes_term(scene, result, companions, link_models)
@@ -276,16 +287,18 @@ def error_budget(scene: Scene, result: CaseResult,
     return ErrorBudget(values, terms, {k: v for k, v in methods.items() if k not in failed},
                        leaves_out, step.validity,
                        step.companion_wall_time_s + companions.wall_time_s,
-                       _crest_gaps(result, values))
+                       _crest_gaps(result, values, headlines),
+                       {name: (headlines[name].unit, headlines[name].what) for name in values})
 
 
-def _crest_gaps(result: CaseResult, values: dict[str, float]) -> dict[str, float]:
-    """Each peak deflection's crest gap [m] (the peak races between crests when its error
-    exceeds it; the first crest does not)."""
+def _crest_gaps(result: CaseResult, values: dict[str, float],
+                headlines: Mapping[str, Headline]) -> dict[str, float]:
+    """Each peak's crest gap [its unit] where its headline asks for one (the peak races
+    between crests when its error exceeds it; the first crest does not)."""
     out = {}
     for name in values:
-        if name.endswith("_peak_deflection_m"):
-            gap = crest_gap(result.datasets[PEAK_PATHS[name]].data)
+        if headlines[name].crest_gap:
+            gap = crest_gap(result.datasets[headlines[name].series].data)
             if gap is not None:
                 out[name] = gap
     return out
@@ -314,12 +327,22 @@ class BudgetRow:
                 f"{self.units}{relative} (root-sum-square of {terms})")
 
 
-def budget_rows(attrs: dict[str, Any]) -> list[BudgetRow]:
+def _described(attrs: Mapping[str, Any]) -> dict[str, tuple[str, str]]:
+    """The quantities a stored budget describes (:data:`DESCRIBED`), else the built-in
+    headlines (a file written before the budget described its quantities)."""
+    if DESCRIBED not in attrs:
+        return {name: (entry.unit, entry.what) for name, entry in BUILTIN_HEADLINES.items()}
+    lines = (line.split("\t") for line in str(attrs[DESCRIBED]).splitlines())
+    return {parts[0]: (parts[1], parts[2]) for parts in lines if len(parts) == 3}
+
+
+def budget_rows(attrs: Mapping[str, Any]) -> list[BudgetRow]:
     """The stored error budget of a case (its attributes; see :meth:`ErrorBudget.attrs`),
-    one row per headline quantity it holds, in :data:`HEADLINES` order. A file written
+    one row per headline quantity it holds, in the order it describes them (a file written
+    before budgets described their quantities: the built-in headlines'). A file written
     before budgets (a step estimate alone) gives rows with that one term."""
     rows = []
-    for quantity, (units, what, _) in HEADLINES.items():
+    for quantity, (units, what) in _described(attrs).items():
         if f"{PREFIX}{quantity}" not in attrs:
             continue
         terms = {term: float(attrs[f"{PREFIX}{quantity}_{term}"]) for term in TERMS
@@ -333,5 +356,5 @@ def budget_rows(attrs: dict[str, Any]) -> list[BudgetRow]:
     return rows
 
 
-__all__ = ["BudgetRow", "ErrorBudget", "HEADLINE_PREFIX", "MESH_FACTOR", "TERMS",
+__all__ = ["DESCRIBED", "BudgetRow", "ErrorBudget", "HEADLINE_PREFIX", "MESH_FACTOR", "TERMS",
            "budget_rows", "combined", "error_budget", "richer_modes"]

@@ -6,9 +6,10 @@ scene, it runs companions that differ only in the step -- at twice and four time
 when the end time is a whole number of doubled steps, else one at half the step -- and
 returns an :class:`ErrorEstimate`:
 
-- ``values``: for each headline quantity (:data:`HEADLINES`: the crank angle and the slider
-  position at the end time, the peak elastic midpoint deflection of each flexible link, the
-  peak von Mises stress of each FFRF link away from its joint faces), the
+- ``values``: for each headline quantity (``headlines``, default
+  :data:`flex.fidelity.headlines.BUILTIN_HEADLINES`: the crank angle and the slider position
+  at the end time, the peak elastic midpoint deflection of each flexible link, the peak von
+  Mises stress of each FFRF link away from its joint faces), the
   estimated error of the run's value [the quantity's units], by Richardson extrapolation.
   With the runs at h, 2h and 4h: the larger of ``|q_h - q_2h| / (2^p - 1)`` and the pair
   (2h, 4h)'s, scaled to h by ``2^-p``, with p the order the three runs show
@@ -36,7 +37,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -45,6 +46,7 @@ import numpy as np
 from flex.base.errors import FlexError
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, apply_overrides
+from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline, crest_gap
 
 #: order of accuracy of the explicit Runge-Kutta methods (``simulation.explicit_method``)
 EXPLICIT_ORDERS = {"RK44": 4, "RK67": 6, "ExplicitMidpoint": 2}
@@ -54,123 +56,24 @@ MIN_STEPS_PER_PERIOD = 10.0
 PREFIX = "estimated_error_"
 
 
-def _final(path: str) -> Callable[[dict[str, Any]], float | None]:
-    return lambda datasets: float(datasets[path].data[-1]) if path in datasets else None
-
-
-def _peak(path: str) -> Callable[[dict[str, Any]], float | None]:
-    def read(datasets: dict[str, Any]) -> float | None:
-        if path not in datasets:
-            return None
-        values = np.abs(np.asarray(datasets[path].data, dtype=float))
-        return float(np.max(values)) if values.size and np.any(values) else None
-    return read
-
-
-def _first_crest(path: str) -> Callable[[dict[str, Any]], float | None]:
-    """Reader of the first crest of ``|path|``: the largest magnitude of the series' first
-    lobe (:func:`flex.fidelity.softening.first_peak_index`), a peak that does not race: the
-    largest crest of an undamped ringing plate can move from one crest to a neighbour a
-    fraction of a per cent lower when the phase error changes (docs/criterion.md)."""
-    def read(datasets: dict[str, Any]) -> float | None:
-        from flex.fidelity.softening import first_peak_index
-
-        if path not in datasets:
-            return None
-        values = np.asarray(datasets[path].data, dtype=float)
-        if not values.size or not np.any(values):
-            return None
-        return float(abs(values[first_peak_index(values)]))
-    return read
-
-
-def crest_gap(values: np.ndarray) -> float | None:
-    """How far the second-largest crest of ``|values|`` lies below the largest [the series'
-    units]: a peak's crest uncertainty (an error of the run larger than this may have picked
-    another crest as the peak); None with fewer than two crests."""
-    magnitude = np.abs(np.asarray(values, dtype=float))
-    inner = magnitude[1:-1]
-    crests = inner[(inner > magnitude[:-2]) & (inner >= magnitude[2:])]
-    if crests.size < 2:
+def headline_difference(headline: Headline, run: Mapping[str, Any], other: Mapping[str, Any]
+                        ) -> float | None:
+    """How far two runs' values of ``headline`` lie apart [its unit]: a peak's by
+    :func:`peak_difference` (a missing series counts as zero: a rigid twin has no
+    deflection), any other's as the difference of the values (a link's own quantity the
+    other run lacks counts as zero: a rigid twin's first crest); None if the run has no
+    value or the other run none of a quantity of the motion."""
+    mine = headline.read(run)
+    if mine is None:
         return None
-    top, second = np.sort(crests)[-2:][::-1]
-    return float(top - second)
-
-
-def _deployment_time(datasets: dict[str, Any]) -> float | None:
-    """Time of the first maximum of the crank angle [s] (delta_t, docs/criterion.md); None
-    when the crank angle has no maximum within the run (a deployment not reached, a
-    constant-speed crank): missing, not the end time."""
-    if "crank/angle" not in datasets:
-        return None
-    angle = np.asarray(datasets["crank/angle"].data, dtype=float)
-    falling = np.flatnonzero(np.diff(angle) < 0)
-    if len(angle) < 3 or len(falling) == 0 or falling[0] == 0:
-        return None
-    top = int(falling[0])
-    time_s = np.asarray(datasets["time"].data, dtype=float)
-    # the parabola through the top sample and its neighbours: the maximum between samples
-    # (a sample time alone is off by up to half a step, more than the run's own error)
-    left, middle, right = angle[top - 1:top + 2]
-    curvature = left - 2.0 * middle + right
-    offset = 0.5 * (left - right) / curvature if curvature < 0 else 0.0
-    return float(time_s[top] + np.clip(offset, -0.5, 0.5) * (time_s[top + 1] - time_s[top]))
-
-
-#: the peak headline quantities and the series they are the peak of
-PEAK_PATHS = {"coupler_peak_deflection_m": "coupler/midpoint_deflection",
-              "crank_peak_deflection_m": "crank/midpoint_deflection",
-              "coupler_peak_bending_stress_Pa": "coupler/peak_bending_stress",
-              "crank_peak_bending_stress_Pa": "crank/peak_bending_stress",
-              "coupler_peak_von_mises_Pa": "coupler/peak_von_mises_stress",
-              "crank_peak_von_mises_Pa": "crank/peak_von_mises_stress",
-              **{f"joint_{joint}_peak_force_N": f"joints/{joint}/force_modulus"
-                 for joint in "ABC"}}
-_PEAK_WHAT = {"coupler_peak_deflection_m": ("m", "peak elastic midpoint deflection of the "
-                                                  "coupler"),
-              "crank_peak_deflection_m": ("m", "peak elastic midpoint deflection of the crank"),
-              "coupler_peak_bending_stress_Pa": ("Pa", "peak bending stress of the coupler"),
-              "crank_peak_bending_stress_Pa": ("Pa", "peak bending stress of the crank"),
-              "coupler_peak_von_mises_Pa": ("Pa", "peak von Mises stress of the coupler (away "
-                                                  "from the joint faces)"),
-              "crank_peak_von_mises_Pa": ("Pa", "peak von Mises stress of the crank (away "
-                                                "from the joint faces)"),
-              **{f"joint_{joint}_peak_force_N": ("N", f"peak force of joint {joint}")
-                 for joint in "ABC"}}
-#: the first crests (a link's own quantity that does not race) and their series
-FIRST_CREST_PATHS = {f"{link}_first_crest_deflection_m": f"{link}/midpoint_deflection"
-                     for link in ("coupler", "crank")}
-#: headline quantity -> (units, what, reader of a result's datasets; None: not in this run)
-HEADLINES: dict[str, tuple[str, str, Callable[[dict[str, Any]], float | None]]] = {
-    "crank_angle_end_rad": ("rad", "crank angle at the end time", _final("crank/angle")),
-    "slider_position_end_m": ("m", "slider position at the end time",
-                              _final("slider/position")),
-    "deployment_time_s": ("s", "deployment time (first maximum of the crank angle)",
-                          _deployment_time),
-    **{name: (*_PEAK_WHAT[name], _peak(path)) for name, path in PEAK_PATHS.items()},
-    **{name: ("m", f"first crest of the elastic midpoint deflection of the {name.split('_')[0]}"
-              " (largest |deflection| of the first lobe)", _first_crest(path))
-       for name, path in FIRST_CREST_PATHS.items()},
-}
-
-
-def headline_difference(name: str, run: dict[str, Any], other: dict[str, Any]) -> float | None:
-    """How far two runs' values of headline quantity ``name`` lie apart [its units]: a peak's
-    by :func:`peak_difference` (a missing series counts as zero: a rigid twin has no
-    deflection), any other's as the difference of the values; None if the run has no value
-    or the other run none for a non-peak quantity."""
-    read = HEADLINES[name][2]
-    if read(run) is None:
-        return None
-    if name in PEAK_PATHS:
-        path = PEAK_PATHS[name]
-        if path not in other:
-            return read(run)
-        return peak_difference(run, other, path)
-    if name in FIRST_CREST_PATHS:  # a rigid twin: no deflection, or none that is not zero
-        return abs(read(run) - (read(other) or 0.0))
-    value = read(other)
-    return None if value is None else abs(read(run) - value)
+    if headline.kind == "peak":
+        if headline.series not in other:
+            return mine
+        return peak_difference(run, other, headline.series)
+    value = headline.read(other)
+    if value is None and headline.link is not None:  # a rigid twin: none of its own
+        value = 0.0
+    return None if value is None else abs(mine - value)
 
 
 @dataclass
@@ -233,10 +136,12 @@ def unresolved_time_scales(time_scales: list[tuple[float, float, str]], step_s: 
 
 def estimate_step_error(scene: Scene, result: CaseResult,
                         run_companion: Callable[[Scene], CaseResult],
-                        time_scales: list[tuple[float, float, str]]) -> ErrorEstimate:
+                        time_scales: list[tuple[float, float, str]],
+                        headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> ErrorEstimate:
     """The estimated step error of ``result``, the run of ``scene`` (concrete models, solver
     keys resolved), from one companion run made by ``run_companion`` (see the module doc).
-    ``time_scales``: the scene's (:func:`flex.dynamics.solver.time_scales`)."""
+    ``time_scales``: the scene's (:func:`flex.dynamics.solver.time_scales`); ``headlines``:
+    the quantities estimated (:mod:`flex.fidelity.headlines`)."""
     sim = scene["simulation"]
     step = float(sim["step_s"])
     other = companion_step_s(step, float(sim["end_time_s"]))
@@ -269,12 +174,12 @@ def estimate_step_error(scene: Scene, result: CaseResult,
                                  f"{companion_step:g} s failed ({exc})",
                                  time.perf_counter() - start)
     values = {}
-    for name, (_, _, read) in HEADLINES.items():
-        read_values = [read(datasets) for datasets in runs]
+    for name, headline in headlines.items():
+        read_values = [headline.read(datasets) for datasets in runs]
         if any(value is None for value in read_values):
             continue
-        if name in PEAK_PATHS:
-            differences = [peak_difference(runs[k], runs[k + 1], PEAK_PATHS[name])
+        if headline.kind == "peak":
+            differences = [peak_difference(runs[k], runs[k + 1], headline.series)
                            for k in range(len(runs) - 1)]
             values[name] = _estimate_from_differences(differences, steps, order)
         else:
@@ -366,7 +271,7 @@ def _order(near: float, far: float, order: int) -> float:
     return float(min(max(math.log2(far / near), 1.0), order))
 
 
-__all__ = ["FIRST_CREST_PATHS", "ErrorEstimate", "HEADLINES", "MIN_STEPS_PER_PERIOD",
-           "companion_step_s", "crest_gap",
+__all__ = ["ErrorEstimate", "MIN_STEPS_PER_PERIOD", "companion_step_s", "crest_gap",
+           "headline_difference", "peak_difference",
            "estimate_step_error", "integrator_order", "observed_order", "richardson_error",
            "unresolved_time_scales"]

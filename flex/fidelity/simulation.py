@@ -27,10 +27,12 @@ from flex.config.settings import tolerance_beyond_reach
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
 from flex.data.scene_edit import derive_scene
+from flex.dynamics.ladder import next_rung
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.dynamics.solver import VALIDITY_WARNING, integrate, scene_reductions, time_scales
 from flex.fidelity.auto import Resolution, resolve
 from flex.fidelity.error_budget import error_budget
+from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 from flex.fidelity.laws import Criterion
 
 
@@ -38,7 +40,8 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
              crank_reduction: Any = None, criterion: Criterion | None = None,
              crank_criterion: Criterion | None = None, *,
              cache_dir: Path | None = None, calibration: Calibration | None = None,
-             link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> CaseResult:
+             link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
+             headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> CaseResult:
     """One case of any scene; raises :class:`~flex.base.errors.FlexError` on bad input or
     divergence.
 
@@ -58,7 +61,8 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     budget on its headline quantities, term by term (step, modes, mesh, model;
     :mod:`flex.fidelity.error_budget`): case attributes ``estimated_error_*``. A failed
     companion leaves the run as it is, its term out, and says why in
-    ``estimated_error_leaves_out``.
+    ``estimated_error_leaves_out``. ``headlines``: the quantities budgeted and certified
+    (:mod:`flex.fidelity.headlines`; default: the built-in ones).
     """
     beyond = tolerance_beyond_reach(scene, calibration, link_models=link_models)
     if beyond:  # said before the (possibly long) work starts, and stored with the result
@@ -66,16 +70,18 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     resolution = resolve(scene, criterion, crank_criterion, cache_dir=cache_dir,
                          calibration=calibration, link_models=link_models)
     if scene["fidelity"]["refine"]:
-        return refine(resolution, name, cache_dir=cache_dir, link_models=link_models)
+        return refine(resolution, name, cache_dir=cache_dir, link_models=link_models,
+                      headlines=headlines)
     return simulate_resolved(resolution, name, reduction, crank_reduction,
-                             cache_dir=cache_dir, beyond=beyond, link_models=link_models)
+                             cache_dir=cache_dir, beyond=beyond, link_models=link_models,
+                             headlines=headlines)
 
 
 def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any = None,
                       crank_reduction: Any = None, *, cache_dir: Path | None = None,
                       beyond: str = "",
-                      link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
-                      ) -> CaseResult:
+                      link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
+                      headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> CaseResult:
     """:func:`simulate` of a scene already resolved (:func:`flex.fidelity.auto.resolve`):
     integrate, attributes, error budget. ``beyond``: why the scene's tolerance is beyond
     what flex can certify ("" if it is not), stored as a validity warning."""
@@ -110,25 +116,26 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
                              link_models=link_models)
 
         budget = error_budget(scene, result, run_companion,
-                              time_scales(scene, reductions, link_models), link_models)
+                              time_scales(scene, reductions, link_models), link_models,
+                              headlines)
         result.attrs.update(budget.attrs())
     return result
 
 
-#: the quantities :func:`refine` certifies: each flexible link's own (docs/criterion.md, "What
-#: the tolerance bounds"): its peak deflection and its first crest (which does not race)
-REFINED = ("_peak_deflection_m", "_first_crest_deflection_m")
 #: most attempts of :func:`refine` (each one a run with its whole error budget)
 MAX_ATTEMPTS = 6
 
 
 def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None = None,
-           link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> CaseResult:
+           link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
+           headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> CaseResult:
     """``fidelity.refine``: run the resolved scene with its error budget; while a certified
-    quantity (:data:`REFINED`) has a total estimated error above ``fidelity.tolerance``
-    relative to itself, refine the knob whose term dominates it (the step halved, the modes
-    of the modal links raised as the modes companion's, the mesh of the meshed links halved,
-    an FFRF coupler climbed to the nonlinear FE rung) and run again, until every one meets
+    quantity (a headline whose entry says ``certified``: each flexible link's peak
+    deflection and first crest, docs/criterion.md) has a total estimated error above
+    ``fidelity.tolerance`` relative to itself, refine the knob whose term dominates it (the
+    step halved, the modes of the modal links raised as the modes companion's, the mesh of
+    the meshed links halved, a link climbed to the next rung of the ladder,
+    :func:`flex.dynamics.ladder.next_rung`) and run again, until every one meets
     it, the next run's estimated cost (:func:`_attempt_cost_s`) would pass
     ``fidelity.refine_limit_s`` [s], :data:`MAX_ATTEMPTS` runs are made or no knob can move.
     Returns the last run, with ``refine_status`` (``met``, or why not),
@@ -147,8 +154,10 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     current = resolution
     for attempt in range(1, MAX_ATTEMPTS + 1):
         scene = current.scene
-        result = simulate_resolved(current, name, cache_dir=cache_dir, link_models=link_models)
-        rows = [row for row in budget_rows(result.attrs) if row.quantity.endswith(REFINED)]
+        result = simulate_resolved(current, name, cache_dir=cache_dir, link_models=link_models,
+                                   headlines=headlines)
+        rows = [row for row in budget_rows(result.attrs)
+                if row.quantity in headlines and headlines[row.quantity].certified]
         over = [row for row in rows if not row.relative <= tolerance]
         settings = _settings_text(scene, link_models)
         if not rows:
@@ -258,11 +267,11 @@ def _refined(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
         return ([f"{link}.mesh_size_m={scene[link]['mesh_size_m'] / 2!r}" for link in meshed]
                 or None, "mesh halved (" + ", ".join(meshed) + ")" if meshed
                 else "the mesh term dominates and no link is meshed")
-    higher = [name for name, entry in link_models.items() if entry.reference
-              and "coupler" in entry.links]
-    if links["coupler"].linear_elastic and not links["crank"].linear_elastic and higher:
-        return ([f'coupler.model="{higher[0]}"'],
-                f"coupler climbed to the {link_models[higher[0]].label} rung")
+    for link in ("coupler", "crank"):
+        higher = next_rung(link, scene[link], link_models)
+        if higher is not None:
+            return ([f'{link}.model="{higher}"'],
+                    f"{link} climbed to the {link_models[higher].label} rung")
     return None, "the model term dominates and no link has a higher rung"
 
 

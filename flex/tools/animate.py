@@ -23,15 +23,15 @@ from __future__ import annotations
 import math
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from flex.base.errors import FlexError
-from flex.dynamics.link_models import BUILTIN_LINK_MODELS
-from flex.tools.motion import Body, CaseMotion, case_motion, model_entry, top_faces
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
+from flex.tools.motion import Body, CaseMotion, case_motion, top_faces
 
 #: frame size [px] (even, as H.264 in yuv420p needs) at :data:`DPI`
 SIZE_PX = (960, 540)
@@ -152,14 +152,15 @@ def _default_magnification(motion: CaseMotion, frames: list[_Frame]) -> float:
 def animate_case(source: str | Path, case: str | None, out: str | Path, *, frames: int = 200,
                  fps: int = 25, magnification: float | None = None,
                  cache_dir: Path | None = None, at_time_s: float | None = None,
-                 progress: Callable[[str], None] | None = None) -> Animation:
+                 progress: Callable[[str], None] | None = None,
+                 link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> Animation:
     """Animate ``case`` of result file ``source`` into ``out`` (``.mp4`` or ``.gif``; see the
     module doc; ``.png``: the one frame nearest ``at_time_s`` [s], by default the time of
     the first flexible link's peak von Mises stress). ``frames``: at most this many, evenly
     spaced over the stored samples; ``magnification``: the deformation scale (None: the
     default of the module doc, from those frames). Refusals (:class:`FlexError`): those of
     :func:`flex.tools.motion.case_motion`, a bad suffix, frame count, rate, time or
-    magnification."""
+    magnification. ``link_models``: the registry the case's models are read from."""
     out = Path(out)
     if out.suffix.lower() not in (".mp4", ".gif", ".png"):
         raise FlexError(f"--out {out}: must end in .mp4, .gif or .png (one frame)")
@@ -172,7 +173,7 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
         print(f"flex animate: no mp4 encoder (install imageio-ffmpeg): writing {out}",
               file=sys.stderr)
     frame_indices(2, frames)  # a bad --frames is refused before anything is read
-    motion = case_motion(source, case, cache_dir=cache_dir)
+    motion = case_motion(source, case, cache_dir=cache_dir, link_models=link_models)
     indices = frame_indices(len(motion.time_s), frames)
     drawn = _frames(motion, indices)
     factor = magnification if magnification is not None else _default_magnification(motion,
@@ -231,7 +232,7 @@ def _render(motion: CaseMotion, frames: list[_Frame], magnification: float):
             artists = []
             for body in motion.bodies:
                 xy = frame.shapes[body.name][:, :2]
-                if model_entry(body.model).rigid:
+                if body.kind == "rigid":
                     artists += axes.fill(*_outline(xy).T, color="0.7", ec="0.2", lw=1.0)
                     continue
                 shape = _drawn(body, frame.shapes[body.name], magnification)

@@ -30,7 +30,7 @@ import os
 import sys
 import time
 import xml.etree.ElementTree as ET
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -39,6 +39,7 @@ import numpy as np
 
 from flex import __version__
 from flex.base.errors import FlexError
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.tools.motion import CaseMotion, case_motion, sample_indices
 
 #: point fields written at every time: name -> (units, description)
@@ -88,14 +89,16 @@ def _stderr(text: str) -> None:
 
 def export_case(source: str | Path, case: str | None, out_dir: str | Path, every: int = 1,
                 *, cache_dir: Path | None = None,
-                progress: Callable[[str], None] | None = _stderr) -> ExportOutput:
+                progress: Callable[[str], None] | None = _stderr,
+                link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> ExportOutput:
     """Export ``case`` of result file ``source`` to ``out_dir`` (created if missing); see the
     module doc. ``every``: export every n-th stored time (and the last). ``cache_dir``: the
     reduction cache folder. Refusals (:class:`FlexError`, one line): those of
     :func:`flex.tools.motion.case_motion`, a bad ``every``, an output folder that cannot be
-    made. ``progress``: where progress lines go (None: nowhere)."""
+    made. ``progress``: where progress lines go (None: nowhere). ``link_models``: the registry
+    the case's models are read from."""
     sample_indices(1, every)  # a bad --every is refused before anything is read
-    motion = case_motion(source, case, cache_dir=cache_dir)
+    motion = case_motion(source, case, cache_dir=cache_dir, link_models=link_models)
     indices = sample_indices(len(motion.time_s), every)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():

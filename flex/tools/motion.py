@@ -27,7 +27,8 @@ from __future__ import annotations
 
 import math
 import tomllib
-from dataclasses import dataclass, field
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -57,6 +58,8 @@ class Body:
     corners: np.ndarray
     has_stress: bool = False
     facts: dict[str, Any] = field(default_factory=dict)  #: provenance (reduction key, ...)
+    #: how its motion is stored (its model's ``stored_motion``: rigid, modal, nodal)
+    kind: str = "rigid"
 
 
 @dataclass
@@ -95,7 +98,7 @@ class CaseMotion:
     @property
     def flexible(self) -> list[Body]:
         """The flexible bodies."""
-        return [body for body in self.bodies if not model_entry(body.model).rigid]
+        return [body for body in self.bodies if body.kind != "rigid"]
 
     def crank_angle_rad(self, index: int) -> float:
         """The crank angle (chord A-B for a flexible crank) at motion sample ``index``."""
@@ -119,8 +122,7 @@ class CaseMotion:
 
     def _state(self, body: Body, index: int) -> BodyState:
         d, s = self._data, self.sample[index]
-        entry = model_entry(body.model)
-        if entry.modal:  # a reduction's modal coordinates in its floating frame
+        if body.kind == "modal":  # a reduction's modal coordinates in its floating frame
             reduction = self._extra[body.name]
             from flex.bodies.stress import nodal_displacement, nodal_stress
 
@@ -130,8 +132,8 @@ class CaseMotion:
                               d[f"{body.name}/frame_angle"][s])
             stress = nodal_stress(reduction, q) if body.has_stress else None
             return BodyState(position, elastic, stress)
-        if entry.meshed:  # every node of the mesh (the nonlinear FE coupler)
-            position = np.asarray(d["coupler/nodal/position"][index], dtype=float)
+        if body.kind == "nodal":  # every node of the mesh (the nonlinear FE coupler)
+            position = np.asarray(d[f"{body.name}/nodal/position"][index], dtype=float)
             plate = self._extra[body.name]
             b = plate.weights_end_a @ position[plate.nodes_end_a]
             c = plate.weights_end_b @ position[plate.nodes_end_b]
@@ -263,19 +265,23 @@ def case_scene(attrs: dict[str, Any], where: str) -> Scene:
         raise FlexError(f"{where}: its scene_toml is not a readable scene ({exc})") from None
 
 
-def model_entry(name: str, where: str = "") -> LinkModel:
-    """The built-in link model ``name`` (its flags say how its stored motion is read): a
-    model that is not built in has no stored-motion reader here (FlexError)."""
-    if name not in BUILTIN_LINK_MODELS:
-        raise FlexError(f"{where or 'a body'}: link model {name!r} has no stored-motion "
-                        f"reader; accepted: {', '.join(BUILTIN_LINK_MODELS)}")
-    return BUILTIN_LINK_MODELS[name]
+def model_entry(name: str, where: str = "",
+                link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> LinkModel:
+    """The entry of link model ``name`` in ``link_models`` (its ``stored_motion`` says how
+    its stored motion is read): a model not in the registry is refused (FlexError)."""
+    if name not in link_models:
+        raise FlexError(f"{where or 'a body'}: link model {name!r} is not in the registry of "
+                        f"link models; accepted: {', '.join(link_models)}")
+    return link_models[name]
 
 
 def case_motion(path: str | Path, case: str | None = None, *,
-                cache_dir: Path | None = None) -> CaseMotion:
+                cache_dir: Path | None = None,
+                link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> CaseMotion:
     """The :class:`CaseMotion` of ``case`` (None: the file's only case) of result file
-    ``path``. ``cache_dir``: the reduction cache folder (None: built in memory). Refused
+    ``path``. ``cache_dir``: the reduction cache folder (None: built in memory);
+    ``link_models``: the registry the case's link models are read from (each entry's
+    ``stored_motion`` says how its motion is read back). Refused
     (:class:`FlexError`, one line) for a failed case, a case without a flexible link, a
     reduction that is not the run's basis, or a nonlinear FE case without its nodal field."""
     path = Path(path)
@@ -285,20 +291,20 @@ def case_motion(path: str | Path, case: str | None = None, *,
     if attrs.get("status") != "ok":
         raise FlexError(f"{where} failed ({attrs.get('message', '')}): nothing to export")
     scene = case_scene(attrs, where)
-    models = {link: model_entry(scene[link]["model"], where)
+    models = {link: model_entry(scene[link]["model"], where, link_models)
               for link in ("crank", "coupler")}
-    if all(model.rigid for model in models.values()):
+    if all(model.stored_motion == "rigid" for model in models.values()):
         raise FlexError(f"{where} has no flexible link (crank and coupler rigid): flex export "
                         f"and animate show FFRF and nonlinear FE links")
     bodies, extra = [], {}
     for link, model in models.items():
-        if model.modal:
+        if model.stored_motion == "modal":
             body, extra[link] = _ffrf_body(link, scene, data, attrs, where, cache_dir)
-        elif model.meshed:
+        elif model.stored_motion == "nodal":
             body, extra[link] = _nonlinear_body(scene, data, where)
         else:
             body = _rigid_body(link, scene)
-        bodies.append(body)
+        bodies.append(replace(body, model=model.name))
     bodies.append(_slider_body(scene))
     return CaseMotion(path, case, scene, data, attrs, bodies, extra)
 
@@ -321,7 +327,8 @@ def _ffrf_body(link: str, scene: Scene, data: dict[str, np.ndarray], attrs: dict
     corners = np.asarray(reduction.fem.elements[0]["Tet4"], dtype=np.int64)
     body = Body(link, FFRF, positions, tet10_cells(corners, positions), corners,
                 has_stress=reduction.has_stress_modes,
-                facts={"reduction_key": reduction.key, "from_cache": reduction.from_cache})
+                facts={"reduction_key": reduction.key, "from_cache": reduction.from_cache},
+                kind="modal")
     return body, reduction
 
 
@@ -342,7 +349,7 @@ def _nonlinear_body(scene: Scene, data: dict[str, np.ndarray], where: str
                         for element in plate.mesh.ngmesh.Elements3D()], dtype=np.int64)
     positions = plate.node_positions_m
     return Body("coupler", NONLINEAR_FE, positions, tet10_cells(corners, positions),
-                corners), plate
+                corners, kind="nodal"), plate
 
 
 def _rigid_body(link: str, scene: Scene) -> Body:

@@ -44,7 +44,8 @@ from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, NONLINEAR_FE
-from flex.fidelity.error_estimate import HEADLINES, PREFIX, integrator_order, richardson_error
+from flex.fidelity.error_estimate import PREFIX, integrator_order, richardson_error
+from flex.fidelity.headlines import BUILTIN_HEADLINES
 from flex.fidelity.simulation import simulate_case
 
 #: the reference's step is the run's divided by this (order 2: 16x more accurate where the
@@ -135,9 +136,9 @@ def _compare(run: CaseResult, references: dict[str, CaseResult], step: float, or
     measured against the FFRF one (:data:`REFERENCE_MODES` modes, mesh-corrected): its model
     term is then not checked (``reference_rung_<q>``)."""
     h = step / REFINEMENT
-    for quantity, (_, _, read) in HEADLINES.items():
-        values = {key: read(case.datasets) for key, case in references.items()}
-        ours = read(run.datasets)
+    for quantity, headline in BUILTIN_HEADLINES.items():
+        values = {key: headline.read(case.datasets) for key, case in references.items()}
+        ours = headline.read(run.datasets)
         if ours is None or f"{PREFIX}{quantity}" not in run.attrs:
             continue
         base, other = ("best", "other") if values["best"] is not None else ("mesh", "mesh_other")
@@ -172,7 +173,7 @@ def _rows(results: Mapping[str, CaseResult]) -> list[dict[str, Any]]:
     """One row per (case, quantity) with an estimate and a true error."""
     rows = []
     for name, case in results.items():
-        for quantity in HEADLINES:
+        for quantity in BUILTIN_HEADLINES:
             if f"true_error_{quantity}" not in case.attrs:
                 continue
             estimated = float(case.attrs[f"{PREFIX}{quantity}"])

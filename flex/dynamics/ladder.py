@@ -1,0 +1,186 @@
+"""The model ladder, as data: each link model's rung, what bounds its error against the rung
+above, what that leaves out, and what ``auto`` and the refinement may do with it.
+
+A link model's registry entry says its rung (:attr:`flex.dynamics.link_models.LinkModel.rung`,
+a function of the link's scene values: the FFRF model is the linear rung without geometric
+stiffness); the callers read the rungs and name no model:
+
+- the error budget's ``model`` term (:mod:`flex.fidelity.error_budget`): a link on a
+  *bounded* rung gets ``own_fraction`` of what its elasticity changes in its own quantities
+  and ``motion_fraction`` of what it changes in the motion (the difference to a companion
+  whose bounded links are rigid twins), plus the difference to the rung's ``companion``
+  (overrides one step up, e.g. geometric stiffness on); every other rung adds its
+  ``leaves_out`` line;
+- ``auto``'s climb (:func:`climb`): past rigid, the lowest rung ``auto`` may take whose
+  ``bound`` meets the tolerance, else the highest;
+- the refinement's model knob (:func:`next_rung`): the next rung up that refinement may take;
+- the readers of stored motion read the entry's ``motion`` (the contract's point 9).
+
+The levels order the rungs (higher: closer to the truth); the numbers are the measured
+bounds of ``make ladder`` and ``make flexible`` (docs/geometric-stiffness.md).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Rung:
+    """One rung of the ladder (see the module doc); fractions are relative [1]."""
+
+    #: its place: higher is closer to the truth
+    level: int
+    #: how reasons and budgets name it
+    name: str
+    #: its model error against the rung above relative to the link's own peak deflection,
+    #: given the rigid probe's compression / Euler load (what ``auto`` climbs on); None: no
+    #: bound (a rigid link: its elasticity is predicted from its loads; the top rung)
+    bound: Callable[[float], float] | None = None
+    #: the budget's model term: fractions of what the elasticity changes in the link's own
+    #: quantities and in the motion
+    own_fraction: float = 0.0
+    motion_fraction: float = 0.0
+    #: overrides (``{link}`` stands for the link) of a companion one step up whose
+    #: difference the model term adds, and the sentence that says so (``{links}``)
+    companion: tuple[str, ...] = ()
+    companion_text: str = ""
+    #: the budget's sentence on how the term was measured
+    measured_by: str = ""
+    #: what a budget leaves out for links on this rung (``{links}``)
+    leaves_out: str = ""
+    #: ``auto`` may climb onto it; the refinement may climb onto it
+    auto: bool = True
+    refine: bool = True
+
+    @property
+    def bounded(self) -> bool:
+        """Its model error is bounded by measured fractions (the budget's model term)."""
+        return self.bound is not None
+
+
+GEOMETRIC_FFRF_ERROR = 0.005
+"""The FFRF rungs' model errors relative to the quantity, measured by ``make ladder``
+(thesis deployment, steel plates 0.5-10 mm, peak elastic midpoint deflection against the
+nonlinear FE coupler's, docs/geometric-stiffness.md): the FFRF coupler (chord frame, with
+the geometric stiffness of its axial force, flex's default) stayed within 0.35 % (largest at
+0.5-0.7 mm and at 10 mm, where both FFRF bodies differ alike from the nonlinear FE one: the
+rigid end faces), bounded by ``GEOMETRIC_FFRF_ERROR``; the linear FFRF coupler
+(``geometric_stiffness = false``) below ``LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD
+x`` (x the rigid probe's compression / Euler load; measured 0.32 % at x = 1e-4, 0.53 % at
+0.0076, 3.2 % at 0.049, 13 % at 0.13, 16 % at 0.20, 18 % at 0.33)."""
+LINEAR_FFRF_ERROR_FLOOR = 0.005
+LINEAR_FFRF_ERROR_PER_LOAD = 1.0
+
+FFRF_MOTION_ERROR_FRACTION = 0.15
+"""The FFRF body's error against the nonlinear FE coupler on the quantities of the motion
+(crank angle and slider position at the end time, peak joint forces, deployment time), as a
+fraction of what the link's elasticity changes in them (the FFRF run against its rigid twin),
+measured by ``make flexible`` (1-10 mm plates over the reference's span; its report prints
+the run's fractions): up to 0.13 on the joint forces' peaks (the axial ringing the reduced
+body represents with one axial mode), up to 0.16 on the crank angle."""
+
+
+def _geometric_ffrf_bound(load_ratio: float) -> float:
+    return GEOMETRIC_FFRF_ERROR
+
+
+def _linear_ffrf_bound(load_ratio: float) -> float:
+    return LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio
+
+
+_FFRF_MEASURED_BY = (
+    f"FFRF with geometric stiffness against the nonlinear FE coupler: "
+    f"{GEOMETRIC_FFRF_ERROR:g} of a link's own peak deflection and stress (make ladder), "
+    f"{FFRF_MOTION_ERROR_FRACTION:g} of what the elasticity changes in the motion and the "
+    f"joint forces (make flexible; the difference to rigid twins)")
+
+#: a rigid link: its elasticity is what the ``auto`` decision predicts from its loads
+RIGID_RUNG = Rung(0, "rigid", leaves_out='the elasticity of the rigid {links} (predicted by '
+                  'model = "auto", fidelity_* attributes)')
+#: the FFRF body without geometric stiffness: softens wrongly under compression
+LINEAR_FFRF_RUNG = Rung(
+    1, "linear FFRF (geometric_stiffness = false)", _linear_ffrf_bound, GEOMETRIC_FFRF_ERROR,
+    FFRF_MOTION_ERROR_FRACTION, ("{link}.geometric_stiffness=true",),
+    "linear FFRF ({links}): plus the difference to a companion with geometric stiffness",
+    _FFRF_MEASURED_BY)
+#: flex's default flexible body: FFRF in the chord frame with geometric stiffness
+FFRF_RUNG = Rung(2, "FFRF", _geometric_ffrf_bound, GEOMETRIC_FFRF_ERROR,
+                 FFRF_MOTION_ERROR_FRACTION, measured_by=_FFRF_MEASURED_BY)
+#: the top: the fully nonlinear FE plate, the reference the others are measured against
+NONLINEAR_FE_RUNG = Rung(
+    9, "nonlinear FE", leaves_out="the nonlinear FE coupler's own model error (the top rung: "
+    "St. Venant-Kirchhoff continuum, deformable joint faces)")
+
+
+def ffrf_rung(values: Mapping[str, Any]) -> Rung:
+    """The FFRF model's rung for a link's scene values: linear without geometric stiffness."""
+    return FFRF_RUNG if values.get("geometric_stiffness", True) else LINEAR_FFRF_RUNG
+
+
+def rungs(link: str, values: Mapping[str, Any], link_models: Mapping[str, Any],
+          **flags: bool) -> list[tuple[Rung, str]]:
+    """The rungs ``link`` may stand on (with ``values``, its scene values), lowest first, as
+    (rung, model name); ``flags``: rung fields that must hold (``auto=True``)."""
+    out = []
+    for name, entry in link_models.items():
+        rung = entry.rung(values) if link in entry.links else None
+        if rung is not None and all(getattr(rung, flag) == value
+                                    for flag, value in flags.items()):
+            out.append((rung, name))
+    return sorted(out, key=lambda pair: pair[0].level)
+
+
+@dataclass(frozen=True)
+class Climb:
+    """``auto``'s flexible rung for a link: the model, its rung, and the reason (the rungs
+    tried with their bounds against the tolerance)."""
+
+    model: str
+    rung: Rung
+    reason: str
+
+
+def climb(link: str, values: Mapping[str, Any], load_ratio: float, tolerance: float,
+          link_models: Mapping[str, Any]) -> Climb:
+    """Past rigid: the lowest rung ``auto`` may pick whose bound (relative to the link's own
+    deflection, at ``load_ratio``, the rigid probe's compression / Euler load) meets
+    ``tolerance``, else the highest one (ValueError when ``auto`` may pick none)."""
+    options = [(rung, name) for rung, name in rungs(link, values, link_models, auto=True)
+               if not link_models[name].rigid and link_models[name].auto_choice]
+    if not options:
+        raise ValueError(f"{link}: no flexible rung that auto may pick")
+    tried = []
+    for rung, name in options:
+        if rung.bound is None:
+            return Climb(name, rung, "; ".join(tried))
+        relative = rung.bound(load_ratio)
+        meets = relative <= tolerance
+        tried.append(f"{rung.name} model error {relative:.3g} of the deflection, make ladder's "
+                     f"measured bound, {'<=' if meets else '>'} tolerance {tolerance:g}")
+        if meets:
+            return Climb(name, rung, "; ".join(tried))
+    rung, name = options[-1]
+    return Climb(name, rung, "; ".join(tried))
+
+
+def next_rung(link: str, values: Mapping[str, Any], link_models: Mapping[str, Any]
+              ) -> str | None:
+    """The model of the next rung above ``link``'s (scene ``values``) that the refinement may
+    climb to, or None: from a rung with no measured bound (a rigid link has no model term to
+    refine; the top has none above), or a model on no rung."""
+    entry = link_models[values["model"]]
+    current = entry.rung(values) if link in entry.links else None
+    if current is None or not current.bounded:
+        return None
+    above = [name for rung, name in rungs(link, values, link_models, refine=True)
+             if rung.level > current.level]
+    return above[0] if above else None
+
+
+__all__ = ["FFRF_MOTION_ERROR_FRACTION", "FFRF_RUNG", "GEOMETRIC_FFRF_ERROR",
+           "LINEAR_FFRF_ERROR_FLOOR", "LINEAR_FFRF_ERROR_PER_LOAD", "LINEAR_FFRF_RUNG",
+           "NONLINEAR_FE_RUNG", "RIGID_RUNG", "Climb", "Rung", "climb", "ffrf_rung",
+           "next_rung", "rungs"]

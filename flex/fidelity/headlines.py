@@ -1,0 +1,188 @@
+"""The headline quantities of a run, as a registry: what every error budget, ``inspect``,
+report, ``make estimates`` and refinement iterate over.
+
+:data:`BUILTIN_HEADLINES` is an immutable mapping (``types.MappingProxyType``) from a
+quantity's name to its :class:`Headline`, in the order they are printed. A function that
+estimates, budgets or certifies headline quantities takes the registry as an argument,
+``headlines``, with the built-ins as its default; a caller with a quantity of its own builds
+its own registry (``MappingProxyType({**BUILTIN_HEADLINES, "mine": Headline(...)})``) and
+passes it along (tests/test_ladder.py runs such a toy through :func:`flex.simulate`,
+``inspect`` and the report).
+
+The contract of an entry:
+
+1. ``name``: the case attribute suffix (``headline_<name>``, ``estimated_error_<name>``); it
+   ends with its unit by convention (``_m``, ``_Pa``, ``_N``, ``_s``, ``_rad``);
+2. ``unit`` and ``what``: how it is printed;
+3. ``read(datasets)``: its value from a run's datasets [its unit], or None when the run does
+   not have it (a rigid link's deflection, a deployment not reached): missing, never zero;
+4. ``kind``: how two runs' values are compared (the step, modes, mesh and model terms are
+   such differences): ``"value"`` (the values' difference), ``"peak"`` (the largest
+   ``|series|`` over ``window``: :func:`flex.fidelity.error_estimate.peak_difference`, which
+   also counts a crest that moves), ``"first_crest"`` (the largest ``|series|`` of its first
+   lobe; a rigid twin's missing series counts as zero); ``series``: the dataset it is read
+   from (peaks and crests);
+5. ``window``: the part of the run it is read over, in words;
+6. ``link``: the link whose own elastic response it is (its model term is the link's rung's
+   ``own_fraction``, :mod:`flex.dynamics.ladder`), or None for a quantity of the motion (the
+   rungs' ``motion_fraction``);
+7. ``certified``: :func:`flex.fidelity.simulation.refine` refines until it meets the
+   tolerance; ``crest_gap``: its budget stores the peak's crest gap (:func:`crest_gap`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from types import MappingProxyType
+from typing import Any
+
+import numpy as np
+
+#: how a headline quantity is compared between two runs (module doc, point 4)
+KINDS = ("value", "peak", "first_crest")
+
+
+@dataclass(frozen=True)
+class Headline:
+    """One headline quantity (see the module's contract)."""
+
+    name: str
+    unit: str
+    what: str
+    read: Callable[[Mapping[str, Any]], float | None]
+    kind: str = "value"
+    series: str | None = None
+    window: str = "the whole run"
+    link: str | None = None
+    certified: bool = False
+    crest_gap: bool = False
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise ValueError(f"headline {self.name}: kind {self.kind!r} is not one of {KINDS}")
+        if self.kind != "value" and self.series is None:
+            raise ValueError(f"headline {self.name}: a {self.kind} needs its series")
+
+
+def final_value(path: str) -> Callable[[Mapping[str, Any]], float | None]:
+    """Reader of the last sample of dataset ``path`` (None without it)."""
+    return lambda datasets: float(datasets[path].data[-1]) if path in datasets else None
+
+
+def peak_value(path: str) -> Callable[[Mapping[str, Any]], float | None]:
+    """Reader of the largest ``|path|`` over the run (None without it, or all zero)."""
+    def read(datasets: Mapping[str, Any]) -> float | None:
+        if path not in datasets:
+            return None
+        values = np.abs(np.asarray(datasets[path].data, dtype=float))
+        return float(np.max(values)) if values.size and np.any(values) else None
+    return read
+
+
+def first_crest_value(path: str) -> Callable[[Mapping[str, Any]], float | None]:
+    """Reader of the first crest of ``|path|``: the largest magnitude of the series' first
+    lobe (:func:`flex.fidelity.softening.first_peak_index`), a peak that does not race: the
+    largest crest of an undamped ringing plate can move from one crest to a neighbour a
+    fraction of a per cent lower when the phase error changes (docs/criterion.md)."""
+    def read(datasets: Mapping[str, Any]) -> float | None:
+        from flex.fidelity.softening import first_peak_index
+
+        if path not in datasets:
+            return None
+        values = np.asarray(datasets[path].data, dtype=float)
+        if not values.size or not np.any(values):
+            return None
+        return float(abs(values[first_peak_index(values)]))
+    return read
+
+
+def crest_gap(values: np.ndarray) -> float | None:
+    """How far the second-largest crest of ``|values|`` lies below the largest [the series'
+    units]: a peak's crest uncertainty (an error of the run larger than this may have picked
+    another crest as the peak); None with fewer than two crests."""
+    magnitude = np.abs(np.asarray(values, dtype=float))
+    inner = magnitude[1:-1]
+    crests = inner[(inner > magnitude[:-2]) & (inner >= magnitude[2:])]
+    if crests.size < 2:
+        return None
+    top, second = np.sort(crests)[-2:][::-1]
+    return float(top - second)
+
+
+def deployment_time_s(datasets: Mapping[str, Any]) -> float | None:
+    """Time of the first maximum of the crank angle [s] (delta_t, docs/criterion.md); None
+    when the crank angle has no maximum within the run (a deployment not reached, a
+    constant-speed crank): missing, not the end time."""
+    if "crank/angle" not in datasets:
+        return None
+    angle = np.asarray(datasets["crank/angle"].data, dtype=float)
+    falling = np.flatnonzero(np.diff(angle) < 0)
+    if len(angle) < 3 or len(falling) == 0 or falling[0] == 0:
+        return None
+    top = int(falling[0])
+    time_s = np.asarray(datasets["time"].data, dtype=float)
+    # the parabola through the top sample and its neighbours: the maximum between samples
+    # (a sample time alone is off by up to half a step, more than the run's own error)
+    left, middle, right = angle[top - 1:top + 2]
+    curvature = left - 2.0 * middle + right
+    offset = 0.5 * (left - right) / curvature if curvature < 0 else 0.0
+    return float(time_s[top] + np.clip(offset, -0.5, 0.5) * (time_s[top + 1] - time_s[top]))
+
+
+def _link_headlines(link: str) -> list[Headline]:
+    """A flexible link's own quantities: its peak deflection, bending and von Mises stress
+    over the whole run, and its deflection's first crest."""
+    deflection = f"{link}/midpoint_deflection"
+    away = " (away from the joint faces)"
+    return [
+        Headline(f"{link}_peak_deflection_m", "m",
+                 f"peak elastic midpoint deflection of the {link}",
+                 peak_value(deflection), "peak", deflection, link=link, certified=True,
+                 crest_gap=True),
+        Headline(f"{link}_peak_bending_stress_Pa", "Pa", f"peak bending stress of the {link}",
+                 peak_value(f"{link}/peak_bending_stress"), "peak",
+                 f"{link}/peak_bending_stress", link=link),
+        Headline(f"{link}_peak_von_mises_Pa", "Pa", f"peak von Mises stress of the {link}{away}",
+                 peak_value(f"{link}/peak_von_mises_stress"), "peak",
+                 f"{link}/peak_von_mises_stress", link=link),
+    ]
+
+
+def _first_crest(link: str) -> Headline:
+    deflection = f"{link}/midpoint_deflection"
+    return Headline(f"{link}_first_crest_deflection_m", "m",
+                    f"first crest of the elastic midpoint deflection of the {link} (largest "
+                    f"|deflection| of the first lobe)", first_crest_value(deflection),
+                    "first_crest", deflection, window="the first lobe of the deflection",
+                    link=link, certified=True)
+
+
+def _joint_force(joint: str) -> Headline:
+    path = f"joints/{joint}/force_modulus"
+    return Headline(f"joint_{joint}_peak_force_N", "N", f"peak force of joint {joint}",
+                    peak_value(path), "peak", path)
+
+
+def _builtin() -> dict[str, Headline]:
+    own = {link: _link_headlines(link) for link in ("coupler", "crank")}
+    entries = [
+        Headline("crank_angle_end_rad", "rad", "crank angle at the end time",
+                 final_value("crank/angle"), window="the end time"),
+        Headline("slider_position_end_m", "m", "slider position at the end time",
+                 final_value("slider/position"), window="the end time"),
+        Headline("deployment_time_s", "s", "deployment time (first maximum of the crank angle)",
+                 deployment_time_s, window="release to the first crank maximum"),
+        # the printed order: deflections, bending stresses, von Mises, joint forces, crests
+        *(own[link][k] for k in range(3) for link in ("coupler", "crank")),
+        *(_joint_force(joint) for joint in "ABC"),
+        *(_first_crest(link) for link in ("coupler", "crank")),
+    ]
+    return {entry.name: entry for entry in entries}
+
+
+#: the built-in headline quantities, by name, in the order they are printed (immutable)
+BUILTIN_HEADLINES: Mapping[str, Headline] = MappingProxyType(_builtin())
+
+__all__ = ["BUILTIN_HEADLINES", "KINDS", "Headline", "crest_gap", "deployment_time_s",
+           "final_value", "first_crest_value", "peak_value"]
