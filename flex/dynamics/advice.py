@@ -101,7 +101,7 @@ _STEP_KEYS = ("simulation.end_time_s", "simulation.step_s", "simulation.output_s
 def _reductions(mech: Mechanism) -> dict[str, Any]:
     return {link: body["reduction"] for link, body in (("crank", mech.crank),
                                                        ("coupler", mech.coupler))
-            if "reduction" in body}
+            if mech.models[link].modal}
 
 
 def mechanism_mass_at_slider(scene: Scene) -> float:

@@ -255,7 +255,6 @@ class _Builder:
         self.markers: dict[str, int] = {}
         self.crank_body: dict | None = None
         self.slider_body: dict = {}
-        self.coupler: dict = {}
         self.wing_joint: int | None = None
         self.joints: dict[str, int] = {}
 
@@ -289,20 +288,17 @@ class _Builder:
         ground markers), the slider, the ground markers at A and C, and the wing welded at A
         when enabled."""
         scene, init, mbs, eii = self.scene, self.init, self.mbs, self.eii
-        crank_model = self.models["crank"]
-        if crank_model.rigid:  # the order numbers the coordinates: kept as it always was
-            crank_model.add(self, "crank", crank_prepared)
+        rigid = self.models["crank"].rigid
+        if rigid:  # the order numbers the coordinates: kept as it always was
+            self.crank_body = self.add_link("crank", crank_prepared)["rigid_body"]
         self.slider_body = self.add_slider()
         m = self.markers
         m["ground_A"] = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=self.ground,
                                                           localPosition=[0, 0, 0]))
         m["ground_C"] = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=self.ground,
                                                           localPosition=list(init.joint_C_m)))
-        if self.crank_body is not None:
-            m["crank_A"] = self.body_marker(self.crank_body, [0.0, 0.0, 0.0])
-            m["crank_B"] = self.body_marker(self.crank_body, init.joint_B_m)
-        else:
-            crank_model.add(self, "crank", crank_prepared)
+        if not rigid:
+            self.add_link("crank", crank_prepared)
         m["slider_C"] = self.body_marker(self.slider_body, init.joint_C_m)
         if scene["wing"]["enabled"]:
             wing_root = _add_wing(self.mech, self.rigid_body, self.body_marker)
@@ -325,30 +321,20 @@ class _Builder:
         return self.rigid_body("slider", slider_mass_kg(self.scene), slider["inertia_kgm2"],
                                init.joint_C_m, 0.0, init.joint_C_velocity_m_per_s, 0.0)
 
-    def _add_flexible_crank(self, crank_reduction: Any) -> None:
-        from flex.bodies.reduction import add_ffrf_link
-
-        if crank_reduction is None:
-            raise SceneError(f'crank.model = "{self.scene["crank"]["model"]}" needs its '
-                             "reduction (flex.fidelity.simulation.simulate builds it from the "
-                             "scene)")
-        # the plate's end_a face is the pivot A (the floating frame), end_b the joint B
-        flexible_crank = add_ffrf_link(
-            self.mbs, crank_reduction, [0.0, 0.0, 0.0], self.init.crank_angle_rad,
-            damping_ratio=self.scene["crank"]["damping_ratio"],
-            damping_model=self.scene["crank"]["damping_model"],
-            initial_angular_velocity_rad_per_s=self.init.crank_speed_rad_per_s, name="crank",
-            joint_markers=self.ffrf_joint_markers,
-            end_a_rotation=bool(self.scene["wing"]["enabled"]))  # the weld turns with A
-        self.markers["crank_A"] = flexible_crank["marker_B"]
-        self.markers["crank_B"] = flexible_crank["marker_C"]
-        self.mech.crank = dict(flexible_crank, reduction=crank_reduction)
+    def add_link(self, link: str, prepared: Any) -> dict[str, Any]:
+        """Add ``link`` as its model adds it (:mod:`flex.dynamics.link_models`, point 5) and
+        keep the handles it returns: its joint markers (``<link>_A``/``_B`` of the crank,
+        ``_B``/``_C`` of the coupler) and, as ``mech.crank`` / ``mech.coupler``, the rest."""
+        handles = self.models[link].add(self, link, prepared)
+        first, second = ("A", "B") if link == "crank" else ("B", "C")
+        self.markers[f"{link}_{first}"], self.markers[f"{link}_{second}"] = \
+            handles["joint_markers"]
+        setattr(self.mech, link, handles)
+        return handles
 
     def add_coupler(self, prepared: Any) -> None:
-        """The coupler B-C, as its model adds it (:mod:`flex.dynamics.link_models`, point 5)."""
-        self.models["coupler"].add(self, "coupler", prepared)
-        self.markers["coupler_B"] = self.coupler["marker_B"]
-        self.markers["coupler_C"] = self.coupler["marker_C"]
+        """The coupler B-C, as its model adds it (:meth:`add_link`)."""
+        self.add_link("coupler", prepared)
 
     def _add_geometric_stiffness(self) -> None:
         """The softening of each FFRF link's bending modes under its own axial force
@@ -476,10 +462,9 @@ class _Builder:
             if body is not None:  # None: a flexible crank, its markers below
                 self._add_body_sensors(name, body)
         for link, model in self.models.items():  # the link model's own (point 6)
-            model.sensors(self, link)
+            model.sensors(self, link, getattr(self.mech, link))
         self._add_joint_sensors()
         self._add_marker_sensors()
-        self._add_flexible_sensors()
 
     def _add_body_sensors(self, name: str, body: dict) -> None:
         """Motion of a rigid body's node (its centre of mass), as ``<name>.<output>``."""
@@ -514,25 +499,3 @@ class _Builder:
         self.mech.constraint_points = [("ground_A", "crank_A"), ("crank_B", "coupler_B"),
                                        ("coupler_C", "slider_C")]
 
-    def _add_flexible_sensors(self) -> None:
-        flexible = {} if self.models["coupler"].rigid else {"coupler": self.coupler}
-        if self.mech.crank:
-            flexible["crank"] = self.mech.crank
-            for name in ("crank_A", "crank_B"):
-                self.add(f"marker_{name}.Velocity",
-                         self.sensor("Marker", "Velocity", markerNumber=self.markers[name]))
-        for name, link in flexible.items():
-            for output in ("Position", "Velocity"):
-                self.add(f"marker_{name}_mid.{output}",
-                         self.sensor("Marker", output, markerNumber=link["marker_mid"]))
-            if "node_modal" not in link:  # nonlinear FE: nodal coordinates only
-                continue
-            self.add(f"{name}.modal_coordinates",
-                     self.sensor("Node", "Coordinates", nodeNumber=link["node_modal"]))
-            for output in ("Position", "Rotation"):  # the floating frame (flex.tools.export)
-                self.add(f"{name}.frame_{output}",
-                         self.sensor("Node", output, nodeNumber=link["node_frame"]))
-            # Exudyn's FFRF body reports its kinetic (rigid + elastic motion) and strain energy
-            sensors = [self.mbs.AddSensor(self.sensor("Body", kind, bodyNumber=link["object"]))
-                       for kind in ("KineticEnergy", "PotentialEnergy")]
-            self.mech.flexible_energy[name] = (sensors[0], sensors[1])

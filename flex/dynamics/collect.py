@@ -100,7 +100,7 @@ def _crank_datasets(mech: Mechanism) -> dict[str, Any]:
     Returns ``"time"`` (an array) beside the datasets.
     """
     init = mech.initial
-    if not mech.crank:
+    if mech.models["crank"].rigid:
         rotation = _sensor(mech, "crank.Rotation")
         time_s, crank_angle = rotation[:, 0], rotation[:, 3]
         speed = _sensor(mech, "crank.AngularVelocity")[:, 3]
@@ -127,7 +127,7 @@ def _crank_datasets(mech: Mechanism) -> dict[str, Any]:
     out["crank/angular_velocity"] = Dataset(speed, "rad/s", "crank angular velocity" + how)
     out["crank/angular_acceleration"] = Dataset(acceleration, "rad/s^2",
                                                 "crank angular acceleration" + how)
-    if not mech.crank:
+    if mech.models["crank"].rigid:
         out["crank/midpoint_position"] = Dataset(_sensor(mech, "crank.Position")[:, 1:3], "m",
                                                  "crank midpoint (centre of mass) x, y")
     else:  # midpoint and elastic response from the flexible crank's markers

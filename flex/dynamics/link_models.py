@@ -29,11 +29,15 @@ The contract of an entry -- what a link model declares, point by point:
    its ``add`` needs (the Craig-Bampton reduction of an FFRF link; ``given``: one the caller
    built; None for models that need nothing).
 5. **how it adds itself to the Exudyn builder**: ``add(builder, link, prepared)`` adds the
-   link's bodies to :class:`flex.dynamics.builder._Builder` and leaves the joint markers in
-   the builder (``crank_body`` for a rigid crank; ``mech.crank`` for a flexible one; the
-   coupler's ``builder.coupler["marker_B"|"marker_C"]``). A rigid crank is added before the
-   slider (the order numbers the coordinates), any other after the ground markers.
-6. **its sensors and datasets**: ``sensors(builder, link)`` adds what its ``datasets(mech,
+   link's bodies to :class:`flex.dynamics.builder._Builder` and returns the handles it made:
+   a dict with ``joint_markers`` (the markers at the link's two joints: A and B for the
+   crank, B and C for the coupler) and whatever its own sensors and datasets read (a rigid
+   link's ``body`` and ``node``; an FFRF link's ``reduction``, ``node_modal``,
+   ``node_frame``, ``object``, ``marker_mid``); the builder keeps them as ``mech.crank`` and
+   ``mech.coupler``. A rigid crank is added before the slider (the order numbers the
+   coordinates), any other after the ground markers.
+6. **its sensors and datasets**: ``sensors(builder, link, handles)`` adds what its
+   ``datasets(mech,
    link, time_s)`` reads after the run (the coupler's ``coupler/...`` datasets; a crank's
    motion is read from its joint markers or rigid body by :mod:`flex.dynamics.collect`);
    ``energy``: whether its energy is known (else the run has no ``energy/...``);
@@ -144,11 +148,11 @@ class LinkModel(LinkSchema):
     auto_choice: bool = False
     #: (4) ``prepare(scene, link, given, cache_dir)``: what ``add`` needs
     prepare: Callable[[Scene, str, Any, Path | None], Any] = _given
-    #: (5) ``add(builder, link, prepared)``
-    add: Callable[[Any, str, Any], None] = _nothing
-    #: (6) ``sensors(builder, link)``, ``datasets(mech, link, time_s)``, known energy,
+    #: (5) ``add(builder, link, prepared)`` -> its handles (a dict with ``joint_markers``)
+    add: Callable[[Any, str, Any], dict[str, Any]] = _nothing
+    #: (6) ``sensors(builder, link, handles)``, ``datasets(mech, link, time_s)``, known energy,
     #: ``recorder(mech, link, settings)``
-    sensors: Callable[[Any, str], None] = _nothing
+    sensors: Callable[[Any, str, dict[str, Any]], None] = _nothing
     datasets: Callable[[Any, str, np.ndarray], dict[str, Dataset]] = _no_datasets
     energy: bool = True
     recorder: Callable[[Any, str, dict[str, Any]], Any] = _nothing
@@ -227,7 +231,7 @@ def _elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
                                           f"change of the distance {chord_name} (axial strain "
                                           "x length)")
     body = mech.crank if link == "crank" else mech.coupler
-    if "reduction" not in body:  # nonlinear FE: nodal coordinates, no modes, no stress yet
+    if not mech.models[link].modal:  # nonlinear FE: nodal coordinates, no modes, no stress
         return out
     modal = _sensor(mech, f"{link}.modal_coordinates")[:, 1:]
     out[f"{link}/modal_coordinates"] = Dataset(
@@ -263,31 +267,31 @@ def stress_window_m(reduction: Any) -> tuple[float, float]:
 # ------------------------------------------------------------------------------------------
 # rigid: a rigid body of the link's mass properties
 # ------------------------------------------------------------------------------------------
-def _add_rigid(builder: Any, link: str, prepared: Any) -> None:
+def _add_rigid(builder: Any, link: str, prepared: Any) -> dict[str, Any]:
     scene, init = builder.scene, builder.init
     if link == "crank":
-        builder.crank_body = builder.rigid_body(
+        body = builder.rigid_body(
             "crank", *plate_mass_properties(scene, "crank"), init.joint_B_m / 2,
             init.crank_angle_rad, init.joint_B_velocity_m_per_s / 2, init.crank_speed_rad_per_s)
-        return
-    mass_kg, inertia_kgm2 = plate_mass_properties(scene)
-    body = builder.rigid_body(
-        "coupler", mass_kg, inertia_kgm2, (init.joint_B_m + init.joint_C_m) / 2,
-        init.coupler_angle_rad,
-        (init.joint_B_velocity_m_per_s + init.joint_C_velocity_m_per_s) / 2,
-        init.coupler_speed_rad_per_s)
-    builder.coupler = {"marker_B": builder.body_marker(body, init.joint_B_m),
-                       "marker_C": builder.body_marker(body, init.joint_C_m)}
-    builder.mech.coupler = {"body": body["bodyNumber"], "node": body["nodeNumber"]}
+        ends = (np.zeros(3), init.joint_B_m)
+    else:
+        body = builder.rigid_body(
+            "coupler", *plate_mass_properties(scene), (init.joint_B_m + init.joint_C_m) / 2,
+            init.coupler_angle_rad,
+            (init.joint_B_velocity_m_per_s + init.joint_C_velocity_m_per_s) / 2,
+            init.coupler_speed_rad_per_s)
+        ends = (init.joint_B_m, init.joint_C_m)
+    return {"body": body["bodyNumber"], "node": body["nodeNumber"], "rigid_body": body,
+            "joint_markers": tuple(builder.body_marker(body, end) for end in ends)}
 
 
-def _rigid_sensors(builder: Any, link: str) -> None:
+def _rigid_sensors(builder: Any, link: str, handles: dict[str, Any]) -> None:
     """A rigid coupler's node (its centre of mass is the midpoint); a rigid crank's body
     sensors are the builder's, as every rigid body's."""
     if link == "coupler":
         for output in ("Position", "Velocity", "Acceleration", "Rotation", "AngularVelocity"):
             builder.add(f"coupler.{output}",
-                        builder.sensor("Node", output, nodeNumber=builder.mech.coupler["node"]))
+                        builder.sensor("Node", output, nodeNumber=handles["node"]))
 
 
 def _rigid_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
@@ -321,6 +325,30 @@ def _flexible_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Da
     out.update(_elastic_datasets(mech, "coupler", "marker_coupler_B", "marker_coupler_C",
                                  "B-C", time_s))
     return out
+
+
+def _flexible_sensors(builder: Any, link: str, handles: dict[str, Any]) -> None:
+    """A flexible link's midpoint marker (position, velocity; a flexible crank's joint-marker
+    velocities too, its chord's turning rate) and, for a modal (FFRF) link, its modal
+    coordinates, floating frame pose (:mod:`flex.tools.export`) and energies (Exudyn's FFRF
+    body reports its kinetic and strain energy)."""
+    if link == "crank":
+        for name in ("crank_A", "crank_B"):
+            builder.add(f"marker_{name}.Velocity", builder.sensor(
+                "Marker", "Velocity", markerNumber=builder.markers[name]))
+    for output in ("Position", "Velocity"):
+        builder.add(f"marker_{link}_mid.{output}",
+                    builder.sensor("Marker", output, markerNumber=handles["marker_mid"]))
+    if not builder.models[link].modal:  # nonlinear FE: nodal coordinates only
+        return
+    builder.add(f"{link}.modal_coordinates",
+                builder.sensor("Node", "Coordinates", nodeNumber=handles["node_modal"]))
+    for output in ("Position", "Rotation"):
+        builder.add(f"{link}.frame_{output}",
+                    builder.sensor("Node", output, nodeNumber=handles["node_frame"]))
+    sensors = [builder.mbs.AddSensor(builder.sensor("Body", kind, bodyNumber=handles["object"]))
+               for kind in ("KineticEnergy", "PotentialEnergy")]
+    builder.mech.flexible_energy[link] = (sensors[0], sensors[1])
 
 
 # ------------------------------------------------------------------------------------------
@@ -378,23 +406,33 @@ def _prepare_reduction(scene: Scene, link: str, given: Any, cache_dir: Path | No
                                                                cache_dir=cache_dir)
 
 
-def _add_ffrf(builder: Any, link: str, reduction: Any) -> None:
-    if link == "crank":
-        builder._add_flexible_crank(reduction)
-        return
+def _add_ffrf(builder: Any, link: str, reduction: Any) -> dict[str, Any]:
     from flex.bodies.reduction import add_ffrf_link
 
-    init = builder.init
-    builder.coupler = add_ffrf_link(
-        builder.mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
-        damping_ratio=builder.scene["coupler"]["damping_ratio"],
-        damping_model=builder.scene["coupler"]["damping_model"],
-        initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
-        initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s,
-        joint_markers=builder.ffrf_joint_markers,
-        end_a_rotation=False,  # the pin at B is free about z
-        end_b_rotation=False)  # the pin at C constrains x and y only
-    builder.mech.coupler = dict(builder.coupler, reduction=reduction)
+    scene, init = builder.scene, builder.init
+    if reduction is None:
+        raise SceneError(f'{link}.model = "{scene[link]["model"]}" needs its reduction '
+                         "(flex.fidelity.simulation.simulate builds it from the scene)")
+    if link == "crank":  # the plate's end_a face is the pivot A (the floating frame), end_b B
+        added = add_ffrf_link(
+            builder.mbs, reduction, [0.0, 0.0, 0.0], init.crank_angle_rad,
+            damping_ratio=scene["crank"]["damping_ratio"],
+            damping_model=scene["crank"]["damping_model"],
+            initial_angular_velocity_rad_per_s=init.crank_speed_rad_per_s, name="crank",
+            joint_markers=builder.ffrf_joint_markers,
+            end_a_rotation=bool(scene["wing"]["enabled"]))  # the weld turns with A
+    else:
+        added = add_ffrf_link(
+            builder.mbs, reduction, list(init.joint_B_m), init.coupler_angle_rad,
+            damping_ratio=scene["coupler"]["damping_ratio"],
+            damping_model=scene["coupler"]["damping_model"],
+            initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
+            initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s,
+            joint_markers=builder.ffrf_joint_markers,
+            end_a_rotation=False,  # the pin at B is free about z
+            end_b_rotation=False)  # the pin at C constrains x and y only
+    return dict(added, reduction=reduction,
+                joint_markers=(added["marker_B"], added["marker_C"]))
 
 
 def _highest_retained_omega(values: dict[str, Any]) -> float:
@@ -439,18 +477,18 @@ NONLINEAR_FE_SOLVER = {"linear_solver": "EigenSparse", "modified_newton": True}
 NONLINEAR_FE_NEWTON_ABSOLUTE_TOLERANCE = 1e-6
 
 
-def _add_nonlinear_fe(builder: Any, link: str, plate: Any) -> None:
+def _add_nonlinear_fe(builder: Any, link: str, plate: Any) -> dict[str, Any]:
     from flex.bodies.nonlinear import add_nonlinear_fe_coupler, nonlinear_plate_for_scene
 
     scene, init = builder.scene, builder.init
     if plate is None:
         _announce_mesh(link, scene[link], "nonlinear FE body")
         plate = nonlinear_plate_for_scene(scene)
-    builder.coupler = add_nonlinear_fe_coupler(
+    added = add_nonlinear_fe_coupler(
         builder.mbs, plate, list(init.joint_B_m), init.coupler_angle_rad,
         initial_velocity_B_m_per_s=list(init.joint_B_velocity_m_per_s),
         initial_angular_velocity_rad_per_s=init.coupler_speed_rad_per_s)
-    builder.mech.coupler = dict(builder.coupler, plate=plate)
+    return dict(added, plate=plate, joint_markers=(added["marker_B"], added["marker_C"]))
 
 
 def _nonlinear_fe_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
@@ -512,11 +550,12 @@ BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
     FFRF: LinkModel.extending(
         BUILTIN_LINK_SCHEMAS[FFRF], label="FFRF (flex's default: geometric stiffness)",
         linear_elastic=True, auto_choice=True, prepare=_prepare_reduction, add=_add_ffrf,
-        datasets=_flexible_datasets, time_scale=_ffrf_time_scale,
+        sensors=_flexible_sensors, datasets=_flexible_datasets, time_scale=_ffrf_time_scale,
         step_cost_s=_ffrf_step_cost_s, rung=ffrf_rung, stored_motion="modal"),
     NONLINEAR_FE: LinkModel.extending(
         BUILTIN_LINK_SCHEMAS[NONLINEAR_FE], label="nonlinear FE (reference)", reference=True,
-        auto_choice=True, add=_add_nonlinear_fe, datasets=_nonlinear_fe_datasets,
+        auto_choice=True, add=_add_nonlinear_fe, sensors=_flexible_sensors,
+        datasets=_nonlinear_fe_datasets,
         energy=False, recorder=_nodal_recorder, time_scale=_nonlinear_fe_time_scale,
         step_cost_s=_nonlinear_fe_step_cost_s, adjust_solver=_nonlinear_fe_solver,
         own_progress=True, rung=_nonlinear_fe_rung, stored_motion="nodal"),
