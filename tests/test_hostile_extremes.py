@@ -103,14 +103,14 @@ def test_a_deployment_not_completed_is_not_an_answer(target, value):
 
 # --- cost estimates and progress ------------------------------------------------------------
 def test_a_reduction_to_many_modes_is_estimated_and_announced(capsys):
-    from flex.dynamics.solver import _announce_mesh
+    from flex.dynamics.solver import announce_mesh
 
     few = estimate_mesh(0.08, 0.001, 0.01, 0.002, 6).build_time_s
     many = estimate_mesh(0.08, 0.001, 0.01, 0.002, 100).build_time_s
     assert many > 60 * few and modes_cost_factor(6) == 1.0
     values = load_scene(overrides=PLATE + ["coupler.modes=100"])["coupler"]
     values["mesh_size_m"] = 0.002
-    _announce_mesh("coupler", values, "reduction with 100 modes", 100)
+    announce_mesh("coupler", values, "reduction with 100 modes", 100)
     (line,) = capsys.readouterr().err.splitlines()
     assert "100 modes" in line and "min" in line and "estimate" in line
 

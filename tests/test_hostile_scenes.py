@@ -28,7 +28,7 @@ from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import SCHEMA, estimate_mesh, load_scene
 from flex.dynamics.solver import (
     VALIDITY_WARNING,
-    _check_finite,
+    check_finite,
     divergence_advice,
     validity_warning,
 )
@@ -422,7 +422,7 @@ def test_check_finite_advice_follows_the_scene():
     time_s = np.arange(11) * 1e-5
     data = {"time": Dataset(time_s, "s"), "constraint_norm": Dataset(np.full(11, 1.0), "m")}
     with pytest.raises(SimulationError) as error:
-        _check_finite(data, {"step_s": 1e-5}, scene)
+        check_finite(data, {"step_s": 1e-5}, scene)
     assert "unlikely to help" in str(error.value)
     assert "no input is 100x" in str(error.value)
     coarse = load_scene(overrides=["simulation.step_s=0.01", "simulation.end_time_s=0.03"])

@@ -132,7 +132,7 @@ def slider_mass_kg(scene: Scene) -> float:
     return scene["slider"]["mass_kg"] + (chain.slider_share_kg if chain else 0.0)
 
 
-def _rotation_z(angle_rad: float) -> np.ndarray:
+def rotation_z(angle_rad: float) -> np.ndarray:
     c, s = np.cos(angle_rad), np.sin(angle_rad)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
@@ -268,7 +268,7 @@ class _Builder:
         inertia = RigidBodyInertia(mass=mass_kg, inertiaTensor=np.eye(3) * inertia_kgm2)
         body = self.mbs.CreateRigidBody(
             name=name, inertia=inertia, referencePosition=list(position),
-            referenceRotationMatrix=_rotation_z(angle_rad), initialVelocity=list(velocity),
+            referenceRotationMatrix=rotation_z(angle_rad), initialVelocity=list(velocity),
             initialAngularVelocity=[0.0, 0.0, angular_velocity_rad_per_s],
             nodeType=self.exu.NodeType.RotationRxyz, returnDict=True)
         self.mech.rigid_bodies[name] = (mass_kg, np.eye(3) * inertia_kgm2)
@@ -278,7 +278,7 @@ class _Builder:
         """A marker on ``body`` at ``global_point`` [m] (reference configuration)."""
         node = self.mbs.GetNode(body["nodeNumber"])
         reference = np.asarray(node["referenceCoordinates"][:3])
-        rotation = _rotation_z(node["referenceCoordinates"][5])
+        rotation = rotation_z(node["referenceCoordinates"][5])
         local = rotation.T @ (np.asarray(global_point) - reference)
         return self.mbs.AddMarker(self.eii.MarkerBodyRigid(bodyNumber=body["bodyNumber"],
                                                            localPosition=list(local)))
@@ -309,7 +309,7 @@ class _Builder:
         the joint face of a flexible crank); return the joint. Its reaction torque is the
         wing root bending moment in the mechanism plane."""
         # both markers turned back by the crank angle: the weld frame is global at t = 0
-        crank_rotation = _rotation_z(self.init.crank_angle_rad)
+        crank_rotation = rotation_z(self.init.crank_angle_rad)
         markers = [_turned_marker(self.mbs, marker, crank_rotation.T)
                    for marker in (crank_root, wing_root)]
         return self.mbs.AddObject(self.eii.ObjectJointGeneric(
@@ -369,8 +369,8 @@ class _Builder:
             self.joints = dict(zip("ABCP", joints, strict=True))
             self.mech.joint_frames = {"A": None, "B": None, "C": None, "P": None}
             return
-        crank_ref = _rotation_z(self.init.crank_angle_rad)
-        coupler_ref = _rotation_z(self.init.coupler_angle_rad)
+        crank_ref = rotation_z(self.init.crank_angle_rad)
+        coupler_ref = rotation_z(self.init.coupler_angle_rad)
         # joint frames coincide with the global axes at t = 0; force outputs are in the frame
         # of marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where
         # it can; the links' markers are turned by copies (_turned_marker)

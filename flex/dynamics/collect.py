@@ -15,8 +15,8 @@ from flex.data.results import Dataset
 from flex.dynamics import planar
 from flex.dynamics.builder import Mechanism
 from flex.dynamics.link_models import (  # noqa: F401 - stress_window_m: re-exported
-    _elastic_datasets,
-    _sensor,
+    elastic_datasets,
+    sensor_data,
     stress_window_m,
 )
 
@@ -28,11 +28,11 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
     time_s = crank_out.pop("time")
     out: dict[str, Dataset] = {"time": Dataset(time_s, "s", "simulation time")}
     out.update(crank_out)
-    out["slider/position"] = Dataset(_sensor(mech, "slider.Position")[:, 1], "m",
+    out["slider/position"] = Dataset(sensor_data(mech, "slider.Position")[:, 1], "m",
                                      "slider x (joint C) along the slide line")
-    out["slider/velocity"] = Dataset(_sensor(mech, "slider.Velocity")[:, 1], "m/s",
+    out["slider/velocity"] = Dataset(sensor_data(mech, "slider.Velocity")[:, 1], "m/s",
                                      "slider velocity along the slide line")
-    out["slider/acceleration"] = Dataset(_sensor(mech, "slider.Acceleration")[:, 1], "m/s^2",
+    out["slider/acceleration"] = Dataset(sensor_data(mech, "slider.Acceleration")[:, 1], "m/s^2",
                                          "slider acceleration along the slide line")
     out["slider/displacement"] = Dataset(init.joint_C_m[0] - out["slider/position"].data, "m",
                                          "slider travel toward the crank pivot since t = 0")
@@ -52,11 +52,11 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
 
     residual_sq = np.zeros_like(time_s)
     for first, second in mech.constraint_points:
-        gap = (_sensor(mech, f"marker_{first}.Position")[:, 1:3]
-               - _sensor(mech, f"marker_{second}.Position")[:, 1:3])
+        gap = (sensor_data(mech, f"marker_{first}.Position")[:, 1:3]
+               - sensor_data(mech, f"marker_{second}.Position")[:, 1:3])
         residual_sq += np.sum(gap**2, axis=1)
-    slider_y = _sensor(mech, "slider.Position")[:, 2] - scene["slider"]["offset_m"]
-    residual_sq += slider_y**2 + _sensor(mech, "slider.Rotation")[:, 3] ** 2
+    slider_y = sensor_data(mech, "slider.Position")[:, 2] - scene["slider"]["offset_m"]
+    residual_sq += slider_y**2 + sensor_data(mech, "slider.Rotation")[:, 3] ** 2
     out["constraint_norm"] = Dataset(np.sqrt(residual_sq), "m",
                                      "norm of the position constraint equations (A, B, C, "
                                      "slide line; slider angle in rad)")
@@ -78,12 +78,12 @@ def _joint_forces(mech: Mechanism) -> dict[str, np.ndarray]:
     """
     out = {}
     for joint in "ABCP":
-        local = -_sensor(mech, f"joint_{joint}.Force")[:, 1:3]
+        local = -sensor_data(mech, f"joint_{joint}.Force")[:, 1:3]
         frame_sensor = mech.joint_frames.get(joint)
         if frame_sensor is None:
             out[joint] = local
             continue
-        frame_angle = np.unwrap(_sensor(mech, f"{frame_sensor}.Rotation")[:, 3])
+        frame_angle = np.unwrap(sensor_data(mech, f"{frame_sensor}.Rotation")[:, 3])
         frame_angle = frame_angle - frame_angle[0]  # joint frames are global at t = 0
         c, s = np.cos(frame_angle), np.sin(frame_angle)
         out[joint] = np.column_stack([c * local[:, 0] - s * local[:, 1],
@@ -101,17 +101,17 @@ def _crank_datasets(mech: Mechanism) -> dict[str, Any]:
     """
     init = mech.initial
     if mech.models["crank"].rigid:
-        rotation = _sensor(mech, "crank.Rotation")
+        rotation = sensor_data(mech, "crank.Rotation")
         time_s, crank_angle = rotation[:, 0], rotation[:, 3]
-        speed = _sensor(mech, "crank.AngularVelocity")[:, 3]
-        acceleration = _sensor(mech, "crank.AngularAcceleration")[:, 3]
+        speed = sensor_data(mech, "crank.AngularVelocity")[:, 3]
+        acceleration = sensor_data(mech, "crank.AngularAcceleration")[:, 3]
         how = " (rigid body)"
     else:
-        position_a = _sensor(mech, "marker_crank_A.Position")
+        position_a = sensor_data(mech, "marker_crank_A.Position")
         time_s = position_a[:, 0]
-        chord = _sensor(mech, "marker_crank_B.Position")[:, 1:3] - position_a[:, 1:3]
-        chord_rate = (_sensor(mech, "marker_crank_B.Velocity")[:, 1:3]
-                      - _sensor(mech, "marker_crank_A.Velocity")[:, 1:3])
+        chord = sensor_data(mech, "marker_crank_B.Position")[:, 1:3] - position_a[:, 1:3]
+        chord_rate = (sensor_data(mech, "marker_crank_B.Velocity")[:, 1:3]
+                      - sensor_data(mech, "marker_crank_A.Velocity")[:, 1:3])
         crank_angle = np.unwrap(np.arctan2(chord[:, 1], chord[:, 0]))
         speed = (chord[:, 0] * chord_rate[:, 1] - chord[:, 1] * chord_rate[:, 0]) \
             / np.sum(chord**2, axis=1)
@@ -128,10 +128,10 @@ def _crank_datasets(mech: Mechanism) -> dict[str, Any]:
     out["crank/angular_acceleration"] = Dataset(acceleration, "rad/s^2",
                                                 "crank angular acceleration" + how)
     if mech.models["crank"].rigid:
-        out["crank/midpoint_position"] = Dataset(_sensor(mech, "crank.Position")[:, 1:3], "m",
+        out["crank/midpoint_position"] = Dataset(sensor_data(mech, "crank.Position")[:, 1:3], "m",
                                                  "crank midpoint (centre of mass) x, y")
     else:  # midpoint and elastic response from the flexible crank's markers
-        out.update(_elastic_datasets(mech, "crank", "marker_crank_A", "marker_crank_B",
+        out.update(elastic_datasets(mech, "crank", "marker_crank_A", "marker_crank_B",
                                      "A-B", time_s))
     return out
 
@@ -152,8 +152,8 @@ def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s:
     kinetic = np.zeros_like(time_s)
     strain = np.zeros_like(time_s)
     for name, (mass_kg, inertia) in mech.rigid_bodies.items():
-        velocity = _sensor(mech, f"{name}.Velocity")[:, 1:4]
-        omega = _sensor(mech, f"{name}.AngularVelocity")[:, 1:4]
+        velocity = sensor_data(mech, f"{name}.Velocity")[:, 1:4]
+        omega = sensor_data(mech, f"{name}.AngularVelocity")[:, 1:4]
         kinetic += 0.5 * mass_kg * np.sum(velocity**2, axis=1)
         kinetic += 0.5 * np.einsum("ij,jk,ik->i", omega, inertia, omega)
     for link, (kinetic_sensor, strain_sensor) in mech.flexible_energy.items():
@@ -161,7 +161,7 @@ def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s:
         strain += np.asarray(mech.mbs.GetSensorStoredData(strain_sensor))[:, 1]
         stiffness = (mech.crank if link == "crank" else mech.coupler).get("geometric_data")
         if stiffness is not None:  # the geometric stiffness's energy: not in Exudyn's body
-            strain += stiffness.energy_J(_sensor(mech, f"{link}.modal_coordinates")[:, 1:])
+            strain += stiffness.energy_J(sensor_data(mech, f"{link}.modal_coordinates")[:, 1:])
     out = {"energy/kinetic": Dataset(kinetic, "J", "kinetic energy of all links")}
     if mech.flexible_energy:
         out["energy/strain"] = Dataset(strain, "J", "elastic strain energy of the flexible links")
@@ -190,9 +190,9 @@ def _spring_chain_energy(mech: Mechanism, slider_displacement_m: np.ndarray
     is in the slider's kinetic energy). Segment j's compression is the segment preload plus
     the x displacement of its slider-side end minus its frame-side end's (x = -travel)."""
     chain = mech.spring_chain["chain"]
-    inner = [_sensor(mech, f"spring_chain.{i}.Coordinates")[:, 1]
+    inner = [sensor_data(mech, f"spring_chain.{i}.Coordinates")[:, 1]
              for i in range(chain.segments - 1)]
-    speeds = [_sensor(mech, f"spring_chain.{i}.Coordinates_t")[:, 1]
+    speeds = [sensor_data(mech, f"spring_chain.{i}.Coordinates_t")[:, 1]
               for i in range(chain.segments - 1)]
     ends = np.array([-slider_displacement_m, *inner, np.zeros_like(slider_displacement_m)])
     compression = chain.segment_preload_m + ends[:-1] - ends[1:]
@@ -204,26 +204,26 @@ def _spring_chain_energy(mech: Mechanism, slider_displacement_m: np.ndarray
 
 def _wing_datasets(mech: Mechanism) -> dict[str, Dataset]:
     """Wing angle, angular velocity and the root (weld) loads, in global axes."""
-    angle = _sensor(mech, "wing.Rotation")[:, 3]
+    angle = sensor_data(mech, "wing.Rotation")[:, 3]
     span_m = mech.scene["wing"]["span_m"]
-    omega = _sensor(mech, "wing.AngularVelocity")[:, 3]
+    omega = sensor_data(mech, "wing.AngularVelocity")[:, 3]
     if mech.planar:
         force, moment = planar.weld_loads(mech)
     else:
         # weld frame = crank frame at t = 0 turned with the crank; Exudyn reports the load
         # on body 0 (the crank), so the load on the wing is its negative
         turn = angle - mech.initial.crank_angle_rad
-        local = -_sensor(mech, "joint_W.ForceLocal")[:, 1:3]
+        local = -sensor_data(mech, "joint_W.ForceLocal")[:, 1:3]
         c, s = np.cos(turn), np.sin(turn)
         force = np.column_stack([c * local[:, 0] - s * local[:, 1],
                                  s * local[:, 0] + c * local[:, 1]])
-        moment = -_sensor(mech, "joint_W.TorqueLocal")[:, 3]
+        moment = -sensor_data(mech, "joint_W.TorqueLocal")[:, 3]
     return {
         "wing/angle": Dataset(angle, "rad", "wing angle from +x (along the crank)"),
         "wing/angular_velocity": Dataset(omega, "rad/s", "wing (and wing-tip) angular velocity"),
         "wing/angular_velocity_deg": Dataset(np.degrees(omega), "deg/s",
                                              "wing angular velocity in the thesis's unit"),
-        "wing/angular_acceleration": Dataset(_sensor(mech, "wing.AngularAcceleration")[:, 3],
+        "wing/angular_acceleration": Dataset(sensor_data(mech, "wing.AngularAcceleration")[:, 3],
                                              "rad/s^2", "wing angular acceleration"),
         "wing/tip_speed": Dataset(np.abs(omega) * span_m, "m/s", "speed of the wing tip"),
         "joints/W/force_on_wing": Dataset(force, "N", "crank on wing at the root (weld), x y"),

@@ -198,11 +198,12 @@ def entries(scene: Scene, link_models: Mapping[str, LinkModel]) -> dict[str, Lin
 # ------------------------------------------------------------------------------------------
 # what a flexible link's markers and modal coordinates give (FFRF and nonlinear FE)
 # ------------------------------------------------------------------------------------------
-def _sensor(mech: Any, name: str) -> np.ndarray:
+def sensor_data(mech: Any, name: str) -> np.ndarray:
+    """The stored data of ``mech``'s sensor ``name`` (time in column 0, then its values)."""
     return np.asarray(mech.mbs.GetSensorStoredData(mech.sensors[name]))
 
 
-def _elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
+def elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
                       chord_name: str, time_s: np.ndarray) -> dict[str, Dataset]:
     """Midpoint motion and elastic response of a flexible ``link`` (FFRF or nonlinear FE).
 
@@ -212,10 +213,10 @@ def _elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
     from flex.bodies.reduction import bending_stress_history, midpoint_deflection
     from flex.bodies.stress import peak_datasets
 
-    position_start = _sensor(mech, f"{start_marker}.Position")[:, 1:4]
-    position_end = _sensor(mech, f"{end_marker}.Position")[:, 1:4]
-    position_mid = _sensor(mech, f"marker_{link}_mid.Position")[:, 1:4]
-    velocity_mid = _sensor(mech, f"marker_{link}_mid.Velocity")[:, 1:3]
+    position_start = sensor_data(mech, f"{start_marker}.Position")[:, 1:4]
+    position_end = sensor_data(mech, f"{end_marker}.Position")[:, 1:4]
+    position_mid = sensor_data(mech, f"marker_{link}_mid.Position")[:, 1:4]
+    velocity_mid = sensor_data(mech, f"marker_{link}_mid.Velocity")[:, 1:3]
     deflection = midpoint_deflection(position_start, position_end, position_mid)
     out: dict[str, Dataset] = {}
     out[f"{link}/midpoint_position"] = Dataset(position_mid[:, :2], "m",
@@ -233,7 +234,7 @@ def _elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
     body = mech.crank if link == "crank" else mech.coupler
     if not mech.models[link].modal:  # nonlinear FE: nodal coordinates, no modes, no stress
         return out
-    modal = _sensor(mech, f"{link}.modal_coordinates")[:, 1:]
+    modal = sensor_data(mech, f"{link}.modal_coordinates")[:, 1:]
     out[f"{link}/modal_coordinates"] = Dataset(
         modal, "1", "elastic coordinates: the static modes, then the fixed-interface eigenmodes")
     reduction = body["reduction"]
@@ -249,8 +250,8 @@ def _elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
 def _frame_datasets(mech: Any, link: str) -> dict[str, Dataset]:
     """The pose of an FFRF link's floating frame (what :mod:`flex.tools.export` places the
     nodal field with): origin x, y [m] and angle about z [rad]."""
-    origin = _sensor(mech, f"{link}.frame_Position")[:, 1:3]
-    angle = np.unwrap(_sensor(mech, f"{link}.frame_Rotation")[:, 3])
+    origin = sensor_data(mech, f"{link}.frame_Position")[:, 1:3]
+    angle = np.unwrap(sensor_data(mech, f"{link}.frame_Rotation")[:, 3])
     return {f"{link}/frame_position": Dataset(origin, "m", "floating frame origin x, y"),
             f"{link}/frame_angle": Dataset(angle, "rad", "floating frame angle from +x")}
 
@@ -298,14 +299,14 @@ def _rigid_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Datas
     if link != "coupler":
         return {}
     return {
-        "coupler/midpoint_position": Dataset(_sensor(mech, "coupler.Position")[:, 1:3], "m",
+        "coupler/midpoint_position": Dataset(sensor_data(mech, "coupler.Position")[:, 1:3], "m",
                                              "coupler midpoint x, y"),
         "coupler/midpoint_acceleration": Dataset(
-            _sensor(mech, "coupler.Acceleration")[:, 1:3], "m/s^2",
+            sensor_data(mech, "coupler.Acceleration")[:, 1:3], "m/s^2",
             "coupler midpoint acceleration x, y (thesis figs. 35-42)"),
         "coupler/midpoint_deflection": Dataset(np.zeros_like(time_s), "m",
                                                "elastic midpoint deflection (rigid: 0)"),
-        "coupler/angle": Dataset(_sensor(mech, "coupler.Rotation")[:, 3], "rad",
+        "coupler/angle": Dataset(sensor_data(mech, "coupler.Rotation")[:, 3], "rad",
                                  "coupler angle from +x (B to C)")}
 
 
@@ -317,12 +318,12 @@ def _flexible_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Da
     markers (a flexible crank's are read with its motion, :mod:`flex.dynamics.collect`)."""
     if link != "coupler":
         return {}
-    position_b = _sensor(mech, "marker_coupler_B.Position")[:, 1:4]
-    position_c = _sensor(mech, "marker_coupler_C.Position")[:, 1:4]
+    position_b = sensor_data(mech, "marker_coupler_B.Position")[:, 1:4]
+    position_c = sensor_data(mech, "marker_coupler_C.Position")[:, 1:4]
     chord = position_c - position_b
     out = {"coupler/angle": Dataset(np.unwrap(np.arctan2(chord[:, 1], chord[:, 0])), "rad",
                                     "angle of the chord B-C from +x")}
-    out.update(_elastic_datasets(mech, "coupler", "marker_coupler_B", "marker_coupler_C",
+    out.update(elastic_datasets(mech, "coupler", "marker_coupler_B", "marker_coupler_C",
                                  "B-C", time_s))
     return out
 
@@ -365,7 +366,7 @@ STEP_COST_FFRF_S = (1.5e-4, 5e-5)  # (per FFRF link, per mode)
 STEP_COST_NONLINEAR_FE_PER_DOF_S = 7e-6
 
 
-def _announce_mesh(link: str, values: dict[str, Any], what: str, modes: int | None = None
+def announce_mesh(link: str, values: dict[str, Any], what: str, modes: int | None = None
                    ) -> None:
     """Say on stderr what a long meshing job will cost before it starts (so a big mesh, or
     a reduction to many modes, is not a silent hang)."""
@@ -392,7 +393,7 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
         raise ValueError(f'{link}: resolve its "auto" modes and mesh first '
                          f"(flex.fidelity.auto.resolve, flex.config.settings.resolve_link_keys)")
     check_meshed_plate(link, dict(c, model=FFRF))  # refused before any meshing
-    _announce_mesh(link, c, f"reduction with {c['modes']} modes (instant if cached)",
+    announce_mesh(link, c, f"reduction with {c['modes']} modes (instant if cached)",
                    c["modes"])
     with heartbeat(f"{link} reduction ({c['modes']} modes)"):
         return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
@@ -435,7 +436,7 @@ def _add_ffrf(builder: Any, link: str, reduction: Any) -> dict[str, Any]:
                 joint_markers=(added["marker_B"], added["marker_C"]))
 
 
-def _highest_retained_omega(values: dict[str, Any]) -> float:
+def highest_retained_omega(values: dict[str, Any]) -> float:
     """Beam estimate of the highest fixed-interface circular frequency [rad/s] a link's
     reduction keeps (its ``modes`` lowest of the kinds its ``mode_selection`` keeps)."""
     from flex.base.physics import clamped_plate_frequencies, in_plane_fixed_interface_omegas
@@ -452,7 +453,7 @@ def _ffrf_time_scale(link: str, values: dict[str, Any], reduction: Any
     if reduction is not None:
         hertz = float(np.max(reduction.fixed_interface_frequencies_Hz))
         return 2 * np.pi * hertz, "highest retained mode"
-    return _highest_retained_omega(values), "highest retained mode (beam estimate)"
+    return highest_retained_omega(values), "highest retained mode (beam estimate)"
 
 
 def _ffrf_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
@@ -482,7 +483,7 @@ def _add_nonlinear_fe(builder: Any, link: str, plate: Any) -> dict[str, Any]:
 
     scene, init = builder.scene, builder.init
     if plate is None:
-        _announce_mesh(link, scene[link], "nonlinear FE body")
+        announce_mesh(link, scene[link], "nonlinear FE body")
         plate = nonlinear_plate_for_scene(scene)
     added = add_nonlinear_fe_coupler(
         builder.mbs, plate, list(init.joint_B_m), init.coupler_angle_rad,
@@ -495,7 +496,7 @@ def _nonlinear_fe_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str
     out = _flexible_datasets(mech, link, time_s)
     # the face markers' linearised rotation can tilt the faces out of plane (see
     # flex.bodies.nonlinear): record how far the midpoint leaves the plane
-    position_mid = _sensor(mech, f"marker_{link}_mid.Position")[:, 1:4]
+    position_mid = sensor_data(mech, f"marker_{link}_mid.Position")[:, 1:4]
     out[f"{link}/midpoint_out_of_plane"] = Dataset(
         position_mid[:, 2] - position_mid[0, 2], "m",
         "midpoint displacement normal to the mechanism plane (z), 0 at t = 0")

@@ -34,8 +34,8 @@ from flex.dynamics.builder import (  # noqa: F401 - the names callers import fro
     InitialConfiguration,
     Mechanism,
     _Builder,
-    _rotation_z,
     initial_configuration,
+    rotation_z,
     wing_mass_properties,
 )
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel, entries

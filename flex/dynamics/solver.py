@@ -54,11 +54,11 @@ from flex.dynamics.advice import (  # noqa: F401 - the names callers import from
     FFRF_DEFLECTION_LIMIT,
     STEPS_PER_PERIOD,
     VALIDITY_WARNING,
-    _check_finite,
-    _reductions,
+    check_finite,
     divergence_advice,
     extreme_inputs,
     mechanism_mass_at_slider,
+    mechanism_reductions,
     time_scales,
     validity_warning,
 )
@@ -68,12 +68,12 @@ from flex.dynamics.link_models import (  # noqa: F401 - the names callers import
     NONLINEAR_FE_NEWTON_ABSOLUTE_TOLERANCE,
     NONLINEAR_FE_SOLVER,
     LinkModel,
-    _announce_mesh,
-    _highest_retained_omega,
+    announce_mesh,
     entries,
+    highest_retained_omega,
     reduction_for_scene,
 )
-from flex.dynamics.mechanism import Mechanism, _rotation_z, build_mechanism
+from flex.dynamics.mechanism import Mechanism, build_mechanism, rotation_z
 from flex.dynamics.runtime import SolverOutput, announce_integration
 
 
@@ -201,7 +201,7 @@ def run(mech: Mechanism, label: str = "") -> dict[str, Any]:
         step, now = solver.it.currentStepIndex, solver.it.currentTime
         failure = "explicit solver failed" if _is_explicit(settings) else "Newton failed"
         detail = " ".join(captured.getvalue().split())[-300:]
-        advice = divergence_advice(mech.scene, _reductions(mech), mech.link_models)
+        advice = divergence_advice(mech.scene, mechanism_reductions(mech), mech.link_models)
         raise SimulationError(f"solver diverged at step {step} (t = {now:.6g} s, step "
                               f"{settings['step_s']:g} s): {failure}"
                               f"{f' ({detail})' if detail else ''}; "
@@ -286,22 +286,22 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     recorders = [recorder for link, model in mech.models.items()
                  if (recorder := model.recorder(mech, link, settings)) is not None]
     counters = run(mech, name)
-    with np.errstate(all="ignore"):  # a diverged run overflows; _check_finite reports it
+    with np.errstate(all="ignore"):  # a diverged run overflows; check_finite reports it
         datasets = collect(mech)
-    _check_finite(datasets, settings, scene, _reductions(mech), link_models)
+    check_finite(datasets, settings, scene, mechanism_reductions(mech), link_models)
     for recorder in recorders:  # its own time: after the check of the sampled datasets
         datasets.update(recorder.datasets())
     import tomli_w
 
     result = CaseResult(name, to_toml(scene), datasets, counters=counters,
                         solver_settings_toml=tomli_w.dumps(settings))
-    result.attrs.update(flexible_link_attrs(scene, datasets, _reductions(mech)))
+    result.attrs.update(flexible_link_attrs(scene, datasets, mechanism_reductions(mech)))
     warning = validity_warning(scene, datasets, link_models)
     if warning:
         result.attrs[VALIDITY_WARNING] = warning
     return result
 
 
-__all__ = ["integrate", "solver_settings", "run", "collect", "_rotation_z",
+__all__ = ["integrate", "solver_settings", "run", "collect", "rotation_z",
            "divergence_advice", "time_scales", "validity_warning", "VALIDITY_WARNING",
            "reduction_for_scene", "scene_reductions", "LINKS"]

@@ -216,6 +216,20 @@ def _window(data: Mapping[str, np.ndarray], end_s: float) -> np.ndarray:
     return np.asarray(data["time"]) <= end_s * (1 + 1e-12)
 
 
+def _common_samples(rigid: Mapping[str, np.ndarray], ffrf: Mapping[str, np.ndarray],
+                    window_end_s: float) -> int:
+    """How many samples from t = 0 both runs have within [0, ``window_end_s``] [s]; refused
+    (ValueError) under three, or where their times differ."""
+    w_r, w_f = _window(rigid, window_end_s), _window(ffrf, window_end_s)
+    count = min(int(w_r.sum()), int(w_f.sum()))
+    if count < 3:
+        raise ValueError(f"window [0, {window_end_s:g}] s holds {count} common samples")
+    t_r, t_f = np.asarray(rigid["time"])[:count], np.asarray(ffrf["time"])[:count]
+    if not np.allclose(t_r, t_f, rtol=0, atol=1e-9 * max(1.0, float(t_r[-1]))):
+        raise ValueError("rigid and FFRF runs are not sampled at the same times")
+    return count
+
+
 def error_measures(rigid: Mapping[str, np.ndarray], ffrf: Mapping[str, np.ndarray],
                    length_m: float, thickness_m: float, width_m: float,
                    window_end_s: float, youngs_modulus_Pa: float = THESIS_YOUNGS_MODULUS_PA
@@ -233,13 +247,7 @@ def error_measures(rigid: Mapping[str, np.ndarray], ffrf: Mapping[str, np.ndarra
     ``stress_ratio`` (the signed dynamic amplification factor, peak FFRF / quasi-static) and
     ``euler_load_ratio`` (:func:`euler_load_ratio` of the rigid twin).
     """
-    w_r, w_f = _window(rigid, window_end_s), _window(ffrf, window_end_s)
-    count = min(int(w_r.sum()), int(w_f.sum()))
-    if count < 3:
-        raise ValueError(f"window [0, {window_end_s:g}] s holds {count} common samples")
-    t_r, t_f = np.asarray(rigid["time"])[:count], np.asarray(ffrf["time"])[:count]
-    if not np.allclose(t_r, t_f, rtol=0, atol=1e-9 * max(1.0, float(t_r[-1]))):
-        raise ValueError("rigid and FFRF runs are not sampled at the same times")
+    count = _common_samples(rigid, ffrf, window_end_s)
 
     def series(data: Mapping[str, np.ndarray], key: str) -> np.ndarray:
         return np.asarray(data[key], dtype=float)[:count]

@@ -134,15 +134,7 @@ def compare_with_reference(label: str, cases: dict[str, CaseResult], reference: 
         return {}, [f"nonlinear FE reference {label}: failed: {reference.message}"]
     ref = {k: v.data for k, v in reference.datasets.items()}
     samples = len(ref["time"])
-    found: dict[str, Values] = {}
-    skipped = []
-    for name, case in cases.items():
-        data = {k: v.data for k, v in case.datasets.items()}
-        if case.status != "ok" or len(data.get("time", ())) < samples or not np.allclose(
-                data["time"][:samples], ref["time"], rtol=0, atol=1e-12):
-            skipped.append(f"{name} ({case.message or 'other time samples'})")
-            continue
-        found[name] = _model_values(data, ref, samples, LABELS.get(name, name))
+    found, skipped = _compared_models(cases, ref)
     compression = (float(coupler_compression_N(
         {k: v.data for k, v in cases[FFRF].datasets.items()}, samples).max())
         if FFRF in found else float("nan"))
@@ -174,6 +166,35 @@ def compare_with_reference(label: str, cases: dict[str, CaseResult], reference: 
                      f"({_error_text(v['peak_error'])}), first peak "
                      f"{_error_text(v['first_peak_error'])}, curves "
                      f"{v['max_curve_difference_over_peak']:.1%} of the peak apart")
+    _motion_fractions(cases, found, ref, prefix, datasets, lines)
+    if skipped:
+        lines.append(f"  not compared: {', '.join(skipped)}")
+    return datasets, lines
+
+
+def _compared_models(cases: dict[str, CaseResult], ref: dict[str, np.ndarray]
+                     ) -> tuple[dict[str, Values], list[str]]:
+    """Each model run that shares the reference's first samples, its values against the
+    reference (:func:`_model_values`); and the runs skipped, with why."""
+    samples = len(ref["time"])
+    found: dict[str, Values] = {}
+    skipped = []
+    for name, case in cases.items():
+        data = {k: v.data for k, v in case.datasets.items()}
+        if case.status != "ok" or len(data.get("time", ())) < samples or not np.allclose(
+                data["time"][:samples], ref["time"], rtol=0, atol=1e-12):
+            skipped.append(f"{name} ({case.message or 'other time samples'})")
+            continue
+        found[name] = _model_values(data, ref, samples, LABELS.get(name, name))
+    return found, skipped
+
+
+def _motion_fractions(cases: dict[str, CaseResult], found: dict[str, Values],
+                      ref: dict[str, np.ndarray], prefix: str, datasets: dict[str, Dataset],
+                      lines: list[str]) -> None:
+    """The FFRF run's error on the motion as a fraction of what the elasticity changes
+    (against its rigid twin), added to ``datasets`` and ``lines`` (in place)."""
+    samples = len(ref["time"])
     if FFRF in found and RIGID in found:
         fractions = motion_error_fractions(
             {k: v.data for k, v in cases[FFRF].datasets.items()},
@@ -184,6 +205,3 @@ def compare_with_reference(label: str, cases: dict[str, CaseResult], reference: 
         lines.append("  FFRF against the reference on the motion, as a fraction of the "
                      "elasticity's effect (FFRF - rigid twin): " + ", ".join(
                          f"{name} {value:.3g}" for name, value in fractions.items()))
-    if skipped:
-        lines.append(f"  not compared: {', '.join(skipped)}")
-    return datasets, lines
