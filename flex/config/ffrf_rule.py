@@ -43,7 +43,7 @@ from typing import Any
 
 from flex.base.physics import in_plane_fixed_interface_omegas, pinned_pinned_omega
 from flex.config.calibration import Calibration, calibration_of
-from flex.data.scene import MESH_ASPECT_LIMIT, plate_mass_properties
+from flex.data.scene import LINKS, MESH_ASPECT_LIMIT, plate_mass_properties
 
 #: steps per first bending period the rule chooses from (make calibrate's grid)
 STEP_GRID = (4, 8, 16, 32, 64, 128)
@@ -151,7 +151,7 @@ def load_time_scale_s(scene: Mapping[str, Mapping[str, Any]]) -> float:
         speed = abs(drive["crank_speed_rad_per_s"])
         return math.pi / speed if speed > 0 else float(scene["simulation"]["end_time_s"])
     mass = scene["slider"]["mass_kg"] + sum(plate_mass_properties(scene, link)[0]
-                                            for link in ("crank", "coupler"))
+                                            for link in LINKS)
     if drive["spring_stiffness_N_per_m"] <= 0:  # a spring of no stiffness loads nothing
         return float(scene["simulation"]["end_time_s"])
     return 0.5 * math.pi * math.sqrt(mass / drive["spring_stiffness_N_per_m"])

@@ -43,6 +43,7 @@ from flex.config.calibration import Calibration, calibration_of
 from flex.config.ffrf_rule import LINK_KEYS, RulePick, fill_link_keys, pick, rule_constants
 from flex.data.scene import (
     BUILTIN_LINK_SCHEMAS,
+    LINKS,
     Scene,
     check_drive_steps,
     check_meshed_plate,
@@ -98,7 +99,7 @@ def has_auto(scene: Scene) -> bool:
 
 def has_auto_link_keys(scene: Scene) -> bool:
     """Whether a link's ``modes`` or ``mesh_size_m`` is ``"auto"`` (flex.config.ffrf_rule)."""
-    return any(scene[link].get(key) == AUTO for link in ("crank", "coupler")
+    return any(scene[link].get(key) == AUTO for link in LINKS
                for key in LINK_KEYS)
 
 
@@ -110,7 +111,7 @@ def resolve_link_keys(scene: Scene, calibration: Calibration | None = None
     resolved = copy.deepcopy(scene)
     filled: dict[str, Any] = {}
     tolerance = float(scene["fidelity"]["tolerance"])
-    for link in ("crank", "coupler"):
+    for link in LINKS:
         for key, value in fill_link_keys(resolved, link, tolerance, calibration).items():
             filled[f"{link}.{key}"] = value
     return resolved, filled
@@ -235,7 +236,7 @@ def resolved_simulation(scene: Scene, calibration: Calibration | None = None, *,
     if not has_auto(scene):
         return scene["simulation"]
     probe = copy.deepcopy(scene)
-    for link in ("crank", "coupler"):
+    for link in LINKS:
         if probe[link]["model"] == AUTO:
             probe[link]["model"] = model_names(link, link_models, rigid=True)[0]
     return resolve_solver_settings(probe, calibration,
@@ -276,7 +277,7 @@ def check_concrete(scene: Scene, choice: SolverChoice | None = None, *,
     - every plate that will be meshed makes sense as a meshed link and fits this machine
       (:func:`flex.data.scene.check_meshed_plate`, with the mesh estimate in the message).
     """
-    for link in ("crank", "coupler"):
+    for link in LINKS:
         values = scene[link]
         if values["model"] == AUTO or (meshes(link, values, link_models)  # a lumped or
                                        and AUTO in (values.get(key)  # rigid link keeps its

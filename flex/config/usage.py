@@ -22,6 +22,7 @@ from typing import Any
 from flex.config.settings import reads_tolerance
 from flex.data.scene import (
     BUILTIN_LINK_SCHEMAS,
+    LINKS,
     Scene,
     default_scene,
     link_model,
@@ -57,7 +58,7 @@ def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset(), *,
     nothing but its arguments.
     """
     unused: dict[str, str] = {}
-    for link in ("crank", "coupler"):
+    for link in LINKS:
         unused.update(_link_unused(link, scene, link_models))
     wing = scene["wing"]
     if not wing["enabled"]:

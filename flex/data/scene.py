@@ -3,7 +3,7 @@
 A scene is a nested ``dict`` ``{section: {key: value}}``. The accepted sections and keys,
 with their types and ranges, are in :data:`SCHEMA`; every key ends in its unit (``_m``,
 ``_kg``, ``_deg``, ...) or is dimensionless. Scenes are loaded from TOML files (the bundled
-parameter sets live in ``flex/scenes/``, e.g. ``cavezza2012``), changed by ``--set
+parameter sets live in ``flex/data/scenes/``, e.g. ``cavezza2012``), changed by ``--set
 section.key=value`` overrides, and checked by :func:`validate`, which refuses an unknown key,
 a wrong type, a non-finite or out-of-range number, and a linkage that cannot assemble, with
 one message naming the key and the accepted range.
@@ -319,7 +319,7 @@ DEFAULT_SCENE = "cavezza2012"
 
 
 def bundled_scenes() -> list[str]:
-    """Names of the parameter sets shipped in ``flex/scenes`` (without ``.toml``)."""
+    """Names of the parameter sets shipped in ``flex/data/scenes`` (without ``.toml``)."""
     folder = resources.files("flex.data.scenes")
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 

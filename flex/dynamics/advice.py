@@ -13,7 +13,7 @@ import numpy as np
 
 from flex.base.errors import SimulationError
 from flex.data.results import Dataset
-from flex.data.scene import Scene, model_names, plate_mass_properties, quoted
+from flex.data.scene import LINKS, Scene, model_names, plate_mass_properties, quoted
 from flex.dynamics.builder import Mechanism
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 
@@ -68,7 +68,7 @@ def validity_warning(scene: Scene, datasets: dict[str, Dataset],
     elastic midpoint deflection exceeds :data:`FFRF_DEFLECTION_LIMIT` of its length (linear
     FFRF validity)."""
     warnings = _buckling_warnings(scene, datasets, link_models)
-    for link in ("crank", "coupler"):
+    for link in LINKS:
         name = f"{link}/midpoint_deflection"
         if not link_models[scene[link]["model"]].linear_elastic or name not in datasets:
             continue
@@ -152,7 +152,7 @@ def time_scales(scene: Scene, reductions: dict[str, Any] | None = None,
         elif drive["kind"] == "constant_speed" and drive["crank_speed_rad_per_s"] != 0:
             out.append((2 * np.pi / abs(drive["crank_speed_rad_per_s"]),
                         STEPS_PER_PERIOD, "crank turn (constant speed)"))
-        for link in ("crank", "coupler"):
+        for link in LINKS:
             values = scene[link]
             scale = link_models[values["model"]].time_scale(link, values,
                                                             reductions.get(link))

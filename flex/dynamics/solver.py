@@ -1,17 +1,20 @@
 """Time integration of a built mechanism and collection of its outputs.
 
-:func:`simulate` is the one entry point the studies use. Contract:
+:func:`integrate` integrates a concrete scene (the studies reach it through
+:func:`flex.fidelity.simulation.simulate`, which decides every ``"auto"`` first). Contract:
 
-- input: a validated scene (and, for an FFRF coupler, its reduction);
+- input: a validated, concrete scene (and, for an FFRF link, its reduction);
 - output: a :class:`~flex.data.results.CaseResult` whose datasets are the quantities of the
   result layout (``time``, ``crank/...``, ``slider/...``, ``joints/<A|B|C>/...``,
   ``constraint_norm``, ``energy/...`` (rigid and FFRF links), ``coupler/...``), each with units;
 - refused before anything is built: what :func:`flex.config.settings.check_concrete` refuses
-  (:class:`~flex.base.errors.SceneError`, a ``failed`` case from :func:`simulate_case`);
+  (:class:`~flex.base.errors.SceneError`, a ``failed`` case from
+  :func:`flex.fidelity.simulation.simulate_case`);
 - status: ``ok``; a diverging run (solver failure, NaN, exploding constraint norm) raises
   :class:`~flex.base.errors.SimulationError` naming the step and time and what may help
   (:func:`divergence_advice`: a smaller step only where the step does not resolve the
-  scene's fastest time scale; the extreme inputs), and :func:`simulate_case` turns that
+  scene's fastest time scale; the extreme inputs), and
+  :func:`flex.fidelity.simulation.simulate_case` turns that
   into a ``failed`` case instead of data; an ``ok`` run whose validity is in doubt (a
   linear FFRF link deflecting beyond 1 % of its length) carries the case attribute
   ``validity_warning`` (:func:`validity_warning`);

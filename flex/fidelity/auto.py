@@ -53,7 +53,7 @@ from flex.config.settings import (
     resolve_link_keys,
     resolve_solver_settings,
 )
-from flex.data.scene import Scene, check_meshed_plate, model_names, to_toml
+from flex.data.scene import LINKS, Scene, check_meshed_plate, model_names, to_toml
 from flex.dynamics.ladder import climb
 from flex.dynamics.link_models import (
     BUILTIN_LINK_MODELS,
@@ -70,8 +70,6 @@ from flex.fidelity.laws import Criterion, criterion_of
 from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection
 from flex.fidelity.probe import FidelityDecision, deployment_probe, probe_scene
 from flex.fidelity.spring_choice import decide_spring
-
-LINKS = ("crank", "coupler")
 
 
 # ------------------------------------------------------------------------------------------

@@ -44,7 +44,7 @@ from typing import Any
 
 from flex.base.errors import FlexError
 from flex.data.results import CaseResult
-from flex.data.scene import Scene, apply_overrides, model_names
+from flex.data.scene import LINKS, Scene, apply_overrides, model_names
 from flex.dynamics.ladder import Rung
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.fidelity.error_estimate import PREFIX, estimate_step_error, headline_difference
@@ -56,7 +56,6 @@ TERMS = ("step", "modes", "mesh", "model")
 MESH_FACTOR = 2.0
 #: case attribute prefix of a headline quantity's value
 HEADLINE_PREFIX = "headline_"
-LINKS = ("crank", "coupler")
 
 
 def richer_modes(modes: int) -> int:

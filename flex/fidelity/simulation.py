@@ -25,7 +25,7 @@ from flex.base.errors import FlexError, SceneError
 from flex.config.calibration import Calibration
 from flex.config.settings import tolerance_beyond_reach
 from flex.data.results import CaseResult
-from flex.data.scene import Scene, to_toml
+from flex.data.scene import LINKS, Scene, to_toml
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.ladder import next_rung
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
@@ -221,7 +221,7 @@ def _attempt_cost_s(scene: Scene, link_models: Mapping[str, LinkModel]) -> float
     from flex.fidelity.error_budget import richer_modes
 
     cost = (1.0 + BUDGET_RUNS) * estimated_run_time_s(scene, link_models=link_models)
-    for link in ("crank", "coupler"):
+    for link in LINKS:
         values, entry = scene[link], link_models[scene[link]["model"]]
         if entry.meshed:
             modes = values["modes"] if entry.modal else None
@@ -235,7 +235,7 @@ def _attempt_cost_s(scene: Scene, link_models: Mapping[str, LinkModel]) -> float
 
 def _settings_text(scene: Scene, link_models: Mapping[str, LinkModel]) -> str:
     parts = [f"step {scene['simulation']['step_s']:g} s"]
-    for link in ("crank", "coupler"):
+    for link in LINKS:
         values = scene[link]
         entry = link_models[values["model"]]
         if entry.meshed:
@@ -250,7 +250,7 @@ def _refined(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
     they do; (None, why not) when it cannot move."""
     from flex.fidelity.error_budget import richer_modes
 
-    links = {link: link_models[scene[link]["model"]] for link in ("crank", "coupler")}
+    links = {link: link_models[scene[link]["model"]] for link in LINKS}
     if term == "step":
         step = scene["simulation"]["step_s"] / 2
         return [f"simulation.step_s={step!r}"], f"step halved to {step:g} s"

@@ -36,7 +36,7 @@ import numpy as np
 
 from flex.base.errors import FlexError
 from flex.data.results import case_names, reading
-from flex.data.scene import Scene, default_scene, merge
+from flex.data.scene import LINKS, Scene, default_scene, merge
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, NONLINEAR_FE, RIGID, LinkModel
 
 #: VTK/XDMF order of a quadratic tetrahedron's mid-edge nodes (corner pairs)
@@ -292,7 +292,7 @@ def case_motion(path: str | Path, case: str | None = None, *,
         raise FlexError(f"{where} failed ({attrs.get('message', '')}): nothing to export")
     scene = case_scene(attrs, where)
     models = {link: model_entry(scene[link]["model"], where, link_models)
-              for link in ("crank", "coupler")}
+              for link in LINKS}
     if all(model.stored_motion == "rigid" for model in models.values()):
         raise FlexError(f"{where} has no flexible link (crank and coupler rigid): flex export "
                         f"and animate show FFRF and nonlinear FE links")

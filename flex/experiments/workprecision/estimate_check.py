@@ -40,7 +40,7 @@ from flex.base.plotting import figure
 from flex.config.settings import resolve_solver_settings
 from flex.data.plates import is_damped
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import Scene
+from flex.data.scene import LINKS, Scene
 from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, NONLINEAR_FE
@@ -64,7 +64,6 @@ NOISE_FLOOR = 1e-8
 _SCALES = {"crank_angle_end_rad": 1.0, "slider_position_end_m": 0.1}
 
 Progress = Callable[[str, int, int], None]
-LINKS = ("crank", "coupler")
 
 
 def _run(scene: Scene, name: str, overrides: list[str], cache_dir: Path | None) -> CaseResult:
