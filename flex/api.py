@@ -237,23 +237,32 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
     models = _link_models(link_models)
     scene = checked_scene(scene, link_models=models)
     _check_case_name(name)
-    _check_options(options, {"reduction": "a flex.bodies.reduction.Reduction",
-                             "crank_reduction": "a flex.bodies.reduction.Reduction",
-                             "criterion": "a flex.fidelity.laws.Criterion",
-                             "crank_criterion": "a flex.fidelity.laws.Criterion",
-                             "calibration": "a flex.config.calibration.Calibration, "
-                                            "'bundled' or a folder",
-                             "headlines": "a mapping of names to "
-                                          "flex.fidelity.headlines.Headline"},
-                   "simulate")
+    options = _simulate_options(options)
+    folder = _cache_dir(cache_dir)
+    check_cases(load_study("simulate"), {name: scene}, given_keys(scene), link_models=models)
+    return simulate_scene(scene, name, cache_dir=folder, link_models=models, **options)
+
+
+#: the keyword arguments :func:`simulate` passes on, and what each must be
+SIMULATE_OPTIONS = {"reduction": "a flex.bodies.reduction.Reduction",
+                    "crank_reduction": "a flex.bodies.reduction.Reduction",
+                    "criterion": "a flex.fidelity.laws.Criterion",
+                    "crank_criterion": "a flex.fidelity.laws.Criterion",
+                    "calibration": "a flex.config.calibration.Calibration, 'bundled' or a "
+                                   "folder",
+                    "headlines": "a mapping of names to flex.fidelity.headlines.Headline"}
+
+
+def _simulate_options(options: dict[str, Any]) -> dict[str, Any]:
+    """:func:`simulate`'s keyword arguments checked (:data:`SIMULATE_OPTIONS`; ArgumentError
+    otherwise), a calibration named by name or folder loaded."""
+    _check_options(options, SIMULATE_OPTIONS, "simulate")
     _check_headlines(options.get("headlines"))
     if isinstance(options.get("calibration"), str | Path):
         from flex.config.calibration import load_calibration
 
-        options["calibration"] = load_calibration(options["calibration"])
-    folder = _cache_dir(cache_dir)
-    check_cases(load_study("simulate"), {name: scene}, given_keys(scene), link_models=models)
-    return simulate_scene(scene, name, cache_dir=folder, link_models=models, **options)
+        options = dict(options, calibration=load_calibration(options["calibration"]))
+    return options
 
 
 def _cache_dir(given: str | Path | None) -> Path:
