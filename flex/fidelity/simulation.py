@@ -14,6 +14,7 @@ command line and :mod:`flex.api` pass the user's folder
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from collections.abc import Mapping
@@ -109,10 +110,32 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
                              crank_reduction if same else None, cache_dir=cache_dir,
                              link_models=link_models)
 
-        budget = error_budget(scene, result, run_companion,
-                              time_scales(scene, reductions, link_models), link_models)
+        scales = time_scales(scene, reductions, link_models)
+        budget = error_budget(scene, result, run_companion, scales, link_models)
         result.attrs.update(budget.attrs())
+        _warn_unresolved_drive(result, scales, float(scene["simulation"]["step_s"]))
+        if budget.unknown:
+            print(f"flex: warning: case {name}: estimated error unknown for "
+                  f"{', '.join(budget.unknown_quantities())}: {'; '.join(budget.unknown)}",
+                  file=sys.stderr, flush=True)
     return result
+
+
+def _warn_unresolved_drive(result: CaseResult, scales: list[tuple[float, float, str]],
+                           step_s: float) -> None:
+    """A drive time scale (the spring on the mechanism, a crank turn) with fewer steps per
+    period than the step estimate's asymptotic range: the motion itself is numerically
+    damped and its error not covered; stored as a validity warning (stderr repeats it)."""
+    from flex.dynamics.advice import DRIVE_SCALES
+    from flex.fidelity.error_estimate import MIN_STEPS_PER_PERIOD, unresolved_time_scales
+
+    unresolved = unresolved_time_scales([s for s in scales if s[2] in DRIVE_SCALES], step_s)
+    if unresolved:
+        text = (f"the step does not resolve the drive: {'; '.join(unresolved)}, fewer than "
+                f"{MIN_STEPS_PER_PERIOD:g}: the motion is numerically damped and its estimated "
+                f"error does not cover that")
+        result.attrs[VALIDITY_WARNING] = "; ".join(
+            filter(None, [str(result.attrs.get(VALIDITY_WARNING, "")), text]))
 
 
 #: the quantities :func:`refine` certifies: each flexible link's own (docs/criterion.md, "What
@@ -155,14 +178,16 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
             status = "nothing to certify (no flexible link's deflection)"
             lines.append(f"{attempt}: {settings}: {status}")
             break
-        worst = max(rows, key=lambda row: row.relative / tolerance)
+        worst = max(rows, key=lambda row: row.relative if row.relative >= 0 else math.inf)
         found = (f"{worst.what} {100 * worst.relative:.3g} % of itself (tolerance "
-                 f"{100 * tolerance:g} %)")
+                 f"{100 * tolerance:g} %)" if not worst.problem else
+                 f"{worst.what} {worst.problem} (tolerance {100 * tolerance:g} %)")
         if not over:
             status = "met"
             lines.append(f"{attempt}: {settings}: met; worst {found}")
             break
-        term = max(worst.terms, key=lambda key: worst.terms[key])
+        term = max(worst.terms, key=lambda key: worst.terms[key] if worst.terms[key] >= 0
+                   else math.inf)  # an unknown term (its companion failed) first
         change, why = _refined(scene, term, link_models)
         spent = time.perf_counter() - start
         if change is None or spent > scene["fidelity"]["refine_limit_s"] \
