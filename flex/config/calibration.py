@@ -177,7 +177,8 @@ def install_calibration(files: Sequence[str | Path], folder: str | Path = BUNDLE
     """Install fitted files (``results/kfit-criterion.toml``, ``crank-criterion.toml``,
     ``calibrate-rule.toml``: :data:`INSTALLS`) as their parts of the calibration in
     ``folder`` (default: the bundled one), all checked before any is copied: each must be
-    TOML with every value in range (:mod:`flex.config.calibration_check`), beside its study's result file (``results/<study>.h5``) and not from a run that
+    TOML with every value in range (:mod:`flex.config.calibration_check`), beside its
+    study's result file (``results/<study>.h5``) and not from a run that
     failed afterwards (a newer ``<study>.failed.h5``). Returns one line per file (copied, or already
     installed). Raises :class:`FlexError` naming the first file that fails a check."""
     folder = Path(folder)
