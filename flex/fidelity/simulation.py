@@ -67,7 +67,8 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     resolution = resolve(scene, criterion, crank_criterion, cache_dir=cache_dir,
                          calibration=calibration, link_models=link_models)
     if scene["fidelity"]["refine"]:
-        return refine(resolution, name, cache_dir=cache_dir, link_models=link_models)
+        return refine(resolution, name, cache_dir=cache_dir, link_models=link_models,
+                      free=free_knobs(scene))
     return simulate_resolved(resolution, name, reduction, crank_reduction,
                              cache_dir=cache_dir, beyond=beyond, link_models=link_models)
 
@@ -143,10 +144,35 @@ def _warn_unresolved_drive(result: CaseResult, scales: list[tuple[float, float, 
 REFINED = ("_peak_deflection_m", "_first_crest_deflection_m")
 #: most attempts of :func:`refine` (each one a run with its whole error budget)
 MAX_ATTEMPTS = 6
+#: :func:`refine`'s status of a run with no quantity it certifies
+NOTHING_TO_REFINE = ("nothing to refine: no flexible link's deflection to certify (the "
+                     "tolerance bounds a flexible link's own deflection; every link is rigid)")
+
+
+#: the knobs refinement turns: scene keys (``<link>.`` ones for each link)
+KNOBS = ("simulation.step_s", "coupler.model", "crank.modes", "coupler.modes",
+         "crank.mesh_size_m", "coupler.mesh_size_m")
+
+
+def free_knobs(scene: Scene) -> frozenset[str]:
+    """The knobs (:data:`KNOBS`) of ``scene`` as the user gave it (before ``"auto"`` is
+    resolved) that refinement may turn: those left on ``"auto"`` or on the bundled
+    scene's value. A value the user set is never changed."""
+    from flex.data.scene import default_scene
+
+    bundled = default_scene()
+    out = set()
+    for knob in KNOBS:
+        section, key = knob.split(".")
+        value = scene[section][key]
+        if value == "auto" or value == bundled[section][key]:
+            out.add(knob)
+    return frozenset(out)
 
 
 def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None = None,
-           link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> CaseResult:
+           link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
+           free: frozenset[str] = frozenset(KNOBS)) -> CaseResult:
     """``fidelity.refine``: run the resolved scene with its error budget; while a certified
     quantity (:data:`REFINED`) has a total estimated error above ``fidelity.tolerance``
     relative to itself, refine the knob whose term dominates it (the step halved, the modes
@@ -158,7 +184,9 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     ``refine_attempts`` (one line per run: its settings, the worst quantity, what changed
     and why) and ``refine_wall_time_s``; a run that did not meet the tolerance says so in
     one stderr line. The companion runs of one attempt are not reused by the next (a known
-    cost: the refined run equals one of them)."""
+    cost: the refined run equals one of them). ``free``: the knobs it may turn
+    (:func:`free_knobs`); one the user set that blocks the tolerance stops it, and the status
+    says which value and what refinement would make of it."""
     from flex.fidelity.error_budget import budget_rows
 
     if not resolution.scene["simulation"]["error_estimate"]:
@@ -175,7 +203,7 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
         over = [row for row in rows if not row.relative <= tolerance]
         settings = _settings_text(scene, link_models)
         if not rows:
-            status = "nothing to certify (no flexible link's deflection)"
+            status = NOTHING_TO_REFINE
             lines.append(f"{attempt}: {settings}: {status}")
             break
         worst = max(rows, key=lambda row: row.relative if row.relative >= 0 else math.inf)
@@ -188,7 +216,7 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
             break
         term = max(worst.terms, key=lambda key: worst.terms[key] if worst.terms[key] >= 0
                    else math.inf)  # an unknown term (its companion failed) first
-        change, why = _refined(scene, term, link_models)
+        change, why = _refined(scene, term, link_models, free)
         spent = time.perf_counter() - start
         if change is None or spent > scene["fidelity"]["refine_limit_s"] \
                 or attempt == MAX_ATTEMPTS:
@@ -216,7 +244,10 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
         current = replace(current, scene=refined)
     result.attrs.update({"refine_status": status, "refine_attempts": "\n".join(lines),
                          "refine_wall_time_s": time.perf_counter() - start})
-    if status != "met":
+    if status == NOTHING_TO_REFINE:
+        print(f"flex: note: case {name}: fidelity.refine: {status}", file=sys.stderr,
+              flush=True)
+    elif status != "met":
         print(f"flex: case {name}: fidelity.tolerance = {tolerance:g} not met by refinement "
               f"({status}); the last run is stored with its budget", file=sys.stderr,
               flush=True)
@@ -260,10 +291,30 @@ def _settings_text(scene: Scene, link_models: Mapping[str, LinkModel]) -> str:
     return "; ".join(parts)
 
 
-def _refined(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
-             ) -> tuple[list[str] | None, str]:
+def _refined(scene: Scene, term: str, link_models: Mapping[str, LinkModel],
+             free: frozenset[str] = frozenset(KNOBS)) -> tuple[list[str] | None, str]:
     """The overrides that refine the knob of ``term`` (step, modes, mesh, model) and what
-    they do; (None, why not) when it cannot move."""
+    they do; (None, why not) when it cannot move, or when it would change a value the user
+    set (not in ``free``): then why says which value and what it would take."""
+    change, why = _refined_any(scene, term, link_models)
+    set_by_user = [item for item in change or [] if item.split("=")[0] not in free]
+    if not set_by_user:
+        return change, why
+    keys = ", ".join(f"{item.split('=')[0]} = {_value(scene, item.split('=')[0])}"
+                     for item in set_by_user)
+    return None, (f"the {term} term dominates and {keys} was set in the scene (refinement "
+                  f"changes only \"auto\" or default values): it would take "
+                  f"{', '.join(set_by_user)} ({why})")
+
+
+def _value(scene: Scene, knob: str) -> Any:
+    section, key = knob.split(".")
+    return scene[section][key]
+
+
+def _refined_any(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
+                 ) -> tuple[list[str] | None, str]:
+    """:func:`_refined` with every knob free."""
     from flex.fidelity.error_budget import richer_modes
 
     links = {link: link_models[scene[link]["model"]] for link in ("crank", "coupler")}

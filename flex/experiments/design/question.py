@@ -117,8 +117,9 @@ class Answer:
 def check_scene(scene: Scene, question: Question) -> None:
     """Refuse (FlexError, one line) a scene the question cannot be asked of: a spring that
     stores no energy whatever the varied value (no rate when the preload varies, no preload
-    when the rate varies), a drive without a spring, or a deployment time asked at or
-    beyond the run's end time (a longer deployment is not measured)."""
+    when the rate varies), a drive without a spring, a deployment time asked at or
+    beyond the run's end time (a longer deployment is not measured), or refinement (its
+    cases have no error budget to follow)."""
     drive, end_s = scene["drive"], float(scene["simulation"]["end_time_s"])
     if question.target == "deployment_time" and question.value >= end_s:
         raise FlexError(f"design: deployment_time <= {question.value:g} s with "
@@ -127,6 +128,11 @@ def check_scene(scene: Scene, question: Question) -> None:
                         f"time, not the target; accepted: simulation.end_time_s > "
                         f"{question.value:g} s (e.g. --set simulation.end_time_s="
                         f"{1.5 * question.value:g})")
+    if scene["fidelity"]["refine"]:
+        raise FlexError("design: fidelity.refine = true: flex design runs its cases without "
+                        "error budgets (simulation.error_estimate = false), which refinement "
+                        "follows; accepted: fidelity.refine = false (refine the answer with "
+                        "'flex run simulate' afterwards)")
     if drive["kind"] != "spring":
         raise FlexError(f'design: drive.kind = "{drive["kind"]}": flex design varies a '
                         f'spring-driven deployment; accepted: drive.kind = "spring"')
@@ -248,7 +254,8 @@ def limiting(evaluation: Evaluation, measure: str = "") -> str:
     """What an infeasible evaluation fails: auto's refusal, the stress, the run's end time
     (its ``measure`` not reached within the run: NaN) or the target."""
     if not evaluation.measures:
-        return "auto's refusal (a coupler near buckling)"
+        reason = str(evaluation.case.attrs.get("design_reason", "")).split(";")[0]
+        return f"auto's refusal ({reason or 'a coupler near buckling'})"
     if evaluation.stress_margin < evaluation.target_margin:
         return "the stress"
     if math.isnan(evaluation.measures.get(measure, 0.0)):
@@ -272,7 +279,8 @@ def unreachable(question: Question, scanned: list[Evaluation]) -> str:
         return (what + f": no scanned case reached its {measure.replace('_', ' ')} within the "
                 f"run (simulation.end_time_s = {end:g} s: the deployment did not complete)")
     if not ran:
-        return what + ": auto refused every scanned scene (near buckling)"
+        reason = str(scanned[0].case.attrs.get("design_reason", "")) if scanned else ""
+        return what + f": auto refused every scanned scene ({reason or 'near buckling'})"
     best = max(ran, key=lambda e: sense * e.measures[measure])
     safe = [e for e in ran if e.stress_margin >= 0]
     text = (f"{what}: the best reached is {best.measures[measure] / scale:.4g} {unit} at "
