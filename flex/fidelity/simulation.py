@@ -244,6 +244,13 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
         current = replace(current, scene=refined)
     result.attrs.update({"refine_status": status, "refine_attempts": "\n".join(lines),
                          "refine_wall_time_s": time.perf_counter() - start})
+    _say_status(name, status, tolerance)
+    return result
+
+
+def _say_status(name: str, status: str, tolerance: float) -> None:
+    """:func:`refine`'s one stderr line: a note when there was nothing to refine, the
+    status when the tolerance was not met."""
     if status == NOTHING_TO_REFINE:
         print(f"flex: note: case {name}: fidelity.refine: {status}", file=sys.stderr,
               flush=True)
@@ -251,7 +258,6 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
         print(f"flex: case {name}: fidelity.tolerance = {tolerance:g} not met by refinement "
               f"({status}); the last run is stored with its budget", file=sys.stderr,
               flush=True)
-    return result
 
 
 #: runs of an attempt's error budget, in run-equivalents (companions at 2 h and 4 h, more
