@@ -444,3 +444,26 @@ def test_knobs_left_on_auto_or_default_are_free():
     from flex.fidelity.simulation import KNOBS, free_knobs
 
     assert free_knobs(load_scene()) == frozenset(KNOBS)
+
+
+STRESS = {"coupler_peak_von_mises_Pa": 2.5e7, "coupler_peak_von_mises_time_s": 0.01,
+          "coupler_peak_von_mises_position_m": np.array([0.04, 0.001, 0.0])}
+MALFORMED_STRESS = [("value_string", {"coupler_peak_von_mises_Pa": "big"}),
+                    ("time_array", {"coupler_peak_von_mises_time_s": np.zeros(4)}),
+                    ("position_short", {"coupler_peak_von_mises_position_m": np.zeros(2)}),
+                    ("position_text", {"coupler_peak_von_mises_position_m": "here"})]
+
+
+@pytest.mark.parametrize("name, change", MALFORMED_STRESS, ids=[m[0] for m in MALFORMED_STRESS])
+def test_inspect_shows_malformed_stress_attributes_without_a_crash(tmp_path, name, change):
+    path = _file(tmp_path, {**_stored_budget(), **STRESS})
+    _damage_file(path, change)
+    before = fingerprint([path])
+    outcome = run_cli(["inspect", str(path)])
+    assert "Traceback" not in outcome.stdout + outcome.stderr
+    assert fingerprint([path]) == before
+    if outcome.status == 2:
+        assert len(outcome.error_lines()) == 1 and "coupler_peak_von_mises" in outcome.stderr
+        return
+    assert outcome.status == 0, outcome.stderr
+    assert "malformed attributes coupler_peak_von_mises_*" in outcome.stdout, outcome.stdout

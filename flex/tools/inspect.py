@@ -312,11 +312,15 @@ def stress_lines(attrs: dict[str, Any]) -> list[str]:
             name = f"{link}_peak_von_mises{suffix}"
             if f"{name}_Pa" not in attrs:
                 continue
-            x, y, z = (1e3 * float(v) for v in np.ravel(attrs[f"{name}_position_m"]))
+            try:
+                x, y, z = (1e3 * float(v) for v in np.ravel(attrs[f"{name}_position_m"]))
+                value, at = float(attrs[f"{name}_Pa"]), float(attrs[f"{name}_time_s"])
+            except (KeyError, TypeError, ValueError):
+                parts.append(f"malformed attributes {name}_* {where}")
+                continue
             error = {row.quantity: row for row in budget_rows(attrs)}.get(f"{name}_Pa")
-            parts.append(f"{attrs[f'{name}_Pa'] / 1e6:.4g} MPa {where} at t = "
-                         f"{attrs[f'{name}_time_s'] * 1e3:.4g} ms, (x, y, z) = ({x:.3g}, "
-                         f"{y:.3g}, {z:.3g}) mm on the plate"
+            parts.append(f"{value / 1e6:.4g} MPa {where} at t = {at * 1e3:.4g} ms, (x, y, z) "
+                         f"= ({x:.3g}, {y:.3g}, {z:.3g}) mm on the plate"
                          + (f" (estimated error {error.total / 1e6:.2g} MPa: the budget "
                             f"above)" if error is not None and not error.problem else
                             " (estimated error: see the budget above)" if error else ""))
