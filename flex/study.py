@@ -221,23 +221,24 @@ def check_cases(module: ModuleType, scenes: dict[str, Scene],
     """Refuse (:class:`SceneError`), before any case runs, a case scene that cannot run or
     would mean nothing (:func:`flex.fidelity.auto.check`), and a value the user gave
     (``given``: ``{"section.key": value}``, :func:`flex.config.usage.explicit_keys`) that no case
-    uses: one the study sets itself in each case, or one no case's models read
+    uses: one the study sets itself in each case (also a key it declares in ``READS``: a study
+    that sets a key in every case does not read the user's), or one no case's models read
     (:func:`flex.config.usage.unused_keys`, minus the keys the study declares it reads itself in
     ``READS``). ``link_models``: the registry of the scenes' link models."""
     for scene in scenes.values():
         check(scene, link_models=link_models)
     reads = set(getattr(module, "READS", ()))
     for name, value in (given or {}).items():
-        if name in reads:
-            continue
         section, key = name.split(".", 1)
         values = [case[section][key] for case in scenes.values()]
-        if values and all(case_value != value for case_value in values):
+        if values and all(case_value != value for case_value in values):  # READS or not
             shown = ", ".join(dict.fromkeys(f"{v:g}" if isinstance(v, float) else repr(v)
                                             for v in values))
             raise SceneError(f"{name} = {value!r}: study '{module.NAME}' sets this key itself "
                              f"in each of its cases ({shown}), so the value given would be "
                              f"ignored; use 'flex run simulate' to run a scene of your own")
+        if name in reads:
+            continue
         reasons = [unused_keys(case, link_models=link_models).get(name)
                    for case in scenes.values()]
         if all(reasons):

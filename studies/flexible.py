@@ -39,8 +39,9 @@ NAME = "flexible"
 DESCRIPTION = ("coupler plates t = 1, 3, 5, 10 mm as FFRF (flex's default), linear FFRF and "
                "rigid twins against the nonlinear FE coupler")
 OVERRIDES = pinned_overrides() + ['coupler.geometry="plate"']
-# keys the study reads itself (its plates and their rigid twins), beside its cases
-READS = ("coupler.length_m", "coupler.thickness_m", "coupler.width_m",
+# keys the study reads itself (its plates and their rigid twins), beside its cases (not the
+# thickness: each plate has its own, MODELS)
+READS = ("coupler.length_m", "coupler.width_m",
          "coupler.youngs_modulus_Pa", "coupler.density_kg_per_m3",
          "coupler.poisson_ratio", "coupler.damping_ratio")
 

@@ -100,20 +100,22 @@ def test_install_copies_fits_from_up_to_date_runs_only(tmp_path, capsys):
     results, target = tmp_path / "results", _copy(tmp_path / "calibration")
     results.mkdir()
     law = results / "kfit-criterion.toml"
-    law.write_text("fit = 1\n")
+    bundled = (BUNDLED_FOLDER / "criteria_fit.toml").read_text()  # a law whose values hold
+    fit_1, fit_2 = (bundled.replace("cases_fitted = ", f"cases_fitted = {n}") for n in (1, 2))
+    law.write_text(fit_1)
     with pytest.raises(FlexError, match="no result file"):
         install_calibration([law], target)
     (results / "kfit.h5").write_text("run")
     assert install_calibration([law], target) == [f"cp {law} {target / 'criteria_fit.toml'}"]
-    assert (target / "criteria_fit.toml").read_text() == "fit = 1\n"
+    assert (target / "criteria_fit.toml").read_text() == fit_1
     assert "is already" in install_calibration([law], target)[0]
     failed = results / "kfit.failed.h5"
     failed.write_text("failed")
     os.utime(failed, (os.path.getmtime(law) + 10,) * 2)
-    law.write_text("fit = 2\n")
+    law.write_text(fit_2)
     with pytest.raises(FlexError, match="the last kfit run failed"):
         install_calibration([law], target)
-    assert (target / "criteria_fit.toml").read_text() == "fit = 1\n"  # nothing copied
+    assert (target / "criteria_fit.toml").read_text() == fit_1  # nothing copied
     other = results / "notes.toml"
     other.write_text("")
     assert main(["install", "--into", str(target), str(other)]) == 2

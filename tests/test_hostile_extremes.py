@@ -84,7 +84,7 @@ def _fake_design_case(reached: bool):
     return case
 
 
-@pytest.mark.parametrize("target, value", [("deployment_time", 100.0), ("final_angle", 10.0)])
+@pytest.mark.parametrize("target, value", [("deployment_time", 0.025), ("final_angle", 10.0)])
 def test_a_deployment_not_completed_is_not_an_answer(target, value):
     from flex.base.errors import FlexError
     from flex.experiments.design import question as dq

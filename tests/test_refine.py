@@ -65,7 +65,7 @@ def test_a_refinement_that_cannot_meet_the_tolerance_says_so_and_keeps_its_best(
 def test_a_rigid_scene_has_nothing_to_refine_and_refinement_needs_the_budget():
     result = simulate(load_scene(overrides=["fidelity.refine=true",
                                             "simulation.end_time_s=0.005"]))
-    assert result.attrs["refine_status"].startswith("nothing to certify")
+    assert result.attrs["refine_status"].startswith("nothing to refine")
     with pytest.raises(SceneError, match="refinement follows the error budget"):
         simulate(load_scene(overrides=["fidelity.refine=true",
                                        "simulation.error_estimate=false"]))

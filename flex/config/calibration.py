@@ -101,10 +101,20 @@ def _frozen(value: Any) -> Any:
 
 def _from_texts(source: str, folder: Path, coupler: str | None, crank: str | None,
                 rule: str, defaults: str) -> Calibration:
-    """The calibration of these four texts (``folder`` names them in messages)."""
+    """The calibration of these four texts (``folder`` names them in messages), each value
+    checked (:func:`flex.config.calibration_check.check_part`)."""
+    from flex.config.calibration_check import check_part
+
+    for part, text in (("coupler_criterion", coupler), ("crank_criterion", crank)):
+        if text is not None:
+            check_part(folder / FILES[part], part, _parse(folder, part, text))
+    parsed = {part: _parse(folder, part, text) for part, text in (("ffrf_rule", rule),
+                                                                  ("solver_defaults", defaults))}
+    for part, data in parsed.items():
+        check_part(folder / FILES[part], part, data)
     return Calibration(source, folder, coupler, crank, rule, defaults,
-                       ffrf_rule=_frozen(_parse(folder, "ffrf_rule", rule)),
-                       solver_defaults=_frozen(_parse(folder, "solver_defaults", defaults)))
+                       ffrf_rule=_frozen(parsed["ffrf_rule"]),
+                       solver_defaults=_frozen(parsed["solver_defaults"]))
 
 
 def _read(folder: Path, part: str, required: bool) -> str | None:
@@ -167,7 +177,8 @@ def install_calibration(files: Sequence[str | Path], folder: str | Path = BUNDLE
     """Install fitted files (``results/kfit-criterion.toml``, ``crank-criterion.toml``,
     ``calibrate-rule.toml``: :data:`INSTALLS`) as their parts of the calibration in
     ``folder`` (default: the bundled one), all checked before any is copied: each must be
-    TOML, beside its study's result file (``results/<study>.h5``) and not from a run that
+    TOML with every value in range (:mod:`flex.config.calibration_check`), beside its
+    study's result file (``results/<study>.h5``) and not from a run that
     failed afterwards (a newer ``<study>.failed.h5``). Returns one line per file (copied, or already
     installed). Raises :class:`FlexError` naming the first file that fails a check."""
     folder = Path(folder)
@@ -180,6 +191,9 @@ def install_calibration(files: Sequence[str | Path], folder: str | Path = BUNDLE
         text = _read_file(given)
         _check_toml(given, text)
         _check_fresh(given)
+        from flex.config.calibration_check import check_part
+
+        check_part(given, part, tomllib.loads(text))
         plan.append((given, folder / FILES[part], text))
     lines = []
     for given, target, text in plan:

@@ -248,16 +248,44 @@ def divergence_advice(scene: Scene, reductions: dict[str, Any] | None = None,
     return "; ".join(parts)
 
 
+#: fewer steps than this per period of the drive (the spring on the mechanism's inertia, or a
+#: constant-speed crank turn) cannot represent the motion at all (Nyquist): what the run
+#: integrates is an alias (measured: a 1e12 N/m spring at h = 1e-5 s, 0.2 steps per period,
+#: turned the crank 95,128 rad in 1 ms, with every sample finite)
+MIN_DRIVE_STEPS_PER_PERIOD = 2.0
+#: the time scales of the drive (:func:`time_scales`' names), whose motion the run is about
+DRIVE_SCALES = ("period of the spring on the mechanism's inertia", "crank turn (constant speed)")
+
+
+def check_resolved(scene: Scene, settings: dict[str, Any],
+                   reductions: dict[str, Any] | None,
+                   link_models: Mapping[str, LinkModel]) -> None:
+    """Raise :class:`SimulationError` when the step is longer than half the drive's period
+    (:data:`MIN_DRIVE_STEPS_PER_PERIOD`): the run's motion is then not the mechanism's,
+    however finite its samples."""
+    step = float(settings["step_s"])
+    for period, _, what in time_scales(scene, reductions, link_models):
+        if what in DRIVE_SCALES and np.isfinite(period) \
+                and period / step < MIN_DRIVE_STEPS_PER_PERIOD:
+            raise SimulationError(
+                f"solution diverged from the mechanism's motion (fewer than "
+                f"{MIN_DRIVE_STEPS_PER_PERIOD:g} steps per {what}: the run integrates an "
+                f"alias of it): {divergence_advice(scene, reductions or {}, link_models)}")
+
+
 def check_finite(datasets: dict[str, Dataset], settings: dict[str, Any],
                   scene: Scene | None = None, reductions: dict[str, Any] | None = None,
                   link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> None:
     """Raise :class:`SimulationError` at the earliest sample where the solution diverged.
 
-    Diverged: any dataset not finite (NaN, inf), or the constraint norm above
+    Diverged: the motion's own time scale not resolved (:func:`check_resolved`), any
+    dataset not finite (NaN, inf), or the constraint norm above
     :data:`CONSTRAINT_NORM_LIMIT_M` (an exploding or torn-apart assembly). The message names
     the integration step (time / step_s), the time [s] and what went wrong, and, given the
     ``scene`` (and its ``reductions`` by link), what may help (:func:`divergence_advice`).
     """
+    if scene is not None:
+        check_resolved(scene, settings, reductions, link_models)
     time_s = np.asarray(datasets["time"].data, dtype=float)
     problems: list[tuple[int, str]] = []
     for name, dataset in datasets.items():

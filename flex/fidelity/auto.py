@@ -138,7 +138,8 @@ def check(scene: Scene, calibration: Calibration | None = None, *,
           ) -> dict[str, tuple[Scene, SolverChoice | None]]:
     """Refuse, before anything is built, meshed or simulated, a scene none of whose
     resolutions can run (:class:`SceneError`, one line naming the key and the accepted
-    range): every candidate (:func:`candidates`) resolved and checked
+    range): refinement without the error budget it follows; every candidate
+    (:func:`candidates`) resolved and checked
     (:func:`flex.config.settings.check_concrete`), refused only when every one fails (a
     check that fails for only some choices is left to the run, which then stores a failed
     case naming it); with ``"auto"`` models, the rigid probe must fit the step limit
@@ -146,6 +147,10 @@ def check(scene: Scene, calibration: Calibration | None = None, *,
     by their TOML (what :func:`resolve` reuses). Takes milliseconds. ``calibration``: what
     the ``"auto"`` values resolve from (None: the bundled calibration); ``link_models``: the
     registry of the scene's link models."""
+    if scene["fidelity"]["refine"] and not scene["simulation"]["error_estimate"]:
+        raise SceneError("fidelity.refine = true with simulation.error_estimate = false: "
+                         "refinement follows the error budget; set error_estimate = true or "
+                         "refine = false")
     # an "auto" link's plate too: what it may mesh
     linked, _ = resolve_link_keys(scene, calibration)
     for link in LINKS:

@@ -42,6 +42,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from flex.base.errors import FlexError
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, apply_overrides, model_names
@@ -80,6 +82,9 @@ class ErrorBudget:
     crest_gaps: dict[str, float] = field(default_factory=dict)
     #: each quantity's (unit, what): stored with the budget, so readers need no registry
     described: dict[str, tuple[str, str]] = field(default_factory=dict)
+    #: why a term is unknown (NaN in ``terms``, making its quantities' totals unknown), one
+    #: phrase per term that could not be measured
+    unknown: list[str] = field(default_factory=list)
 
     def total(self, quantity: str) -> float:
         """The root-sum-square of the quantity's terms [its units] (module doc)."""
@@ -112,7 +117,13 @@ class ErrorBudget:
         if self.described:
             out[DESCRIBED] = "\n".join(f"{quantity}\t{unit}\t{what}" for quantity, (unit, what)
                                        in self.described.items())
+        if self.unknown:
+            out[UNKNOWN_ATTR] = "; ".join(self.unknown)
         return out
+
+    def unknown_quantities(self) -> list[str]:
+        """The quantities whose total is unknown (a term that could not be measured)."""
+        return [name for name in self.terms if not math.isfinite(self.total(name))]
 
 
 def combined(terms: Any) -> float:
@@ -122,6 +133,8 @@ def combined(terms: Any) -> float:
 
 #: case attribute of a budget's quantities, one ``name<TAB>unit<TAB>what`` line each
 DESCRIBED = "headlines_described"
+#: case attribute saying why a budget's unknown terms (NaN) could not be measured
+UNKNOWN_ATTR = f"{PREFIX}unknown"
 #: case attribute prefix of a peak's crest gap (:func:`flex.fidelity.error_estimate.crest_gap`)
 CREST_GAP_PREFIX = "crest_gap_"
 
@@ -151,7 +164,9 @@ class _Companions:
 
     def differences(self, result: CaseResult, other: CaseResult | None) -> dict[str, float]:
         """Each headline quantity's difference between ``result`` and ``other`` (0 for a
-        quantity ``other`` lacks where ``result`` has it, e.g. a rigid twin's stress)."""
+        link's own quantity ``other`` lacks where ``result`` has it, e.g. a rigid twin's
+        stress; NaN, unknown, for a quantity of the motion ``other`` lacks, e.g. a deployment
+        time its crank never reached)."""
         if other is None:
             return {}
         out = {}
@@ -159,6 +174,8 @@ class _Companions:
             difference = headline_difference(headline, result.datasets, other.datasets)
             if difference is not None:
                 out[name] = difference
+            elif headline.read(result.datasets) is not None:  # the companion lacks it
+                out[name] = math.nan
         return out
 
     def run(self, what: str, scene: Scene) -> CaseResult | None:
@@ -276,18 +293,32 @@ def error_budget(scene: Scene, result: CaseResult,
     leaves_out += companions.failures
     if "step" in failed:
         leaves_out.append(f"step: {step.validity}")
-    terms = {}
-    for name in values:
-        terms[name] = {"step": step.values.get(name, 0.0), "modes": modes.get(name, 0.0),
-                       "mesh": mesh.get(name, 0.0), "model": model.get(name, 0.0)}
-        for term in failed:
-            terms[name].pop(term, None)
+    measured = {"step": step.values, "modes": modes, "mesh": mesh, "model": model}
+    terms = {name: {term: measured[term].get(name, math.nan if term in failed else 0.0)
+                    for term in TERMS} for name in values}
     methods = {"step": step.method, "modes": modes_how, "mesh": mesh_how, "model": model_how}
     return ErrorBudget(values, terms, {k: v for k, v in methods.items() if k not in failed},
                        leaves_out, step.validity,
                        step.companion_wall_time_s + companions.wall_time_s,
                        _crest_gaps(result, values, headlines),
-                       {name: (headlines[name].unit, headlines[name].what) for name in values})
+                       {name: (headlines[name].unit, headlines[name].what) for name in values},
+                       _unknown(terms, failed, [f"step: {step.validity}", *companions.failures],
+                                headlines))
+
+
+def _unknown(terms: dict[str, dict[str, float]], failed: set[str], failures: list[str],
+             headlines: Mapping[str, Headline]) -> list[str]:
+    """Why each unknown (NaN) term could not be measured: its companion failed, or it has no
+    value of a quantity the run has (one phrase per term, on one line)."""
+    out: dict[str, str] = {}
+    for name, row in terms.items():
+        for term, value in row.items():
+            if math.isfinite(value) or term in out:
+                continue
+            reason = next((text for text in failures if text.startswith(f"{term}:")), None)
+            out[term] = (reason if term in failed and reason else
+                         f"{term}: its companion run has no {headlines[name].what}")
+    return [" ".join(text.split()) for text in out.values()]
 
 
 def _crest_gaps(result: CaseResult, values: dict[str, float],
@@ -306,8 +337,9 @@ def _crest_gaps(result: CaseResult, values: dict[str, float],
 @dataclass(frozen=True)
 class BudgetRow:
     """One headline quantity of a stored case, for display: its name, what it is, units,
-    value, total estimated error, relative error and the terms (from the case
-    attributes)."""
+    value, total estimated error, relative error and the terms (from the case attributes);
+    ``problem``: "" for a budget that holds, else why its total cannot be shown (``unknown:
+    ...``, ``inconsistent: ...``, ``malformed: ...``; the total is then NaN)."""
 
     quantity: str
     what: str
@@ -316,12 +348,17 @@ class BudgetRow:
     total: float
     relative: float
     terms: dict[str, float]
+    problem: str = ""
 
     def text(self) -> str:
-        """``what: value units +- total (relative %) = rss of step a, modes b, ...``."""
+        """``what: value units +- total (relative %) = rss of step a, modes b, ...``, or
+        ``what: value units +- unknown (why)`` for a budget with a problem."""
+        terms = ", ".join(f"{term} {term_text(value)}" for term, value in self.terms.items())
+        if self.problem:
+            return (f"{self.what}: {self.value:.6g} {self.units} +- {self.problem}"
+                    + (f" (terms: {terms})" if terms else ""))
         relative = (f" ({100 * self.relative:.2g} %)" if math.isfinite(self.relative)
                     else "")
-        terms = ", ".join(f"{term} {value:.2g}" for term, value in self.terms.items())
         return (f"{self.what}: {self.value:.6g} {self.units} +- {self.total:.2g} "
                 f"{self.units}{relative} (root-sum-square of {terms})")
 
@@ -335,25 +372,90 @@ def _described(attrs: Mapping[str, Any]) -> dict[str, tuple[str, str]]:
     return {parts[0]: (parts[1], parts[2]) for parts in lines if len(parts) == 3}
 
 
+def term_text(value: float) -> str:
+    """A stored term for display: ``unknown`` for one not measured (NaN)."""
+    return f"{value:.2g}" if math.isfinite(value) else "unknown"
+
+
+#: how far a stored total may lie from the root-sum-square of its stored terms (relative)
+CONSISTENCY = 1e-6
+
+
+def _number(attrs: dict[str, Any], key: str) -> tuple[float | None, str]:
+    """The stored attribute ``key`` as a float (None: absent), or why it is malformed."""
+    if key not in attrs:
+        return None, ""
+    value = attrs[key]
+    try:
+        if isinstance(value, bytes | str | bool | np.bool_) or np.ndim(value) != 0:
+            raise TypeError(type(value).__name__)
+        number = float(np.real_if_close(value))
+    except (TypeError, ValueError):
+        return math.nan, f"malformed: attribute {key} is not a real number ({_shown(value)})"
+    if number < 0 or math.isinf(number):
+        return math.nan, f"malformed: attribute {key} = {number:g} (an error is >= 0, finite)"
+    return number, ""
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
 def budget_rows(attrs: Mapping[str, Any]) -> list[BudgetRow]:
     """The stored error budget of a case (its attributes; see :meth:`ErrorBudget.attrs`),
-    one row per headline quantity it holds, in the order it describes them (a file written
-    before budgets described their quantities: the built-in headlines'). A file written
-    before budgets (a step estimate alone) gives rows with that one term."""
+    one row per headline quantity it holds (a value ``headline_*`` or an error
+    ``estimated_error_*``), in the order the budget describes them (:data:`DESCRIBED`; a file
+    written before: the built-in headlines' order). A file written before budgets (a step
+    estimate alone) gives rows with that one term. Each row is checked: a term not measured
+    (NaN) or an error not stored makes it ``unknown``, a total that is not the
+    root-sum-square of its terms ``inconsistent``, a value that is not a real number >= 0
+    ``malformed`` (:attr:`BudgetRow.problem`)."""
     rows = []
     for quantity, (units, what) in _described(attrs).items():
-        if f"{PREFIX}{quantity}" not in attrs:
+        keys = [f"{PREFIX}{quantity}", f"{HEADLINE_PREFIX}{quantity}",
+                *(f"{PREFIX}{quantity}_{term}" for term in TERMS)]
+        if not any(key in attrs for key in keys):
             continue
-        terms = {term: float(attrs[f"{PREFIX}{quantity}_{term}"]) for term in TERMS
-                 if f"{PREFIX}{quantity}_{term}" in attrs} or {
-            "step": float(attrs[f"{PREFIX}{quantity}"])}
-        value = float(attrs.get(f"{HEADLINE_PREFIX}{quantity}", math.nan))
-        total = float(attrs[f"{PREFIX}{quantity}"])
-        rows.append(BudgetRow(quantity, what, units, value, total,
-                              float(attrs.get(f"{PREFIX}{quantity}_relative", math.nan)),
-                              terms))
+        rows.append(_budget_row(attrs, quantity, units, what))
     return rows
 
 
+def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> BudgetRow:
+    """:func:`budget_rows`' row of one quantity."""
+    total, problem = _number(attrs, f"{PREFIX}{quantity}")
+    terms, problems = {}, [problem] if problem else []
+    for term in TERMS:
+        value, problem = _number(attrs, f"{PREFIX}{quantity}_{term}")
+        if value is not None:
+            terms[term] = value
+            problems += [problem] if problem else []
+    raw = attrs.get(f"{HEADLINE_PREFIX}{quantity}", math.nan)
+    try:
+        value = float(raw) if not isinstance(raw, str | bytes) else math.nan
+    except (TypeError, ValueError):
+        value = math.nan
+    if not terms and total is not None and math.isfinite(total):
+        terms = {"step": total}
+    unmeasured = [term for term, number in terms.items() if math.isnan(number)]
+    if problems:
+        problem = problems[0]
+    elif total is None:
+        problem = "unknown (no estimated error stored)"
+    elif unmeasured:
+        problem = f"unknown ({', '.join(unmeasured)} term not measured: see 'unknown')"
+    elif math.isnan(total):
+        problem = "unknown (the stored total is not a number)"
+    elif abs(total - combined(terms.values())) > CONSISTENCY * max(total, 1e-300):
+        problem = (f"inconsistent (stored total {total:.3g} {units} is not the "
+                   f"root-sum-square of its terms, {combined(terms.values()):.3g} {units})")
+    if problem:
+        return BudgetRow(quantity, what, units, value, math.nan, math.nan, terms, problem)
+    stored, _ = _number(attrs, f"{PREFIX}{quantity}_relative")
+    relative = (total / abs(value) if math.isfinite(value) and value != 0 else
+                stored if stored is not None else math.nan)
+    return BudgetRow(quantity, what, units, value, total, relative, terms)
+
+
 __all__ = ["DESCRIBED", "BudgetRow", "ErrorBudget", "HEADLINE_PREFIX", "MESH_FACTOR", "TERMS",
-           "budget_rows", "combined", "error_budget", "richer_modes"]
+           "UNKNOWN_ATTR", "budget_rows", "term_text", "combined", "error_budget", "richer_modes"]

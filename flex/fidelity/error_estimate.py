@@ -176,7 +176,10 @@ def estimate_step_error(scene: Scene, result: CaseResult,
     values = {}
     for name, headline in headlines.items():
         read_values = [headline.read(datasets) for datasets in runs]
-        if any(value is None for value in read_values):
+        if read_values[0] is None:
+            continue
+        if any(value is None for value in read_values):  # a companion lacks it: unknown
+            values[name] = math.nan
             continue
         if headline.kind == "peak":
             differences = [peak_difference(runs[k], runs[k + 1], headline.series)

@@ -111,16 +111,18 @@ def crest_gap(values: np.ndarray) -> float | None:
 
 
 def deployment_time_s(datasets: Mapping[str, Any]) -> float | None:
-    """Time of the first maximum of the crank angle [s] (delta_t, docs/criterion.md); None
+    """Time of the first maximum of the crank angle [s] (delta_t, docs/criterion.md;
+    :func:`flex.fidelity.criteria.first_maximum_index`, which ignores round-off); None
     when the crank angle has no maximum within the run (a deployment not reached, a
-    constant-speed crank): missing, not the end time."""
+    constant-speed crank, a crank that never moves): missing, not the end time."""
+    from flex.fidelity.criteria import first_maximum_index
+
     if "crank/angle" not in datasets:
         return None
     angle = np.asarray(datasets["crank/angle"].data, dtype=float)
-    falling = np.flatnonzero(np.diff(angle) < 0)
-    if len(angle) < 3 or len(falling) == 0 or falling[0] == 0:
+    top = first_maximum_index(angle)
+    if top is None or top == 0:
         return None
-    top = int(falling[0])
     time_s = np.asarray(datasets["time"].data, dtype=float)
     # the parabola through the top sample and its neighbours: the maximum between samples
     # (a sample time alone is off by up to half a step, more than the run's own error)

@@ -14,6 +14,7 @@ command line and :mod:`flex.api` pass the user's folder
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from collections.abc import Mapping
@@ -71,7 +72,7 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
                          calibration=calibration, link_models=link_models)
     if scene["fidelity"]["refine"]:
         return refine(resolution, name, cache_dir=cache_dir, link_models=link_models,
-                      headlines=headlines)
+                      headlines=headlines, free=free_knobs(scene))
     return simulate_resolved(resolution, name, reduction, crank_reduction,
                              cache_dir=cache_dir, beyond=beyond, link_models=link_models,
                              headlines=headlines)
@@ -115,20 +116,66 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
                              crank_reduction if same else None, cache_dir=cache_dir,
                              link_models=link_models)
 
-        budget = error_budget(scene, result, run_companion,
-                              time_scales(scene, reductions, link_models), link_models,
-                              headlines)
+        scales = time_scales(scene, reductions, link_models)
+        budget = error_budget(scene, result, run_companion, scales, link_models, headlines)
         result.attrs.update(budget.attrs())
+        _warn_unresolved_drive(result, scales, float(scene["simulation"]["step_s"]))
+        if budget.unknown:
+            print(f"flex: warning: case {name}: estimated error unknown for "
+                  f"{', '.join(budget.unknown_quantities())}: {'; '.join(budget.unknown)}",
+                  file=sys.stderr, flush=True)
     return result
+
+
+def _warn_unresolved_drive(result: CaseResult, scales: list[tuple[float, float, str]],
+                           step_s: float) -> None:
+    """A drive time scale (the spring on the mechanism, a crank turn) with fewer steps per
+    period than the step estimate's asymptotic range: the motion itself is numerically
+    damped and its error not covered; stored as a validity warning (stderr repeats it)."""
+    from flex.dynamics.advice import DRIVE_SCALES
+    from flex.fidelity.error_estimate import MIN_STEPS_PER_PERIOD, unresolved_time_scales
+
+    unresolved = unresolved_time_scales([s for s in scales if s[2] in DRIVE_SCALES], step_s)
+    if unresolved:
+        text = (f"the step does not resolve the drive: {'; '.join(unresolved)}, fewer than "
+                f"{MIN_STEPS_PER_PERIOD:g}: the motion is numerically damped and its estimated "
+                f"error does not cover that")
+        result.attrs[VALIDITY_WARNING] = "; ".join(
+            filter(None, [str(result.attrs.get(VALIDITY_WARNING, "")), text]))
 
 
 #: most attempts of :func:`refine` (each one a run with its whole error budget)
 MAX_ATTEMPTS = 6
+#: :func:`refine`'s status of a run with no quantity it certifies
+NOTHING_TO_REFINE = ("nothing to refine: no flexible link's deflection to certify (the "
+                     "tolerance bounds a flexible link's own deflection; every link is rigid)")
+
+
+#: the knobs refinement turns: scene keys (``<link>.`` ones for each link)
+KNOBS = ("simulation.step_s", "coupler.model", "crank.modes", "coupler.modes",
+         "crank.mesh_size_m", "coupler.mesh_size_m")
+
+
+def free_knobs(scene: Scene) -> frozenset[str]:
+    """The knobs (:data:`KNOBS`) of ``scene`` as the user gave it (before ``"auto"`` is
+    resolved) that refinement may turn: those left on ``"auto"`` or on the bundled
+    scene's value. A value the user set is never changed."""
+    from flex.data.scene import default_scene
+
+    bundled = default_scene()
+    out = set()
+    for knob in KNOBS:
+        section, key = knob.split(".")
+        value = scene[section][key]
+        if value == "auto" or value == bundled[section][key]:
+            out.add(knob)
+    return frozenset(out)
 
 
 def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None = None,
            link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
-           headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> CaseResult:
+           headlines: Mapping[str, Headline] = BUILTIN_HEADLINES,
+           free: frozenset[str] = frozenset(KNOBS)) -> CaseResult:
     """``fidelity.refine``: run the resolved scene with its error budget; while a certified
     quantity (a headline whose entry says ``certified``: each flexible link's peak
     deflection and first crest, docs/criterion.md) has a total estimated error above
@@ -142,7 +189,9 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     ``refine_attempts`` (one line per run: its settings, the worst quantity, what changed
     and why) and ``refine_wall_time_s``; a run that did not meet the tolerance says so in
     one stderr line. The companion runs of one attempt are not reused by the next (a known
-    cost: the refined run equals one of them)."""
+    cost: the refined run equals one of them). ``free``: the knobs it may turn
+    (:func:`free_knobs`); one the user set that blocks the tolerance stops it, and the status
+    says which value and what refinement would make of it."""
     from flex.fidelity.error_budget import budget_rows
 
     if not resolution.scene["simulation"]["error_estimate"]:
@@ -161,18 +210,20 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
         over = [row for row in rows if not row.relative <= tolerance]
         settings = _settings_text(scene, link_models)
         if not rows:
-            status = "nothing to certify (no flexible link's deflection)"
+            status = NOTHING_TO_REFINE
             lines.append(f"{attempt}: {settings}: {status}")
             break
-        worst = max(rows, key=lambda row: row.relative / tolerance)
+        worst = max(rows, key=lambda row: row.relative if row.relative >= 0 else math.inf)
         found = (f"{worst.what} {100 * worst.relative:.3g} % of itself (tolerance "
-                 f"{100 * tolerance:g} %)")
+                 f"{100 * tolerance:g} %)" if not worst.problem else
+                 f"{worst.what} {worst.problem} (tolerance {100 * tolerance:g} %)")
         if not over:
             status = "met"
             lines.append(f"{attempt}: {settings}: met; worst {found}")
             break
-        term = max(worst.terms, key=lambda key: worst.terms[key])
-        change, why = _refined(scene, term, link_models)
+        term = max(worst.terms, key=lambda key: worst.terms[key] if worst.terms[key] >= 0
+                   else math.inf)  # an unknown term (its companion failed) first
+        change, why = _refined(scene, term, link_models, free)
         spent = time.perf_counter() - start
         if change is None or spent > scene["fidelity"]["refine_limit_s"] \
                 or attempt == MAX_ATTEMPTS:
@@ -200,11 +251,20 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
         current = replace(current, scene=refined)
     result.attrs.update({"refine_status": status, "refine_attempts": "\n".join(lines),
                          "refine_wall_time_s": time.perf_counter() - start})
-    if status != "met":
+    _say_status(name, status, tolerance)
+    return result
+
+
+def _say_status(name: str, status: str, tolerance: float) -> None:
+    """:func:`refine`'s one stderr line: a note when there was nothing to refine, the
+    status when the tolerance was not met."""
+    if status == NOTHING_TO_REFINE:
+        print(f"flex: note: case {name}: fidelity.refine: {status}", file=sys.stderr,
+              flush=True)
+    elif status != "met":
         print(f"flex: case {name}: fidelity.tolerance = {tolerance:g} not met by refinement "
               f"({status}); the last run is stored with its budget", file=sys.stderr,
               flush=True)
-    return result
 
 
 #: runs of an attempt's error budget, in run-equivalents (companions at 2 h and 4 h, more
@@ -244,10 +304,30 @@ def _settings_text(scene: Scene, link_models: Mapping[str, LinkModel]) -> str:
     return "; ".join(parts)
 
 
-def _refined(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
-             ) -> tuple[list[str] | None, str]:
+def _refined(scene: Scene, term: str, link_models: Mapping[str, LinkModel],
+             free: frozenset[str] = frozenset(KNOBS)) -> tuple[list[str] | None, str]:
     """The overrides that refine the knob of ``term`` (step, modes, mesh, model) and what
-    they do; (None, why not) when it cannot move."""
+    they do; (None, why not) when it cannot move, or when it would change a value the user
+    set (not in ``free``): then why says which value and what it would take."""
+    change, why = _refined_any(scene, term, link_models)
+    set_by_user = [item for item in change or [] if item.split("=")[0] not in free]
+    if not set_by_user:
+        return change, why
+    keys = ", ".join(f"{item.split('=')[0]} = {_value(scene, item.split('=')[0])}"
+                     for item in set_by_user)
+    return None, (f"the {term} term dominates and {keys} was set in the scene (refinement "
+                  f"changes only \"auto\" or default values): it would take "
+                  f"{', '.join(set_by_user)} ({why})")
+
+
+def _value(scene: Scene, knob: str) -> Any:
+    section, key = knob.split(".")
+    return scene[section][key]
+
+
+def _refined_any(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
+                 ) -> tuple[list[str] | None, str]:
+    """:func:`_refined` with every knob free."""
     from flex.fidelity.error_budget import richer_modes
 
     links = {link: link_models[scene[link]["model"]] for link in LINKS}

@@ -277,12 +277,13 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
         return []
     lines = ["  estimated error (total = the root-sum-square of the terms):"]
     lines += [f"    {row.text()}" for row in rows] or ["    none"]
-    for key in ("method", "leaves_out", "validity"):
+    for key in ("method", "leaves_out", "validity", "unknown"):
         if attrs.get(PREFIX + key):
             lines.append(f"    {key.replace('_', ' ')}: {attrs[PREFIX + key]}")
     lines += [f"    crest gap of the {key.removeprefix('crest_gap_').split('_')[0]}'s peak "
-              f"deflection: {float(value):.3g} m (the second-largest crest lies this far "
-              f"below it)" for key, value in attrs.items() if key.startswith("crest_gap_")]
+              f"deflection: {_shown_number(value, '.3g')} m (the second-largest crest lies "
+              f"this far below it)" for key, value in attrs.items()
+              if key.startswith("crest_gap_")]
     if attrs.get("refine_status"):
         lines.append(f"  refinement (fidelity.refine): {attrs['refine_status']}, "
                      f"{float(attrs.get('refine_wall_time_s', 0.0)):.3g} s")
@@ -290,11 +291,19 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
     return lines
 
 
+def _shown_number(value: Any, spec: str) -> str:
+    """A stored number for display; a value that is not one, shown as malformed."""
+    try:
+        return format(float(value), spec)
+    except (TypeError, ValueError):
+        return f"malformed ({type(value).__name__})"
+
+
 def stress_lines(attrs: dict[str, Any]) -> list[str]:
     """The peak von Mises stress of each FFRF link (case attributes of
     :func:`flex.bodies.stress.peak_attrs`), where and when, with its estimated error:
     one line per link."""
-    from flex.fidelity.error_estimate import PREFIX
+    from flex.fidelity.error_budget import budget_rows
 
     lines = []
     for link in ("coupler", "crank"):
@@ -303,13 +312,18 @@ def stress_lines(attrs: dict[str, Any]) -> list[str]:
             name = f"{link}_peak_von_mises{suffix}"
             if f"{name}_Pa" not in attrs:
                 continue
-            x, y, z = (1e3 * float(v) for v in np.ravel(attrs[f"{name}_position_m"]))
-            error = attrs.get(f"{PREFIX}{name}_Pa")
-            parts.append(f"{attrs[f'{name}_Pa'] / 1e6:.4g} MPa {where} at t = "
-                         f"{attrs[f'{name}_time_s'] * 1e3:.4g} ms, (x, y, z) = ({x:.3g}, "
-                         f"{y:.3g}, {z:.3g}) mm on the plate"
-                         + (f" (estimated error {error / 1e6:.2g} MPa: the budget above)"
-                            if error is not None else ""))
+            try:
+                x, y, z = (1e3 * float(v) for v in np.ravel(attrs[f"{name}_position_m"]))
+                value, at = float(attrs[f"{name}_Pa"]), float(attrs[f"{name}_time_s"])
+            except (KeyError, TypeError, ValueError):
+                parts.append(f"malformed attributes {name}_* {where}")
+                continue
+            error = {row.quantity: row for row in budget_rows(attrs)}.get(f"{name}_Pa")
+            parts.append(f"{value / 1e6:.4g} MPa {where} at t = {at * 1e3:.4g} ms, (x, y, z) "
+                         f"= ({x:.3g}, {y:.3g}, {z:.3g}) mm on the plate"
+                         + (f" (estimated error {error.total / 1e6:.2g} MPa: the budget "
+                            f"above)" if error is not None and not error.problem else
+                            " (estimated error: see the budget above)" if error else ""))
         if parts:
             lines.append(f"peak von Mises stress, {link}: " + "; ".join(parts))
     return lines

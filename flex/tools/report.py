@@ -320,17 +320,17 @@ def _cases_section(cases: list[dict[str, Any]]) -> list[str]:
 def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
     """Each case's error budget: a row per headline quantity (value, total estimated error,
     relative, terms), then how the terms were made and what they leave out."""
-    from flex.fidelity.error_budget import TERMS, budget_rows
+    from flex.fidelity.error_budget import TERMS, budget_rows, term_text
     from flex.fidelity.error_estimate import PREFIX
 
     rows, notes = [], {}
     for case in cases:
         for row in budget_rows(case["attrs"]):
             rows.append([_code(case["name"]), row.what, f"{row.value:.6g} {row.units}",
-                         f"{row.total:.2g} {row.units}",
+                         row.problem or f"{row.total:.2g} {row.units}",
                          f"{100 * row.relative:.2g} %" if math.isfinite(row.relative) else "-",
-                         *(f"{row.terms[t]:.2g}" if t in row.terms else "-" for t in TERMS)])
-        for key in ("method", "leaves_out", "validity"):
+                         *(term_text(row.terms[t]) if t in row.terms else "-" for t in TERMS)])
+        for key in ("method", "leaves_out", "validity", "unknown"):
             if case["attrs"].get(PREFIX + key):
                 notes.setdefault(key, {}).setdefault(case["attrs"][PREFIX + key], []).append(
                     case["name"])

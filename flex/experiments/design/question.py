@@ -117,8 +117,22 @@ class Answer:
 def check_scene(scene: Scene, question: Question) -> None:
     """Refuse (FlexError, one line) a scene the question cannot be asked of: a spring that
     stores no energy whatever the varied value (no rate when the preload varies, no preload
-    when the rate varies), or a drive without a spring."""
-    drive = scene["drive"]
+    when the rate varies), a drive without a spring, a deployment time asked at or
+    beyond the run's end time (a longer deployment is not measured), or refinement (its
+    cases have no error budget to follow)."""
+    drive, end_s = scene["drive"], float(scene["simulation"]["end_time_s"])
+    if question.target == "deployment_time" and question.value >= end_s:
+        raise FlexError(f"design: deployment_time <= {question.value:g} s with "
+                        f"simulation.end_time_s = {end_s:g} s: a deployment longer than the "
+                        f"run is not measured, so the answer would be bounded by the end "
+                        f"time, not the target; accepted: simulation.end_time_s > "
+                        f"{question.value:g} s (e.g. --set simulation.end_time_s="
+                        f"{1.5 * question.value:g})")
+    if scene["fidelity"]["refine"]:
+        raise FlexError("design: fidelity.refine = true: flex design runs its cases without "
+                        "error budgets (simulation.error_estimate = false), which refinement "
+                        "follows; accepted: fidelity.refine = false (refine the answer with "
+                        "'flex run simulate' afterwards)")
     if drive["kind"] != "spring":
         raise FlexError(f'design: drive.kind = "{drive["kind"]}": flex design varies a '
                         f'spring-driven deployment; accepted: drive.kind = "spring"')
@@ -232,14 +246,22 @@ def answer(scene: Scene, question: Question, cache_dir: Path | None = None,
     best = min(found, key=lambda v: abs(v - current))
     limit = max((e for e in seen.values() if e.margin < 0), key=lambda e: -abs(e.value - best))
     return Answer(question, best, evaluate(best), list(seen.values()),
-                  f"on the feasible boundary (brentq), limited by {limiting(limit)}")
+                  f"on the feasible boundary (brentq), limited by "
+                  f"{limiting(limit, TARGETS[question.target][0])}")
 
 
-def limiting(evaluation: Evaluation) -> str:
-    """What an infeasible evaluation fails: auto's refusal, the stress or the target."""
+def limiting(evaluation: Evaluation, measure: str = "") -> str:
+    """What an infeasible evaluation fails: auto's refusal, the stress, the run's end time
+    (its ``measure`` not reached within the run: NaN) or the target."""
     if not evaluation.measures:
-        return "auto's refusal (a coupler near buckling)"
-    return "the stress" if evaluation.stress_margin < evaluation.target_margin else "the target"
+        reason = str(evaluation.case.attrs.get("design_reason", "")).split(";")[0]
+        return f"auto's refusal ({reason or 'a coupler near buckling'})"
+    if evaluation.stress_margin < evaluation.target_margin:
+        return "the stress"
+    if math.isnan(evaluation.measures.get(measure, 0.0)):
+        return (f"the run's end time (its {measure.replace('_', ' ')} was not reached within "
+                f"the run: simulation.end_time_s bounds the answer, not the target)")
+    return "the target"
 
 
 def unreachable(question: Question, scanned: list[Evaluation]) -> str:
@@ -257,7 +279,8 @@ def unreachable(question: Question, scanned: list[Evaluation]) -> str:
         return (what + f": no scanned case reached its {measure.replace('_', ' ')} within the "
                 f"run (simulation.end_time_s = {end:g} s: the deployment did not complete)")
     if not ran:
-        return what + ": auto refused every scanned scene (near buckling)"
+        reason = str(scanned[0].case.attrs.get("design_reason", "")) if scanned else ""
+        return what + f": auto refused every scanned scene ({reason or 'near buckling'})"
     best = max(ran, key=lambda e: sense * e.measures[measure])
     safe = [e for e in ran if e.stress_margin >= 0]
     text = (f"{what}: the best reached is {best.measures[measure] / scale:.4g} {unit} at "
