@@ -79,14 +79,20 @@ def test_a_refine_limit_without_refine_would_be_ignored_and_is_refused():
 
 
 def test_a_refinement_whose_next_run_would_exceed_the_limit_stops_before_it(reduction_cache):
-    """3 mm at 1 %: the mesh term dominates the peak's budget and does not shrink as the mesh
-    is halved (the peak races, docs/criterion.md); the next halving would mesh and reduce
-    ~2.7e5 DOF twice (flex's mesh estimate, minutes): with a 60 s limit the refinement stops
-    before starting it, and says what it would have cost."""
+    """3 mm at 1 %: the budget does not shrink as the settings are refined (the peak races,
+    docs/criterion.md), so the refinement runs until its cost limit: the next mesh halving
+    alone would mesh and reduce ~2.7e5 DOF twice (flex's mesh estimate, minutes). Which knob
+    the limit stops depends on how fast this machine ran the earlier attempts (the limit is
+    wall time: 60 s here), so the test asks for the class of stop, not the knob: a cost
+    limit, stated with what the refused attempt would have cost (an estimate) or the time
+    already spent, the attempts listed, the last run kept with its budget."""
     result = simulate(load_scene(overrides=[*PLATE[:2], "coupler.thickness_m=0.003",
                                             "fidelity.tolerance=0.01", "fidelity.refine=true",
                                             "fidelity.refine_limit_s=60"]),
                       cache_dir=reduction_cache)
     status = result.attrs["refine_status"]
-    assert status.startswith("cost limit: mesh halved") and "(estimate)" in status
-    assert "would take" in status and result.attrs["refine_wall_time_s"] < 60
+    assert status.startswith("cost limit"), status
+    assert ("would take" in status and "(estimate)" in status) or "s of fidelity." in status
+    attempts = result.attrs["refine_attempts"].splitlines()
+    assert 1 <= len(attempts) <= 6 and "stopped: cost limit" in attempts[-1]
+    assert "estimated_error_coupler_peak_deflection_m" in result.attrs
