@@ -19,8 +19,8 @@ import pytest
 from flex.base.errors import FlexError, SimulationError
 from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import load_scene
+from flex.dynamics.advice import check_finite
 from flex.dynamics.reference import SliderCrankDAE, solve_reference
-from flex.dynamics.solver import _check_finite
 from flex.fidelity.simulation import simulate, simulate_case
 
 SHORT = ["simulation.end_time_s=0.01"]
@@ -81,7 +81,7 @@ def test_check_finite_reports_the_earliest_problem_with_step_and_time():
     data = {"time": Dataset(time_s, "s"), "crank/angle": Dataset(angle, "rad"),
             "constraint_norm": Dataset(norm, "m")}
     with pytest.raises(SimulationError) as error:
-        _check_finite(data, {"step_s": 1e-5})
+        check_finite(data, {"step_s": 1e-5})
     assert "step 8 (t = 8e-05 s" in str(error.value)
     assert "constraint norm" in str(error.value)
 

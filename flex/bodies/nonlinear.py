@@ -63,7 +63,7 @@ import numpy as np
 from flex.base.errors import SceneError
 from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction.body import add_plate_markers, as_vector3
-from flex.bodies.reduction.build import END_A, END_B, _mid_set, _ngsolve_thread_count
+from flex.bodies.reduction.build import END_A, END_B, mid_set, ngsolve_thread_count
 from flex.data.results import Dataset
 
 _MESH_ORDER = 2  # as the reduction: linear tets lock in bending
@@ -133,7 +133,7 @@ def build_nonlinear_plate(length_m: float, thickness_m: float, width_m: float,
                          f"length_m ({length_m!r})")
     from exudyn.FEM import FEMinterface
 
-    with _ngsolve_thread_count(ngsolve_threads):
+    with ngsolve_thread_count(ngsolve_threads):
         mesh = plate_mesh(length_m, thickness_m, width_m, mesh_size_m)
         fem = FEMinterface()
         # the reduction's import: it makes the mesh second order in place (once only: a
@@ -148,7 +148,7 @@ def build_nonlinear_plate(length_m: float, thickness_m: float, width_m: float,
         if node_set["Name"] in (END_A, END_B):
             nodes = np.sort(np.asarray(node_set["NodeNumbers"], dtype=np.int64))
             face_sets[node_set["Name"]] = (nodes, fem.GetNodeWeightsFromSurfaceAreas(nodes))
-    mid_nodes, mid_weights = _mid_set(positions, length_m, mesh_size_m)
+    mid_nodes, mid_weights = mid_set(positions, length_m, mesh_size_m)
 
     def centre(nodes: np.ndarray, weights: np.ndarray) -> np.ndarray:
         return np.asarray(weights) @ positions[nodes]

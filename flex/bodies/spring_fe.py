@@ -12,9 +12,9 @@ from flex.base.errors import SceneError
 from flex.bodies.spring import (
     MUSIC_WIRE_YOUNGS_MODULUS_PA,
     SpringDesign,
-    _require_positive,
     bergstrasser_factor,
     nominal_torsional_shear_stress_Pa,
+    require_positive,
     wahl_factor,
 )
 
@@ -82,18 +82,18 @@ def fe_helix_segment_stress(design: SpringDesign, force_N: float, *,
     an idle 2-core machine (netgen's mesh generation dominates; 4-9 s were measured under load).
     netgen refines by the wire's curvature, so ``mesh_size_m`` above ~d/4 changes little.
     """
-    f_axial = _require_positive("force_N", force_N, "N")
-    turns = _require_positive("segment_turns", segment_turns, "turns")
+    f_axial = require_positive("force_N", force_N, "N")
+    turns = require_positive("segment_turns", segment_turns, "turns")
     if turns > 1.0:
         raise SceneError(f"spring segment_turns = {segment_turns!r}: must be in (0, 1] turns")
-    e_mod = _require_positive("youngs_modulus_Pa", youngs_modulus_Pa, "Pa")
+    e_mod = require_positive("youngs_modulus_Pa", youngs_modulus_Pa, "Pa")
     if element_order not in (2, 3, 4):
         raise SceneError(f"spring element_order = {element_order!r}: must be 2, 3 or 4")
     if not (isinstance(sample_points, int) and sample_points >= 4):
         raise SceneError(f"spring sample_points = {sample_points!r}: must be an integer >= 4")
     d = design.wire_diameter_m
     radius_wire = d / 2.0
-    maxh = radius_wire if mesh_size_m is None else _require_positive("mesh_size_m",
+    maxh = radius_wire if mesh_size_m is None else require_positive("mesh_size_m",
                                                                     mesh_size_m, "m")
     poisson = e_mod / (2.0 * design.shear_modulus_Pa) - 1.0
     if not -1.0 < poisson < 0.5:

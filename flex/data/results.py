@@ -40,7 +40,7 @@ import numpy as np
 
 from flex import __version__
 from flex.base.errors import ResultFileError
-from flex.data.result_layout import _describe_value, check_layout
+from flex.data.result_layout import check_layout, describe_value
 
 FORMAT = "flex-results/1"
 
@@ -228,7 +228,7 @@ def write_results(path: str | Path, study: str, cases: list[CaseResult],
         cause = _os_error_in(exc)
         if cause is None:
             raise
-        raise ResultFileError(f"cannot write result file '{path}': {_os_reason(cause)}; "
+        raise ResultFileError(f"cannot write result file '{path}': {os_reason(cause)}; "
                               f"the previous file (if any) is unchanged") from None
     return path
 
@@ -246,11 +246,15 @@ def _os_error_in(exc: BaseException) -> OSError | None:
     return None
 
 
-def _os_reason(exc: OSError) -> str:
+def os_reason(exc: OSError) -> str:
     """A one-line reason: ``No space left on device`` rather than HDF5's multi-line text."""
     if exc.errno:
         return os.strerror(exc.errno)
     return " ".join(str(exc).split())[:200]
+
+
+#: the old private name, still imported by flex/tools/plotcurves.py (to go with that import)
+_os_reason = os_reason
 
 
 def _write_file(path: Path, study: str, cases: list[CaseResult], scene_toml: str,
@@ -321,7 +325,7 @@ def open_results(path: str | Path, check: bool = True):
             stream.read(1)
     except OSError as exc:
         raise ResultFileError(f"result file '{path}' cannot be read: "
-                              f"{_os_reason(exc)}") from None
+                              f"{os_reason(exc)}") from None
     if size == 0:
         raise ResultFileError(f"result file '{path}' is empty (0 bytes), not an HDF5 file")
     try:
@@ -355,7 +359,7 @@ def open_results(path: str | Path, check: bool = True):
             except UnicodeDecodeError:
                 pass
         if not isinstance(fmt, str) or fmt != FORMAT:
-            found = (f"flex_format = {_describe_value(fmt)}" if fmt is not None
+            found = (f"flex_format = {describe_value(fmt)}" if fmt is not None
                      else "no flex_format attribute")
             raise ResultFileError(f"result file '{path}' was not written by flex ({found}; "
                                   f"expected {FORMAT!r})")

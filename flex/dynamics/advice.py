@@ -1,7 +1,7 @@
 """What a run's results mean and what may help when a run fails: validity warnings of a
 finished run (:func:`validity_warning`), the scene's time scales (:func:`time_scales`),
 its extreme inputs and the advice a divergence carries (:func:`divergence_advice`,
-:func:`_check_finite`). Split from :mod:`flex.dynamics.solver` (which re-exports these names).
+:func:`check_finite`). Split from :mod:`flex.dynamics.solver` (which re-exports these names).
 """
 
 from __future__ import annotations
@@ -98,7 +98,8 @@ EXTREME_FACTOR = 100.0
 _STEP_KEYS = ("simulation.end_time_s", "simulation.step_s", "simulation.output_step_s")
 
 
-def _reductions(mech: Mechanism) -> dict[str, Any]:
+def mechanism_reductions(mech: Mechanism) -> dict[str, Any]:
+    """The reductions of a built mechanism's FFRF links, by link name (rigid links: none)."""
     return {link: body["reduction"] for link, body in (("crank", mech.crank),
                                                        ("coupler", mech.coupler))
             if "reduction" in body}
@@ -248,9 +249,9 @@ def divergence_advice(scene: Scene, reductions: dict[str, Any] | None = None,
     return "; ".join(parts)
 
 
-def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any],
-                  scene: Scene | None = None, reductions: dict[str, Any] | None = None,
-                  link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> None:
+def check_finite(datasets: dict[str, Dataset], settings: dict[str, Any],
+                 scene: Scene | None = None, reductions: dict[str, Any] | None = None,
+                 link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> None:
     """Raise :class:`SimulationError` at the earliest sample where the solution diverged.
 
     Diverged: any dataset not finite (NaN, inf), or the constraint norm above
@@ -280,3 +281,8 @@ def _check_finite(datasets: dict[str, Dataset], settings: dict[str, Any],
               else f"; {divergence_advice(scene, reductions or {}, link_models)}")
     raise SimulationError(f"solution diverged at step {step} (t = {now:.6g} s, step "
                           f"{settings['step_s']:g} s): {what}{advice}")
+
+
+#: the old private names, still imported by flex/dynamics/solver.py (to go with that import)
+_check_finite = check_finite
+_reductions = mechanism_reductions

@@ -11,7 +11,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.bodies.reduction.build import END_A, END_B, Reduction, _is_number
+from flex.bodies.reduction.build import END_A, END_B, Reduction, is_number
 
 
 class MidpointDeflection(NamedTuple):
@@ -90,7 +90,7 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
     for label, value in (("angle_rad", angle_rad),
                          ("initial_angular_velocity_rad_per_s",
                           initial_angular_velocity_rad_per_s)):
-        if not (_is_number(value) and math.isfinite(value)):
+        if not (is_number(value) and math.isfinite(value)):
             raise SceneError(f"{label} = {value!r}: must be a finite number")
     if joint_markers not in JOINT_MARKERS:
         raise SceneError(f"joint_markers = {joint_markers!r}: must be one of "
@@ -141,7 +141,7 @@ def _band_damping(mbs, body, reduction: Reduction, damping_model: str,
 def _stiffness_proportional_damping_s(reduction: Reduction, damping_ratio: float) -> float:
     """Rayleigh ``beta`` [s] that gives the first pinned-pinned mode ``damping_ratio`` of
     critical damping (0 for none); SceneError outside [0, 1) or without that mode."""
-    if not (_is_number(damping_ratio) and 0.0 <= damping_ratio < 1.0):
+    if not (is_number(damping_ratio) and 0.0 <= damping_ratio < 1.0):
         raise SceneError(f"damping_ratio = {damping_ratio!r}: must lie in [0, 1)")
     if damping_ratio == 0:
         return 0.0

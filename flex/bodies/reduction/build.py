@@ -20,16 +20,16 @@ import numpy as np
 from flex.base.errors import SceneError
 from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction.basis import (
-    _craig_bampton_basis,
-    _fix_eigenmode_signs,
+    craig_bampton_basis,
+    fix_eigenmode_signs,
 )
 from flex.bodies.reduction.cache import (
     CACHE_FORMAT_VERSION,
-    _cache_key,
-    _content_digest,
-    _load_cached,
-    _meta_digest,
-    _say_unproven,
+    cache_key,
+    fem_content_digest,
+    load_cached,
+    meta_digest,
+    say_unproven,
 )
 from flex.data.cache import (
     REDUCTION_CACHE,
@@ -103,15 +103,16 @@ class Reduction(PlateLink):
 # ------------------------------------------------------------------------------------------
 # input checks
 # ------------------------------------------------------------------------------------------
-def _is_number(value: Any) -> bool:
+def is_number(value: Any) -> bool:
+    """A real number, not a bool (``True`` is an ``int`` to Python, never a size to flex)."""
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 def _check_inputs(sizes: dict[str, float], poisson_ratio: float, modes: int) -> None:
     for name, value in sizes.items():
-        if not (_is_number(value) and math.isfinite(value) and value > 0):
+        if not (is_number(value) and math.isfinite(value) and value > 0):
             raise SceneError(f"reduction {name} = {value!r}: must be a finite number > 0")
-    if not (_is_number(poisson_ratio) and 0.0 < poisson_ratio < 0.5):
+    if not (is_number(poisson_ratio) and 0.0 < poisson_ratio < 0.5):
         raise SceneError(
             f"reduction poisson_ratio = {poisson_ratio!r}: must lie in the open range (0, 0.5)")
     if isinstance(modes, bool) or not isinstance(modes, int | np.integer) or modes < 1:
@@ -132,8 +133,8 @@ def _node_set(fem, name: str) -> dict:
     raise KeyError(name)
 
 
-def _mid_set(positions: np.ndarray, length_m: float, mesh_size_m: float,
-             ) -> tuple[np.ndarray, np.ndarray]:
+def mid_set(positions: np.ndarray, length_m: float, mesh_size_m: float,
+            ) -> tuple[np.ndarray, np.ndarray]:
     """Nodes of a thin slab around x = length/2 and weights placing their centre there.
 
     A tetrahedral mesh has no node plane at mid-length, so the marker averages a slab of
@@ -207,7 +208,7 @@ def _pinned_pinned_frequency_Hz(ffrf_interface, reduction_length_m: float,
 
 
 @contextlib.contextmanager
-def _ngsolve_thread_count(threads: int | None) -> Iterator[None]:
+def ngsolve_thread_count(threads: int | None) -> Iterator[None]:
     """Run NGsolve's task manager with ``threads`` threads inside the block, then restore."""
     if threads is None:
         yield
@@ -274,15 +275,15 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
                       mesh_order=int(mesh_order), stress_modes=True)
     if mode_selection != "all":  # "all" keeps the keys (and cache entries) it always had
         parameters["mode_selection"] = mode_selection
-    key = _cache_key(parameters)
+    key = cache_key(parameters)
     cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"
 
-    fem = _load_cached(cache_file, key) if cache_file is not None else None
+    fem = load_cached(cache_file, key) if cache_file is not None else None
     from_cache = fem is not None
     ffrf_interface = None
     if fem is None:
-        _say_unproven(cache_file)
-        with _ngsolve_thread_count(ngsolve_threads):
+        say_unproven(cache_file)
+        with ngsolve_thread_count(ngsolve_threads):
             fem, ffrf_interface = _build_fem(parameters, key)
         if cache_file is not None and not store(
                 cache_file, lambda temporary: fem.SaveToFile(str(temporary), mode="HDF5"),
@@ -343,16 +344,16 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
         node_set["NodeNumbers"] = nodes
         node_set["NodeWeights"] = fem.GetNodeWeightsFromSurfaceAreas(nodes)
         interfaces.append(nodes)
-    static_modes = _craig_bampton_basis(fem, mass_form, stiffness_form, interfaces,
+    static_modes = craig_bampton_basis(fem, mass_form, stiffness_form, interfaces,
                                         parameters["modes"],
                                         parameters.get("mode_selection", "all"))
-    _fix_eigenmode_signs(fem.modeBasis["matrix"], static_modes)
+    fix_eigenmode_signs(fem.modeBasis["matrix"], static_modes)
     material = KirchhoffMaterial(parameters["youngs_modulus_Pa"], parameters["poisson_ratio"],
                                  parameters["density_kg_per_m3"])
     fem.ComputePostProcessingModesNGsolve(space, material=material,
                                           outputVariableType=exu.OutputVariableType.StressLocal)
     positions = fem.GetNodePositionsAsArray()
-    mid_nodes, mid_weights = _mid_set(positions, length_m, parameters["mesh_size_m"])
+    mid_nodes, mid_weights = mid_set(positions, length_m, parameters["mesh_size_m"])
     fem.nodeSets.append({"Name": MID, "NodeNumbers": mid_nodes, "NodeWeights": mid_weights})
 
     from exudyn.FEM import ObjectFFRFreducedOrderInterface
@@ -370,9 +371,9 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
         "mass_kg": float(ffrf_interface.totalMass),
         "n_elements": int(mesh.ne),
         "cold_build_time_s": time.perf_counter() - start,
-        "digest": _content_digest(fem),
+        "digest": fem_content_digest(fem),
     }
-    fem.metaData["flex"]["meta_digest"] = _meta_digest(fem.metaData["flex"])
+    fem.metaData["flex"]["meta_digest"] = meta_digest(fem.metaData["flex"])
     # handed to the Reduction (not stored): saves re-projecting on the first add
     return fem, ffrf_interface
 
