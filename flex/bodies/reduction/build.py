@@ -225,6 +225,7 @@ def ngsolve_thread_count(threads: int | None) -> Iterator[None]:
     finally:
         ngsolve.SetNumThreads(previous)
 
+
 def build_reduction(length_m: float, thickness_m: float, width_m: float,
                     youngs_modulus_Pa: float, density_kg_per_m3: float, poisson_ratio: float,
                     mesh_size_m: float, modes: int,
@@ -264,6 +265,30 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
     sizes = {"length_m": length_m, "thickness_m": thickness_m, "width_m": width_m,
              "youngs_modulus_Pa": youngs_modulus_Pa, "density_kg_per_m3": density_kg_per_m3,
              "mesh_size_m": mesh_size_m}
+    parameters = _reduction_parameters(sizes, poisson_ratio, modes, mode_selection, mesh_order)
+    key = cache_key(parameters)
+    cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"
+    fem, ffrf_interface, from_cache, cache_file = _cached_or_built(parameters, key, cache_file,
+                                                                   ngsolve_threads)
+    meta = fem.metaData["flex"]
+    return Reduction(
+        fem=fem, **sizes, poisson_ratio=float(poisson_ratio), modes=int(modes),
+        mode_selection=mode_selection, **_node_set_fields(fem),
+        fixed_interface_frequencies_Hz=np.sqrt(np.abs(np.asarray(fem.eigenValues))) / (2 * np.pi),
+        pinned_pinned_frequency_Hz=float(meta["pinned_pinned_frequency_Hz"]),
+        mass_kg=float(meta["mass_kg"]), n_nodes=int(fem.NumberOfNodes()),
+        n_elements=int(meta["n_elements"]), n_dof=3 * int(fem.NumberOfNodes()),
+        cold_build_time_s=float(meta["cold_build_time_s"]),
+        build_time_s=time.perf_counter() - start, from_cache=from_cache,
+        cache_file=cache_file, key=key,
+        _ffrf_interface=ffrf_interface,
+    )
+
+
+def _reduction_parameters(sizes: dict[str, float], poisson_ratio: float, modes: int,
+                          mode_selection: str, mesh_order: int) -> dict[str, Any]:
+    """The checked arguments of :func:`build_reduction` as the parameters its cache key
+    hashes (bad values raise :class:`flex.base.errors.SceneError`)."""
     _check_inputs(sizes, poisson_ratio, modes)
     if mode_selection not in MODE_SELECTIONS:
         raise SceneError(f"reduction mode_selection = {mode_selection!r}: must be one of "
@@ -275,9 +300,15 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
                       mesh_order=int(mesh_order), stress_modes=True)
     if mode_selection != "all":  # "all" keeps the keys (and cache entries) it always had
         parameters["mode_selection"] = mode_selection
-    key = cache_key(parameters)
-    cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"
+    return parameters
 
+
+def _cached_or_built(parameters: dict[str, Any], key: str, cache_file: Path | None,
+                     ngsolve_threads: int | None) -> tuple[Any, Any, bool, Path | None]:
+    """The FEMinterface of ``key``: the cache entry that proves its content, or a new build
+    stored in its place. Returns the FEMinterface, its ObjectFFRFreducedOrderInterface (None
+    when loaded from the cache), whether it was loaded, and the cache file (None when nothing
+    is kept)."""
     fem = load_cached(cache_file, key) if cache_file is not None else None
     from_cache = fem is not None
     ffrf_interface = None
@@ -289,32 +320,21 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
                 cache_file, lambda temporary: fem.SaveToFile(str(temporary), mode="HDF5"),
                 REDUCTION_CACHE):
             cache_file = None  # not kept (said): nothing is cached beside it either
+    return fem, ffrf_interface, from_cache, cache_file
 
-    meta = fem.metaData["flex"]
-    end_a, end_b, mid = (_node_set(fem, name) for name in (END_A, END_B, MID))
+
+def _node_set_fields(fem) -> dict[str, np.ndarray]:
+    """The :class:`Reduction` fields of the node sets ``end_a``, ``end_b`` and ``mid``: node
+    numbers, weights (summing to 1) and weighted reference centres [m]."""
     positions = fem.GetNodePositionsAsArray()
-
-    def centre(node_set: dict) -> np.ndarray:
-        return np.asarray(node_set["NodeWeights"]) @ positions[node_set["NodeNumbers"]]
-
-    return Reduction(
-        fem=fem, **sizes, poisson_ratio=float(poisson_ratio), modes=int(modes),
-        mode_selection=mode_selection,
-        nodes_end_a=np.asarray(end_a["NodeNumbers"]),
-        weights_end_a=unit_sum(end_a["NodeWeights"]),
-        nodes_end_b=np.asarray(end_b["NodeNumbers"]),
-        weights_end_b=unit_sum(end_b["NodeWeights"]),
-        nodes_mid=np.asarray(mid["NodeNumbers"]), weights_mid=unit_sum(mid["NodeWeights"]),
-        centre_end_a=centre(end_a), centre_end_b=centre(end_b), centre_mid=centre(mid),
-        fixed_interface_frequencies_Hz=np.sqrt(np.abs(np.asarray(fem.eigenValues))) / (2 * np.pi),
-        pinned_pinned_frequency_Hz=float(meta["pinned_pinned_frequency_Hz"]),
-        mass_kg=float(meta["mass_kg"]), n_nodes=int(fem.NumberOfNodes()),
-        n_elements=int(meta["n_elements"]), n_dof=3 * int(fem.NumberOfNodes()),
-        cold_build_time_s=float(meta["cold_build_time_s"]),
-        build_time_s=time.perf_counter() - start, from_cache=from_cache,
-        cache_file=cache_file, key=key,
-        _ffrf_interface=ffrf_interface,
-    )
+    fields = {}
+    for field_name, set_name in (("end_a", END_A), ("end_b", END_B), ("mid", MID)):
+        node_set = _node_set(fem, set_name)
+        fields[f"nodes_{field_name}"] = np.asarray(node_set["NodeNumbers"])
+        fields[f"weights_{field_name}"] = unit_sum(node_set["NodeWeights"])
+        fields[f"centre_{field_name}"] = (np.asarray(node_set["NodeWeights"])
+                                          @ positions[node_set["NodeNumbers"]])
+    return fields
 
 
 def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
@@ -345,8 +365,8 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
         node_set["NodeWeights"] = fem.GetNodeWeightsFromSurfaceAreas(nodes)
         interfaces.append(nodes)
     static_modes = craig_bampton_basis(fem, mass_form, stiffness_form, interfaces,
-                                        parameters["modes"],
-                                        parameters.get("mode_selection", "all"))
+                                       parameters["modes"],
+                                       parameters.get("mode_selection", "all"))
     fix_eigenmode_signs(fem.modeBasis["matrix"], static_modes)
     material = KirchhoffMaterial(parameters["youngs_modulus_Pa"], parameters["poisson_ratio"],
                                  parameters["density_kg_per_m3"])
