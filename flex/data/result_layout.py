@@ -95,8 +95,8 @@ def check_layout(h5, label: str | Path = "") -> None:
     - every dataset holds numbers or text (no compound, complex, reference or empty
       dataset); its ``units`` and ``description`` attributes are text when present.
 
-    Valid files written by :func:`write_results` always pass. ``/summary`` and other
-    top-level groups are checked for links, dataset types and attribute types only.
+    Valid files written by :func:`~flex.data.results.write_results` always pass. ``/summary``
+    and other top-level groups are checked for links, dataset types and attribute types only.
     """
     label = label or h5.filename
     where = "/"

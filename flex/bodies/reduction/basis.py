@@ -14,7 +14,8 @@ def craig_bampton_basis(fem, mass_form, stiffness_form, interfaces: list[np.ndar
                         modes: int, selection: str) -> int:
     """Put the chord-frame Craig-Bampton basis in ``fem`` (``modeBasis``, ``eigenValues``):
     static modes and ``modes`` fixed-interface eigenmodes, all of them or the in-plane ones
-    (``selection``, see :func:`build_reduction`). Returns the number of static modes.
+    (``selection``, see :func:`~flex.bodies.reduction.build.build_reduction`). Returns the
+    number of static modes.
 
     Exudyn's Hurty-Craig-Bampton modes make ``end_a`` the floating frame (it gets no static
     modes) and give ``end_b`` its six rigid-face modes; :func:`_chord_frame` then trades

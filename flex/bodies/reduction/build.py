@@ -52,11 +52,11 @@ MODE_SELECTIONS = ("in_plane", "all")
 # ------------------------------------------------------------------------------------------
 @dataclass
 class Reduction(PlateLink):
-    """A reduced flexible plate link, ready for :func:`add_ffrf_link`.
+    """A reduced flexible plate link, ready for :func:`~flex.bodies.reduction.body.add_ffrf_link`.
 
     Node index arrays refer to ``fem``'s mesh nodes; weights sum to 1. ``centre_*`` are the
     weighted reference positions of the node sets in body coordinates [m]: the points the
-    markers of :func:`add_ffrf_link` report.
+    markers of :func:`~flex.bodies.reduction.body.add_ffrf_link` report.
     """
 
     fem: Any  #: exudyn.FEM.FEMinterface holding mesh, M, K, mode basis, stress modes
@@ -244,7 +244,8 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
         mechanism plane z = 0 -- the 3 in-plane static modes of ``end_b`` (x, y, rotation
         about z) and the lowest ``modes`` in-plane eigenmodes -- since a planar mechanism
         loads its links in plane and the out-of-plane bending and torsion modes carry
-        nothing (decoupled by symmetry, :func:`_in_plane_eigenmodes`); ``"all"`` keeps the 6
+        nothing (decoupled by symmetry,
+        :func:`~flex.bodies.reduction.basis._in_plane_eigenmodes`); ``"all"`` keeps the 6
         static modes and the lowest ``modes`` eigenmodes of any kind.
       - the mesh uses second-order tetrahedra; stress post-processing modes (local stress,
         Pa per unit modal coordinate) are always computed.

@@ -124,8 +124,9 @@ def load_cached(path: Path, key: str):
 
 
 def meta_digest(meta: Mapping[str, Any]) -> str:
-    """Digest of the entry's own numbers (mass, frequency, ...: read by :class:`Reduction`
-    as they are stored), beside :func:`fem_content_digest` of its arrays."""
+    """Digest of the entry's own numbers (mass, frequency, ...: read by
+    :class:`~flex.bodies.reduction.build.Reduction` as they are stored), beside
+    :func:`fem_content_digest` of its arrays."""
     return content_digest((name, number_text(meta[name])) for name in sorted(meta)
                           if name not in ("digest", "meta_digest"))
 
