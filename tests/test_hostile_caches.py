@@ -101,8 +101,8 @@ def test_a_damaged_reduction_entry_is_not_loaded_and_is_said_to_be_rebuilt(entry
     damaged.write_bytes(good)
     with h5py.File(damaged, "r+") as h5:
         REDUCTION_DAMAGES[name](h5)
-    assert red_cache._load_cached(damaged, key) is None
-    red_cache._say_unproven(damaged)
+    assert red_cache.load_cached(damaged, key) is None
+    red_cache.say_unproven(damaged)
     lines = capsys.readouterr().err.splitlines()
     assert len(lines) == 1 and lines[0].startswith("flex: reduction cache: entry "), lines
     assert str(damaged) in lines[0] and "did not prove its content" in lines[0]
@@ -125,8 +125,8 @@ def test_a_broken_reduction_file_is_not_loaded(entry, tmp_path, capsys, name):
         content = good[:len(good) // 2] if name == "truncated_half" else good[:-10]
     broken = tmp_path / path.name
     broken.write_bytes(content)
-    assert red_cache._load_cached(broken, key) is None
-    red_cache._say_unproven(broken)
+    assert red_cache.load_cached(broken, key) is None
+    red_cache.say_unproven(broken)
     (line,) = capsys.readouterr().err.splitlines()
     assert "reduction cache" in line and str(broken) in line
 
@@ -144,7 +144,7 @@ def test_a_damaged_entry_is_rebuilt_replaced_and_said_once(entry, tmp_path, caps
     rebuilt = red.build_reduction(*PLATE, folder)
     err = capsys.readouterr().err.splitlines()
     assert not rebuilt.from_cache and len(err) == 1 and "building the reduction again" in err[0]
-    assert red_cache._load_cached(target, key) is not None  # replaced by a whole entry
+    assert red_cache.load_cached(target, key) is not None  # replaced by a whole entry
     again = red.build_reduction(*PLATE, folder)
     assert again.from_cache and capsys.readouterr().err == ""
     assert sorted(p.name for p in folder.iterdir()) == [path.name]  # no temporary left

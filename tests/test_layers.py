@@ -85,3 +85,23 @@ def test_the_library_never_imports_the_studies():
     for path in modules():
         text = path.read_text()
         assert "from studies" not in text and "import studies" not in text, path.name
+
+
+def _shelf_imports(shelf: str) -> dict[str, set[str]]:
+    """Per module of ``flex/experiments/<shelf>``: the other experiments shelves it imports."""
+    found = {}
+    for path in sorted((FLEX / "experiments" / shelf).rglob("*.py")):
+        shelves = {target.split(".")[2] for target in flex_imports(path)
+                   if target.startswith("flex.experiments.") and len(target.split(".")) > 2}
+        found[dotted_name(path)] = shelves - {shelf}
+    return found
+
+
+def test_fitting_builds_on_workprecision_never_the_other_way():
+    """The laws and the FFRF rule are fitted on work-precision measurements
+    (``experiments/fitting`` imports ``experiments/workprecision``); work-precision never
+    imports the fitting."""
+    backward = [name for name, shelves in _shelf_imports("workprecision").items()
+                if "fitting" in shelves]
+    assert not backward, f"workprecision imports fitting: {backward}"
+    assert any("workprecision" in shelves for shelves in _shelf_imports("fitting").values())

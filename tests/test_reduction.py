@@ -127,12 +127,12 @@ def test_second_build_is_a_fast_identical_cache_hit(reduction, cache_dir):
 
 
 def test_key_depends_on_every_argument(reduction, tmp_path):
-    from flex.bodies.reduction.cache import _cache_key
+    from flex.bodies.reduction.cache import cache_key
 
     base = {"length_m": LENGTH, "modes": MODES}
-    assert _cache_key(base) == _cache_key(dict(base))
-    assert _cache_key(base) != _cache_key({**base, "modes": MODES + 1})
-    assert _cache_key(base) != _cache_key({**base, "length_m": LENGTH * (1 + 1e-12)})
+    assert cache_key(base) == cache_key(dict(base))
+    assert cache_key(base) != cache_key({**base, "modes": MODES + 1})
+    assert cache_key(base) != cache_key({**base, "length_m": LENGTH * (1 + 1e-12)})
 
 
 def _copy_entry(reduction, directory):

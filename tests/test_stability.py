@@ -19,8 +19,8 @@ import pytest
 from flex.base.errors import FlexError, SimulationError
 from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import load_scene
+from flex.dynamics.advice import check_finite
 from flex.dynamics.reference import SliderCrankDAE, solve_reference
-from flex.dynamics.solver import check_finite
 from flex.fidelity.simulation import simulate, simulate_case
 
 SHORT = ["simulation.end_time_s=0.01"]

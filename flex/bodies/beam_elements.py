@@ -68,10 +68,6 @@ def _assemble_beam(length_m: float, thickness_m: float, width_m: float, element_
 
     rod_stiffness = np.array([[1.0, -1.0], [-1.0, 1.0]]) / element_length
     rod_mass = np.array([[2.0, 1.0], [1.0, 2.0]]) * element_length / 6.0
-    # Shear strain at the element midpoint (one-point rule) for [w1, psi1, w2, psi2], with
-    # gamma = w' - psi.
-    shear_strain = np.array([-1.0 / element_length, -0.5, 1.0 / element_length, -0.5])
-    curvature = np.array([0.0, -1.0, 0.0, 1.0]) / element_length
     for element in range(element_count):
         first = 6 * element
         for component, axial_rigidity, inertia_per_length in (
@@ -86,13 +82,8 @@ def _assemble_beam(length_m: float, thickness_m: float, width_m: float, element_
             dofs = [first + deflection, first + rotation, first + 6 + deflection,
                     first + 6 + rotation]
             signs = np.diag([1.0, sign, 1.0, sign])
-            element_stiffness = (youngs_Pa * inertia * element_length
-                                 * np.outer(curvature, curvature)
-                                 + shear_correction * shear_Pa * area * element_length
-                                 * np.outer(shear_strain, shear_strain))
-            element_mass = np.zeros((4, 4))
-            element_mass[np.ix_([0, 2], [0, 2])] = density * area * rod_mass
-            element_mass[np.ix_([1, 3], [1, 3])] = density * inertia * rod_mass
+            element_stiffness, element_mass = _bending_element(
+                element_length, material, area, inertia, shear_correction, rod_mass)
             scatter(dofs, signs @ element_stiffness @ signs, signs @ element_mass @ signs)
     rows, cols = np.concatenate(triplets["rows"]), np.concatenate(triplets["cols"])
     stiffness = sp.csr_matrix((np.concatenate(triplets["stiffness"]), (rows, cols)),
@@ -100,6 +91,28 @@ def _assemble_beam(length_m: float, thickness_m: float, width_m: float, element_
     mass = sp.csr_matrix((np.concatenate(triplets["mass"]), (rows, cols)),
                          shape=(dof_count, dof_count))
     return stiffness, mass
+
+
+def _bending_element(element_length: float, material: Material, area: float, inertia: float,
+                     shear_correction: float, rod_mass: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """Stiffness and consistent mass of one linear Timoshenko bending element for
+    [w1, psi1, w2, psi2] (length [m], area [m^2], second moment [m^4]; ``rod_mass`` the linear
+    rod's unit mass matrix): bending plus shear at the midpoint (one-point rule)."""
+    youngs_Pa, shear_Pa = material.youngs_modulus_Pa, material.shear_modulus_Pa
+    density = material.density_kg_per_m3
+    # Shear strain at the element midpoint (one-point rule) for [w1, psi1, w2, psi2], with
+    # gamma = w' - psi.
+    shear_strain = np.array([-1.0 / element_length, -0.5, 1.0 / element_length, -0.5])
+    curvature = np.array([0.0, -1.0, 0.0, 1.0]) / element_length
+    element_stiffness = (youngs_Pa * inertia * element_length
+                         * np.outer(curvature, curvature)
+                         + shear_correction * shear_Pa * area * element_length
+                         * np.outer(shear_strain, shear_strain))
+    element_mass = np.zeros((4, 4))
+    element_mass[np.ix_([0, 2], [0, 2])] = density * area * rod_mass
+    element_mass[np.ix_([1, 3], [1, 3])] = density * inertia * rod_mass
+    return element_stiffness, element_mass
 
 
 def _mode_kinds(vectors: np.ndarray, free: np.ndarray, mass, dof_count: int

@@ -272,34 +272,64 @@ def timoshenko_bending_rad_per_s(
     eb_rad_per_s = euler_bernoulli_bending_rad_per_s(length_m, height_m, width_m,
                                                      end_condition, mode_count, material)
     if end_condition == "pinned-pinned":
-        wave_number = np.arange(1, mode_count + 1) * math.pi / length_m
-        rotary_density = density * inertia if rotary_inertia else 0.0
-        shear_term = (1.0 / shear_stiffness_N) if shear_deformation else 0.0
-        # Divide the determinant by kappa G A (finite form when shear is switched off):
-        # rho A rho I s w^4 - w^2 (rho I k^2 + rho A + rho A E I k^2 s) + E I k^4 = 0.
-        quartic = density * area * rotary_density * shear_term
-        quadratic = (rotary_density * wave_number**2 + density * area
-                     + density * area * youngs_Pa * inertia * wave_number**2 * shear_term)
-        constant = youngs_Pa * inertia * wave_number**4
-        if quartic == 0.0:
-            omega_sq = constant / quadratic
-        else:
-            # Lower root, written to avoid cancellation.
-            discriminant = np.sqrt(quadratic**2 - 4.0 * quartic * constant)
-            omega_sq = 2.0 * constant / (quadratic + discriminant)
-        return np.sqrt(omega_sq)
+        return _pinned_pinned_timoshenko_rad_per_s(
+            length_m, mode_count, youngs_Pa, density, area, inertia,
+            shear_stiffness_N if shear_deformation else None, rotary_inertia)
 
     slenderness_sq = inertia / (area * length_m**2)
     shear_flexibility = (youngs_Pa * inertia / (shear_stiffness_N * length_m**2)
                          if shear_deformation else 0.0)
+    roots = _timoshenko_roots(end_condition, mode_count, slenderness_sq, shear_flexibility,
+                              rotary_inertia)
+    if len(roots) < mode_count:
+        raise SceneError(
+            f"Timoshenko {end_condition} beam L = {length_m} m, h = {height_m} m: found only "
+            f"{len(roots)} of {mode_count} modes below the Euler-Bernoulli bound")
+    parameter = np.array(roots)
+    omega = parameter / length_m**2 * math.sqrt(youngs_Pa * inertia / (density * area))
+    # Timoshenko <= Euler-Bernoulli mode by mode: a cheap guard against a missed root.
+    if np.any(omega > eb_rad_per_s * (1.0 + 1e-9)):
+        raise SceneError("Timoshenko root search lost a mode (frequency above Euler-Bernoulli)")
+    return omega
+
+
+def _pinned_pinned_timoshenko_rad_per_s(
+        length_m: float, mode_count: int, youngs_Pa: float, density: float, area: float,
+        inertia: float, shear_stiffness_N: float | None, rotary_inertia: bool) -> np.ndarray:
+    """The closed form of a pinned-pinned Timoshenko beam (:func:`timoshenko_bending_rad_per_s`):
+    omega_n, rad/s, n = 1..mode_count; ``shear_stiffness_N`` kappa G A [N], None without shear
+    deformation; SI units."""
+    wave_number = np.arange(1, mode_count + 1) * math.pi / length_m
+    rotary_density = density * inertia if rotary_inertia else 0.0
+    shear_term = (1.0 / shear_stiffness_N) if shear_stiffness_N is not None else 0.0
+    # Divide the determinant by kappa G A (finite form when shear is switched off):
+    # rho A rho I s w^4 - w^2 (rho I k^2 + rho A + rho A E I k^2 s) + E I k^4 = 0.
+    quartic = density * area * rotary_density * shear_term
+    quadratic = (rotary_density * wave_number**2 + density * area
+                 + density * area * youngs_Pa * inertia * wave_number**2 * shear_term)
+    constant = youngs_Pa * inertia * wave_number**4
+    if quartic == 0.0:
+        omega_sq = constant / quadratic
+    else:
+        # Lower root, written to avoid cancellation.
+        discriminant = np.sqrt(quadratic**2 - 4.0 * quartic * constant)
+        omega_sq = 2.0 * constant / (quadratic + discriminant)
+    return np.sqrt(omega_sq)
+
+
+def _timoshenko_roots(end_condition: str, mode_count: int, slenderness_sq: float,
+                      shear_flexibility: float, rotary_inertia: bool) -> list[float]:
+    """The lowest ``mode_count`` (fewer if the scan misses some) frequency parameters Omega =
+    sqrt(rho A / E I) omega L^2 of a Timoshenko beam, roots of its transfer-matrix determinant
+    (:func:`_timoshenko_determinant`) below the last Euler-Bernoulli value."""
     eb_parameter = euler_bernoulli_beta_l(end_condition, mode_count) ** 2
 
     def determinant(parameter: float) -> float:
         return _timoshenko_determinant(parameter**2, end_condition, slenderness_sq,
                                        shear_flexibility, rotary_inertia)
 
-    # Scan Omega = sqrt(rho A / E I) omega L^2 from near 0 (free-free has a double root at 0,
-    # rigid-body motion, which the scan must not count) up to the last Euler-Bernoulli value.
+    # Scan Omega from near 0 (free-free has a double root at 0, rigid-body motion, which the
+    # scan must not count) up to the last Euler-Bernoulli value.
     scan = np.linspace(0.05 * eb_parameter[0], eb_parameter[-1] * 1.0000001,
                        120 * mode_count + 1)
     values = np.array([determinant(p) for p in scan])
@@ -311,16 +341,7 @@ def timoshenko_bending_rad_per_s(
             roots.append(brent_root(determinant, scan[index], scan[index + 1]))
         if len(roots) == mode_count:
             break
-    if len(roots) < mode_count:
-        raise SceneError(
-            f"Timoshenko {end_condition} beam L = {length_m} m, h = {height_m} m: found only "
-            f"{len(roots)} of {mode_count} modes below the Euler-Bernoulli bound")
-    parameter = np.array(roots)
-    omega = parameter / length_m**2 * math.sqrt(youngs_Pa * inertia / (density * area))
-    # Timoshenko <= Euler-Bernoulli mode by mode: a cheap guard against a missed root.
-    if np.any(omega > eb_rad_per_s * (1.0 + 1e-9)):
-        raise SceneError("Timoshenko root search lost a mode (frequency above Euler-Bernoulli)")
-    return omega
+    return roots
 
 
 def axial_rad_per_s(length_m: float, end_condition: str, mode_count: int = 5,

@@ -395,13 +395,8 @@ def plate_modes(length_m: float, thickness_m: float, width_m: float, mesh_size_m
     Raises :class:`SceneError` for non-positive sizes, an unknown boundary condition or a
     failed convergence check (relative residual above 1e-6).
     """
-    check_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
-                   mesh_size_m=mesh_size_m)
-    check_choice("boundary_condition", boundary_condition, LINK_BOUNDARY_CONDITIONS)
-    check_count("mode_count", mode_count)
-    if element_order not in (1, 2, 3):
-        raise SceneError(f"element_order = {element_order!r}: must be 1, 2 or 3")
-    material.check()
+    _check_plate_inputs(length_m, thickness_m, width_m, mesh_size_m, boundary_condition,
+                        mode_count, element_order, material)
     start_s = time.perf_counter()
 
     import ngsolve as ngs
@@ -418,18 +413,15 @@ def plate_modes(length_m: float, thickness_m: float, width_m: float, mesh_size_m
         mesh, fes, boundary_condition, solve_shifted)
     eigenvalues, eigenvectors, rigid_Hz = _lowest_eigenpairs(
         stiffness_csr, mass_csr, apply_inverse, shift, mode_count, rigid_count)
-    max_relative_residual = _max_relative_residual(stiffness_csr, mass_csr, constraints,
-                                                   eigenvalues, eigenvectors)
-    if max_relative_residual > 1e-6:
-        raise SceneError(f"eigensolver did not converge: relative residual "
-                         f"{max_relative_residual:.1e} > 1e-6 (plate {length_m} x {thickness_m}"
-                         f" x {width_m} m, maxh {mesh_size_m} m, {boundary_condition})")
+    max_relative_residual = _converged_residual(
+        stiffness_csr, mass_csr, constraints, eigenvalues, eigenvectors,
+        f"plate {length_m} x {thickness_m} x {width_m} m, maxh {mesh_size_m} m, "
+        f"{boundary_condition}")
     coordinates_m, samples = _vertex_samples(mesh, fes, eigenvectors)
     eigenvalues, eigenvectors, samples = _align_degenerate_modes(
         eigenvalues, eigenvectors, samples, stiffness_csr)
     kind_shares = np.array([parity_kind_shares(*sample) for sample in samples])
-    triangles = np.array([[vertex.nr - 1 for vertex in element.vertices]
-                          for element in mesh.ngmesh.Elements2D()], dtype=np.int64)
+    triangles = _surface_triangles(mesh)
     omegas = np.sqrt(np.maximum(eigenvalues, 0.0))
     return PlateModes(
         length_m=float(length_m), thickness_m=float(thickness_m), width_m=float(width_m),
@@ -444,6 +436,39 @@ def plate_modes(length_m: float, thickness_m: float, width_m: float, mesh_size_m
         constraint_count=int(constraints.shape[0]),
         max_relative_residual=max_relative_residual, rigid_body_frequencies_Hz=rigid_Hz,
         wall_time_s=time.perf_counter() - start_s)
+
+
+def _check_plate_inputs(length_m: float, thickness_m: float, width_m: float,
+                        mesh_size_m: float, boundary_condition: str, mode_count: int,
+                        element_order: int, material: Material) -> None:
+    """Raise :class:`SceneError` for :func:`plate_modes`'s bad inputs (the first one found):
+    a size not > 0, an unknown boundary condition, a bad mode count, element order or
+    material."""
+    check_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
+                   mesh_size_m=mesh_size_m)
+    check_choice("boundary_condition", boundary_condition, LINK_BOUNDARY_CONDITIONS)
+    check_count("mode_count", mode_count)
+    if element_order not in (1, 2, 3):
+        raise SceneError(f"element_order = {element_order!r}: must be 1, 2 or 3")
+    material.check()
+
+
+def _converged_residual(stiffness_csr, mass_csr, constraints, eigenvalues: np.ndarray,
+                        eigenvectors: np.ndarray, plate: str) -> float:
+    """The eigenpairs' largest relative residual (:func:`_max_relative_residual`); above 1e-6 a
+    :class:`SceneError` says the eigensolver did not converge on ``plate``."""
+    max_relative_residual = _max_relative_residual(stiffness_csr, mass_csr, constraints,
+                                                   eigenvalues, eigenvectors)
+    if max_relative_residual > 1e-6:
+        raise SceneError(f"eigensolver did not converge: relative residual "
+                         f"{max_relative_residual:.1e} > 1e-6 ({plate})")
+    return max_relative_residual
+
+
+def _surface_triangles(mesh) -> np.ndarray:
+    """The mesh's surface triangles as 0-based vertex numbers, one row each."""
+    return np.array([[vertex.nr - 1 for vertex in element.vertices]
+                     for element in mesh.ngmesh.Elements2D()], dtype=np.int64)
 
 
 def _align_degenerate_modes(eigenvalues: np.ndarray, eigenvectors: np.ndarray,

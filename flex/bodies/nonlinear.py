@@ -63,7 +63,7 @@ import numpy as np
 from flex.base.errors import SceneError
 from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction.body import add_plate_markers, as_vector3
-from flex.bodies.reduction.build import END_A, END_B, _mid_set, _ngsolve_thread_count
+from flex.bodies.reduction.build import END_A, END_B, mid_set, ngsolve_thread_count
 from flex.data.results import Dataset
 
 _MESH_ORDER = 2  # as the reduction: linear tets lock in bending
@@ -119,21 +119,10 @@ def build_nonlinear_plate(length_m: float, thickness_m: float, width_m: float,
     sizes = {"length_m": length_m, "thickness_m": thickness_m, "width_m": width_m,
              "youngs_modulus_Pa": youngs_modulus_Pa, "density_kg_per_m3": density_kg_per_m3,
              "mesh_size_m": mesh_size_m}
-    for name, value in sizes.items():
-        if isinstance(value, bool) or not (isinstance(value, int | float)
-                                           and math.isfinite(value) and value > 0):
-            raise SceneError(f"nonlinear FE plate {name} = {value!r}: must be a finite "
-                             f"number > 0")
-    if isinstance(poisson_ratio, bool) or not (isinstance(poisson_ratio, int | float)
-                                               and 0.0 < poisson_ratio < 0.5):
-        raise SceneError(f"nonlinear FE plate poisson_ratio = {poisson_ratio!r}: must lie in "
-                         f"the open range (0, 0.5)")
-    if mesh_size_m > length_m:
-        raise SceneError(f"nonlinear FE plate mesh_size_m = {mesh_size_m!r}: must be <= "
-                         f"length_m ({length_m!r})")
+    _check_plate_inputs(sizes, poisson_ratio)
     from exudyn.FEM import FEMinterface
 
-    with _ngsolve_thread_count(ngsolve_threads):
+    with ngsolve_thread_count(ngsolve_threads):
         mesh = plate_mesh(length_m, thickness_m, width_m, mesh_size_m)
         fem = FEMinterface()
         # the reduction's import: it makes the mesh second order in place (once only: a
@@ -143,12 +132,8 @@ def build_nonlinear_plate(length_m: float, thickness_m: float, width_m: float,
                                   poissonsRatio=poisson_ratio, meshOrder=_MESH_ORDER,
                                   boundaryNamesList=[END_A, END_B])
     positions = fem.GetNodePositionsAsArray()
-    face_sets = {}
-    for node_set in fem.nodeSets:
-        if node_set["Name"] in (END_A, END_B):
-            nodes = np.sort(np.asarray(node_set["NodeNumbers"], dtype=np.int64))
-            face_sets[node_set["Name"]] = (nodes, fem.GetNodeWeightsFromSurfaceAreas(nodes))
-    mid_nodes, mid_weights = _mid_set(positions, length_m, mesh_size_m)
+    face_sets = _face_sets(fem)
+    mid_nodes, mid_weights = mid_set(positions, length_m, mesh_size_m)
 
     def centre(nodes: np.ndarray, weights: np.ndarray) -> np.ndarray:
         return np.asarray(weights) @ positions[nodes]
@@ -168,6 +153,35 @@ def build_nonlinear_plate(length_m: float, thickness_m: float, width_m: float,
         centre_end_a=centre(nodes_a, weights_a), centre_end_b=centre(nodes_b, weights_b),
         centre_mid=centre(mid_nodes, mid_weights), mass_matrix=mass_matrix, mass_kg=mass_kg,
         n_elements=int(mesh.ne), build_time_s=time.perf_counter() - start)
+
+
+def _check_plate_inputs(sizes: dict[str, float], poisson_ratio: float) -> None:
+    """Raise :class:`flex.base.errors.SceneError` unless every size (and E, density) is a
+    finite number > 0, Poisson's ratio lies in (0, 0.5) and the mesh size is at most the
+    length (:func:`build_nonlinear_plate`)."""
+    for name, value in sizes.items():
+        if isinstance(value, bool) or not (isinstance(value, int | float)
+                                           and math.isfinite(value) and value > 0):
+            raise SceneError(f"nonlinear FE plate {name} = {value!r}: must be a finite "
+                             f"number > 0")
+    if isinstance(poisson_ratio, bool) or not (isinstance(poisson_ratio, int | float)
+                                               and 0.0 < poisson_ratio < 0.5):
+        raise SceneError(f"nonlinear FE plate poisson_ratio = {poisson_ratio!r}: must lie in "
+                         f"the open range (0, 0.5)")
+    if sizes["mesh_size_m"] > sizes["length_m"]:
+        raise SceneError(f"nonlinear FE plate mesh_size_m = {sizes['mesh_size_m']!r}: must be "
+                         f"<= length_m ({sizes['length_m']!r})")
+
+
+def _face_sets(fem) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The joint faces' node sets (``end_a``, ``end_b``): sorted node numbers and area
+    weights, as the reduction numbers and weighs them."""
+    face_sets = {}
+    for node_set in fem.nodeSets:
+        if node_set["Name"] in (END_A, END_B):
+            nodes = np.sort(np.asarray(node_set["NodeNumbers"], dtype=np.int64))
+            face_sets[node_set["Name"]] = (nodes, fem.GetNodeWeightsFromSurfaceAreas(nodes))
+    return face_sets
 
 
 class _HyperelasticForces:
@@ -333,15 +347,9 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
     import exudyn.itemInterface as eii
     from exudyn.rigidBodyUtilities import RotationMatrixZ
 
-    position_B = as_vector3(position_B, "position_B")
-    velocity_B = as_vector3(initial_velocity_B_m_per_s, "initial_velocity_B_m_per_s")
-    for label, value in (("angle_rad", angle_rad),
-                         ("initial_angular_velocity_rad_per_s",
-                          initial_angular_velocity_rad_per_s)):
-        if isinstance(value, bool) or not (isinstance(value, int | float)
-                                           and math.isfinite(value)):
-            raise SceneError(f"{label} = {value!r}: must be a finite number")
-
+    position_B, velocity_B = _checked_placement(position_B, angle_rad,
+                                                initial_velocity_B_m_per_s,
+                                                initial_angular_velocity_rad_per_s)
     rotation = np.asarray(RotationMatrixZ(float(angle_rad)))
     reference = plate.node_positions_m
     placed = position_B + reference @ rotation.T
@@ -364,6 +372,22 @@ def add_nonlinear_fe_coupler(mbs, plate: NonlinearPlate, position_B: Sequence[fl
         "n_dof": plate.n_dof,
         "elastic_forces": elastic,
     }
+
+
+def _checked_placement(position_B: Sequence[float], angle_rad: float,
+                       velocity_B: Sequence[float], angular_velocity_rad_per_s: float
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`add_nonlinear_fe_coupler`'s placement and initial velocity checked (a
+    :class:`flex.base.errors.SceneError` names the first bad one): position and velocity of B
+    as 3-vectors."""
+    position_B = as_vector3(position_B, "position_B")
+    velocity_B = as_vector3(velocity_B, "initial_velocity_B_m_per_s")
+    for label, value in (("angle_rad", angle_rad),
+                         ("initial_angular_velocity_rad_per_s", angular_velocity_rad_per_s)):
+        if isinstance(value, bool) or not (isinstance(value, int | float)
+                                           and math.isfinite(value)):
+            raise SceneError(f"{label} = {value!r}: must be a finite number")
+    return position_B, velocity_B
 
 
 #: the nonlinear FE coupler's nodal positions are stored at most this many times plus one

@@ -71,7 +71,7 @@ EndType = Literal["plain", "plain_ground", "squared", "squared_ground"]
 END_TYPES: tuple[str, ...] = ("plain", "plain_ground", "squared", "squared_ground")
 
 
-def _require_positive(name: str, value: float, unit: str) -> float:
+def require_positive(name: str, value: float, unit: str) -> float:
     """Return ``float(value)`` or raise :class:`SceneError` unless it is finite and > 0."""
     try:
         number = float(value)
@@ -96,7 +96,7 @@ def _solve_rate_law(unknown: str, **known: float) -> float:
     product = 1.0
     for name, value in known.items():
         exponent, unit = _RATE_LAW[name]
-        product *= _require_positive(name, value, unit) ** exponent
+        product *= require_positive(name, value, unit) ** exponent
     return (8.0 / product) ** (1.0 / _RATE_LAW[unknown][0])
 
 
@@ -174,7 +174,7 @@ def rate_reproduction_table(
     """
     stated_rate = helical_spring_rate_N_per_m(shear_modulus_Pa, wire_diameter_m,
                                               mean_coil_diameter_m, active_coils)
-    k = _require_positive("rate_N_per_m", rate_N_per_m, "N/m")
+    k = require_positive("rate_N_per_m", rate_N_per_m, "N/m")
     return [
         RateReproduction("spring rate k (of the stated inputs)", "N/m", k, stated_rate),
         RateReproduction("mean coil diameter D", "m", mean_coil_diameter_m,
@@ -208,7 +208,7 @@ def total_coils(active_coils: float, end_type: EndType) -> float:
 
     plain: N_a; plain_ground: N_a + 1; squared and squared_ground: N_a + 2.
     """
-    n = _require_positive("active_coils", active_coils, "coils")
+    n = require_positive("active_coils", active_coils, "coils")
     if end_type not in END_TYPES:
         raise SceneError(f"spring end_type = {end_type!r}: must be one of {', '.join(END_TYPES)}")
     return n + {"plain": 0.0, "plain_ground": 1.0, "squared": 2.0, "squared_ground": 2.0}[end_type]
@@ -217,7 +217,7 @@ def total_coils(active_coils: float, end_type: EndType) -> float:
 def solid_length_m(wire_diameter_m: float, active_coils: float, end_type: EndType) -> float:
     """Solid length L_s [m] (Shigley table 10-1): ``d (N_t + 1)`` for plain and squared ends,
     ``d N_t`` for ground ends (plain_ground, squared_ground)."""
-    d = _require_positive("wire_diameter_m", wire_diameter_m, "m")
+    d = require_positive("wire_diameter_m", wire_diameter_m, "m")
     n_total = total_coils(active_coils, end_type)
     return d * n_total if end_type.endswith("_ground") else d * (n_total + 1.0)
 
@@ -226,9 +226,9 @@ def pitch_m(free_length_m: float, wire_diameter_m: float, active_coils: float,
             end_type: EndType) -> float:
     """Coil pitch p [m] from the free length (Shigley table 10-1): plain (L0 - d)/N_a,
     plain_ground L0/(N_a + 1), squared (L0 - 3d)/N_a, squared_ground (L0 - 2d)/N_a."""
-    length = _require_positive("free_length_m", free_length_m, "m")
-    d = _require_positive("wire_diameter_m", wire_diameter_m, "m")
-    n = _require_positive("active_coils", active_coils, "coils")
+    length = require_positive("free_length_m", free_length_m, "m")
+    d = require_positive("wire_diameter_m", wire_diameter_m, "m")
+    n = require_positive("active_coils", active_coils, "coils")
     if end_type not in END_TYPES:
         raise SceneError(f"spring end_type = {end_type!r}: must be one of {', '.join(END_TYPES)}")
     pitch = {"plain": (length - d) / n, "plain_ground": length / (n + 1.0),
@@ -255,7 +255,7 @@ class SpringDesign:
         for name, unit in (("wire_diameter_m", "m"), ("mean_coil_diameter_m", "m"),
                            ("active_coils", "coils"), ("free_length_m", "m"),
                            ("shear_modulus_Pa", "Pa"), ("density_kg_per_m3", "kg/m^3")):
-            _require_positive(name, getattr(self, name), unit)
+            require_positive(name, getattr(self, name), unit)
         if self.end_type not in END_TYPES:
             raise SceneError(f"spring end_type = {self.end_type!r}: must be one of "
                              f"{', '.join(END_TYPES)}")
@@ -306,7 +306,7 @@ class SpringDesign:
 
     def fractional_overrun_to_closure(self, working_deflection_m: float) -> float:
         """xi = (L0 - L_s) / y - 1 [-]; Shigley sec. 10-7 recommends xi >= 0.15."""
-        y = _require_positive("working_deflection_m", working_deflection_m, "m")
+        y = require_positive("working_deflection_m", working_deflection_m, "m")
         return self.deflection_to_solid_m / y - 1.0
 
 
@@ -336,13 +336,13 @@ CONSISTENT_THESIS_SPRING = SpringDesign(
 
 def spring_index(mean_coil_diameter_m: float, wire_diameter_m: float) -> float:
     """Spring index C = D / d [-]."""
-    D = _require_positive("mean_coil_diameter_m", mean_coil_diameter_m, "m")
-    d = _require_positive("wire_diameter_m", wire_diameter_m, "m")
+    D = require_positive("mean_coil_diameter_m", mean_coil_diameter_m, "m")
+    d = require_positive("wire_diameter_m", wire_diameter_m, "m")
     return D / d
 
 
 def _require_index_above_one(spring_index_: float) -> float:
-    c = _require_positive("spring_index", spring_index_, "-")
+    c = require_positive("spring_index", spring_index_, "-")
     if not c > 1.0:
         raise SceneError(f"spring spring_index = {spring_index_!r}: must be > 1 (D > d)")
     return c
@@ -372,16 +372,16 @@ def direct_shear_factor(spring_index_: float) -> float:
 def nominal_torsional_shear_stress_Pa(force_N: float, mean_coil_diameter_m: float,
                                       wire_diameter_m: float) -> float:
     """Torsion-only shear stress at the wire surface, ``8 F D / (pi d^3)`` [Pa]."""
-    f = _require_positive("force_N", force_N, "N")
-    D = _require_positive("mean_coil_diameter_m", mean_coil_diameter_m, "m")
-    d = _require_positive("wire_diameter_m", wire_diameter_m, "m")
+    f = require_positive("force_N", force_N, "N")
+    D = require_positive("mean_coil_diameter_m", mean_coil_diameter_m, "m")
+    d = require_positive("wire_diameter_m", wire_diameter_m, "m")
     return 8.0 * f * D / (math.pi * d**3)
 
 
 def a228_minimum_tensile_strength_Pa(wire_diameter_m: float) -> float:
     """Minimum tensile strength of ASTM A228 music wire, ``S_ut = A / d^m`` [Pa] with d in mm,
     A = 2211 MPa mm^m, m = 0.145 (Shigley table 10-4), for d = 0.10 ... 6.5 mm."""
-    d = _require_positive("wire_diameter_m", wire_diameter_m, "m")
+    d = require_positive("wire_diameter_m", wire_diameter_m, "m")
     low, high = A228_WIRE_DIAMETER_RANGE_M
     if not low <= d <= high:
         raise SceneError(f"spring wire_diameter_m = {wire_diameter_m!r}: the A228 strength fit "
@@ -424,7 +424,7 @@ def spring_stress_check(design: SpringDesign, deflection_m: float,
                         set_removed: bool = False) -> SpringStressCheck:
     """Shear stress of ``design`` compressed by ``deflection_m`` [m] (force F = k y) against
     the A228 allowable (:func:`music_wire_allowable_torsional_stress_Pa`)."""
-    y = _require_positive("deflection_m", deflection_m, "m")
+    y = require_positive("deflection_m", deflection_m, "m")
     force = design.rate_N_per_m * y
     c = design.spring_index
     nominal = nominal_torsional_shear_stress_Pa(force, design.mean_coil_diameter_m,
@@ -445,26 +445,26 @@ def spring_stress_check(design: SpringDesign, deflection_m: float,
 def active_coil_mass_kg(density_kg_per_m3: float, wire_diameter_m: float,
                         mean_coil_diameter_m: float, active_coils: float) -> float:
     """Mass of the active coils, ``rho (pi d^2 / 4) (pi D N)`` [kg] (Shigley sec. 10-8)."""
-    rho = _require_positive("density_kg_per_m3", density_kg_per_m3, "kg/m^3")
-    d = _require_positive("wire_diameter_m", wire_diameter_m, "m")
-    D = _require_positive("mean_coil_diameter_m", mean_coil_diameter_m, "m")
-    n = _require_positive("active_coils", active_coils, "coils")
+    rho = require_positive("density_kg_per_m3", density_kg_per_m3, "kg/m^3")
+    d = require_positive("wire_diameter_m", wire_diameter_m, "m")
+    D = require_positive("mean_coil_diameter_m", mean_coil_diameter_m, "m")
+    n = require_positive("active_coils", active_coils, "coils")
     return rho * math.pi * d**2 / 4.0 * math.pi * D * n
 
 
 def surge_frequency_fixed_fixed_Hz(rate_N_per_m: float, active_mass_kg: float) -> float:
     """First surge frequency, both ends fixed: ``f = (1/2) sqrt(k / m)`` [Hz] (Shigley
     sec. 10-8). Equivalent to a bar with wave speed c: f = c / (2 L), k = EA/L, m = rho A L."""
-    k = _require_positive("rate_N_per_m", rate_N_per_m, "N/m")
-    m = _require_positive("active_mass_kg", active_mass_kg, "kg")
+    k = require_positive("rate_N_per_m", rate_N_per_m, "N/m")
+    m = require_positive("active_mass_kg", active_mass_kg, "kg")
     return 0.5 * math.sqrt(k / m)
 
 
 def surge_frequency_fixed_free_Hz(rate_N_per_m: float, active_mass_kg: float) -> float:
     """First surge frequency, one end fixed and one free: ``f = (1/4) sqrt(k / m)`` [Hz]
     (Shigley sec. 10-8)."""
-    k = _require_positive("rate_N_per_m", rate_N_per_m, "N/m")
-    m = _require_positive("active_mass_kg", active_mass_kg, "kg")
+    k = require_positive("rate_N_per_m", rate_N_per_m, "N/m")
+    m = require_positive("active_mass_kg", active_mass_kg, "kg")
     return 0.25 * math.sqrt(k / m)
 
 
@@ -474,9 +474,9 @@ def surge_frequency_fixed_end_mass_Hz(rate_N_per_m: float, active_mass_kg: float
     carrying a point mass M at the other: ``beta tan(beta) = m / M``
     (:func:`flex.base.physics.spring_end_mass_wave_numbers`), ``omega = beta sqrt(k / m)``
     (a bar with a tip mass). M -> 0 gives the fixed-free value."""
-    k = _require_positive("rate_N_per_m", rate_N_per_m, "N/m")
-    m = _require_positive("active_mass_kg", active_mass_kg, "kg")
-    big_m = _require_positive("end_mass_kg", end_mass_kg, "kg")
+    k = require_positive("rate_N_per_m", rate_N_per_m, "N/m")
+    m = require_positive("active_mass_kg", active_mass_kg, "kg")
+    big_m = require_positive("end_mass_kg", end_mass_kg, "kg")
     beta = float(spring_end_mass_wave_numbers(m / big_m, 1)[0])
     return beta * math.sqrt(k / m) / (2.0 * math.pi)
 
@@ -489,8 +489,8 @@ def rigid_or_flexible_ratio(event_duration_s: float, frequency_Hz: float,
     (2 pi too small) period, which makes n 2 pi times larger. The thesis calls a body rigid if
     n > 108 (:data:`THESIS_RIGID_CRITERION_RATIO`).
     """
-    dt = _require_positive("event_duration_s", event_duration_s, "s")
-    f = _require_positive("frequency_Hz", frequency_Hz, "Hz")
+    dt = require_positive("event_duration_s", event_duration_s, "s")
+    f = require_positive("frequency_Hz", frequency_Hz, "Hz")
     if period_convention in ("physical", "thesis"):
         return n_values(dt, TWO_PI * f)[period_convention]
     raise SceneError(f"spring period_convention = {period_convention!r}: must be "

@@ -12,9 +12,9 @@ from flex.base.errors import SceneError
 from flex.bodies.spring import (
     MUSIC_WIRE_YOUNGS_MODULUS_PA,
     SpringDesign,
-    _require_positive,
     bergstrasser_factor,
     nominal_torsional_shear_stress_Pa,
+    require_positive,
     wahl_factor,
 )
 
@@ -82,24 +82,10 @@ def fe_helix_segment_stress(design: SpringDesign, force_N: float, *,
     an idle 2-core machine (netgen's mesh generation dominates; 4-9 s were measured under load).
     netgen refines by the wire's curvature, so ``mesh_size_m`` above ~d/4 changes little.
     """
-    f_axial = _require_positive("force_N", force_N, "N")
-    turns = _require_positive("segment_turns", segment_turns, "turns")
-    if turns > 1.0:
-        raise SceneError(f"spring segment_turns = {segment_turns!r}: must be in (0, 1] turns")
-    e_mod = _require_positive("youngs_modulus_Pa", youngs_modulus_Pa, "Pa")
-    if element_order not in (2, 3, 4):
-        raise SceneError(f"spring element_order = {element_order!r}: must be 2, 3 or 4")
-    if not (isinstance(sample_points, int) and sample_points >= 4):
-        raise SceneError(f"spring sample_points = {sample_points!r}: must be an integer >= 4")
+    f_axial, turns, e_mod, maxh, poisson = _checked_inputs(
+        design, force_N, segment_turns, mesh_size_m, element_order, youngs_modulus_Pa,
+        sample_points)
     d = design.wire_diameter_m
-    radius_wire = d / 2.0
-    maxh = radius_wire if mesh_size_m is None else _require_positive("mesh_size_m",
-                                                                    mesh_size_m, "m")
-    poisson = e_mod / (2.0 * design.shear_modulus_Pa) - 1.0
-    if not -1.0 < poisson < 0.5:
-        raise SceneError(f"spring youngs_modulus_Pa = {youngs_modulus_Pa!r}: with G = "
-                         f"{design.shear_modulus_Pa:g} Pa the Poisson ratio {poisson:.3f} "
-                         "must lie in (-1, 0.5), i.e. 2G < E < 3G")
     start = time.perf_counter()
     mesh = _helix_segment_mesh(design, turns, maxh, element_order)
     space, stress_cf, fe_rate = _solve_helix_segment(mesh, design, f_axial, turns, e_mod,
@@ -118,6 +104,31 @@ def fe_helix_segment_stress(design: SpringDesign, force_N: float, *,
         nominal_shear_stress_Pa=nominal, fe_rate_N_per_m=fe_rate,
         analytic_rate_N_per_m=design.rate_N_per_m,
         wall_time_s=time.perf_counter() - start)
+
+
+def _checked_inputs(design: SpringDesign, force_N: float, segment_turns: float,
+                    mesh_size_m: float | None, element_order: int, youngs_modulus_Pa: float,
+                    sample_points: int) -> tuple[float, float, float, float, float]:
+    """:func:`fe_helix_segment_stress`'s inputs checked (a :class:`SceneError` names the
+    first bad one): force [N], turns, E [Pa], maxh [m] (default d/2) and Poisson ratio."""
+    f_axial = require_positive("force_N", force_N, "N")
+    turns = require_positive("segment_turns", segment_turns, "turns")
+    if turns > 1.0:
+        raise SceneError(f"spring segment_turns = {segment_turns!r}: must be in (0, 1] turns")
+    e_mod = require_positive("youngs_modulus_Pa", youngs_modulus_Pa, "Pa")
+    if element_order not in (2, 3, 4):
+        raise SceneError(f"spring element_order = {element_order!r}: must be 2, 3 or 4")
+    if not (isinstance(sample_points, int) and sample_points >= 4):
+        raise SceneError(f"spring sample_points = {sample_points!r}: must be an integer >= 4")
+    radius_wire = design.wire_diameter_m / 2.0
+    maxh = radius_wire if mesh_size_m is None else require_positive("mesh_size_m",
+                                                                    mesh_size_m, "m")
+    poisson = e_mod / (2.0 * design.shear_modulus_Pa) - 1.0
+    if not -1.0 < poisson < 0.5:
+        raise SceneError(f"spring youngs_modulus_Pa = {youngs_modulus_Pa!r}: with G = "
+                         f"{design.shear_modulus_Pa:g} Pa the Poisson ratio {poisson:.3f} "
+                         "must lie in (-1, 0.5), i.e. 2G < E < 3G")
+    return f_axial, turns, e_mod, maxh, poisson
 
 
 def _helix_frame(design: SpringDesign, angle_rad: float):

@@ -75,6 +75,21 @@ def _periods_and_counts(prefix: str, omega_rad_per_s: np.ndarray, deployment_tim
     }
 
 
+def _table5_published_columns(length_m: float, width_m: float) -> dict[str, np.ndarray]:
+    """Table 5's plates (length and width [m], the thesis's thicknesses) and its published
+    columns, one entry per model (:func:`thesis_table5_reproduction`)."""
+    return {
+        "model": THESIS_TABLE5["model"].copy(),
+        "coupler_length_m": np.full(4, length_m),
+        "coupler_width_m": np.full(4, width_m),
+        "coupler_thickness_m": THESIS_TABLE5["coupler_thickness_m"].copy(),
+        "thesis_frequency_as_published": THESIS_TABLE5["frequency_as_published"].copy(),
+        "thesis_period_as_published_s": THESIS_TABLE5["period_as_published_s"].copy(),
+        "thesis_n_as_published": THESIS_TABLE5["n_as_published"].copy(),
+        "thesis_verdict_as_published": THESIS_TABLE5["verdict_as_published"].copy(),
+    }
+
+
 def thesis_table5_reproduction(mesh_sizes_m: Sequence[float] | None = TABLE5_FE_MESH_SIZES_M,
                                material: Material = THESIS_STEEL,
                                deployment_time_s: float = DEPLOYMENT_TIME_S,
@@ -113,14 +128,7 @@ def thesis_table5_reproduction(mesh_sizes_m: Sequence[float] | None = TABLE5_FE_
     timoshenko = np.array([timoshenko_bending_rad_per_s(length_m, t, width_m, "pinned-pinned",
                                                         1, material)[0] for t in thickness_m])
     table: dict[str, np.ndarray] = {
-        "model": THESIS_TABLE5["model"].copy(),
-        "coupler_length_m": np.full(4, length_m),
-        "coupler_width_m": np.full(4, width_m),
-        "coupler_thickness_m": thickness_m.copy(),
-        "thesis_frequency_as_published": THESIS_TABLE5["frequency_as_published"].copy(),
-        "thesis_period_as_published_s": THESIS_TABLE5["period_as_published_s"].copy(),
-        "thesis_n_as_published": THESIS_TABLE5["n_as_published"].copy(),
-        "thesis_verdict_as_published": THESIS_TABLE5["verdict_as_published"].copy(),
+        **_table5_published_columns(length_m, width_m),
         "euler_bernoulli_omega_rad_per_s": eb,
         "euler_bernoulli_frequency_Hz": eb / (2 * math.pi),
         "timoshenko_omega_rad_per_s": timoshenko,
@@ -226,8 +234,28 @@ def thesis_link_modal_reproduction(
     check_positive(section_side_m=section_side_m, deployment_time_s=deployment_time_s)
     length_m, published, thesis_k = _PUBLISHED[link]
     values = published["frequency_as_published"]
-    mode_count = values.size
-    table: dict[str, np.ndarray] = {
+    table = _published_link_columns(published, thesis_k, deployment_time_s)
+    models = _link_models(length_m, section_side_m, element_count, boundary_condition,
+                          values.size, material)
+    if fe_mesh_size_m is not None:
+        models["fe"], fe_columns = _fe_link_model(length_m, section_side_m, fe_mesh_size_m,
+                                                  boundary_condition, values.size, material)
+        table.update(fe_columns)
+    table.update(_link_model_columns(models, values, deployment_time_s))
+    table.update(link_length_m=np.array(length_m), section_side_m=np.array(section_side_m),
+                 element_count=np.array(element_count),
+                 boundary_condition=np.array(boundary_condition),
+                 deployment_time_s=np.array(deployment_time_s))
+    return table
+
+
+def _published_link_columns(published: dict[str, np.ndarray], thesis_k: float,
+                            deployment_time_s: float) -> dict[str, np.ndarray]:
+    """The thesis's columns of Table 7 or 9 (``published``, k as published ``thesis_k``) and
+    the counts n and k they give read as Hz and as rad/s
+    (:func:`thesis_link_modal_reproduction`)."""
+    values = published["frequency_as_published"]
+    return {
         "mode": published["mode"].copy(),
         "thesis_value_as_published": values.copy(),
         "thesis_period_as_published_s": published["period_as_published_s"].copy(),
@@ -239,27 +267,32 @@ def thesis_link_modal_reproduction(
         "k_reading_rad_per_s": np.array(physics.n_values(deployment_time_s,
                                                          values[-1])["physical"]),
     }
-    models = _link_models(length_m, section_side_m, element_count, boundary_condition,
-                          mode_count, material)
-    if fe_mesh_size_m is not None:
-        modes = plate_modes(length_m, section_side_m, section_side_m, fe_mesh_size_m,
-                            boundary_condition, mode_count, material)
-        models["fe"] = (modes.frequencies_Hz, modes.mode_kinds)
-        table["fe_mesh_size_m"] = np.array(fe_mesh_size_m)
-        table["fe_dof_count"] = np.array(modes.dof_count)
+
+
+def _fe_link_model(length_m: float, section_side_m: float, fe_mesh_size_m: float,
+                   boundary_condition: str, mode_count: int, material: Material
+                   ) -> tuple[tuple[np.ndarray, tuple[str, ...]], dict[str, np.ndarray]]:
+    """The 3D FE column of a square-section link (:func:`plate_modes`, netgen maxh
+    ``fe_mesh_size_m``): its frequencies [Hz] and mode kinds, and its columns
+    ``fe_mesh_size_m`` and ``fe_dof_count``."""
+    modes = plate_modes(length_m, section_side_m, section_side_m, fe_mesh_size_m,
+                        boundary_condition, mode_count, material)
+    return ((modes.frequencies_Hz, modes.mode_kinds),
+            {"fe_mesh_size_m": np.array(fe_mesh_size_m),
+             "fe_dof_count": np.array(modes.dof_count)})
+
+
+def _link_model_columns(models: dict[str, tuple[np.ndarray, tuple[str, ...]]],
+                        values: np.ndarray, deployment_time_s: float) -> dict[str, np.ndarray]:
+    """Per model (prefix: frequencies [Hz], kinds) its columns beside the thesis's ``values``:
+    frequency, kind, relative difference, period and k (:func:`thesis_link_modal_reproduction`)."""
+    table = {}
     for prefix, (frequencies_Hz, kinds) in models.items():
         table[f"{prefix}_frequency_Hz"] = frequencies_Hz
         table[f"{prefix}_kind"] = np.array(kinds)
         table[f"{prefix}_vs_thesis_relative"] = frequencies_Hz / values - 1.0
         table[f"{prefix}_period_s"] = 1.0 / frequencies_Hz
         table[f"{prefix}_k"] = np.array(deployment_time_s * frequencies_Hz[-1])
-    table.update({
-        "link_length_m": np.array(length_m),
-        "section_side_m": np.array(section_side_m),
-        "element_count": np.array(element_count),
-        "boundary_condition": np.array(boundary_condition),
-        "deployment_time_s": np.array(deployment_time_s),
-    })
     return table
 
 

@@ -19,7 +19,7 @@ CASE_TEXT_ATTRIBUTES = ("status", "message", "scene_toml", "solver_settings_toml
 DATASET_TEXT_ATTRIBUTES = ("units", "description")
 
 
-def _describe_value(value: Any) -> str:
+def describe_value(value: Any) -> str:
     """A short description of an unexpected attribute value: its type and (short) value."""
     import h5py
 
@@ -53,7 +53,7 @@ def _text_attribute(obj, key: str, where: str, label) -> str | None:
     elif isinstance(value, str):
         return str(value)
     raise ResultFileError(f"result file '{label}': attribute {key!r} of {where} is "
-                          f"{_describe_value(value)}; expected a text string")
+                          f"{describe_value(value)}; expected a text string")
 
 
 def _number_attribute(obj, key: str, where: str, label) -> None:
@@ -61,7 +61,7 @@ def _number_attribute(obj, key: str, where: str, label) -> None:
     if isinstance(value, bool | int | float | np.bool_ | np.integer | np.floating):
         return
     raise ResultFileError(f"result file '{label}': attribute {key!r} of {where} is "
-                          f"{_describe_value(value)}; expected a number")
+                          f"{describe_value(value)}; expected a number")
 
 
 def _link_kind(group, name: str) -> str | None:
@@ -95,8 +95,8 @@ def check_layout(h5, label: str | Path = "") -> None:
     - every dataset holds numbers or text (no compound, complex, reference or empty
       dataset); its ``units`` and ``description`` attributes are text when present.
 
-    Valid files written by :func:`write_results` always pass. ``/summary`` and other
-    top-level groups are checked for links, dataset types and attribute types only.
+    Valid files written by :func:`~flex.data.results.write_results` always pass. ``/summary``
+    and other top-level groups are checked for links, dataset types and attribute types only.
     """
     label = label or h5.filename
     where = "/"

@@ -40,7 +40,7 @@ import numpy as np
 
 from flex import __version__
 from flex.base.errors import ResultFileError
-from flex.data.result_layout import _describe_value, check_layout
+from flex.data.result_layout import check_layout, describe_value
 
 FORMAT = "flex-results/1"
 
@@ -228,7 +228,7 @@ def write_results(path: str | Path, study: str, cases: list[CaseResult],
         cause = _os_error_in(exc)
         if cause is None:
             raise
-        raise ResultFileError(f"cannot write result file '{path}': {_os_reason(cause)}; "
+        raise ResultFileError(f"cannot write result file '{path}': {os_reason(cause)}; "
                               f"the previous file (if any) is unchanged") from None
     return path
 
@@ -246,11 +246,14 @@ def _os_error_in(exc: BaseException) -> OSError | None:
     return None
 
 
-def _os_reason(exc: OSError) -> str:
+def os_reason(exc: OSError) -> str:
     """A one-line reason: ``No space left on device`` rather than HDF5's multi-line text."""
     if exc.errno:
         return os.strerror(exc.errno)
     return " ".join(str(exc).split())[:200]
+
+
+#: the old private name, still imported by flex/tools/plotcurves.py (to go with that import)
 
 
 def _write_file(path: Path, study: str, cases: list[CaseResult], scene_toml: str,
@@ -302,9 +305,22 @@ def open_results(path: str | Path, check: bool = True):
     a folder, empty, not HDF5 (or truncated), HDF5 not written by flex (no ``flex_format``
     attribute), or (``check``, the default) a layout :func:`check_layout` refuses.
     """
-    import h5py
-
     path = Path(path)
+    _check_readable_file(path)
+    h5 = _open_hdf5(path)
+    try:
+        _check_format(h5, path)
+        if check:
+            check_layout(h5, path)
+    except BaseException:
+        h5.close()
+        raise
+    return h5
+
+
+def _check_readable_file(path: Path) -> None:
+    """Raise :class:`ResultFileError` unless ``path`` is a regular, readable, non-empty file
+    (missing, a link to nothing, a folder, a device, unreadable, empty: each said so)."""
     if not path.exists():
         if path.is_symlink():
             raise ResultFileError(f"result file '{path}' is a symbolic link to nothing "
@@ -321,11 +337,18 @@ def open_results(path: str | Path, check: bool = True):
             stream.read(1)
     except OSError as exc:
         raise ResultFileError(f"result file '{path}' cannot be read: "
-                              f"{_os_reason(exc)}") from None
+                              f"{os_reason(exc)}") from None
     if size == 0:
         raise ResultFileError(f"result file '{path}' is empty (0 bytes), not an HDF5 file")
+
+
+def _open_hdf5(path: Path):
+    """``path`` opened read-only by h5py, or :class:`ResultFileError` saying why it cannot be
+    (not HDF5, truncated, locked by another process, damaged)."""
+    import h5py
+
     try:
-        h5 = h5py.File(path, "r")
+        return h5py.File(path, "r")
     except (OSError, RuntimeError, ValueError) as exc:
         try:
             hdf5 = h5py.is_hdf5(path)
@@ -343,28 +366,26 @@ def open_results(path: str | Path, check: bool = True):
             raise ResultFileError(f"result file '{path}' is locked by another process "
                                   f"(HDF5 file locking)") from None
         raise ResultFileError(f"result file '{path}' is damaged or truncated HDF5") from None
+
+
+def _check_format(h5, path: Path) -> None:
+    """Raise :class:`ResultFileError` unless the open file's root attribute ``flex_format``
+    is :data:`FORMAT` (unreadable, missing or another value: not written by flex)."""
     try:
+        fmt = h5.attrs.get("flex_format")
+    except (OSError, RuntimeError, KeyError, ValueError, TypeError):
+        raise ResultFileError(f"result file '{path}' is damaged: its root attribute "
+                              f"flex_format cannot be read") from None
+    if isinstance(fmt, bytes):
         try:
-            fmt = h5.attrs.get("flex_format")
-        except (OSError, RuntimeError, KeyError, ValueError, TypeError):
-            raise ResultFileError(f"result file '{path}' is damaged: its root attribute "
-                                  f"flex_format cannot be read") from None
-        if isinstance(fmt, bytes):
-            try:
-                fmt = fmt.decode("utf-8")
-            except UnicodeDecodeError:
-                pass
-        if not isinstance(fmt, str) or fmt != FORMAT:
-            found = (f"flex_format = {_describe_value(fmt)}" if fmt is not None
-                     else "no flex_format attribute")
-            raise ResultFileError(f"result file '{path}' was not written by flex ({found}; "
-                                  f"expected {FORMAT!r})")
-        if check:
-            check_layout(h5, path)
-    except BaseException:
-        h5.close()
-        raise
-    return h5
+            fmt = fmt.decode("utf-8")
+        except UnicodeDecodeError:
+            pass
+    if not isinstance(fmt, str) or fmt != FORMAT:
+        found = (f"flex_format = {describe_value(fmt)}" if fmt is not None
+                 else "no flex_format attribute")
+        raise ResultFileError(f"result file '{path}' was not written by flex ({found}; "
+                              f"expected {FORMAT!r})")
 
 
 def read_case(path: str | Path, case: str) -> dict[str, np.ndarray]:

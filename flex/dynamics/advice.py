@@ -99,6 +99,7 @@ _STEP_KEYS = ("simulation.end_time_s", "simulation.step_s", "simulation.output_s
 
 
 def mechanism_reductions(mech: Mechanism) -> dict[str, Any]:
+    """The reductions of a built mechanism's FFRF links, by link name (rigid links: none)."""
     return {link: body["reduction"] for link, body in (("crank", mech.crank),
                                                        ("coupler", mech.coupler))
             if mech.models[link].modal}
@@ -274,8 +275,8 @@ def check_resolved(scene: Scene, settings: dict[str, Any],
 
 
 def check_finite(datasets: dict[str, Dataset], settings: dict[str, Any],
-                  scene: Scene | None = None, reductions: dict[str, Any] | None = None,
-                  link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> None:
+                 scene: Scene | None = None, reductions: dict[str, Any] | None = None,
+                 link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> None:
     """Raise :class:`SimulationError` at the earliest sample where the solution diverged.
 
     Diverged: the motion's own time scale not resolved (:func:`check_resolved`), any
@@ -308,3 +309,6 @@ def check_finite(datasets: dict[str, Dataset], settings: dict[str, Any],
               else f"; {divergence_advice(scene, reductions or {}, link_models)}")
     raise SimulationError(f"solution diverged at step {step} (t = {now:.6g} s, step "
                           f"{settings['step_s']:g} s): {what}{advice}")
+
+
+#: the old private names, still imported by flex/dynamics/solver.py (to go with that import)

@@ -29,8 +29,8 @@ import numpy as np
 from flex.base.errors import FlexError, OutputError
 from flex.data.results import (
     ResultPathError,
-    _os_reason,
     atomic_path,
+    os_reason,
     parse_spec,
     reading,
     select_datasets,
@@ -252,7 +252,7 @@ def _draw(plt, path, specs, files, curves_by_file, curves, y_units, title, targe
         with atomic_path(target) as tmp:
             fig.savefig(tmp, dpi=120, format=target.suffix.lower()[1:])
     except OSError as exc:
-        raise OutputError(f"cannot write figure '{target}': {_os_reason(exc)}; the previous "
+        raise OutputError(f"cannot write figure '{target}': {os_reason(exc)}; the previous "
                           f"figure (if any) is unchanged") from None
     except (ValueError, OverflowError, ArithmeticError) as exc:
         reason = " ".join(str(exc).split())[:120]

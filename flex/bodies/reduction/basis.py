@@ -10,11 +10,12 @@ _STATIC_MODES = 6  # of end_b: 3 translations + 3 rotations of the rigid face
 
 
 
-def _craig_bampton_basis(fem, mass_form, stiffness_form, interfaces: list[np.ndarray],
-                         modes: int, selection: str) -> int:
+def craig_bampton_basis(fem, mass_form, stiffness_form, interfaces: list[np.ndarray],
+                        modes: int, selection: str) -> int:
     """Put the chord-frame Craig-Bampton basis in ``fem`` (``modeBasis``, ``eigenValues``):
     static modes and ``modes`` fixed-interface eigenmodes, all of them or the in-plane ones
-    (``selection``, see :func:`build_reduction`). Returns the number of static modes.
+    (``selection``, see :func:`~flex.bodies.reduction.build.build_reduction`). Returns the
+    number of static modes.
 
     Exudyn's Hurty-Craig-Bampton modes make ``end_a`` the floating frame (it gets no static
     modes) and give ``end_b`` its six rigid-face modes; :func:`_chord_frame` then trades
@@ -153,7 +154,7 @@ def _in_plane_eigenmodes(fem, positions: np.ndarray, eigenmodes: np.ndarray, mod
     return symmetric @ combination[:, :modes], eigenvalues[:modes]
 
 
-def _fix_eigenmode_signs(basis: np.ndarray, static_modes: int = _STATIC_MODES) -> None:
+def fix_eigenmode_signs(basis: np.ndarray, static_modes: int = _STATIC_MODES) -> None:
     """Turn each fixed-interface eigenmode so its largest entry is positive (in place).
 
     PINVIT returns modes of arbitrary sign (and threads change round-off), so two builds of

@@ -11,7 +11,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.bodies.reduction.build import END_A, END_B, Reduction, _is_number
+from flex.bodies.reduction.build import END_A, END_B, Reduction, is_number
 
 
 class MidpointDeflection(NamedTuple):
@@ -32,13 +32,11 @@ def as_vector3(value: Sequence[float], name: str) -> np.ndarray:
 
 
 def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_rad: float,
-                  damping_ratio: float = 0.0,
-                  damping_model: str = "stiffness_proportional",
+                  damping_ratio: float = 0.0, damping_model: str = "stiffness_proportional",
                   initial_velocity_B_m_per_s: Sequence[float] = (0.0, 0.0, 0.0),
-                  initial_angular_velocity_rad_per_s: float = 0.0,
-                  name: str = "coupler", joint_markers: str = "fewest",
-                  end_b_rotation: bool = True, end_a_rotation: bool = True
-                  ) -> dict[str, Any]:
+                  initial_angular_velocity_rad_per_s: float = 0.0, name: str = "coupler",
+                  joint_markers: str = "fewest", end_b_rotation: bool = True,
+                  end_a_rotation: bool = True) -> dict[str, Any]:
     """Add the reduced plate to ``mbs`` as an ``ObjectFFRFreducedOrder`` between B and C.
 
     Written for the coupler (``end_a`` at B, ``end_b`` at C); the crank uses it with
@@ -73,48 +71,63 @@ def add_ffrf_link(mbs, reduction: Reduction, position_B: Sequence[float], angle_
         the starting configuration (e.g. a crank turning at constant speed); default rest.
       - the body is added at the reference configuration; call ``mbs.Assemble()`` afterwards.
 
-    Returns a dict:
-      ``object`` (ObjectIndex of the ObjectFFRFreducedOrder), ``node_frame`` (NodeIndex of the
-      floating frame, Euler parameters), ``node_modal`` (NodeIndex of the modal elastic
-      coordinates: sensor ``OutputVariableType.Coordinates`` feeds
-      :func:`bending_stress_history`), ``marker_B``, ``marker_C``, ``marker_mid``
-      (MarkerIndex), ``position_B``, ``position_C``, ``position_mid`` (reference positions
-      [m], global), ``rotation_matrix`` (3x3, body to global), ``mass_kg``,
-      ``stiffness_proportional_damping_s`` (beta [s]), ``modal_damping`` (None, or the
-      bands' ``(frequencies [Hz], damping ratios)`` per mode of the reduced body).
+    Returns a dict: ``object`` (ObjectIndex of the ObjectFFRFreducedOrder), ``node_frame``
+    (NodeIndex of the floating frame, Euler parameters), ``node_modal`` (NodeIndex of the modal
+    elastic coordinates: sensor ``OutputVariableType.Coordinates`` feeds
+    :func:`bending_stress_history`), ``marker_B``, ``marker_C``, ``marker_mid`` (MarkerIndex),
+    ``position_B``, ``position_C``, ``position_mid`` (reference positions [m], global),
+    ``rotation_matrix`` (3x3, body to global), ``mass_kg``, ``stiffness_proportional_damping_s``
+    (beta [s]), ``modal_damping`` (None, or the bands' ``(frequencies [Hz], damping ratios)``
+    per mode of the reduced body).
     """
-    from exudyn.rigidBodyUtilities import RotationMatrixZ
+    position_B, velocity_B = _checked_placement(position_B, angle_rad, initial_velocity_B_m_per_s,
+                                                initial_angular_velocity_rad_per_s, joint_markers)
+    beta = _stiffness_proportional_damping_s(reduction, damping_ratio)
+    rotation, link = _add_ffrf_object(mbs, reduction, position_B, angle_rad, velocity_B,
+                                      initial_angular_velocity_rad_per_s, beta, name)
+    modal_damping = _band_damping(mbs, link["object"], reduction, damping_model, damping_ratio)
+    joints = None if joint_markers == "all_face_nodes" else _ffrf_joint_markers(
+        mbs, link["object"], link["node_frame"], reduction, name, end_b_rotation, end_a_rotation)
+    return {**link, **add_plate_markers(mbs, link["object"], reduction, position_B, rotation,
+                                        name, joint_markers=joints),
+            "stiffness_proportional_damping_s": beta, "modal_damping": modal_damping}
 
+
+def _checked_placement(position_B: Sequence[float], angle_rad: float,
+                       velocity_B: Sequence[float], angular_velocity_rad_per_s: float,
+                       joint_markers: str) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`add_ffrf_link`'s placement and initial velocity checked (a
+    :class:`flex.base.errors.SceneError` names the first bad one): position and velocity of B
+    as 3-vectors."""
     position_B = as_vector3(position_B, "position_B")
-    velocity_B = as_vector3(initial_velocity_B_m_per_s, "initial_velocity_B_m_per_s")
+    velocity_B = as_vector3(velocity_B, "initial_velocity_B_m_per_s")
     for label, value in (("angle_rad", angle_rad),
-                         ("initial_angular_velocity_rad_per_s",
-                          initial_angular_velocity_rad_per_s)):
-        if not (_is_number(value) and math.isfinite(value)):
+                         ("initial_angular_velocity_rad_per_s", angular_velocity_rad_per_s)):
+        if not (is_number(value) and math.isfinite(value)):
             raise SceneError(f"{label} = {value!r}: must be a finite number")
     if joint_markers not in JOINT_MARKERS:
         raise SceneError(f"joint_markers = {joint_markers!r}: must be one of "
                          f"{', '.join(JOINT_MARKERS)}")
-    beta = _stiffness_proportional_damping_s(reduction, damping_ratio)
+    return position_B, velocity_B
+
+
+def _add_ffrf_object(mbs, reduction: Reduction, position_B: np.ndarray, angle_rad: float,
+                     velocity_B: np.ndarray, angular_velocity_rad_per_s: float, beta: float,
+                     name: str) -> tuple[np.ndarray, dict[str, Any]]:
+    """The reduction's ``ObjectFFRFreducedOrder`` added at B turned by ``angle_rad`` about z,
+    with its initial velocity and stiffness-proportional damping ``beta`` [s]. Returns the
+    rotation matrix (body to global) and the ``object``, ``node_frame`` and ``node_modal``
+    entries of :func:`add_ffrf_link`'s result."""
+    from exudyn.rigidBodyUtilities import RotationMatrixZ
+
     rotation = np.asarray(RotationMatrixZ(float(angle_rad)))
     added = reduction.ffrf_interface().AddObjectFFRFreducedOrder(
         mbs, positionRef=list(position_B), rotationMatrixRef=rotation,
         initialVelocity=list(velocity_B),
-        initialAngularVelocity=[0.0, 0.0, float(initial_angular_velocity_rad_per_s)],
+        initialAngularVelocity=[0.0, 0.0, float(angular_velocity_rad_per_s)],
         stiffnessProportionalDamping=beta, name=name)
-    body = added["oFFRFreducedOrder"]
-    modal_damping = _band_damping(mbs, body, reduction, damping_model, damping_ratio)
-    return {
-        "object": body,
-        "node_frame": added["nRigidBody"],
-        "node_modal": added["nGenericODE2"],
-        **add_plate_markers(mbs, body, reduction, position_B, rotation, name,
-                            joint_markers=None if joint_markers == "all_face_nodes" else
-                            _ffrf_joint_markers(mbs, body, added["nRigidBody"], reduction,
-                                                name, end_b_rotation, end_a_rotation)),
-        "stiffness_proportional_damping_s": beta,
-        "modal_damping": modal_damping,
-    }
+    return rotation, {"object": added["oFFRFreducedOrder"], "node_frame": added["nRigidBody"],
+                      "node_modal": added["nGenericODE2"]}
 
 
 def _band_damping(mbs, body, reduction: Reduction, damping_model: str,
@@ -141,7 +154,7 @@ def _band_damping(mbs, body, reduction: Reduction, damping_model: str,
 def _stiffness_proportional_damping_s(reduction: Reduction, damping_ratio: float) -> float:
     """Rayleigh ``beta`` [s] that gives the first pinned-pinned mode ``damping_ratio`` of
     critical damping (0 for none); SceneError outside [0, 1) or without that mode."""
-    if not (_is_number(damping_ratio) and 0.0 <= damping_ratio < 1.0):
+    if not (is_number(damping_ratio) and 0.0 <= damping_ratio < 1.0):
         raise SceneError(f"damping_ratio = {damping_ratio!r}: must lie in [0, 1)")
     if damping_ratio == 0:
         return 0.0

@@ -20,16 +20,16 @@ import numpy as np
 from flex.base.errors import SceneError
 from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction.basis import (
-    _craig_bampton_basis,
-    _fix_eigenmode_signs,
+    craig_bampton_basis,
+    fix_eigenmode_signs,
 )
 from flex.bodies.reduction.cache import (
     CACHE_FORMAT_VERSION,
-    _cache_key,
-    _content_digest,
-    _load_cached,
-    _meta_digest,
-    _say_unproven,
+    cache_key,
+    fem_content_digest,
+    load_cached,
+    meta_digest,
+    say_unproven,
 )
 from flex.data.cache import (
     REDUCTION_CACHE,
@@ -52,11 +52,11 @@ MODE_SELECTIONS = ("in_plane", "all")
 # ------------------------------------------------------------------------------------------
 @dataclass
 class Reduction(PlateLink):
-    """A reduced flexible plate link, ready for :func:`add_ffrf_link`.
+    """A reduced flexible plate link, ready for :func:`~flex.bodies.reduction.body.add_ffrf_link`.
 
     Node index arrays refer to ``fem``'s mesh nodes; weights sum to 1. ``centre_*`` are the
     weighted reference positions of the node sets in body coordinates [m]: the points the
-    markers of :func:`add_ffrf_link` report.
+    markers of :func:`~flex.bodies.reduction.body.add_ffrf_link` report.
     """
 
     fem: Any  #: exudyn.FEM.FEMinterface holding mesh, M, K, mode basis, stress modes
@@ -103,15 +103,16 @@ class Reduction(PlateLink):
 # ------------------------------------------------------------------------------------------
 # input checks
 # ------------------------------------------------------------------------------------------
-def _is_number(value: Any) -> bool:
+def is_number(value: Any) -> bool:
+    """A real number, not a bool (``True`` is an ``int`` to Python, never a size to flex)."""
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 def _check_inputs(sizes: dict[str, float], poisson_ratio: float, modes: int) -> None:
     for name, value in sizes.items():
-        if not (_is_number(value) and math.isfinite(value) and value > 0):
+        if not (is_number(value) and math.isfinite(value) and value > 0):
             raise SceneError(f"reduction {name} = {value!r}: must be a finite number > 0")
-    if not (_is_number(poisson_ratio) and 0.0 < poisson_ratio < 0.5):
+    if not (is_number(poisson_ratio) and 0.0 < poisson_ratio < 0.5):
         raise SceneError(
             f"reduction poisson_ratio = {poisson_ratio!r}: must lie in the open range (0, 0.5)")
     if isinstance(modes, bool) or not isinstance(modes, int | np.integer) or modes < 1:
@@ -132,8 +133,8 @@ def _node_set(fem, name: str) -> dict:
     raise KeyError(name)
 
 
-def _mid_set(positions: np.ndarray, length_m: float, mesh_size_m: float,
-             ) -> tuple[np.ndarray, np.ndarray]:
+def mid_set(positions: np.ndarray, length_m: float, mesh_size_m: float,
+            ) -> tuple[np.ndarray, np.ndarray]:
     """Nodes of a thin slab around x = length/2 and weights placing their centre there.
 
     A tetrahedral mesh has no node plane at mid-length, so the marker averages a slab of
@@ -207,7 +208,7 @@ def _pinned_pinned_frequency_Hz(ffrf_interface, reduction_length_m: float,
 
 
 @contextlib.contextmanager
-def _ngsolve_thread_count(threads: int | None) -> Iterator[None]:
+def ngsolve_thread_count(threads: int | None) -> Iterator[None]:
     """Run NGsolve's task manager with ``threads`` threads inside the block, then restore."""
     if threads is None:
         yield
@@ -223,6 +224,7 @@ def _ngsolve_thread_count(threads: int | None) -> Iterator[None]:
         yield
     finally:
         ngsolve.SetNumThreads(previous)
+
 
 def build_reduction(length_m: float, thickness_m: float, width_m: float,
                     youngs_modulus_Pa: float, density_kg_per_m3: float, poisson_ratio: float,
@@ -242,7 +244,8 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
         mechanism plane z = 0 -- the 3 in-plane static modes of ``end_b`` (x, y, rotation
         about z) and the lowest ``modes`` in-plane eigenmodes -- since a planar mechanism
         loads its links in plane and the out-of-plane bending and torsion modes carry
-        nothing (decoupled by symmetry, :func:`_in_plane_eigenmodes`); ``"all"`` keeps the 6
+        nothing (decoupled by symmetry,
+        :func:`~flex.bodies.reduction.basis._in_plane_eigenmodes`); ``"all"`` keeps the 6
         static modes and the lowest ``modes`` eigenmodes of any kind.
       - the mesh uses second-order tetrahedra; stress post-processing modes (local stress,
         Pa per unit modal coordinate) are always computed.
@@ -263,6 +266,30 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
     sizes = {"length_m": length_m, "thickness_m": thickness_m, "width_m": width_m,
              "youngs_modulus_Pa": youngs_modulus_Pa, "density_kg_per_m3": density_kg_per_m3,
              "mesh_size_m": mesh_size_m}
+    parameters = _reduction_parameters(sizes, poisson_ratio, modes, mode_selection, mesh_order)
+    key = cache_key(parameters)
+    cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"
+    fem, ffrf_interface, from_cache, cache_file = _cached_or_built(parameters, key, cache_file,
+                                                                   ngsolve_threads)
+    meta = fem.metaData["flex"]
+    return Reduction(
+        fem=fem, **sizes, poisson_ratio=float(poisson_ratio), modes=int(modes),
+        mode_selection=mode_selection, **_node_set_fields(fem),
+        fixed_interface_frequencies_Hz=np.sqrt(np.abs(np.asarray(fem.eigenValues))) / (2 * np.pi),
+        pinned_pinned_frequency_Hz=float(meta["pinned_pinned_frequency_Hz"]),
+        mass_kg=float(meta["mass_kg"]), n_nodes=int(fem.NumberOfNodes()),
+        n_elements=int(meta["n_elements"]), n_dof=3 * int(fem.NumberOfNodes()),
+        cold_build_time_s=float(meta["cold_build_time_s"]),
+        build_time_s=time.perf_counter() - start, from_cache=from_cache,
+        cache_file=cache_file, key=key,
+        _ffrf_interface=ffrf_interface,
+    )
+
+
+def _reduction_parameters(sizes: dict[str, float], poisson_ratio: float, modes: int,
+                          mode_selection: str, mesh_order: int) -> dict[str, Any]:
+    """The checked arguments of :func:`build_reduction` as the parameters its cache key
+    hashes (bad values raise :class:`flex.base.errors.SceneError`)."""
     _check_inputs(sizes, poisson_ratio, modes)
     if mode_selection not in MODE_SELECTIONS:
         raise SceneError(f"reduction mode_selection = {mode_selection!r}: must be one of "
@@ -274,46 +301,41 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
                       mesh_order=int(mesh_order), stress_modes=True)
     if mode_selection != "all":  # "all" keeps the keys (and cache entries) it always had
         parameters["mode_selection"] = mode_selection
-    key = _cache_key(parameters)
-    cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"
+    return parameters
 
-    fem = _load_cached(cache_file, key) if cache_file is not None else None
+
+def _cached_or_built(parameters: dict[str, Any], key: str, cache_file: Path | None,
+                     ngsolve_threads: int | None) -> tuple[Any, Any, bool, Path | None]:
+    """The FEMinterface of ``key``: the cache entry that proves its content, or a new build
+    stored in its place. Returns the FEMinterface, its ObjectFFRFreducedOrderInterface (None
+    when loaded from the cache), whether it was loaded, and the cache file (None when nothing
+    is kept)."""
+    fem = load_cached(cache_file, key) if cache_file is not None else None
     from_cache = fem is not None
     ffrf_interface = None
     if fem is None:
-        _say_unproven(cache_file)
-        with _ngsolve_thread_count(ngsolve_threads):
+        say_unproven(cache_file)
+        with ngsolve_thread_count(ngsolve_threads):
             fem, ffrf_interface = _build_fem(parameters, key)
         if cache_file is not None and not store(
                 cache_file, lambda temporary: fem.SaveToFile(str(temporary), mode="HDF5"),
                 REDUCTION_CACHE):
             cache_file = None  # not kept (said): nothing is cached beside it either
+    return fem, ffrf_interface, from_cache, cache_file
 
-    meta = fem.metaData["flex"]
-    end_a, end_b, mid = (_node_set(fem, name) for name in (END_A, END_B, MID))
+
+def _node_set_fields(fem) -> dict[str, np.ndarray]:
+    """The :class:`Reduction` fields of the node sets ``end_a``, ``end_b`` and ``mid``: node
+    numbers, weights (summing to 1) and weighted reference centres [m]."""
     positions = fem.GetNodePositionsAsArray()
-
-    def centre(node_set: dict) -> np.ndarray:
-        return np.asarray(node_set["NodeWeights"]) @ positions[node_set["NodeNumbers"]]
-
-    return Reduction(
-        fem=fem, **sizes, poisson_ratio=float(poisson_ratio), modes=int(modes),
-        mode_selection=mode_selection,
-        nodes_end_a=np.asarray(end_a["NodeNumbers"]),
-        weights_end_a=unit_sum(end_a["NodeWeights"]),
-        nodes_end_b=np.asarray(end_b["NodeNumbers"]),
-        weights_end_b=unit_sum(end_b["NodeWeights"]),
-        nodes_mid=np.asarray(mid["NodeNumbers"]), weights_mid=unit_sum(mid["NodeWeights"]),
-        centre_end_a=centre(end_a), centre_end_b=centre(end_b), centre_mid=centre(mid),
-        fixed_interface_frequencies_Hz=np.sqrt(np.abs(np.asarray(fem.eigenValues))) / (2 * np.pi),
-        pinned_pinned_frequency_Hz=float(meta["pinned_pinned_frequency_Hz"]),
-        mass_kg=float(meta["mass_kg"]), n_nodes=int(fem.NumberOfNodes()),
-        n_elements=int(meta["n_elements"]), n_dof=3 * int(fem.NumberOfNodes()),
-        cold_build_time_s=float(meta["cold_build_time_s"]),
-        build_time_s=time.perf_counter() - start, from_cache=from_cache,
-        cache_file=cache_file, key=key,
-        _ffrf_interface=ffrf_interface,
-    )
+    fields = {}
+    for field_name, set_name in (("end_a", END_A), ("end_b", END_B), ("mid", MID)):
+        node_set = _node_set(fem, set_name)
+        fields[f"nodes_{field_name}"] = np.asarray(node_set["NodeNumbers"])
+        fields[f"weights_{field_name}"] = unit_sum(node_set["NodeWeights"])
+        fields[f"centre_{field_name}"] = (np.asarray(node_set["NodeWeights"])
+                                          @ positions[node_set["NodeNumbers"]])
+    return fields
 
 
 def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
@@ -343,16 +365,16 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
         node_set["NodeNumbers"] = nodes
         node_set["NodeWeights"] = fem.GetNodeWeightsFromSurfaceAreas(nodes)
         interfaces.append(nodes)
-    static_modes = _craig_bampton_basis(fem, mass_form, stiffness_form, interfaces,
-                                        parameters["modes"],
-                                        parameters.get("mode_selection", "all"))
-    _fix_eigenmode_signs(fem.modeBasis["matrix"], static_modes)
+    static_modes = craig_bampton_basis(fem, mass_form, stiffness_form, interfaces,
+                                       parameters["modes"],
+                                       parameters.get("mode_selection", "all"))
+    fix_eigenmode_signs(fem.modeBasis["matrix"], static_modes)
     material = KirchhoffMaterial(parameters["youngs_modulus_Pa"], parameters["poisson_ratio"],
                                  parameters["density_kg_per_m3"])
     fem.ComputePostProcessingModesNGsolve(space, material=material,
                                           outputVariableType=exu.OutputVariableType.StressLocal)
     positions = fem.GetNodePositionsAsArray()
-    mid_nodes, mid_weights = _mid_set(positions, length_m, parameters["mesh_size_m"])
+    mid_nodes, mid_weights = mid_set(positions, length_m, parameters["mesh_size_m"])
     fem.nodeSets.append({"Name": MID, "NodeNumbers": mid_nodes, "NodeWeights": mid_weights})
 
     from exudyn.FEM import ObjectFFRFreducedOrderInterface
@@ -370,9 +392,9 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
         "mass_kg": float(ffrf_interface.totalMass),
         "n_elements": int(mesh.ne),
         "cold_build_time_s": time.perf_counter() - start,
-        "digest": _content_digest(fem),
+        "digest": fem_content_digest(fem),
     }
-    fem.metaData["flex"]["meta_digest"] = _meta_digest(fem.metaData["flex"])
+    fem.metaData["flex"]["meta_digest"] = meta_digest(fem.metaData["flex"])
     # handed to the Reduction (not stored): saves re-projecting on the first add
     return fem, ffrf_interface
 

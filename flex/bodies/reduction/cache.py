@@ -59,7 +59,8 @@ def _engine_versions() -> dict[str, str]:
     return {"exudyn": version("exudyn"), "ngsolve": version("ngsolve")}
 
 
-def _cache_key(parameters: dict[str, Any]) -> str:
+def cache_key(parameters: dict[str, Any]) -> str:
+    """A reduction's cache key: its parameters, the cache format and the engines' versions."""
     # repr(float) is exact and canonical, so 0.003 and 3e-3 hash alike, 0.0030000001 not
     canonical = {k: (repr(float(v)) if isinstance(v, float) else v)
                  for k, v in parameters.items()}
@@ -69,7 +70,7 @@ def _cache_key(parameters: dict[str, Any]) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
-def _content_digest(fem) -> str:
+def fem_content_digest(fem) -> str:
     """SHA-256 over the arrays a simulation uses: detects a damaged file that still opens."""
     digest = hashlib.sha256()
     parts = [fem.GetNodePositionsAsArray(), fem.modeBasis["matrix"], np.asarray(fem.eigenValues)]
@@ -86,7 +87,7 @@ def _content_digest(fem) -> str:
     return digest.hexdigest()
 
 
-def _load_cached(path: Path, key: str):
+def load_cached(path: Path, key: str):
     """Return the FEMinterface stored under ``path`` if it is whole and made for ``key``.
 
     Returns None for a missing, truncated, foreign or damaged file (the caller rebuilds).
@@ -111,8 +112,8 @@ def _load_cached(path: Path, key: str):
     try:
         fem.LoadFromFile(str(path), mode="HDF5")
         meta = fem.metaData["flex"]
-        if (meta["digest"] != _content_digest(fem)
-                or meta.get("meta_digest") != _meta_digest(meta)):
+        if (meta["digest"] != fem_content_digest(fem)
+                or meta.get("meta_digest") != meta_digest(meta)):
             return None
         n_nodes = fem.NumberOfNodes()
         if fem.modeBasis["matrix"].shape[0] != 3 * n_nodes:
@@ -122,14 +123,15 @@ def _load_cached(path: Path, key: str):
     return fem
 
 
-def _meta_digest(meta: Mapping[str, Any]) -> str:
-    """Digest of the entry's own numbers (mass, frequency, ...: read by :class:`Reduction`
-    as they are stored), beside :func:`_content_digest` of its arrays."""
+def meta_digest(meta: Mapping[str, Any]) -> str:
+    """Digest of the entry's own numbers (mass, frequency, ...: read by
+    :class:`~flex.bodies.reduction.build.Reduction` as they are stored), beside
+    :func:`fem_content_digest` of its arrays."""
     return content_digest((name, number_text(meta[name])) for name in sorted(meta)
                           if name not in ("digest", "meta_digest"))
 
 
-def _say_unproven(path: Path | None) -> None:
+def say_unproven(path: Path | None) -> None:
     """One line when an existing entry is about to be rebuilt (it did not prove its
     content: damaged, edited, foreign, an older format, or not a file)."""
     if path is None or not path.is_file() or entry_problem(path):
@@ -137,4 +139,7 @@ def _say_unproven(path: Path | None) -> None:
     say(REDUCTION_CACHE, f"entry '{path}' did not prove its content (its key or content "
                          f"digest does not match: damaged, edited, foreign or of an older "
                          f"format); building the reduction again")
+
+
+#: the old private names, still used by tests/test_hostile_caches.py (to go with that use)
 

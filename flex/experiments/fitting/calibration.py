@@ -3,12 +3,10 @@
 For every scene of a family (FFRF coupler on a rigid crank: plates of several thicknesses
 and materials, springs and drives) :func:`measure_scene` runs
 
-- a **converged reference**: 12 in-plane modes, a mesh of about the thickness (at most L /
-  32, at least :data:`REFERENCE_MESH_FLOOR_M`) and a step that resolves the 12th mode
-  (:data:`REFERENCE_STEPS_PER_TOP_PERIOD` steps per period, at most T1 / 400), with the
-  evidence of three one-level coarsenings (8 modes, twice the step, 1.5 x the mesh; their
-  changes summed are the reference's accuracy,
-  :func:`flex.experiments.workprecision.convergence.converged_reference`);
+- a **converged reference**
+  (:func:`flex.experiments.workprecision.coupler_reference.scene_reference`: 12 in-plane
+  modes, a mesh of about the thickness and a step that resolves the 12th mode, with the
+  evidence of three one-level coarsenings);
 - the **grid**: every pair of :data:`GRID_MODES` and :data:`GRID_STEPS_PER_PERIOD` (step T1 /
   N) on the rule's mesh, each timed as a user runs it (whole ``simulate``, warm reduction
   cache, median of ``repeats``) and measured against the reference (relative error of the
@@ -23,6 +21,8 @@ modelled run time (:func:`modelled_time_s`); :func:`cross_validate` refits with 
 calibration scene left out and judges the fit on it; :func:`validate` applies the fitted rule to
 scenes outside the calibration and compares it with the fastest grid pair robustly within the
 level, by measured time (target: within the level, at most :data:`SLOWDOWN_LIMIT` x slower).
+The tolerance levels (:data:`LEVELS`) and the runs' solver keys are
+:mod:`flex.experiments.workprecision.coupler_reference`'s.
 """
 
 from __future__ import annotations
@@ -30,14 +30,13 @@ from __future__ import annotations
 import itertools
 import math
 import tomllib
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from flex.base.errors import FlexError
-from flex.base.physics import in_plane_fixed_interface_omegas
 from flex.config.ffrf_rule import (
     MODE_GRID,
     STEP_GRID,
@@ -53,7 +52,12 @@ from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
 from flex.data.tables import table_datasets
 from flex.dynamics.solver import FFRF_DEFLECTION_LIMIT
-from flex.experiments.workprecision.convergence import converged_reference
+from flex.experiments.workprecision.coupler_reference import (
+    LEVELS,
+    Progress,
+    coupler_setting,
+    scene_reference,
+)
 from flex.experiments.workprecision.measurement import (
     ReductionPool,
     Reference,
@@ -66,8 +70,6 @@ from flex.experiments.workprecision.measurement import (
 #: the grid: in-plane eigenmodes and steps per first bending period
 GRID_MODES = MODE_GRID
 GRID_STEPS_PER_PERIOD = tuple(float(n) for n in STEP_GRID)
-#: the tolerance levels calibrated (relative error of the peak midpoint deflection)
-LEVELS = (0.01, 0.001)
 #: a calibrated law must keep every calibration scene's certified error (measured + the
 #: reference's own accuracy, itself a sum of one-level changes: conservative) within this
 #: fraction of the level (robustly: at its step and every finer one, :func:`robustly_within`)
@@ -88,43 +90,6 @@ STEPS_EXPONENTS = tuple(round(0.05 * k, 2) for k in range(31))
 MIN_SCENES = 3
 #: validation target: the rule's pick at most this many times slower than the grid's fastest
 SLOWDOWN_LIMIT = 3.0
-#: reference discretization
-REFERENCE_MODES = 12
-REFERENCE_STEPS_PER_TOP_PERIOD = 16.0
-REFERENCE_MESH_FLOOR_M = 0.00075
-#: solver keys of every run (make tradeoff's fastest FFRF choices)
-SOLVER = {"newton": "modified", "newton_relative_tolerance": 1e-8, "spectral_radius": 0.9}
-
-Progress = Callable[[str], None]
-
-
-def _setting(label: str, step_s: float, modes: int, mesh_m: float) -> Setting:
-    return Setting.of(label, step_s=step_s, coupler__modes=modes,
-                      coupler__mesh_size_m=mesh_m, output_step_s=0.0, **SOLVER)
-
-
-def reference_discretization(coupler: Mapping[str, Any]) -> tuple[float, int, float]:
-    """Step [s], modes and mesh size [m] of a scene's reference (see the module doc)."""
-    omegas = in_plane_fixed_interface_omegas(
-        coupler["length_m"], coupler["thickness_m"], coupler["width_m"],
-        coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"], coupler["poisson_ratio"],
-        REFERENCE_MODES)
-    top_period = 2 * math.pi / omegas[-1]
-    step = min(first_period_s(coupler) / 400.0, top_period / REFERENCE_STEPS_PER_TOP_PERIOD)
-    mesh = max(min(coupler["thickness_m"], coupler["length_m"] / 32.0), REFERENCE_MESH_FLOOR_M)
-    return step, REFERENCE_MODES, mesh
-
-
-def scene_reference(scene: Scene, pool: ReductionPool, progress: Progress | None = None
-                    ) -> Reference:
-    """The converged reference of ``scene`` with its evidence (see the module doc)."""
-    step, modes, mesh = reference_discretization(scene["coupler"])
-    finest = _setting("reference", step, modes, mesh)
-    coarsenings = {f"modes {modes} -> 8": _setting("modes 8", step, 8, mesh),
-                   "step_s x2": _setting("step x2", 2 * step, modes, mesh),
-                   "mesh x1.5": _setting("mesh x1.5", step, modes, 1.5 * mesh)}
-    return converged_reference(scene, "reference", finest, coarsenings, min(LEVELS) / 3,
-                               pool, progress=progress)
 
 
 def grid_settings(scene: Scene, mesh_rule: Mapping[str, float] | None = None
@@ -133,7 +98,7 @@ def grid_settings(scene: Scene, mesh_rule: Mapping[str, float] | None = None
     (:func:`flex.config.ffrf_rule.rule_mesh_size_m` with the constants ``mesh_rule``)."""
     coupler = scene["coupler"]
     period, mesh = first_period_s(coupler), rule_mesh_size_m(coupler, mesh_rule)
-    return [(modes, per, _setting(f"modes={modes} T1/{per:g}", period / per, modes, mesh))
+    return [(modes, per, coupler_setting(f"modes={modes} T1/{per:g}", period / per, modes, mesh))
             for modes in GRID_MODES for per in GRID_STEPS_PER_PERIOD]
 
 

@@ -382,7 +382,8 @@ def summarize(results: dict[str, CaseResult], notes: dict[str, Any],
     """The kfit summary (a :class:`flex.study.Summary`-shaped ``(datasets, report,
     figure_data)`` tuple): fit table, laws, k(tolerance), the thesis's k, the validation,
     the sweep's figures. ``notes``: the run's (``analysis``, ``sweep``), else fitted again;
-    ``left_out``: the candidates not generated (:func:`left_out_cases`)."""
+    ``left_out``: the candidates not generated
+    (:func:`~flex.experiments.fitting.kfit.left_out_cases`)."""
     analysis = notes.get("analysis") or analyse(results)
     data, fits = analysis["table"], analysis["fits"]
     datasets = _table_datasets(data, results)

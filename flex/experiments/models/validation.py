@@ -352,19 +352,7 @@ def _runs(results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
                             if k.startswith("rigid_start")}
     runs.update({k: v for k, v in results.items() if v.status == "ok" and k != "rigid"})
     references = {"beam": _curves(runs[BEST_BEAM]), "fe": _curves(results[reference])}
-    lines += ["", "3. From the rigid start (undeformed, as flex starts), t = 0.1 s and over "
-              "0-0.1 s, against two references:",
-              f"   beam = '{BEST_BEAM}' (consistent mass and stiffening, 4 axial bubbles); "
-              f"fe = '{reference}' (nonlinear FE rod)",
-              f"   Euler-Bernoulli pinned-pinned first bending: {omega_eb / (2 * math.pi):.1f} "
-              f"Hz; Euler buckling load {buckling:.0f} N; crank harmonics 8 and 9: "
-              f"{8 * BENCH.crank_speed_rad_per_s / (2 * math.pi):.1f}, "
-              f"{9 * BENCH.crank_speed_rad_per_s / (2 * math.pi):.1f} Hz",
-              *_axial_load_lines(buckling),
-              f"   {'run':44s} {'q_mid(0.1)':>10s} {'x3(0.1)':>12s} {'peak':>6s} {'rms/beam':>8s} "
-              f"{'rms/fe':>6s} {'dx3/beam':>8s} {'dx3/fe':>7s} {'oop':>6s} {'wall':>5s}",
-              f"   {'':44s} {'[um]':>10s} {'[m]':>12s} {'[Hz]':>6s} {'[1]':>8s} {'[1]':>6s} "
-              f"{'[um]':>8s} {'[um]':>7s} {'[um]':>6s} {'[s]':>5s}"]
+    lines += _runs_header(reference, omega_eb, buckling)
     rows = []
     for name, run in runs.items():
         curves = _curves(run)
@@ -389,7 +377,36 @@ def _runs(results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
         datasets[f"runs/{key}/chord_change"] = Dataset(curves["chord"], "m", name)
     lines += _change_lines(runs, solutions["published"])
     datasets["runs/time"] = Dataset(references["fe"]["time"], "s", "sample times of every run")
-    datasets["table/run"] = Dataset(np.array([r[0] for r in rows], dtype=object), "1", "run")
+    datasets.update(_runs_table(rows, reference))
+    datasets["published/two_mode_published_start/midpoint_deflection"] = Dataset(
+        solutions["published"].midpoint_deflection_m, "m", "independent two-mode model from "
+        "the published initial state, published settings")
+    datasets["published/euler_bernoulli_frequency"] = Dataset(
+        omega_eb / (2 * math.pi), "Hz", "pinned-pinned first bending, 8 mm steel, 0.3 m")
+    return lines, datasets
+
+
+def _runs_header(reference: str, omega_eb: float, buckling: float) -> list[str]:
+    """Section 3's heading: its references, the rod's bending frequency and buckling load
+    (``omega_eb`` rad/s, ``buckling`` N), the crank harmonics, the axial loads, the columns."""
+    return ["", "3. From the rigid start (undeformed, as flex starts), t = 0.1 s and over "
+            "0-0.1 s, against two references:",
+            f"   beam = '{BEST_BEAM}' (consistent mass and stiffening, 4 axial bubbles); "
+            f"fe = '{reference}' (nonlinear FE rod)",
+            f"   Euler-Bernoulli pinned-pinned first bending: {omega_eb / (2 * math.pi):.1f} "
+            f"Hz; Euler buckling load {buckling:.0f} N; crank harmonics 8 and 9: "
+            f"{8 * BENCH.crank_speed_rad_per_s / (2 * math.pi):.1f}, "
+            f"{9 * BENCH.crank_speed_rad_per_s / (2 * math.pi):.1f} Hz",
+            *_axial_load_lines(buckling),
+            f"   {'run':44s} {'q_mid(0.1)':>10s} {'x3(0.1)':>12s} {'peak':>6s} {'rms/beam':>8s} "
+            f"{'rms/fe':>6s} {'dx3/beam':>8s} {'dx3/fe':>7s} {'oop':>6s} {'wall':>5s}",
+            f"   {'':44s} {'[um]':>10s} {'[m]':>12s} {'[Hz]':>6s} {'[1]':>8s} {'[1]':>6s} "
+            f"{'[um]':>8s} {'[um]':>7s} {'[um]':>6s} {'[s]':>5s}"]
+
+
+def _runs_table(rows: list[tuple], reference: str) -> dict[str, Dataset]:
+    """Section 3's table, one dataset per column (``table/*``), one row per run."""
+    datasets = {"table/run": Dataset(np.array([r[0] for r in rows], dtype=object), "1", "run")}
     for column, (name, unit, what) in enumerate((
             ("deflection_at_0p1s", "m", "midpoint deflection at 0.1 s"),
             ("slider_at_0p1s", "m", "slider position at 0.1 s"),
@@ -405,12 +422,7 @@ def _runs(results: dict[str, CaseResult], solutions: dict[str, CrankSolution],
              "plane (nonlinear FE)"),
             ("wall_time", "s", "wall time")), start=1):
         datasets[f"table/{name}"] = Dataset(np.array([r[column] for r in rows]), unit, what)
-    datasets["published/two_mode_published_start/midpoint_deflection"] = Dataset(
-        solutions["published"].midpoint_deflection_m, "m", "independent two-mode model from "
-        "the published initial state, published settings")
-    datasets["published/euler_bernoulli_frequency"] = Dataset(
-        omega_eb / (2 * math.pi), "Hz", "pinned-pinned first bending, 8 mm steel, 0.3 m")
-    return lines, datasets
+    return datasets
 
 
 def first_mode_geometric_stiffness_per_N(bench: CrankBenchmark = BENCH,

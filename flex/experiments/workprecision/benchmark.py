@@ -366,13 +366,14 @@ def _newton_variants(scene: Scene, plan: StepCostPlan, repeats: int, pool: Reduc
 
 def bench_plates(scene: Scene, plan: PlatesPlan, repeats: int, pool: ReductionPool, say: Say,
                  notes: dict[str, Any]) -> dict[str, CaseResult]:
-    """Per plate: the converged reference of :mod:`flex.experiments.fitting.calibration` (its
-    accuracy certifies a level only within a third of it), then per tolerance flex's own
-    choice (every solver and link key ``"auto"``: :mod:`flex.config.ffrf_rule`, or the
-    visible fallback) timed and measured against it. ``notes["plates"]``: one row each."""
+    """Per plate: the converged reference of
+    :mod:`flex.experiments.workprecision.coupler_reference` (the calibration's; its accuracy
+    certifies a level only within a third of it), then per tolerance flex's own choice (every
+    solver and link key ``"auto"``: :mod:`flex.config.ffrf_rule`, or the visible fallback)
+    timed and measured against it. ``notes["plates"]``: one row each."""
     from flex.config.settings import AUTO_OVERRIDES, resolve_solver_settings
     from flex.data.scene_edit import derive_scene
-    from flex.experiments.fitting.calibration import scene_reference
+    from flex.experiments.workprecision.coupler_reference import scene_reference
     from flex.experiments.workprecision.measurement import certifies
 
     rows, out = [], {}

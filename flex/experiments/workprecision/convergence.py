@@ -134,18 +134,8 @@ def converged_reference(base: Scene, label: str, finest: Setting,
     observables, counters = run_once(scene, finest, pool)
     reference = Reference(label, observables, finest, {}, tolerance,
                           float(counters["wall_time_s"]), description)
-    runs: dict[str, tuple[Observables, float]] = {
-        repr(finest.knobs()): (observables, float(counters["wall_time_s"]))}
-
-    def run(setting: Setting) -> tuple[Observables, float]:
-        key = repr(setting.knobs())
-        if key not in runs:
-            if progress:
-                progress(f"reference {label}: evidence {setting.label}")
-            obs, count = run_once(scene_for(base, setting), setting, pool)
-            runs[key] = (obs, float(count["wall_time_s"]))
-        return runs[key]
-
+    run = _memoized_run(base, label, pool, progress, {
+        repr(finest.knobs()): (observables, float(counters["wall_time_s"]))})
     for name, coarser in coarsenings.items():
         try:
             coarse_observables, wall = run(coarser)
@@ -165,6 +155,24 @@ def converged_reference(base: Scene, label: str, finest: Setting,
     if anchor is not None and refinements:
         reference.evidence["interaction"] = _interaction(reference, refinements, anchor, run)
     return reference
+
+
+def _memoized_run(base: Scene, label: str, pool: ReductionPool | None,
+                  progress: Callable[[str], None] | None,
+                  runs: dict[str, tuple[Observables, float]]
+                  ) -> Callable[[Setting], tuple[Observables, float]]:
+    """A function running a setting of ``base`` once per knob values (``runs``: the runs so
+    far, keyed by ``repr`` of the knobs): its observables and integration wall time [s]."""
+    def run(setting: Setting) -> tuple[Observables, float]:
+        key = repr(setting.knobs())
+        if key not in runs:
+            if progress:
+                progress(f"reference {label}: evidence {setting.label}")
+            obs, count = run_once(scene_for(base, setting), setting, pool)
+            runs[key] = (obs, float(count["wall_time_s"]))
+        return runs[key]
+
+    return run
 
 
 def _refinement_evidence(reference: Reference, refinement: Refinement,

@@ -171,9 +171,11 @@ class Reference:
     ``evidence`` maps each coarsening (``"step_s x2"``, ``"modes 12 -> 8"``, ...) or
     refinement sequence (``"step_s"``, ...) to its record: ``error`` is the knob's estimate of
     the reference's own relative error (largest over the error measures: the change itself
-    for a one-level coarsening, :func:`richardson`'s estimate for a sequence, with ``order``,
-    ``change_fine``, ``change_coarse``, ``asymptotic``, ``values``); ``tolerance`` is the
-    relative accuracy the reference claims, ``accuracy`` the sum of the knobs' estimates.
+    for a one-level coarsening,
+    :func:`~flex.experiments.workprecision.convergence.richardson`'s estimate for a sequence,
+    with ``order``, ``change_fine``, ``change_coarse``, ``asymptotic``, ``values``);
+    ``tolerance`` is the relative accuracy the reference claims, ``accuracy`` the sum of the
+    knobs' estimates.
     """
 
     label: str
