@@ -348,7 +348,7 @@ def load_scene(source: str | Path | None = None, overrides: list[str] | None = N
 def default_scene() -> Scene:
     """The bundled default parameter set (:data:`DEFAULT_SCENE`), as read from its file,
     with the schema default of every key the file does not state (:attr:`Field.default`)."""
-    scene = _read_toml(_scene_path(DEFAULT_SCENE), DEFAULT_SCENE)
+    scene = read_toml(scene_path(DEFAULT_SCENE), DEFAULT_SCENE)
     for section, fields in SCHEMA.items():
         for key, field in fields.items():
             if field.default is not None:
@@ -362,11 +362,12 @@ def read_source(source: str | Path | None) -> Scene | None:
     if source is None or str(source) == DEFAULT_SCENE:
         return None
     path = Path(source)
-    return _read_toml(path if path.suffix == ".toml" or path.exists()
-                      else _scene_path(str(source)), str(source))
+    return read_toml(path if path.suffix == ".toml" or path.exists()
+                      else scene_path(str(source)), str(source))
 
 
-def _scene_path(name: str) -> Path:
+def scene_path(name: str) -> Path:
+    """The file of bundled scene ``name`` (SceneError naming the bundled ones if missing)."""
     path = Path(str(resources.files("flex.data.scenes").joinpath(f"{name}.toml")))
     if not path.exists():
         raise SceneError(f"scene '{name}' is neither a TOML file nor a bundled parameter set "
@@ -374,7 +375,8 @@ def _scene_path(name: str) -> Path:
     return path
 
 
-def _read_toml(path: Path, label: str) -> Scene:
+def read_toml(path: Path, label: str) -> Scene:
+    """The TOML scene file ``path`` as a dict (SceneError naming ``label`` if unreadable)."""
     try:
         data = path.read_bytes()
     except FileNotFoundError:

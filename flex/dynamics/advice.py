@@ -183,9 +183,9 @@ def extreme_inputs(scene: Scene,
     ``flex/config/solver_defaults.toml``), most extreme first, as ``key = value (bundled: x)``."""
     from flex.config.settings import AUTO, solver_defaults
     from flex.config.usage import unused_keys
-    from flex.data.scene import DEFAULT_SCENE, SCHEMA, _read_toml, _scene_path
+    from flex.data.scene import DEFAULT_SCENE, SCHEMA, read_toml, scene_path
 
-    bundled = _read_toml(_scene_path(DEFAULT_SCENE), DEFAULT_SCENE)
+    bundled = read_toml(scene_path(DEFAULT_SCENE), DEFAULT_SCENE)
     unused = unused_keys(scene, link_models=link_models)
     found: list[tuple[float, str]] = []
     for section, fields in SCHEMA.items():

@@ -1,5 +1,5 @@
 """The slider-crank's parts in Exudyn: its initial configuration, the :class:`Mechanism` a
-build returns, and the 3D builder (:class:`_Builder`) that :func:`flex.dynamics.mechanism.
+build returns, and the 3D builder (:class:`Builder`) that :func:`flex.dynamics.mechanism.
 build_mechanism` drives (:mod:`flex.dynamics.planar` extends it with 2D items for rigid
 scenes). The sketch of the mechanism and the choice of build are in
 :mod:`flex.dynamics.mechanism`; the crank's and the coupler's bodies are added by their link
@@ -216,7 +216,7 @@ def wing_mass_properties(scene: Scene) -> tuple[float, float, float]:
 
 def _add_wing(mech: Mechanism, rigid_body, body_marker) -> int:
     """Add the wing as a rigid body with its root at A; return its marker at the root (the
-    builder welds it to the crank: :meth:`_Builder.weld`)."""
+    builder welds it to the crank: :meth:`Builder.weld`)."""
     init = mech.initial
     mass_kg, inertia_kgm2, centre_m = wing_mass_properties(mech.scene)
     direction = np.array([np.cos(init.crank_angle_rad), np.sin(init.crank_angle_rad), 0.0])
@@ -229,7 +229,7 @@ def _add_wing(mech: Mechanism, rigid_body, body_marker) -> int:
     return body_marker(wing_body, [0.0, 0.0, 0.0])
 
 
-class _Builder:
+class Builder:
     """Adds the items of one slider-crank to a new Exudyn system, in a fixed order (the
     order numbers the coordinates, so it is kept the same for every scene of a kind)."""
 

@@ -29,7 +29,7 @@ The contract of an entry -- what a link model declares, point by point:
    its ``add`` needs (the Craig-Bampton reduction of an FFRF link; ``given``: one the caller
    built; None for models that need nothing).
 5. **how it adds itself to the Exudyn builder**: ``add(builder, link, prepared)`` adds the
-   link's bodies to :class:`flex.dynamics.builder._Builder` and returns the handles it made:
+   link's bodies to :class:`flex.dynamics.builder.Builder` and returns the handles it made:
    a dict with ``joint_markers`` (the markers at the link's two joints: A and B for the
    crank, B and C for the coupler) and whatever its own sensors and datasets read (a rigid
    link's ``body`` and ``node``; an FFRF link's ``reduction``, ``node_modal``,

@@ -31,9 +31,9 @@ from typing import Any
 from flex.base.errors import SceneError
 from flex.data.scene import Scene
 from flex.dynamics.builder import (  # noqa: F401 - the names callers import from here
+    Builder,
     InitialConfiguration,
     Mechanism,
-    _Builder,
     initial_configuration,
     rotation_z,
     wing_mass_properties,
@@ -67,7 +67,7 @@ def build_mechanism(scene: Scene, reduction: Any = None, crank_reduction: Any = 
                          "integrator (simulation.integrator != \"explicit_penalty\")")
     use_planar = is_planar(scene, link_models) if planar is None else planar
     builder = (PlanarBuilder(scene, link_models=link_models) if use_planar
-               else _Builder(scene, ffrf_joint_markers, link_models=link_models))
+               else Builder(scene, ffrf_joint_markers, link_models=link_models))
     builder.add_crank_and_slider(crank_reduction)
     builder.add_coupler(reduction)
     builder.add_joints()

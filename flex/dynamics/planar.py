@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from flex.data.scene import LINKS, Scene, link_model
-from flex.dynamics.builder import Mechanism, _Builder, slider_mass_kg
+from flex.dynamics.builder import Builder, Mechanism, slider_mass_kg
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 
 
@@ -45,7 +45,7 @@ def is_planar(scene: Scene, link_models: Mapping[str, Any] = BUILTIN_LINK_MODELS
             and scene["simulation"]["integrator"] != "explicit_penalty")
 
 
-class PlanarBuilder(_Builder):
+class PlanarBuilder(Builder):
     """The 3D builder's order and sensor names with 2D bodies and joints and a 1D slider."""
 
     #: index of the angle among a 2D rigid-body node's coordinates (x y angle)

@@ -18,7 +18,7 @@ import math
 import sys
 import time
 from collections.abc import Mapping
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -202,57 +202,66 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     tolerance = float(resolution.scene["fidelity"]["tolerance"])
     current = resolution
     for attempt in range(1, MAX_ATTEMPTS + 1):
-        scene = current.scene
         result = simulate_resolved(current, name, cache_dir=cache_dir, link_models=link_models,
                                    headlines=headlines)
         rows = [row for row in budget_rows(result.attrs)
                 if row.quantity in headlines and headlines[row.quantity].certified]
-        over = [row for row in rows if not row.relative <= tolerance]
-        settings = _settings_text(scene, link_models)
-        if not rows:
-            status = NOTHING_TO_REFINE
-            lines.append(f"{attempt}: {settings}: {status}")
+        step = _next_attempt(current.scene, rows, tolerance, attempt,
+                             time.perf_counter() - start, link_models, free)
+        lines.append(f"{attempt}: {_settings_text(current.scene, link_models)}: {step.line}")
+        if step.refined is None:
             break
-        worst = max(rows, key=lambda row: row.relative if row.relative >= 0 else math.inf)
-        found = (f"{worst.what} {100 * worst.relative:.3g} % of itself (tolerance "
-                 f"{100 * tolerance:g} %)" if not worst.problem else
-                 f"{worst.what} {worst.problem} (tolerance {100 * tolerance:g} %)")
-        if not over:
-            status = "met"
-            lines.append(f"{attempt}: {settings}: met; worst {found}")
-            break
-        term = max(worst.terms, key=lambda key: worst.terms[key] if worst.terms[key] >= 0
-                   else math.inf)  # an unknown term (its companion failed) first
-        change, why = _refined(scene, term, link_models, free)
-        spent = time.perf_counter() - start
-        if change is None or spent > scene["fidelity"]["refine_limit_s"] \
-                or attempt == MAX_ATTEMPTS:
-            status = (why if change is None else
-                      f"cost limit ({spent:.0f} s of fidelity.refine_limit_s = "
-                      f"{scene['fidelity']['refine_limit_s']:g} s)" if attempt < MAX_ATTEMPTS
-                      else f"{MAX_ATTEMPTS} runs made")
-            lines.append(f"{attempt}: {settings}: {found}, {term} term dominant; stopped: "
-                         f"{status}")
-            break
-        try:  # validated as --set is: a mesh too fine for this machine stops here
-            refined = derive_scene(scene, change, link_models=link_models)
-        except SceneError as refused:
-            status = f"{why}: refused: {refused}"
-            lines.append(f"{attempt}: {settings}: {found}; stopped: {status}")
-            break
-        cost_s = _attempt_cost_s(refined, link_models)
-        if spent + cost_s > scene["fidelity"]["refine_limit_s"]:
-            status = (f"cost limit: {why} would take ~{cost_s:.3g} s with its budget (estimate), "
-                      f"beyond fidelity.refine_limit_s = {scene['fidelity']['refine_limit_s']:g} "
-                      f"s after {spent:.3g} s")
-            lines.append(f"{attempt}: {settings}: {found}; stopped: {status}")
-            break
-        lines.append(f"{attempt}: {settings}: {found}, {term} term dominant -> {why}")
-        current = replace(current, scene=refined)
-    result.attrs.update({"refine_status": status, "refine_attempts": "\n".join(lines),
+        current = replace(current, scene=step.refined)
+    result.attrs.update({"refine_status": step.status, "refine_attempts": "\n".join(lines),
                          "refine_wall_time_s": time.perf_counter() - start})
-    _say_status(name, status, tolerance)
+    _say_status(name, step.status, tolerance)
     return result
+
+
+@dataclass(frozen=True)
+class _Step:
+    """What :func:`refine` does after an attempt: the next scene (None: stop, with
+    ``status``), and the attempt's line after its settings."""
+
+    refined: Scene | None
+    status: str
+    line: str
+
+
+def _next_attempt(scene: Scene, rows: list[Any], tolerance: float, attempt: int,
+                  spent_s: float, link_models: Mapping[str, LinkModel],
+                  free: frozenset[str]) -> _Step:
+    """After attempt ``attempt`` (its certified budget ``rows``, ``spent_s`` [s] so far): the
+    tolerance met, nothing to certify, or the knob of the worst quantity's dominant term
+    turned, unless it cannot move, is refused, or would pass the cost limit."""
+    if not rows:
+        return _Step(None, NOTHING_TO_REFINE, NOTHING_TO_REFINE)
+    worst = max(rows, key=lambda row: row.relative if row.relative >= 0 else math.inf)
+    found = (f"{worst.what} {100 * worst.relative:.3g} % of itself (tolerance "
+             f"{100 * tolerance:g} %)" if not worst.problem else
+             f"{worst.what} {worst.problem} (tolerance {100 * tolerance:g} %)")
+    if all(row.relative <= tolerance for row in rows):
+        return _Step(None, "met", f"met; worst {found}")
+    term = max(worst.terms, key=lambda key: worst.terms[key] if worst.terms[key] >= 0
+               else math.inf)  # an unknown term (its companion failed) first
+    change, why = _refined(scene, term, link_models, free)
+    limit = scene["fidelity"]["refine_limit_s"]
+    if change is None or spent_s > limit or attempt == MAX_ATTEMPTS:
+        status = (why if change is None else
+                  f"cost limit ({spent_s:.0f} s of fidelity.refine_limit_s = {limit:g} s)"
+                  if attempt < MAX_ATTEMPTS else f"{MAX_ATTEMPTS} runs made")
+        return _Step(None, status, f"{found}, {term} term dominant; stopped: {status}")
+    try:  # validated as --set is: a mesh too fine for this machine stops here
+        refined = derive_scene(scene, change, link_models=link_models)
+    except SceneError as refused:
+        status = f"{why}: refused: {refused}"
+        return _Step(None, status, f"{found}; stopped: {status}")
+    cost_s = _attempt_cost_s(refined, link_models)
+    if spent_s + cost_s > limit:
+        status = (f"cost limit: {why} would take ~{cost_s:.3g} s with its budget (estimate), "
+                  f"beyond fidelity.refine_limit_s = {limit:g} s after {spent_s:.3g} s")
+        return _Step(None, status, f"{found}; stopped: {status}")
+    return _Step(refined, "", f"{found}, {term} term dominant -> {why}")
 
 
 def _say_status(name: str, status: str, tolerance: float) -> None:
