@@ -445,8 +445,6 @@ def _dispatch(argv: list[str] | None) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    import re
-
     from flex.study import from_environment, load_study, run_study
 
     if args.workers is not None and args.workers < 1:
@@ -459,10 +457,13 @@ def _run(args: argparse.Namespace) -> int:
     if sweep_options and not getattr(load_study(args.study), "SWEEP", False):
         raise FlexError(f"{' and '.join(sweep_options)}: study '{args.study}' runs its cases "
                         f"in this process; these options apply to sweep studies (kfit)")
-    if args.scheduler is not None and not re.match(
-            r"^(processes|serial|local|(tcp|tls|inproc|ucx|ws|wss)://\S+)$", args.scheduler):
-        raise FlexError(f"--scheduler {args.scheduler!r}: expected processes (default), serial, "
-                        f"local (Dask on this machine) or a Dask address like tcp://host:8786")
+    if args.scheduler is not None:
+        from flex.sweep.executors import check_scheduler
+
+        try:
+            check_scheduler(args.scheduler)
+        except FlexError as exc:
+            raise FlexError(f"--{exc}") from None
     sweep = None
     if getattr(load_study(args.study), "SWEEP", False):
         import dataclasses

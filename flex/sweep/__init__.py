@@ -70,6 +70,7 @@ from flex.sweep.executors import (
     SerialExecutor,
     _guarded,
     _prepare_guarded,
+    check_scheduler,
     make_executor,
     simulate_scene_case,
 )
@@ -456,7 +457,12 @@ def settings_from_environment(environ: Mapping[str, str]) -> SweepSettings:
     except ValueError:
         raise FlexError(f"FLEX_WORKERS = {workers!r}: must be an integer >= 1") from None
     folder = environ.get("FLEX_SWEEP_DIR") or None
-    return SweepSettings(scheduler=environ.get("FLEX_SCHEDULER") or None, workers=count,
+    scheduler = environ.get("FLEX_SCHEDULER") or None
+    try:
+        check_scheduler(scheduler)
+    except FlexError as exc:
+        raise FlexError(f"FLEX_SCHEDULER: {exc}") from None
+    return SweepSettings(scheduler=scheduler, workers=count,
                          folder=Path(folder) if folder else None,
                          retry_failed=environ.get("FLEX_RETRY_FAILED", "") == "1",
                          progress=environ.get("FLEX_PROGRESS", "1") != "0")
