@@ -109,6 +109,9 @@ def _view_tools(commands) -> None:
     export.add_argument("--out", required=True, metavar="DIR", help="output folder")
     export.add_argument("--every", type=int, default=1, metavar="N",
                         help="export every N-th stored time (and the last; default 1)")
+    export.add_argument("--force", action="store_true",
+                        help="replace existing output files that flex did not write "
+                             "(default: refused)")
     animate = commands.add_parser(
         "animate", help="animate a case: the mechanism with its flexible links deformed",
         description="Draw the mechanism in its plane at the stored times, each flexible link "
@@ -131,6 +134,9 @@ def _view_tools(commands) -> None:
     animate.add_argument("--magnification", type=float, metavar="X",
                          help="deformation scale (default: the peak deflection drawn as "
                               "1/20 of the link length, rounded to 1, 2 or 5 x 10^k)")
+    animate.add_argument("--force", action="store_true",
+                         help="replace an existing --out that flex did not write "
+                              "(default: refused)")
 
 
 def _design_command(commands) -> None:
@@ -298,7 +304,8 @@ def _view_tool(args: argparse.Namespace) -> int:
     if args.command == "export":
         from flex.tools.export import export_case
 
-        done = export_case(args.file, args.case, args.out, args.every, cache_dir=cache_dir)
+        done = export_case(args.file, args.case, args.out, args.every, cache_dir=cache_dir,
+                           force=args.force)
         _print(f"wrote {done.xdmf} and {done.hdf5.name} ({done.times} times, {done.nodes} "
                f"nodes, {done.bytes_written / 1e6:.1f} MB)")
         return EXIT_OK
@@ -306,7 +313,7 @@ def _view_tool(args: argparse.Namespace) -> int:
 
     done = animate_case(args.file, args.case, args.out, frames=args.frames, fps=args.fps,
                         magnification=args.magnification, cache_dir=cache_dir,
-                        at_time_s=args.at_time_s)
+                        at_time_s=args.at_time_s, force=args.force)
     _print(f"wrote {done.path} ({done.frames} frame{'s' if done.frames != 1 else ''}, "
            f"{done.width}x{done.height} px, "
            f"deformation x {done.magnification:g})")

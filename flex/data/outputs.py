@@ -11,6 +11,8 @@
   a report path that is a folder) or an interrupt leaves the previous files as they were.
 - A run that did not end as its study declares never replaces an existing result file: it
   is written beside it as :func:`failed_path` (``<name>.failed.h5``).
+- Other outputs (``flex export``, ``flex animate``) replace only files flex wrote
+  (:func:`check_replaceable`, its provenance marker); :func:`free_bytes` for a size check.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ import os
 import secrets
 import shutil
 import tempfile
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from flex.base.errors import OutputError
@@ -59,6 +61,45 @@ def check_writable_folder(folder: Path, label: str) -> None:
         raise OutputError(f"{label}: '{existing}' is a file, not a folder")
     if not os.access(existing, os.W_OK | os.X_OK):
         raise OutputError(f"{label}: folder '{existing}' is not writable")
+
+
+def check_replaceable(path: Path, written_by_flex: Callable[[Path], bool], label: str,
+                      force: bool = False) -> None:
+    """Refuse (:class:`OutputError`, one line) to replace ``path`` when it is a folder, or
+    an existing file that ``written_by_flex`` does not recognise as flex's own output (its
+    provenance marker), unless ``force``: a file of the same name that someone else wrote is
+    never replaced silently."""
+    if path.is_dir():
+        raise OutputError(f"{label} '{path}' is a folder; nothing was changed")
+    if force or not (path.exists() or path.is_symlink()):
+        return
+    try:
+        ours = path.is_file() and written_by_flex(path)
+    except OSError:
+        ours = False
+    if not ours:
+        raise OutputError(f"{label} '{path}' exists and was not written by flex (no flex "
+                          f"provenance in it): move it away, choose another output, or pass "
+                          f"--force to replace it; nothing was changed")
+
+
+def has_marker(path: Path, marker: bytes, window: int = 1 << 16) -> bool:
+    """Whether ``marker`` occurs in the first or the last ``window`` bytes of ``path`` (a
+    provenance string a writer put in a file's metadata)."""
+    with path.open("rb") as file:
+        head = file.read(window)
+        size = file.seek(0, os.SEEK_END)
+        file.seek(max(0, size - window))
+        return marker in head or marker in file.read(window)
+
+
+def free_bytes(folder: Path) -> int:
+    """Free space [bytes] for an unprivileged writer in ``folder`` (or its nearest existing
+    ancestor)."""
+    existing = folder if str(folder) else Path(".")
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    return int(shutil.disk_usage(existing).free)
 
 
 def _same_file(a: Path, b: Path) -> bool:

@@ -29,7 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from flex.base.errors import FlexError
+from flex.base.errors import FlexError, OutputError
+from flex.data.outputs import check_replaceable, check_writable_folder, has_marker
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 from flex.tools.motion import Body, CaseMotion, case_motion, model_entry, top_faces
 
@@ -38,6 +39,9 @@ SIZE_PX = (960, 540)
 DPI = 100
 #: the default magnification draws the peak chord deflection as this fraction of the length
 DRAWN_DEFLECTION = 1 / 20
+#: provenance written into every animation's metadata (PNG text, GIF comment, mp4 comment):
+#: an existing output is replaced only when it carries it
+MARKER = b"written by flex animate"
 
 
 @dataclass
@@ -152,14 +156,16 @@ def _default_magnification(motion: CaseMotion, frames: list[_Frame]) -> float:
 def animate_case(source: str | Path, case: str | None, out: str | Path, *, frames: int = 200,
                  fps: int = 25, magnification: float | None = None,
                  cache_dir: Path | None = None, at_time_s: float | None = None,
-                 progress: Callable[[str], None] | None = None) -> Animation:
+                 progress: Callable[[str], None] | None = None,
+                 force: bool = False) -> Animation:
     """Animate ``case`` of result file ``source`` into ``out`` (``.mp4`` or ``.gif``; see the
     module doc; ``.png``: the one frame nearest ``at_time_s`` [s], by default the time of
     the first flexible link's peak von Mises stress). ``frames``: at most this many, evenly
     spaced over the stored samples; ``magnification``: the deformation scale (None: the
     default of the module doc, from those frames). Refusals (:class:`FlexError`): those of
     :func:`flex.tools.motion.case_motion`, a bad suffix, frame count, rate, time or
-    magnification."""
+    magnification, an existing ``out`` that flex did not write (no :data:`MARKER` in its
+    metadata; unless ``force``), a write that fails (nothing partial is left)."""
     out = Path(out)
     if out.suffix.lower() not in (".mp4", ".gif", ".png"):
         raise FlexError(f"--out {out}: must end in .mp4, .gif or .png (one frame)")
@@ -179,11 +185,16 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
                                                                                      drawn)
     if out.suffix.lower() == ".png":
         drawn = _frames(motion, [_nearest(motion, at_time_s)])
-    out.parent.mkdir(parents=True, exist_ok=True)
+    check_replaceable(out, lambda path: has_marker(path, MARKER), "flex animate: --out", force)
+    check_writable_folder(out.parent, f"--out {out}")
     part = out.with_name(f".{out.stem}.{os.getpid()}.part{out.suffix}")
     try:
+        out.parent.mkdir(parents=True, exist_ok=True)
         _write(part, _render(motion, drawn, factor), fps)
         os.replace(part, out)
+    except OSError as exc:
+        raise OutputError(f"cannot write '{out}': {exc.strerror or exc}; the partial file was "
+                          f"removed and no existing file was changed") from None
     finally:
         part.unlink(missing_ok=True)
     if progress:
@@ -281,7 +292,8 @@ def _write(path: Path, frames, fps: int) -> None:
 
         writer = imageio_ffmpeg.write_frames(str(path), SIZE_PX, fps=fps, codec="libx264",
                                              pix_fmt_out="yuv420p", macro_block_size=1,
-                                             ffmpeg_log_level="error")
+                                             ffmpeg_log_level="error", output_params=[
+                                                 "-metadata", f"comment={MARKER.decode()}"])
         writer.send(None)
         try:
             for frame in frames:
@@ -292,11 +304,16 @@ def _write(path: Path, frames, fps: int) -> None:
     from PIL import Image
 
     if path.suffix.lower() == ".png":
-        Image.fromarray(next(iter(frames))).save(path, format="PNG", optimize=True)
+        from PIL.PngImagePlugin import PngInfo
+
+        info = PngInfo()
+        info.add_text("Software", MARKER.decode())
+        Image.fromarray(next(iter(frames))).save(path, format="PNG", optimize=True,
+                                                 pnginfo=info)
         return
     images = [Image.fromarray(frame).quantize(colors=255) for frame in frames]
     images[0].save(path, format="GIF", save_all=True, append_images=images[1:],
-                   duration=round(1000 / fps), loop=0)
+                   duration=round(1000 / fps), loop=0, comment=MARKER)
 
 
 def default_animation_path(result: Path, case: str) -> Path:
@@ -324,8 +341,9 @@ def animate_results(result: str | Path, *, cache_dir: Path | None = None,
                    or not BUILTIN_LINK_MODELS[scene[link]["model"]].rigid
                    for link in ("crank", "coupler")):
                 chosen.append(name)
+    # figures/ beside a result file is flex's own folder: a run replaces its figures there
     return [animate_case(result, name, default_animation_path(result, name), frames=frames,
-                         cache_dir=cache_dir) for name in chosen]
+                         cache_dir=cache_dir, force=True) for name in chosen]
 
 
 __all__ = ["Animation", "animate_case", "animate_results", "chord_deflection",
