@@ -239,21 +239,24 @@ def _render(motion: CaseMotion, frames: list[_Frame], magnification: float):
     title = f"{motion.case}: " + ", ".join(f"{b.name} {b.model}" for b in motion.bodies)
     try:
         for frame in frames:
-            artists = []
+            artists, drawn = [], {}
             for body in motion.bodies:
                 xy = frame.shapes[body.name][:, :2]
                 if model_entry(body.model).rigid:
-                    artists += axes.fill(*_outline(xy).T, color="0.7", ec="0.2", lw=1.0)
+                    drawn[body.name] = xy
+                    artists += axes.fill(*_outline(xy).T, **_BOX_STYLE[body.name == "slider"])
                     continue
-                shape = _drawn(body, frame.shapes[body.name], magnification)
+                shape = drawn[body.name] = _drawn(body, frame.shapes[body.name], magnification)
                 grid = Triangulation(shape[:, 0], shape[:, 1], faces[body.name])
                 stress = frame.stress[body.name]
                 if stress is None:
                     artists.append(axes.tripcolor(grid, np.zeros(len(shape)), cmap="Greys",
-                                                  vmin=-1, vmax=3, shading="gouraud"))
+                                                  vmin=-1, vmax=3, shading="gouraud",
+                                                  zorder=2))
                 else:
                     artists.append(axes.tripcolor(grid, stress / 1e6, cmap=colour_map,
-                                                  norm=norm, shading="gouraud"))
+                                                  norm=norm, shading="gouraud", zorder=2))
+            artists += _joints(motion, drawn, axes)
             artists.append(axes.set_title(
                 f"{title}\nt = {frame.time_s * 1e3:.3f} ms, crank angle "
                 f"{math.degrees(frame.crank_angle_rad):.2f} deg, deformation x "
@@ -264,6 +267,21 @@ def _render(motion: CaseMotion, frames: list[_Frame], magnification: float):
                 artist.remove()
     finally:
         plt.close(figure)
+
+
+#: rigid links (False) and the slider (True): the slider drawn light and behind the coupler,
+#: so that the coupler's end and joint C stay visible on it
+_BOX_STYLE = {False: {"color": "0.7", "ec": "0.2", "lw": 1.0, "zorder": 1},
+              True: {"color": "0.88", "ec": "0.45", "lw": 0.8, "zorder": 0.5}}
+
+
+def _joints(motion: CaseMotion, drawn: dict[str, np.ndarray], axes) -> list:
+    """Joints B and C (the centres of the coupler's end faces as drawn) as small circles on
+    top of every body."""
+    coupler = next(body for body in motion.bodies if body.name == "coupler")
+    ends = [drawn["coupler"][face].mean(axis=0) for face in _face_nodes(coupler)]
+    return axes.plot(*np.array(ends).T, "o", ms=5, mfc="white", mec="black", mew=1.2,
+                     zorder=4, ls="none")
 
 
 def _outline(xy: np.ndarray) -> np.ndarray:
