@@ -346,10 +346,13 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the process exit status (:mod:`flex.base.errors`). No exception
     leaves it: a bug prints one ``flex: internal error`` line and returns 3 (``FLEX_DEBUG=1``
     shows the traceback)."""
+    from flex.base.interrupts import interrupts_not_swallowed
+
     received: list[int] = []
     restore = _catch_signals(received)
     try:
-        return _dispatch(argv)
+        with interrupts_not_swallowed():
+            return _dispatch(argv)
     except FlexError as exc:
         print(f"flex: error: {_one_line(str(exc))}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -413,8 +416,8 @@ def _interrupted(exc: BaseException, received: list[int]) -> int:
     written = getattr(exc, "written", [])
     if written:
         files = ", ".join(str(path) for path in written)
-        print(f"flex: {what}; already written: {files}; figures not yet drawn were left as "
-              f"they were", file=sys.stderr)
+        print(f"flex: {what}; already written: {files}; nothing else was changed (files not "
+              f"yet written were left as they were)", file=sys.stderr)
     else:
         print(f"flex: {what}; no result file was changed", file=sys.stderr)
     return EXIT_SIGTERM if terminated else EXIT_SIGINT
@@ -489,10 +492,16 @@ def _run(args: argparse.Namespace) -> int:
                        figures=not args.no_figures, quiet=args.quiet, sweep=sweep,
                        **from_environment(args.study, os.environ))
     if args.animate and output.as_expected and output.path is not None:
+        from flex.study import Interrupted
         from flex.tools.animate import animate_results
 
         cache_dir = from_environment(args.study, os.environ)["cache_dir"]
-        for done in animate_results(output.path, cache_dir=cache_dir):
-            if not args.quiet:
-                _print(f"wrote {done.path} ({done.frames} frames)")
+        written = [output.path, *output.figures, *([output.report] if output.report else [])]
+        try:
+            for done in animate_results(output.path, cache_dir=cache_dir):
+                written.append(done.path)
+                if not args.quiet:
+                    _print(f"wrote {done.path} ({done.frames} frames)")
+        except KeyboardInterrupt as exc:  # the run's files are in place: say so
+            raise Interrupted(written, getattr(exc, "kind", type(exc))) from None
     return EXIT_OK if output.as_expected else EXIT_FAILED

@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SimulationError, Terminated
+from flex.base.interrupts import interrupts_not_swallowed
 from flex.base.progress import heartbeat
 from flex.config.settings import check_concrete
 from flex.data.results import CaseResult, Dataset
@@ -183,7 +184,7 @@ def run(mech: Mechanism, label: str = "") -> dict[str, Any]:
         previous = {sig: signal.signal(sig, on_interrupt)
                     for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        with redirect_stdout(captured):
+        with redirect_stdout(captured), interrupts_not_swallowed():
             ok = solver.SolveSystem(mech.mbs, _exudyn_settings(settings))
     except Exception as exc:  # Exudyn raises RuntimeError/ValueError on Newton failure
         ok = False

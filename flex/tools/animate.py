@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 import os
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -341,9 +341,10 @@ def default_animation_path(result: Path, case: str) -> Path:
 
 
 def animate_results(result: str | Path, *, cache_dir: Path | None = None,
-                    frames: int = 200) -> list[Animation]:
+                    frames: int = 200) -> Iterator[Animation]:
     """Animate every ok case with a flexible link of a result file
-    (:func:`default_animation_path`); ``flex run --animate``."""
+    (:func:`default_animation_path`), yielding each animation once it is written (``flex run
+    --animate``)."""
     from flex.data.results import attribute_value, case_names, reading
     from flex.tools.motion import case_scene
 
@@ -360,8 +361,9 @@ def animate_results(result: str | Path, *, cache_dir: Path | None = None,
                    for link in ("crank", "coupler")):
                 chosen.append(name)
     # figures/ beside a result file is flex's own folder: a run replaces its figures there
-    return [animate_case(result, name, default_animation_path(result, name), frames=frames,
-                         cache_dir=cache_dir, force=True) for name in chosen]
+    for name in chosen:
+        yield animate_case(result, name, default_animation_path(result, name), frames=frames,
+                           cache_dir=cache_dir, force=True)
 
 
 __all__ = ["Animation", "animate_case", "animate_results", "chord_deflection",
