@@ -180,6 +180,7 @@ def run(mech: Mechanism, label: str = "") -> dict[str, Any]:
     if threading.current_thread() is threading.main_thread():
         def on_interrupt(signum, frame):
             interrupted.append(signum)
+            mech.mbs.SetRenderEngineStopFlag(True)  # Exudyn may drop the exception: stop it
             raise Terminated if signum == signal.SIGTERM else KeyboardInterrupt
         previous = {sig: signal.signal(sig, on_interrupt)
                     for sig in (signal.SIGINT, signal.SIGTERM)}
