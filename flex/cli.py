@@ -37,6 +37,10 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(EXIT_BAD_INPUT)
 
 
+#: seconds without a line on stderr after which the command line says it is still working
+#: (README: "progress at least every 10 s")
+PROGRESS_INTERVAL_S = 10.0
+
 EPILOG = "exit status:\n" + "\n".join(f"  {code:<4} {text}" for code, text in
                                       EXIT_STATUSES.items())
 
@@ -347,11 +351,14 @@ def main(argv: list[str] | None = None) -> int:
     leaves it: a bug prints one ``flex: internal error`` line and returns 3 (``FLEX_DEBUG=1``
     shows the traceback)."""
     from flex.base.interrupts import interrupts_not_swallowed
+    from flex.base.progress import silence_watch
 
     received: list[int] = []
     restore = _catch_signals(received)
+    stderr = sys.stderr
     try:
-        with interrupts_not_swallowed():
+        with interrupts_not_swallowed(), silence_watch(stderr, PROGRESS_INTERVAL_S) as watched:
+            sys.stderr = watched  # a line on stderr at least every PROGRESS_INTERVAL_S
             return _dispatch(argv)
     except FlexError as exc:
         print(f"flex: error: {_one_line(str(exc))}", file=sys.stderr)
@@ -374,6 +381,7 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)
         return EXIT_INTERNAL
     finally:
+        sys.stderr = stderr
         restore()
 
 
