@@ -54,6 +54,7 @@ def describe(path: str | Path, spec: str | None = None) -> dict[str, Any]:
                                "attributes": root, "scene_toml": scene_toml,
                                "cases": {}, "summary": [], "other": []}
         base_scene = _parse_toml(scene_toml)
+        out["case_count"] = len(case_names(h5))
         for case in case_names(h5):
             group = h5[f"cases/{case}"]
             if not hasattr(group, "keys"):
@@ -215,8 +216,11 @@ def format_description(info: dict[str, Any]) -> str:
 
     cases = info["cases"]
     statuses = ", ".join(f"{name} {case['status']}" for name, case in cases.items())
+    total = info.get("case_count", len(cases))
+    shown = (f" (the {len(cases)} of the file's {total} cases that {info['selection']} "
+             f"matches)" if info.get("selection") and total != len(cases) else "")
     row("study", f"{prov.get('study', '?')} ({prov.get('flex_format', '?')})"
-        + (f"; cases: {statuses}" if statuses else ""))
+        + (f"; cases: {statuses}{shown}" if statuses else ""))
     dirty = {"yes": " (with uncommitted changes)", "no": " (clean)"}.get(
         str(prov.get("git_dirty")), "")
     row("flex", f"{prov.get('flex_version', '?')}, git {prov.get('git_commit', '?')}{dirty}")
@@ -239,11 +243,7 @@ def format_description(info: dict[str, Any]) -> str:
         if case["scene_changes"]:
             changes = ", ".join(f"{k} = {_short(v)}" for k, v in case["scene_changes"].items())
             lines.append(f"  scene: the file's scene with {changes}")
-        attrs = case["attributes"]
-        if attrs.get("solver_defaults_keys"):
-            lines.append(f"  solver: \"auto\" -> {attrs['solver_defaults_keys']} "
-                         f"({attrs.get('solver_defaults_entry', '?')}: "
-                         f"{attrs.get('solver_defaults_reason', '')})")
+        lines += _solver_lines(case)
         lines += _table(case["datasets"])
     for title, entries in (("summary", info["summary"]), ("other", info["other"])):
         if entries:
@@ -255,14 +255,40 @@ def format_description(info: dict[str, Any]) -> str:
     if '= "auto"' in scene_toml:
         heading = 'scene (root attribute scene_toml; each case holds its "auto" keys resolved)'
 
-    if info.get("selection") and len(cases) == 1:
+    if len(cases) == 1:  # one case (in the file, or matching PATH): the settings it ran with
         (name, case), = cases.items()
         if case["scene_toml"]:
-            scene_toml, heading = case["scene_toml"], f"scene of case {name} (resolved)"
+            scene_toml, heading = case["scene_toml"], (
+                f"scene of case {name} (resolved: the settings it ran with"
+                f"{', after refinement' if case['attributes'].get('refine_status') else ''})")
     if scene_toml:
         lines += ["", heading]
         lines += [f"  {line}" if line else "" for line in scene_toml.rstrip().splitlines()]
     return "\n".join(lines)
+
+
+def _solver_lines(case: dict[str, Any]) -> list[str]:
+    """What the case's ``"auto"`` solver keys resolved to; after ``fidelity.refine`` that was
+    the first guess, and the settings the stored run used (its scene) follow."""
+    attrs = case["attributes"]
+    keys = str(attrs.get("solver_defaults_keys", ""))
+    if not keys:
+        return []
+    refined = bool(attrs.get("refine_status"))
+    lines = [f"  solver: \"auto\" -> {'first guess ' if refined else ''}{keys} "
+             f"({attrs.get('solver_defaults_entry', '?')}: "
+             f"{attrs.get('solver_defaults_reason', '')})"]
+    scene = _parse_toml(case["scene_toml"])
+    if refined and scene:
+        final = []
+        for item in keys.split(", "):
+            name = item.split(" = ")[0]
+            section, key = name.split(".") if "." in name else ("simulation", name)
+            if isinstance(scene.get(section), dict) and key in scene[section]:
+                final.append(f"{name} = {scene[section][key]!r}")
+        lines.append(f"  refined (fidelity.refine: {attrs['refine_status']}): the stored run "
+                     f"used {', '.join(final)}")
+    return lines
 
 
 def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
