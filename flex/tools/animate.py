@@ -178,6 +178,8 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
         print(f"flex animate: no mp4 encoder (install imageio-ffmpeg): writing {out}",
               file=sys.stderr)
     frame_indices(2, frames)  # a bad --frames is refused before anything is read
+    check_replaceable(out, lambda path: has_marker(path, MARKER), "flex animate: --out", force)
+    check_writable_folder(out.parent, f"--out {out}")
     motion = case_motion(source, case, cache_dir=cache_dir)
     indices = frame_indices(len(motion.time_s), frames)
     drawn = _frames(motion, indices)
@@ -185,8 +187,6 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
                                                                                      drawn)
     if out.suffix.lower() == ".png":
         drawn = _frames(motion, [_nearest(motion, at_time_s)])
-    check_replaceable(out, lambda path: has_marker(path, MARKER), "flex animate: --out", force)
-    check_writable_folder(out.parent, f"--out {out}")
     part = out.with_name(f".{out.stem}.{os.getpid()}.part{out.suffix}")
     try:
         out.parent.mkdir(parents=True, exist_ok=True)

@@ -41,7 +41,7 @@ import numpy as np
 from flex import __version__
 from flex.base.errors import OutputError
 from flex.data.outputs import check_replaceable, check_writable_folder, free_bytes, has_marker
-from flex.tools.motion import CaseMotion, case_motion, sample_indices
+from flex.tools.motion import CaseMotion, case_motion, pick_case, sample_indices
 
 #: point fields written at every time: name -> (units, description)
 FIELDS = {
@@ -103,15 +103,15 @@ def export_case(source: str | Path, case: str | None, out_dir: str | Path, every
     removed). ``progress``: where the size estimate and progress lines go (None: nowhere).
     The HDF5 file is assembled in memory (about its compressed size) and then written."""
     sample_indices(1, every)  # a bad --every is refused before anything is read
-    motion = case_motion(source, case, cache_dir=cache_dir)
-    indices = sample_indices(len(motion.time_s), every)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise OutputError(f"--out {out}: is a file, not a folder")
-    xdmf, hdf5 = output_paths(source, motion.case, out)
+    xdmf, hdf5 = output_paths(source, pick_case(source, case), out)
     check_replaceable(hdf5, _ours_hdf5, "flex export: output", force)
     check_replaceable(xdmf, _ours_xdmf, "flex export: output", force)
     check_writable_folder(out, f"--out {out}")
+    motion = case_motion(source, case, cache_dir=cache_dir)
+    indices = sample_indices(len(motion.time_s), every)
     nodes = sum(len(body.reference_m) for body in motion.bodies)
     estimate = estimate_bytes(len(indices), nodes, sum(len(b.cells) for b in motion.bodies))
     free = free_bytes(out)
