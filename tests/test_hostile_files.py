@@ -282,10 +282,12 @@ def test_flex_scene_ladder_prints_its_scene():
 BAD_ADDRESSES = [("tcp://localhost", "needs a port"), ("tcp://10.0.0.1", "needs a port"),
                  ("tls://[::1]", "needs a port"), ("ws://host:", "needs a port"),
                  ("tcp://host:99999", "outside 1..65535"), ("tcp://host:0", "outside"),
-                 ("tcp://", "needs a port"), ("host:8786", "expected processes")]
+                 ("tcp://", "needs a port"), ("host:8786", "expected processes"),
+                 ("", "expected processes")]
 
 
-@pytest.mark.parametrize("address, words", BAD_ADDRESSES, ids=[a for a, _ in BAD_ADDRESSES])
+@pytest.mark.parametrize("address, words", BAD_ADDRESSES,
+                         ids=[a or "empty" for a, _ in BAD_ADDRESSES])
 def test_a_scheduler_address_without_a_usable_port_is_refused(tmp_path, address, words):
     check_refused(["run", "kfit", "--scheduler", address, "--out", str(tmp_path / "k.h5")],
                   [repr(address), words], watch=[tmp_path])

@@ -23,8 +23,13 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import TextIO
 
-#: seconds between two progress lines of one job
+#: the longest silence on stderr the command line allows itself [s] (README: "progress every
+#: 10 s"; :func:`silence_watch`)
 PROGRESS_INTERVAL_S = 10.0
+#: seconds between two progress lines of one job: a little below
+#: :data:`PROGRESS_INTERVAL_S`, so that a job's own lines come first and the silence watch
+#: speaks only when nothing else does
+REPORT_INTERVAL_S = 9.0
 
 
 def duration_text(seconds: float) -> str:
@@ -39,7 +44,7 @@ def duration_text(seconds: float) -> str:
 
 
 @contextmanager
-def heartbeat(what: str, interval_s: float = PROGRESS_INTERVAL_S, stream: TextIO | None = None
+def heartbeat(what: str, interval_s: float = REPORT_INTERVAL_S, stream: TextIO | None = None
               ) -> Iterator[None]:
     """Print ``flex: <what>: still running after <t>`` every ``interval_s`` seconds while the
     block runs (nothing for a block shorter than that)."""
@@ -125,7 +130,7 @@ class Progress:
     then at most every ``interval_s`` seconds."""
 
     def __init__(self, what: str, first_s: float = 2.0,
-                 interval_s: float = PROGRESS_INTERVAL_S, stream: TextIO | None = None) -> None:
+                 interval_s: float = REPORT_INTERVAL_S, stream: TextIO | None = None) -> None:
         self.what, self.first_s, self.interval_s = what, first_s, interval_s
         self.stream = stream
         self.start = time.perf_counter()

@@ -51,6 +51,7 @@ from pathlib import Path
 from typing import Any
 
 from flex.base.errors import FlexError
+from flex.base.progress import REPORT_INTERVAL_S
 from flex.data.cache import SWEEP_CASES, folder_problem, say
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
@@ -117,7 +118,7 @@ class _Job:
 #: plain progress lines (stderr not a terminal): at most one per this many seconds as cases
 #: finish, and at least one per PROGRESS_MAX_SILENCE_S while the sweep runs
 PROGRESS_MIN_INTERVAL_S = 5.0
-PROGRESS_MAX_SILENCE_S = 10.0
+PROGRESS_MAX_SILENCE_S = REPORT_INTERVAL_S
 
 
 def _is_terminal(stream: Any) -> bool:

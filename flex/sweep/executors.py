@@ -202,7 +202,7 @@ SCHEDULER_CHOICES = ("expected processes (default), serial, local (Dask on this 
 def check_scheduler(scheduler: str | None) -> None:
     """Refuse (:class:`FlexError`, one line) a ``scheduler`` that is none of the module
     doc's: a Dask address needs ``protocol://host:port`` with a port in 1..65535."""
-    if scheduler in (None, "", "processes", "serial", "local"):
+    if scheduler in (None, "processes", "serial", "local"):
         return
     match = ADDRESS.match(str(scheduler))
     if match is None and re.match(r"^(tcp|tls|ucx|ws|wss)://", str(scheduler)):
@@ -216,7 +216,8 @@ def check_scheduler(scheduler: str | None) -> None:
 
 def make_executor(scheduler: str | None = None, workers: int | None = None) -> Executor:
     """The executor for ``scheduler`` (see the module doc); unknown values are refused
-    (:func:`check_scheduler`)."""
+    (:func:`check_scheduler`; ``""`` is the default, as None)."""
+    scheduler = scheduler or None
     check_scheduler(scheduler)
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise FlexError(f"workers = {workers!r}: must be an integer >= 1")

@@ -40,6 +40,7 @@ import numpy as np
 
 from flex import __version__
 from flex.base.errors import OutputError
+from flex.base.progress import REPORT_INTERVAL_S
 from flex.data.outputs import check_replaceable, check_writable_folder, free_bytes, has_marker
 from flex.tools.motion import CaseMotion, case_motion, pick_case, sample_indices
 
@@ -62,7 +63,7 @@ CONSTANT_FIELDS = {
 #: result file keeps the run's own numbers), half the size of float64
 FIELD_DTYPE = np.float32
 #: seconds between two progress lines
-PROGRESS_INTERVAL_S = 10.0
+PROGRESS_INTERVAL_S = REPORT_INTERVAL_S
 #: HDF5 bookkeeping of one compressed dataset with its attributes [bytes], measured ~1.9 kB
 DATASET_OVERHEAD_BYTES = 2500
 
