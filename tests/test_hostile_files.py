@@ -327,3 +327,21 @@ def test_auto_links_of_a_mechanism_that_does_not_deploy_fail_clearly(tmp_path, s
     failed = [line for line in outcome.stderr.splitlines() if "FAILED case" in line]
     assert len(failed) == 1 and f'{link} = "auto"' in failed[0], outcome.stderr
     assert "does not deploy" in failed[0] and "spring_preload_m = 0" in failed[0]
+
+
+# --- a result file of the same name that flex did not write ----------------------------------
+RESULT_WRITERS = {
+    "run": ["run", "simulate", "--no-figures", "--set", "simulation.end_time_s=0.004"],
+    "design": ["design", "--vary", "preload", "--peak-speed", "50"],
+}
+
+
+@pytest.mark.parametrize("content", ["text", "empty", "plain-hdf5", "png-without-marker"])
+@pytest.mark.parametrize("command", RESULT_WRITERS)
+def test_a_result_file_flex_did_not_write_is_not_replaced(tmp_path, foreign, command, content):
+    there = tmp_path / "mine.h5"
+    there.write_bytes(foreign[content])
+    outcome = check_refused([*RESULT_WRITERS[command], "--out", str(there)],
+                            [str(there), "not written by flex", "nothing was run"],
+                            watch=[tmp_path])
+    assert "[0/" not in outcome.stderr and "flex: design: case" not in outcome.stderr

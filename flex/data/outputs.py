@@ -1,7 +1,8 @@
 """Where a run's outputs go, checked before anything runs; figures written all or nothing.
 
 - A result file ends in ``.h5``/``.hdf5``, is not an input of the run (the scene file, a
-  file the run reads), and its folder can be written: :func:`check_output` refuses
+  file the run reads), replaces only a result file flex wrote, and its folder can be
+  written: :func:`check_output` refuses
   otherwise, before any case is simulated.
 - Figures go to ``figures/`` beside the result file, named after it:
   ``results/dynamics.h5`` -> ``results/figures/dynamics-*.png``, ``runs/a.h5`` ->
@@ -45,8 +46,21 @@ def check_output(path: str | Path, inputs: Iterable[str | Path] = ()) -> Path:
         if source and _same_file(out, Path(source)):
             raise OutputError(f"--out '{out}' is an input of this run ({source}); "
                               f"choose another result file")
+    check_replaceable(out, _is_flex_result, "--out", hint="move it away or choose another "
+                      "--out (a result file flex wrote is replaced); nothing was run")
     check_writable_folder(out.parent, f"--out '{out}'")
     return out
+
+
+def _is_flex_result(path: Path) -> bool:
+    """Whether ``path`` is an HDF5 file flex wrote (its ``flex_format`` root attribute)."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as h5:
+            return "flex_format" in h5.attrs
+    except (OSError, ValueError):
+        return False
 
 
 def check_writable_folder(folder: Path, label: str) -> None:
@@ -64,7 +78,9 @@ def check_writable_folder(folder: Path, label: str) -> None:
 
 
 def check_replaceable(path: Path, written_by_flex: Callable[[Path], bool], label: str,
-                      force: bool = False) -> None:
+                      force: bool = False,
+                      hint: str = "move it away, choose another output, or pass --force to "
+                                  "replace it; nothing was changed") -> None:
     """Refuse (:class:`OutputError`, one line) to replace ``path`` when it is a folder, or
     an existing file that ``written_by_flex`` does not recognise as flex's own output (its
     provenance marker), unless ``force``: a file of the same name that someone else wrote is
@@ -79,8 +95,7 @@ def check_replaceable(path: Path, written_by_flex: Callable[[Path], bool], label
         ours = False
     if not ours:
         raise OutputError(f"{label} '{path}' exists and was not written by flex (no flex "
-                          f"provenance in it): move it away, choose another output, or pass "
-                          f"--force to replace it; nothing was changed")
+                          f"provenance in it): {hint}")
 
 
 def has_marker(path: Path, marker: bytes, window: int = 1 << 16) -> bool:
