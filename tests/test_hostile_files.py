@@ -345,3 +345,30 @@ def test_a_result_file_flex_did_not_write_is_not_replaced(tmp_path, foreign, com
                             [str(there), "not written by flex", "nothing was run"],
                             watch=[tmp_path])
     assert "[0/" not in outcome.stderr and "flex: design: case" not in outcome.stderr
+
+
+# --- inspect: attributes a hand made strings or arrays ---------------------------------------
+PEAK = {"coupler_peak_von_mises_Pa": 2.8e7, "coupler_peak_von_mises_time_s": 0.015,
+        "coupler_peak_von_mises_position_m": np.array([0.04, 0.0005, -0.005]),
+        "estimated_error_coupler_peak_von_mises_Pa": 2.1e6,
+        "crest_gap_coupler_peak_deflection_m": 2.3e-5, "refine_status": "met",
+        "refine_wall_time_s": 16.8, "refine_attempts": "1: met"}
+#: inspect's own lines (estimated_error_* budget rows: flex.fidelity.error_budget.budget_rows)
+BROKEN = ["coupler_peak_von_mises_Pa", "coupler_peak_von_mises_time_s",
+          "crest_gap_coupler_peak_deflection_m", "refine_wall_time_s"]
+
+
+@pytest.mark.parametrize("value", ["28 MPa", np.array([1.5, 2.5])], ids=["string", "array"])
+@pytest.mark.parametrize("name", BROKEN)
+def test_inspect_shows_a_hand_made_attribute_as_stored(tmp_path, name, value):
+    from flex.data.results import CaseResult, Dataset, write_results
+
+    attrs = dict(PEAK, **{name: value})
+    path = write_results(tmp_path / "hand.h5", "simulate", [CaseResult("c", "", {
+        "time": Dataset(np.linspace(0, 1, 3), "s")}, attrs=attrs)])
+    before = fingerprint([path])
+    outcome = run_cli(["inspect", str(path)])
+    assert outcome.status == EXIT_OK and "Traceback" not in outcome.stderr, outcome.stderr
+    shown = "28 MPa" if isinstance(value, str) else "[1.5, 2.5]"
+    assert shown in outcome.stdout, outcome.stdout  # as stored, not a number made up
+    assert fingerprint([path]) == before

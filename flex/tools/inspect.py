@@ -307,11 +307,11 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
         if attrs.get(PREFIX + key):
             lines.append(f"    {key.replace('_', ' ')}: {attrs[PREFIX + key]}")
     lines += [f"    crest gap of the {key.removeprefix('crest_gap_').split('_')[0]}'s peak "
-              f"deflection: {float(value):.3g} m (the second-largest crest lies this far "
+              f"deflection: {_quantity(value, 'm')} (the second-largest crest lies this far "
               f"below it)" for key, value in attrs.items() if key.startswith("crest_gap_")]
     if attrs.get("refine_status"):
         lines.append(f"  refinement (fidelity.refine): {attrs['refine_status']}, "
-                     f"{float(attrs.get('refine_wall_time_s', 0.0)):.3g} s")
+                     f"{_quantity(attrs.get('refine_wall_time_s', 0.0), 's')}")
         lines += [f"    {line}" for line in str(attrs.get("refine_attempts", "")).splitlines()]
     return lines
 
@@ -330,7 +330,16 @@ def stress_lines(attrs: dict[str, Any]) -> list[str]:
             if f"{name}_Pa" not in attrs:
                 continue
             x, y, z = (1e3 * float(v) for v in np.ravel(attrs[f"{name}_position_m"]))
-            error = attrs.get(f"{PREFIX}{name}_Pa")
+            raw_error = attrs.get(f"{PREFIX}{name}_Pa")
+            error = _number(raw_error)
+            if _number(attrs[f"{name}_Pa"]) is None or _number(attrs.get(
+                    f"{name}_time_s")) is None or np.size(attrs.get(f"{name}_position_m")) != 3:
+                parts.append(f"{_short(attrs[f'{name}_Pa'])} Pa {where} at t = "
+                             f"{_short(attrs.get(f'{name}_time_s'))} s (attributes that are "
+                             f"not one number, shown as stored)")
+                continue
+            if raw_error is not None and error is None:
+                parts.append(f"estimated error {_short(raw_error)} (not a number, as stored)")
             parts.append(f"{attrs[f'{name}_Pa'] / 1e6:.4g} MPa {where} at t = "
                          f"{attrs[f'{name}_time_s'] * 1e3:.4g} ms, (x, y, z) = ({x:.3g}, "
                          f"{y:.3g}, {z:.3g}) mm on the plate"
@@ -339,6 +348,23 @@ def stress_lines(attrs: dict[str, Any]) -> list[str]:
         if parts:
             lines.append(f"peak von Mises stress, {link}: " + "; ".join(parts))
     return lines
+
+
+def _number(value: Any) -> float | None:
+    """``value`` as a float when it is one number (a stored attribute a hand may have made
+    a string or an array), else None."""
+    if isinstance(value, bool | str | bytes) or np.size(value) != 1:
+        return None
+    try:
+        return float(np.ravel(value)[0])
+    except (TypeError, ValueError):
+        return None
+
+
+def _quantity(value: Any, units: str) -> str:
+    """A stored number with its units, or the stored value as it is when it is not one."""
+    number = _number(value)
+    return f"{number:.3g} {units}" if number is not None else f"{_short(value)} (not a number)"
 
 
 def _case_line(case: dict[str, Any]) -> str:
