@@ -19,8 +19,12 @@ datasets' ``units`` attributes and in the XDMF ``Information`` element ``units``
 - ``body_id`` (see the ``bodies`` Information) and ``reference_position_link_m`` (body
   coordinates of each node), the same at every time.
 
-Field datasets are written per time (``/fields/<name>/<index>``), gzip-compressed; the
-files are written under temporary names and renamed when complete.
+Field datasets are written per time (``/fields/<name>/<index>``), gzip-compressed. Before
+writing, the export says what it will write (times, nodes, :func:`estimate_bytes`, the free
+space) and refuses when the estimate exceeds the free space; an existing output that flex did
+not write is refused (unless ``force``). The HDF5 file is built in memory and both files are
+written under temporary names beside their targets and renamed when complete: a full disk
+mid-write is one line, with no partial file left.
 """
 
 from __future__ import annotations

@@ -254,7 +254,6 @@ def format_description(info: dict[str, Any]) -> str:
     scene_toml, heading = info["scene_toml"], "scene (resolved; root attribute scene_toml)"
     if '= "auto"' in scene_toml:
         heading = 'scene (root attribute scene_toml; each case holds its "auto" keys resolved)'
-
     if len(cases) == 1:  # one case (in the file, or matching PATH): the settings it ran with
         (name, case), = cases.items()
         if case["scene_toml"]:
