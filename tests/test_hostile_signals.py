@@ -150,7 +150,8 @@ sys.exit(main(sys.argv[1:]))
 def test_sigterm_while_animating_in_a_real_process(tmp_path):
     """The reported case: SIGTERM during ``--animate`` said "no result file was changed"."""
     done = _signal_when_ready([sys.executable, "-c", ANIMATE_BLOCKS,
-                               *_animate_argv(tmp_path / "run.h5")], signal.SIGTERM)
+                               *_animate_argv(tmp_path / "run.h5"), "--no-figures"],
+                              signal.SIGTERM)
     assert done.returncode == EXIT_SIGTERM, done.stderr
     last = done.stderr.strip().splitlines()[-1]
     assert last.startswith("flex: terminated; already written: ") and "run.h5" in last, last
