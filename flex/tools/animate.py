@@ -26,6 +26,7 @@ import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 
 import numpy as np
 
@@ -271,8 +272,8 @@ def _render(motion: CaseMotion, frames: list[_Frame], magnification: float):
 
 #: rigid links (False) and the slider (True): the slider drawn light and behind the coupler,
 #: so that the coupler's end and joint C stay visible on it
-_BOX_STYLE = {False: {"color": "0.7", "ec": "0.2", "lw": 1.0, "zorder": 1},
-              True: {"color": "0.88", "ec": "0.45", "lw": 0.8, "zorder": 0.5}}
+_BOX_STYLE = (MappingProxyType({"color": "0.7", "ec": "0.2", "lw": 1.0, "zorder": 1}),
+              MappingProxyType({"color": "0.88", "ec": "0.45", "lw": 0.8, "zorder": 0.5}))
 
 
 def _joints(motion: CaseMotion, drawn: dict[str, np.ndarray], axes) -> list:
