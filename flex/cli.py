@@ -37,6 +37,10 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(EXIT_BAD_INPUT)
 
 
+#: seconds without a line on stderr after which the command line says it is still working
+#: (README: "progress at least every 10 s")
+PROGRESS_INTERVAL_S = 10.0
+
 EPILOG = "exit status:\n" + "\n".join(f"  {code:<4} {text}" for code, text in
                                       EXIT_STATUSES.items())
 
@@ -109,6 +113,9 @@ def _view_tools(commands) -> None:
     export.add_argument("--out", required=True, metavar="DIR", help="output folder")
     export.add_argument("--every", type=int, default=1, metavar="N",
                         help="export every N-th stored time (and the last; default 1)")
+    export.add_argument("--force", action="store_true",
+                        help="replace existing output files that flex did not write "
+                             "(default: refused)")
     animate = commands.add_parser(
         "animate", help="animate a case: the mechanism with its flexible links deformed",
         description="Draw the mechanism in its plane at the stored times, each flexible link "
@@ -131,6 +138,9 @@ def _view_tools(commands) -> None:
     animate.add_argument("--magnification", type=float, metavar="X",
                          help="deformation scale (default: the peak deflection drawn as "
                               "1/20 of the link length, rounded to 1, 2 or 5 x 10^k)")
+    animate.add_argument("--force", action="store_true",
+                         help="replace an existing --out that flex did not write "
+                              "(default: refused)")
 
 
 def _design_command(commands) -> None:
@@ -298,7 +308,8 @@ def _view_tool(args: argparse.Namespace) -> int:
     if args.command == "export":
         from flex.tools.export import export_case
 
-        done = export_case(args.file, args.case, args.out, args.every, cache_dir=cache_dir)
+        done = export_case(args.file, args.case, args.out, args.every, cache_dir=cache_dir,
+                           force=args.force)
         _print(f"wrote {done.xdmf} and {done.hdf5.name} ({done.times} times, {done.nodes} "
                f"nodes, {done.bytes_written / 1e6:.1f} MB)")
         return EXIT_OK
@@ -306,7 +317,7 @@ def _view_tool(args: argparse.Namespace) -> int:
 
     done = animate_case(args.file, args.case, args.out, frames=args.frames, fps=args.fps,
                         magnification=args.magnification, cache_dir=cache_dir,
-                        at_time_s=args.at_time_s)
+                        at_time_s=args.at_time_s, force=args.force)
     _print(f"wrote {done.path} ({done.frames} frame{'s' if done.frames != 1 else ''}, "
            f"{done.width}x{done.height} px, "
            f"deformation x {done.magnification:g})")
@@ -339,10 +350,16 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point; returns the process exit status (:mod:`flex.base.errors`). No exception
     leaves it: a bug prints one ``flex: internal error`` line and returns 3 (``FLEX_DEBUG=1``
     shows the traceback)."""
+    from flex.base.interrupts import interrupts_not_swallowed
+    from flex.base.progress import silence_watch
+
     received: list[int] = []
     restore = _catch_signals(received)
+    stderr = sys.stderr
     try:
-        return _dispatch(argv)
+        with interrupts_not_swallowed(), silence_watch(stderr, PROGRESS_INTERVAL_S) as watched:
+            sys.stderr = watched  # a line on stderr at least every PROGRESS_INTERVAL_S
+            return _dispatch(argv)
     except FlexError as exc:
         print(f"flex: error: {_one_line(str(exc))}", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -364,6 +381,7 @@ def main(argv: list[str] | None = None) -> int:
               file=sys.stderr)
         return EXIT_INTERNAL
     finally:
+        sys.stderr = stderr
         restore()
 
 
@@ -406,8 +424,8 @@ def _interrupted(exc: BaseException, received: list[int]) -> int:
     written = getattr(exc, "written", [])
     if written:
         files = ", ".join(str(path) for path in written)
-        print(f"flex: {what}; already written: {files}; figures not yet drawn were left as "
-              f"they were", file=sys.stderr)
+        print(f"flex: {what}; already written: {files}; nothing else was changed (files not "
+              f"yet written were left as they were)", file=sys.stderr)
     else:
         print(f"flex: {what}; no result file was changed", file=sys.stderr)
     return EXIT_SIGTERM if terminated else EXIT_SIGINT
@@ -445,8 +463,6 @@ def _dispatch(argv: list[str] | None) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    import re
-
     from flex.study import from_environment, load_study, run_study
 
     if args.workers is not None and args.workers < 1:
@@ -459,10 +475,13 @@ def _run(args: argparse.Namespace) -> int:
     if sweep_options and not getattr(load_study(args.study), "SWEEP", False):
         raise FlexError(f"{' and '.join(sweep_options)}: study '{args.study}' runs its cases "
                         f"in this process; these options apply to sweep studies (kfit)")
-    if args.scheduler is not None and not re.match(
-            r"^(processes|serial|local|(tcp|tls|inproc|ucx|ws|wss)://\S+)$", args.scheduler):
-        raise FlexError(f"--scheduler {args.scheduler!r}: expected processes (default), serial, "
-                        f"local (Dask on this machine) or a Dask address like tcp://host:8786")
+    if args.scheduler is not None:
+        from flex.sweep.executors import check_scheduler
+
+        try:
+            check_scheduler(args.scheduler)
+        except FlexError as exc:
+            raise FlexError(f"--{exc}") from None
     sweep = None
     if getattr(load_study(args.study), "SWEEP", False):
         import dataclasses
@@ -481,10 +500,16 @@ def _run(args: argparse.Namespace) -> int:
                        figures=not args.no_figures, quiet=args.quiet, sweep=sweep,
                        **from_environment(args.study, os.environ))
     if args.animate and output.as_expected and output.path is not None:
+        from flex.study import Interrupted
         from flex.tools.animate import animate_results
 
         cache_dir = from_environment(args.study, os.environ)["cache_dir"]
-        for done in animate_results(output.path, cache_dir=cache_dir):
-            if not args.quiet:
-                _print(f"wrote {done.path} ({done.frames} frames)")
+        written = [output.path, *output.figures, *([output.report] if output.report else [])]
+        try:
+            for done in animate_results(output.path, cache_dir=cache_dir):
+                written.append(done.path)
+                if not args.quiet:
+                    _print(f"wrote {done.path} ({done.frames} frames)")
+        except KeyboardInterrupt as exc:  # the run's files are in place: say so
+            raise Interrupted(written, getattr(exc, "kind", type(exc))) from None
     return EXIT_OK if output.as_expected else EXIT_FAILED

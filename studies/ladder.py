@@ -52,7 +52,7 @@ def _label(thickness_mm: float) -> str:
 def cases(scene: Scene) -> dict[str, Scene]:
     out = {}
     for thickness_mm, (mesh_mm, step_s) in PLATES.items():
-        plate = dict(scene["coupler"], thickness_m=thickness_mm * 1e-3)  # a link, not a scene
+        plate = dict(scene, coupler=dict(scene["coupler"], thickness_m=thickness_mm * 1e-3))
         end_time_s = round(max(1.1 * first_period_s(plate), 0.005), 4)
         for model, model_scene in rung_scenes(scene, thickness_mm * 1e-3, mesh_mm * 1e-3,
                                               step_s, end_time_s).items():

@@ -149,11 +149,18 @@ def test_progress_is_throttled_and_the_heartbeat_beats():
     progress = Progress("work", first_s=0.0, interval_s=3600.0, stream=stream)
     assert progress.update("one") and not progress.update("two")
     assert stream.getvalue() == "flex: work: one\n"
-    beats = io.StringIO()
-    with heartbeat("meshing", interval_s=0.01, stream=beats):
-        import time
+    import threading
 
-        time.sleep(0.1)
+    class Beats(io.StringIO):  # says when the first beat was written: no clock in the test
+        written = threading.Event()
+
+        def write(self, text: str) -> int:
+            self.written.set()
+            return super().write(text)
+
+    beats = Beats()
+    with heartbeat("meshing", interval_s=0.01, stream=beats):
+        assert beats.written.wait(timeout=60)  # the timeout only guards against a hang
     assert "flex: meshing: still running after" in beats.getvalue()
     assert duration_text(90) == "90 s" and duration_text(600) == "10 min"
 

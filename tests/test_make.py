@@ -323,12 +323,13 @@ def test_sweep_progress_lines_are_spaced_with_a_heartbeat(monkeypatch):
     bar.close()
     lines = stream.getvalue().splitlines()
     assert lines[0] == "demo: 10 cases to run"
+    silence = sweep.PROGRESS_MAX_SILENCE_S  # 9 s: below the command line's 10 s watch
     assert [line.split(",")[0] for line in lines[1:]] == [
         "demo: 5/10 cases (done=5 failed=0 remaining=5)",   # 5 s
-        "demo: 10/10 cases (done=10 failed=0 remaining=0)",  # heartbeat at 15 s
-        "demo: 10/10 cases (done=10 failed=0 remaining=0)",  # heartbeat at 25 s
+        "demo: 10/10 cases (done=10 failed=0 remaining=0)",  # heartbeat at 5 s + silence
+        "demo: 10/10 cases (done=10 failed=0 remaining=0)",  # heartbeat at 5 s + 2 silence
         "demo: 10/10 cases (done=10 failed=0 remaining=0)"]  # finished (the last case: once)
-    assert "~5 s left" in lines[1] and "15 s elapsed" in lines[2]
+    assert "~5 s left" in lines[1] and f"{5 + silence:.0f} s elapsed" in lines[2]
     assert lines[-1].endswith("30 s elapsed, finished")
 
 

@@ -2,7 +2,6 @@
 preparation, the local process pool and a real local Dask cluster."""
 
 import os
-import time
 
 import h5py
 import pytest
@@ -136,7 +135,6 @@ def test_local_process_pool_survives_a_crashing_worker(tmp_path):
 
 def test_real_local_dask_cluster_runs_a_sweep(tmp_path):
     distributed = pytest.importorskip("distributed")
-    start = time.perf_counter()
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   host="127.0.0.1", dashboard_address=None,
                                   silence_logs=40) as cluster:
@@ -152,7 +150,6 @@ def test_real_local_dask_cluster_runs_a_sweep(tmp_path):
         # the same sweep again resumes entirely from the files
         again = run_sweep(scenes, tmp_path, failing_case, scheduler=address, progress=False)
         assert again.ran == 0 and again.resumed == 4
-    assert time.perf_counter() - start < 60
 
 
 def test_results_round_trip_keeps_units_and_attributes(tmp_path):

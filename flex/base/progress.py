@@ -4,6 +4,9 @@
 - :func:`heartbeat`: a context manager printing ``flex: <what>: still running after 30 s``
   lines to stderr at a fixed interval while a long call that reports nothing itself runs
   (a mesh, an eigen-solve), from a daemon thread that ends with the block.
+- :func:`silence_watch`: a stream wrapper for the command line: a line whenever nothing
+  was printed for :data:`PROGRESS_INTERVAL_S` (many short steps, each below its own
+  announce threshold, are not silent for minutes).
 - :class:`Progress`: a throttled reporter for work that knows how far it is: the first
   line after ``first_s`` seconds, then at most one every ``interval_s``.
 
@@ -20,8 +23,13 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import TextIO
 
-#: seconds between two progress lines of one job
+#: the longest silence on stderr the command line allows itself [s] (README: "progress every
+#: 10 s"; :func:`silence_watch`)
 PROGRESS_INTERVAL_S = 10.0
+#: seconds between two progress lines of one job: a little below
+#: :data:`PROGRESS_INTERVAL_S`, so that a job's own lines come first and the silence watch
+#: speaks only when nothing else does
+REPORT_INTERVAL_S = 9.0
 
 
 def duration_text(seconds: float) -> str:
@@ -36,7 +44,7 @@ def duration_text(seconds: float) -> str:
 
 
 @contextmanager
-def heartbeat(what: str, interval_s: float = 30.0, stream: TextIO | None = None
+def heartbeat(what: str, interval_s: float = REPORT_INTERVAL_S, stream: TextIO | None = None
               ) -> Iterator[None]:
     """Print ``flex: <what>: still running after <t>`` every ``interval_s`` seconds while the
     block runs (nothing for a block shorter than that)."""
@@ -58,13 +66,71 @@ def heartbeat(what: str, interval_s: float = 30.0, stream: TextIO | None = None
         thread.join(timeout=1.0)
 
 
+class _Watched:
+    """A text stream that notes when it was last written to, and its last line."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self.stream = stream
+        self.lock = threading.Lock()
+        self.last_s = time.perf_counter()
+        self.last_line = ""
+
+    def write(self, text: str) -> int:
+        with self.lock:
+            self.last_s = time.perf_counter()
+            lines = [line for line in text.splitlines() if line.strip()]
+            if lines:
+                self.last_line = lines[-1].strip()
+            return self.stream.write(text)
+
+    def __getattr__(self, name: str):
+        return getattr(self.stream, name)
+
+
+@contextmanager
+def silence_watch(stream: TextIO, interval_s: float = PROGRESS_INTERVAL_S
+                  ) -> Iterator[TextIO]:
+    """Yield a stream that writes to ``stream``; while the block runs, whenever nothing was
+    written to it for ``interval_s`` seconds, a line ``flex: still working after <t> (last
+    line <t> ago: <line>)`` is (so a log shows a line at least every ``interval_s``, whatever
+    the work and however it is split into steps shorter than their own announce
+    thresholds)."""
+    watched = _Watched(stream)
+    done = threading.Event()
+    start = time.perf_counter()
+
+    def watch() -> None:
+        while True:
+            remaining = interval_s - (time.perf_counter() - watched.last_s)
+            if remaining > 0:
+                if done.wait(remaining):
+                    return
+                continue
+            now = time.perf_counter()
+            last = (f" (last line {duration_text(now - watched.last_s)} ago: "
+                    f"{watched.last_line})" if watched.last_line else "")
+            try:
+                print(f"flex: still working after {duration_text(now - start)}{last}",
+                      file=watched, flush=True)
+            except (OSError, ValueError):  # a closed stream: nothing more to say
+                return
+
+    thread = threading.Thread(target=watch, name="flex-silence-watch", daemon=True)
+    thread.start()
+    try:
+        yield watched
+    finally:
+        done.set()
+        thread.join(timeout=1.0)
+
+
 class Progress:
     """Throttled progress lines ``flex: <what>: <text>`` for work that knows how far it is:
     :meth:`update` prints only once ``first_s`` seconds have passed since the start and
     then at most every ``interval_s`` seconds."""
 
     def __init__(self, what: str, first_s: float = 2.0,
-                 interval_s: float = PROGRESS_INTERVAL_S, stream: TextIO | None = None) -> None:
+                 interval_s: float = REPORT_INTERVAL_S, stream: TextIO | None = None) -> None:
         self.what, self.first_s, self.interval_s = what, first_s, interval_s
         self.stream = stream
         self.start = time.perf_counter()

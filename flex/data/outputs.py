@@ -1,7 +1,8 @@
 """Where a run's outputs go, checked before anything runs; figures written all or nothing.
 
 - A result file ends in ``.h5``/``.hdf5``, is not an input of the run (the scene file, a
-  file the run reads), and its folder can be written: :func:`check_output` refuses
+  file the run reads), replaces only a result file flex wrote, and its folder can be
+  written: :func:`check_output` refuses
   otherwise, before any case is simulated.
 - Figures go to ``figures/`` beside the result file, named after it:
   ``results/dynamics.h5`` -> ``results/figures/dynamics-*.png``, ``runs/a.h5`` ->
@@ -11,6 +12,8 @@
   a report path that is a folder) or an interrupt leaves the previous files as they were.
 - A run that did not end as its study declares never replaces an existing result file: it
   is written beside it as :func:`failed_path` (``<name>.failed.h5``).
+- Other outputs (``flex export``, ``flex animate``) replace only files flex wrote
+  (:func:`check_replaceable`, its provenance marker); :func:`free_bytes` for a size check.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ import os
 import secrets
 import shutil
 import tempfile
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 from flex.base.errors import OutputError
@@ -43,8 +46,21 @@ def check_output(path: str | Path, inputs: Iterable[str | Path] = ()) -> Path:
         if source and _same_file(out, Path(source)):
             raise OutputError(f"--out '{out}' is an input of this run ({source}); "
                               f"choose another result file")
+    check_replaceable(out, _is_flex_result, "--out", hint="move it away or choose another "
+                      "--out (a result file flex wrote is replaced); nothing was run")
     check_writable_folder(out.parent, f"--out '{out}'")
     return out
+
+
+def _is_flex_result(path: Path) -> bool:
+    """Whether ``path`` is an HDF5 file flex wrote (its ``flex_format`` root attribute)."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as h5:
+            return "flex_format" in h5.attrs
+    except (OSError, ValueError):
+        return False
 
 
 def check_writable_folder(folder: Path, label: str) -> None:
@@ -59,6 +75,46 @@ def check_writable_folder(folder: Path, label: str) -> None:
         raise OutputError(f"{label}: '{existing}' is a file, not a folder")
     if not os.access(existing, os.W_OK | os.X_OK):
         raise OutputError(f"{label}: folder '{existing}' is not writable")
+
+
+def check_replaceable(path: Path, written_by_flex: Callable[[Path], bool], label: str,
+                      force: bool = False,
+                      hint: str = "move it away, choose another output, or pass --force to "
+                                  "replace it; nothing was changed") -> None:
+    """Refuse (:class:`OutputError`, one line) to replace ``path`` when it is a folder, or
+    an existing file that ``written_by_flex`` does not recognise as flex's own output (its
+    provenance marker), unless ``force``: a file of the same name that someone else wrote is
+    never replaced silently."""
+    if path.is_dir():
+        raise OutputError(f"{label} '{path}' is a folder; nothing was changed")
+    if force or not (path.exists() or path.is_symlink()):
+        return
+    try:
+        ours = path.is_file() and written_by_flex(path)
+    except OSError:
+        ours = False
+    if not ours:
+        raise OutputError(f"{label} '{path}' exists and was not written by flex (no flex "
+                          f"provenance in it): {hint}")
+
+
+def has_marker(path: Path, marker: bytes, window: int = 1 << 16) -> bool:
+    """Whether ``marker`` occurs in the first or the last ``window`` bytes of ``path`` (a
+    provenance string a writer put in a file's metadata)."""
+    with path.open("rb") as file:
+        head = file.read(window)
+        size = file.seek(0, os.SEEK_END)
+        file.seek(max(0, size - window))
+        return marker in head or marker in file.read(window)
+
+
+def free_bytes(folder: Path) -> int:
+    """Free space [bytes] for an unprivileged writer in ``folder`` (or its nearest existing
+    ancestor)."""
+    existing = folder if str(folder) else Path(".")
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    return int(shutil.disk_usage(existing).free)
 
 
 def _same_file(a: Path, b: Path) -> bool:

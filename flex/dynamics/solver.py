@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SimulationError, Terminated
+from flex.base.interrupts import interrupts_not_swallowed
 from flex.base.progress import heartbeat
 from flex.config.settings import check_concrete
 from flex.data.results import CaseResult, Dataset
@@ -182,11 +183,12 @@ def run(mech: Mechanism, label: str = "") -> dict[str, Any]:
     if threading.current_thread() is threading.main_thread():
         def on_interrupt(signum, frame):
             interrupted.append(signum)
+            mech.mbs.SetRenderEngineStopFlag(True)  # Exudyn may drop the exception: stop it
             raise Terminated if signum == signal.SIGTERM else KeyboardInterrupt
         previous = {sig: signal.signal(sig, on_interrupt)
                     for sig in (signal.SIGINT, signal.SIGTERM)}
     try:
-        with redirect_stdout(captured):
+        with redirect_stdout(captured), interrupts_not_swallowed():
             ok = solver.SolveSystem(mech.mbs, _exudyn_settings(settings))
     except Exception as exc:  # Exudyn raises RuntimeError/ValueError on Newton failure
         ok = False

@@ -388,6 +388,14 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
     criterion = criterion or criterion_of(calibration, "coupler")
     tolerance = float(resolved["fidelity"]["tolerance"])
     delta_t_s, how, probe = deployment_probe(resolved, calibration)
+    if not delta_t_s > 0:  # a mechanism that does not move (no preload): no time scale
+        links = " and ".join(f"{link}.model" for link, wants in
+                             (("coupler", wants_coupler), ("crank", wants_crank)) if wants)
+        raise SceneError(f'{links} = "auto": the rigid run does not deploy (delta_t = '
+                         f"{delta_t_s:g} s: the crank angle's first maximum is at t = 0; "
+                         f"drive.spring_preload_m = {resolved['drive']['spring_preload_m']:g} "
+                         f"m), so the criterion has no time scale; give the spring a preload "
+                         f'> 0 or set the link model ("rigid", "ffrf")')
     if wants_coupler:
         decision, how = _decide_coupler(resolved, probe, delta_t_s, how, tolerance, criterion,
                                         calibration, link_models)

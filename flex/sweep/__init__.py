@@ -51,6 +51,7 @@ from pathlib import Path
 from typing import Any
 
 from flex.base.errors import FlexError
+from flex.base.progress import REPORT_INTERVAL_S
 from flex.data.cache import SWEEP_CASES, folder_problem, say
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
@@ -70,6 +71,7 @@ from flex.sweep.executors import (
     SerialExecutor,
     _guarded,
     _prepare_guarded,
+    check_scheduler,
     make_executor,
     simulate_scene_case,
 )
@@ -116,7 +118,7 @@ class _Job:
 #: plain progress lines (stderr not a terminal): at most one per this many seconds as cases
 #: finish, and at least one per PROGRESS_MAX_SILENCE_S while the sweep runs
 PROGRESS_MIN_INTERVAL_S = 5.0
-PROGRESS_MAX_SILENCE_S = 10.0
+PROGRESS_MAX_SILENCE_S = REPORT_INTERVAL_S
 
 
 def _is_terminal(stream: Any) -> bool:
@@ -456,7 +458,12 @@ def settings_from_environment(environ: Mapping[str, str]) -> SweepSettings:
     except ValueError:
         raise FlexError(f"FLEX_WORKERS = {workers!r}: must be an integer >= 1") from None
     folder = environ.get("FLEX_SWEEP_DIR") or None
-    return SweepSettings(scheduler=environ.get("FLEX_SCHEDULER") or None, workers=count,
+    scheduler = environ.get("FLEX_SCHEDULER") or None
+    try:
+        check_scheduler(scheduler)
+    except FlexError as exc:
+        raise FlexError(f"FLEX_SCHEDULER: {exc}") from None
+    return SweepSettings(scheduler=scheduler, workers=count,
                          folder=Path(folder) if folder else None,
                          retry_failed=environ.get("FLEX_RETRY_FAILED", "") == "1",
                          progress=environ.get("FLEX_PROGRESS", "1") != "0")

@@ -191,8 +191,34 @@ class DaskExecutor(Executor):
             self._cluster.close()
 
 
+#: a Dask scheduler address: protocol://host:port (host a name, IPv4 or [IPv6]); inproc://
+#: addresses need no port
+ADDRESS = re.compile(r"^(?:(?:tcp|tls|ucx|ws|wss)://(?:\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+)"
+                     r":(?P<port>\d{1,5})|inproc://\S+)$")
+SCHEDULER_CHOICES = ("expected processes (default), serial, local (Dask on this machine) or "
+                     "a Dask address like tcp://host:8786")
+
+
+def check_scheduler(scheduler: str | None) -> None:
+    """Refuse (:class:`FlexError`, one line) a ``scheduler`` that is none of the module
+    doc's: a Dask address needs ``protocol://host:port`` with a port in 1..65535."""
+    if scheduler in (None, "processes", "serial", "local"):
+        return
+    match = ADDRESS.match(str(scheduler))
+    if match is None and re.match(r"^(tcp|tls|ucx|ws|wss)://", str(scheduler)):
+        raise FlexError(f"scheduler {scheduler!r}: a Dask address needs a port, "
+                        f"protocol://host:port like tcp://host:8786")
+    if match is None:
+        raise FlexError(f"scheduler {scheduler!r}: {SCHEDULER_CHOICES}")
+    if match["port"] is not None and not 1 <= int(match["port"]) <= 65535:
+        raise FlexError(f"scheduler {scheduler!r}: port {match['port']} is outside 1..65535")
+
+
 def make_executor(scheduler: str | None = None, workers: int | None = None) -> Executor:
-    """The executor for ``scheduler`` (see the module doc); unknown values are refused."""
+    """The executor for ``scheduler`` (see the module doc); unknown values are refused
+    (:func:`check_scheduler`; ``""`` is the default, as None)."""
+    scheduler = scheduler or None
+    check_scheduler(scheduler)
     if workers is not None and (not isinstance(workers, int) or workers < 1):
         raise FlexError(f"workers = {workers!r}: must be an integer >= 1")
     if scheduler in (None, "", "processes"):
@@ -201,8 +227,5 @@ def make_executor(scheduler: str | None = None, workers: int | None = None) -> E
         return SerialExecutor()
     if scheduler == "local":
         return DaskExecutor(None, workers)
-    if re.match(r"^(tcp|tls|inproc|ucx|ws|wss)://", scheduler):
-        return DaskExecutor(scheduler, workers)
-    raise FlexError(f"scheduler {scheduler!r}: expected processes (default), serial, local "
-                    f"(Dask on this machine) or a Dask address like tcp://host:8786")
+    return DaskExecutor(scheduler, workers)
 

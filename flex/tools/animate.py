@@ -23,13 +23,15 @@ from __future__ import annotations
 import math
 import os
 import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 
 import numpy as np
 
-from flex.base.errors import FlexError
+from flex.base.errors import FlexError, OutputError
+from flex.data.outputs import check_replaceable, check_writable_folder, has_marker
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.tools.motion import Body, CaseMotion, case_motion, top_faces
 
@@ -38,6 +40,9 @@ SIZE_PX = (960, 540)
 DPI = 100
 #: the default magnification draws the peak chord deflection as this fraction of the length
 DRAWN_DEFLECTION = 1 / 20
+#: provenance written into every animation's metadata (PNG text, GIF comment, mp4 comment):
+#: an existing output is replaced only when it carries it
+MARKER = b"written by flex animate"
 
 
 @dataclass
@@ -153,6 +158,7 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
                  fps: int = 25, magnification: float | None = None,
                  cache_dir: Path | None = None, at_time_s: float | None = None,
                  progress: Callable[[str], None] | None = None,
+                 force: bool = False,
                  link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> Animation:
     """Animate ``case`` of result file ``source`` into ``out`` (``.mp4`` or ``.gif``; see the
     module doc; ``.png``: the one frame nearest ``at_time_s`` [s], by default the time of
@@ -160,7 +166,9 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
     spaced over the stored samples; ``magnification``: the deformation scale (None: the
     default of the module doc, from those frames). Refusals (:class:`FlexError`): those of
     :func:`flex.tools.motion.case_motion`, a bad suffix, frame count, rate, time or
-    magnification. ``link_models``: the registry the case's models are read from."""
+    magnification, an existing ``out`` that flex did not write (no :data:`MARKER` in its
+    metadata; unless ``force``), a write that fails (nothing partial is left).
+    ``link_models``: the registry the case's models are read from."""
     out = Path(out)
     if out.suffix.lower() not in (".mp4", ".gif", ".png"):
         raise FlexError(f"--out {out}: must end in .mp4, .gif or .png (one frame)")
@@ -173,6 +181,8 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
         print(f"flex animate: no mp4 encoder (install imageio-ffmpeg): writing {out}",
               file=sys.stderr)
     frame_indices(2, frames)  # a bad --frames is refused before anything is read
+    check_replaceable(out, lambda path: has_marker(path, MARKER), "flex animate: --out", force)
+    check_writable_folder(out.parent, f"--out {out}")
     motion = case_motion(source, case, cache_dir=cache_dir, link_models=link_models)
     indices = frame_indices(len(motion.time_s), frames)
     drawn = _frames(motion, indices)
@@ -180,11 +190,14 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
                                                                                      drawn)
     if out.suffix.lower() == ".png":
         drawn = _frames(motion, [_nearest(motion, at_time_s)])
-    out.parent.mkdir(parents=True, exist_ok=True)
     part = out.with_name(f".{out.stem}.{os.getpid()}.part{out.suffix}")
     try:
+        out.parent.mkdir(parents=True, exist_ok=True)
         _write(part, _render(motion, drawn, factor), fps)
         os.replace(part, out)
+    except OSError as exc:
+        raise OutputError(f"cannot write '{out}': {exc.strerror or exc}; the partial file was "
+                          f"removed and no existing file was changed") from None
     finally:
         part.unlink(missing_ok=True)
     if progress:
@@ -229,21 +242,24 @@ def _render(motion: CaseMotion, frames: list[_Frame], magnification: float):
     title = f"{motion.case}: " + ", ".join(f"{b.name} {b.model}" for b in motion.bodies)
     try:
         for frame in frames:
-            artists = []
+            artists, drawn = [], {}
             for body in motion.bodies:
                 xy = frame.shapes[body.name][:, :2]
                 if body.kind == "rigid":
-                    artists += axes.fill(*_outline(xy).T, color="0.7", ec="0.2", lw=1.0)
+                    drawn[body.name] = xy
+                    artists += axes.fill(*_outline(xy).T, **_BOX_STYLE[body.name == "slider"])
                     continue
-                shape = _drawn(body, frame.shapes[body.name], magnification)
+                shape = drawn[body.name] = _drawn(body, frame.shapes[body.name], magnification)
                 grid = Triangulation(shape[:, 0], shape[:, 1], faces[body.name])
                 stress = frame.stress[body.name]
                 if stress is None:
                     artists.append(axes.tripcolor(grid, np.zeros(len(shape)), cmap="Greys",
-                                                  vmin=-1, vmax=3, shading="gouraud"))
+                                                  vmin=-1, vmax=3, shading="gouraud",
+                                                  zorder=2))
                 else:
                     artists.append(axes.tripcolor(grid, stress / 1e6, cmap=colour_map,
-                                                  norm=norm, shading="gouraud"))
+                                                  norm=norm, shading="gouraud", zorder=2))
+            artists += _joints(motion, drawn, axes)
             artists.append(axes.set_title(
                 f"{title}\nt = {frame.time_s * 1e3:.3f} ms, crank angle "
                 f"{math.degrees(frame.crank_angle_rad):.2f} deg, deformation x "
@@ -254,6 +270,21 @@ def _render(motion: CaseMotion, frames: list[_Frame], magnification: float):
                 artist.remove()
     finally:
         plt.close(figure)
+
+
+#: rigid links (False) and the slider (True): the slider drawn light and behind the coupler,
+#: so that the coupler's end and joint C stay visible on it
+_BOX_STYLE = (MappingProxyType({"color": "0.7", "ec": "0.2", "lw": 1.0, "zorder": 1}),
+              MappingProxyType({"color": "0.88", "ec": "0.45", "lw": 0.8, "zorder": 0.5}))
+
+
+def _joints(motion: CaseMotion, drawn: dict[str, np.ndarray], axes) -> list:
+    """Joints B and C (the centres of the coupler's end faces as drawn) as small circles on
+    top of every body."""
+    coupler = next(body for body in motion.bodies if body.name == "coupler")
+    ends = [drawn["coupler"][face].mean(axis=0) for face in _face_nodes(coupler)]
+    return axes.plot(*np.array(ends).T, "o", ms=5, mfc="white", mec="black", mew=1.2,
+                     zorder=4, ls="none")
 
 
 def _outline(xy: np.ndarray) -> np.ndarray:
@@ -282,7 +313,8 @@ def _write(path: Path, frames, fps: int) -> None:
 
         writer = imageio_ffmpeg.write_frames(str(path), SIZE_PX, fps=fps, codec="libx264",
                                              pix_fmt_out="yuv420p", macro_block_size=1,
-                                             ffmpeg_log_level="error")
+                                             ffmpeg_log_level="error", output_params=[
+                                                 "-metadata", f"comment={MARKER.decode()}"])
         writer.send(None)
         try:
             for frame in frames:
@@ -293,11 +325,16 @@ def _write(path: Path, frames, fps: int) -> None:
     from PIL import Image
 
     if path.suffix.lower() == ".png":
-        Image.fromarray(next(iter(frames))).save(path, format="PNG", optimize=True)
+        from PIL.PngImagePlugin import PngInfo
+
+        info = PngInfo()
+        info.add_text("Software", MARKER.decode())
+        Image.fromarray(next(iter(frames))).save(path, format="PNG", optimize=True,
+                                                 pnginfo=info)
         return
     images = [Image.fromarray(frame).quantize(colors=255) for frame in frames]
     images[0].save(path, format="GIF", save_all=True, append_images=images[1:],
-                   duration=round(1000 / fps), loop=0)
+                   duration=round(1000 / fps), loop=0, comment=MARKER)
 
 
 def default_animation_path(result: Path, case: str) -> Path:
@@ -307,9 +344,10 @@ def default_animation_path(result: Path, case: str) -> Path:
 
 
 def animate_results(result: str | Path, *, cache_dir: Path | None = None,
-                    frames: int = 200) -> list[Animation]:
+                    frames: int = 200) -> Iterator[Animation]:
     """Animate every ok case with a flexible link of a result file
-    (:func:`default_animation_path`); ``flex run --animate``."""
+    (:func:`default_animation_path`), yielding each animation once it is written (``flex run
+    --animate``)."""
     from flex.data.results import attribute_value, case_names, reading
     from flex.tools.motion import case_scene
 
@@ -325,8 +363,10 @@ def animate_results(result: str | Path, *, cache_dir: Path | None = None,
                    or not BUILTIN_LINK_MODELS[scene[link]["model"]].rigid
                    for link in ("crank", "coupler")):
                 chosen.append(name)
-    return [animate_case(result, name, default_animation_path(result, name), frames=frames,
-                         cache_dir=cache_dir) for name in chosen]
+    # figures/ beside a result file is flex's own folder: a run replaces its figures there
+    for name in chosen:
+        yield animate_case(result, name, default_animation_path(result, name), frames=frames,
+                           cache_dir=cache_dir, force=True)
 
 
 __all__ = ["Animation", "animate_case", "animate_results", "chord_deflection",

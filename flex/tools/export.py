@@ -19,12 +19,17 @@ datasets' ``units`` attributes and in the XDMF ``Information`` element ``units``
 - ``body_id`` (see the ``bodies`` Information) and ``reference_position_link_m`` (body
   coordinates of each node), the same at every time.
 
-Field datasets are written per time (``/fields/<name>/<index>``), gzip-compressed; the
-files are written under temporary names and renamed when complete.
+Field datasets are written per time (``/fields/<name>/<index>``), gzip-compressed. Before
+writing, the export says what it will write (times, nodes, :func:`estimate_bytes`, the free
+space) and refuses when the estimate exceeds the free space; an existing output that flex did
+not write is refused (unless ``force``). The HDF5 file is built in memory and both files are
+written under temporary names beside their targets and renamed when complete: a full disk
+mid-write is one line, with no partial file left.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import sys
@@ -38,9 +43,11 @@ from typing import Any
 import numpy as np
 
 from flex import __version__
-from flex.base.errors import FlexError
+from flex.base.errors import OutputError
+from flex.base.progress import REPORT_INTERVAL_S
+from flex.data.outputs import check_replaceable, check_writable_folder, free_bytes, has_marker
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
-from flex.tools.motion import CaseMotion, case_motion, sample_indices
+from flex.tools.motion import CaseMotion, case_motion, pick_case, sample_indices
 
 #: point fields written at every time: name -> (units, description)
 FIELDS = {
@@ -61,7 +68,9 @@ CONSTANT_FIELDS = {
 #: result file keeps the run's own numbers), half the size of float64
 FIELD_DTYPE = np.float32
 #: seconds between two progress lines
-PROGRESS_INTERVAL_S = 10.0
+PROGRESS_INTERVAL_S = REPORT_INTERVAL_S
+#: HDF5 bookkeeping of one compressed dataset with its attributes [bytes], measured ~1.9 kB
+DATASET_OVERHEAD_BYTES = 2500
 
 
 @dataclass
@@ -90,37 +99,112 @@ def _stderr(text: str) -> None:
 def export_case(source: str | Path, case: str | None, out_dir: str | Path, every: int = 1,
                 *, cache_dir: Path | None = None,
                 progress: Callable[[str], None] | None = _stderr,
+                force: bool = False,
                 link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> ExportOutput:
     """Export ``case`` of result file ``source`` to ``out_dir`` (created if missing); see the
     module doc. ``every``: export every n-th stored time (and the last). ``cache_dir``: the
-    reduction cache folder. Refusals (:class:`FlexError`, one line): those of
-    :func:`flex.tools.motion.case_motion`, a bad ``every``, an output folder that cannot be
-    made. ``progress``: where progress lines go (None: nowhere). ``link_models``: the registry
-    the case's models are read from."""
+    reduction cache folder. Refusals (:class:`FlexError`, one line, nothing changed): those
+    of :func:`flex.tools.motion.case_motion`, a bad ``every``, an output folder that cannot
+    be made, an existing output file flex did not write (unless ``force``), less free space
+    than :func:`estimate_bytes`, and a write that fails (a full disk: the partial files are
+    removed). ``progress``: where the size estimate and progress lines go (None: nowhere).
+    The HDF5 file is assembled in memory (about its compressed size) and then written.
+    ``link_models``: the registry the case's models are read from."""
     sample_indices(1, every)  # a bad --every is refused before anything is read
-    motion = case_motion(source, case, cache_dir=cache_dir, link_models=link_models)
-    indices = sample_indices(len(motion.time_s), every)
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
-        raise FlexError(f"--out {out}: is a file, not a folder")
-    out.mkdir(parents=True, exist_ok=True)
-    xdmf, hdf5 = output_paths(source, motion.case, out)
+        raise OutputError(f"--out {out}: is a file, not a folder")
+    xdmf, hdf5 = output_paths(source, pick_case(source, case), out)
+    check_replaceable(hdf5, _ours_hdf5, "flex export: output", force)
+    check_replaceable(xdmf, _ours_xdmf, "flex export: output", force)
+    check_writable_folder(out, f"--out {out}")
+    motion = case_motion(source, case, cache_dir=cache_dir, link_models=link_models)
+    indices = sample_indices(len(motion.time_s), every)
     nodes = sum(len(body.reference_m) for body in motion.bodies)
-    estimate = len(indices) * nodes * 8 * np.dtype(FIELD_DTYPE).itemsize  # 8 values a node
+    estimate = estimate_bytes(len(indices), nodes, sum(len(b.cells) for b in motion.bodies))
+    free = free_bytes(out)
+    if estimate > free:
+        raise OutputError(f"--out {out}: the export needs up to {size_text(estimate)} "
+                          f"({len(indices)} times x {nodes} nodes, before compression) but "
+                          f"{size_text(free)} is free there: free space, choose another "
+                          f"--out, or export fewer times (--every N); nothing was written")
     if progress:
-        progress(f"flex export: {motion.case}: {len(indices)} times x {nodes} nodes "
-                 f"(~{estimate / 1e6:.0f} MB before compression) -> {xdmf}")
-    parts = (_part(hdf5), _part(xdmf))
+        progress(f"flex export: {motion.case}: {len(indices)} times x {nodes} nodes, up to "
+                 f"{size_text(estimate)} ({size_text(free)} free) -> {xdmf} and {hdf5.name}")
+    _place(out, (hdf5, xdmf), lambda parts: _write_both(parts, hdf5.name, motion, indices,
+                                                        nodes, progress))
+    return ExportOutput(xdmf, hdf5, len(indices), nodes, sum(len(b.cells) for b in motion.bodies),
+                        hdf5.stat().st_size + xdmf.stat().st_size, motion)
+
+
+def estimate_bytes(times: int, nodes: int, cells: int) -> int:
+    """Upper estimate of an export's size [bytes], as if nothing compressed: 8 float32
+    values a node and time, HDF5's bookkeeping of the 4 datasets a time (about
+    :data:`DATASET_OVERHEAD_BYTES` each), the mesh (geometry, Tet10 topology), the constant
+    fields and the XDMF file (about 500 bytes a time)."""
+    return (times * (nodes * 8 * np.dtype(FIELD_DTYPE).itemsize
+                     + len(FIELDS) * DATASET_OVERHEAD_BYTES + 500)
+            + nodes * (24 + 4 + 24) + cells * 10 * 8 + 16 * DATASET_OVERHEAD_BYTES)
+
+
+def size_text(count: float) -> str:
+    """A byte count for a person: ``12 kB``, ``3.4 MB``, ``291 MB``, ``1.2 GB``."""
+    for unit, scale in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if count >= scale:
+            return f"{count / scale:.3g} {unit}"
+    return f"{count:.0f} bytes"
+
+
+def _write_both(parts: tuple[Path, Path], h5name: str, motion: CaseMotion,
+                indices: np.ndarray, nodes: int,
+                progress: Callable[[str], None] | None) -> None:
+    image, cells = _hdf5_image(motion, indices, progress)
+    with parts[0].open("wb") as file:
+        file.write(image)
+    del image
+    _write_xdmf(parts[1], h5name, motion, indices, nodes, cells)
+
+
+def _place(out: Path, targets: tuple[Path, ...],
+           write: Callable[[tuple[Path, ...]], None]) -> None:
+    """Call ``write`` with private names beside ``targets`` and move each into place when
+    all are written; an OSError (a full disk) or an interrupt leaves no private file and no
+    target changed (one line, :class:`OutputError`)."""
+    parts = tuple(_part(target) for target in targets)
+    made = not out.exists()
     try:
-        cells = _write_hdf5(parts[0], motion, indices, progress)
-        _write_xdmf(parts[1], hdf5.name, motion, indices, nodes, cells)
-        os.replace(parts[0], hdf5)
-        os.replace(parts[1], xdmf)
+        out.mkdir(parents=True, exist_ok=True)
+        write(parts)
+        for part, target in zip(parts, targets, strict=True):
+            os.replace(part, target)
+    except OSError as exc:
+        for part in parts:
+            part.unlink(missing_ok=True)
+        if made:
+            with contextlib.suppress(OSError):
+                out.rmdir()  # the folder this export made, empty again
+        raise OutputError(f"cannot write {' and '.join(str(t) for t in targets)}: "
+                          f"{exc.strerror or exc}; the partial files were removed and no "
+                          f"existing file was changed") from None
     finally:
         for part in parts:
             part.unlink(missing_ok=True)
-    return ExportOutput(xdmf, hdf5, len(indices), nodes, cells,
-                        hdf5.stat().st_size + xdmf.stat().st_size, motion)
+
+
+def _ours_hdf5(path: Path) -> bool:
+    """Whether ``path`` is an HDF5 file flex export wrote (its root provenance)."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as h5:
+            return "flex_version" in h5.attrs and "mesh/topology" in h5
+    except (OSError, ValueError):
+        return False
+
+
+def _ours_xdmf(path: Path) -> bool:
+    """Whether ``path`` is an XDMF file flex export wrote (its ``source`` Information)."""
+    return has_marker(path, b'Name="source" Value=') and has_marker(path, b"(flex ")
 
 
 def _part(path: Path) -> Path:
@@ -172,34 +256,44 @@ def _dataset(group, name: str, data: np.ndarray, units: str, description: str) -
     created.attrs["description"] = description
 
 
-def _write_hdf5(path: Path, motion: CaseMotion, indices: np.ndarray,
-                progress: Callable[[str], None] | None) -> int:
-    """The HDF5 file: mesh, constant fields, times and per-time fields; returns the number
-    of cells."""
+def _hdf5_image(motion: CaseMotion, indices: np.ndarray,
+                progress: Callable[[str], None] | None) -> tuple[bytes, int]:
+    """The HDF5 file's bytes (built in memory: HDF5 writing to a disk that fills leaves the
+    library in a state that crashes the interpreter) and the number of cells."""
     import h5py
 
+    with h5py.File(f"flex-export-{id(motion)}.h5", "w", driver="core",
+                   backing_store=False) as h5:
+        cells = _fill_hdf5(h5, motion, indices, progress)
+        h5.flush()
+        return h5.id.get_file_image(), cells
+
+
+def _fill_hdf5(h5, motion: CaseMotion, indices: np.ndarray,
+               progress: Callable[[str], None] | None) -> int:
+    """Fill the HDF5 file ``h5``: mesh, constant fields, times and per-time fields; returns
+    the number of cells."""
     mesh = _mesh(motion)
     start = last = time.monotonic()
-    with h5py.File(path, "w") as h5:
-        h5.attrs.update(_provenance(motion))
-        _dataset(h5, "mesh/geometry", mesh["geometry"], "m",
-                 "node positions at the case's first sample, mechanism frame")
-        _dataset(h5, "mesh/topology", mesh["topology"], "1",
-                 "quadratic tetrahedra (VTK node order), node indices")
-        for name, (units, description) in CONSTANT_FIELDS.items():
-            _dataset(h5, f"constant/{name}", mesh[name], units, description)
-        _dataset(h5, "time", motion.time_s[indices], "s", "exported times")
-        _dataset(h5, "sample", motion.sample[indices], "1",
-                 "index of each exported time in the case's time")
-        for count, index in enumerate(indices):
-            for name, values in _fields(motion, int(index), mesh["geometry"]).items():
-                _dataset(h5, f"fields/{name}/{count:06d}", values.astype(FIELD_DTYPE),
-                         *FIELDS[name])
-            now = time.monotonic()
-            if progress and now - last >= PROGRESS_INTERVAL_S:
-                last = now
-                progress(f"flex export: time {count + 1} of {len(indices)} "
-                         f"({now - start:.0f} s)")
+    h5.attrs.update(_provenance(motion))
+    _dataset(h5, "mesh/geometry", mesh["geometry"], "m",
+             "node positions at the case's first sample, mechanism frame")
+    _dataset(h5, "mesh/topology", mesh["topology"], "1",
+             "quadratic tetrahedra (VTK node order), node indices")
+    for name, (units, description) in CONSTANT_FIELDS.items():
+        _dataset(h5, f"constant/{name}", mesh[name], units, description)
+    _dataset(h5, "time", motion.time_s[indices], "s", "exported times")
+    _dataset(h5, "sample", motion.sample[indices], "1",
+             "index of each exported time in the case's time")
+    for count, index in enumerate(indices):
+        for name, values in _fields(motion, int(index), mesh["geometry"]).items():
+            _dataset(h5, f"fields/{name}/{count:06d}", values.astype(FIELD_DTYPE),
+                     *FIELDS[name])
+        now = time.monotonic()
+        if progress and now - last >= PROGRESS_INTERVAL_S:
+            last = now
+            progress(f"flex export: time {count + 1} of {len(indices)} "
+                     f"({now - start:.0f} s)")
     return len(mesh["topology"])
 
 
@@ -265,4 +359,5 @@ def _write_xdmf(path: Path, h5name: str, motion: CaseMotion, indices: np.ndarray
     path.write_text('<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n")
 
 
-__all__ = ["CONSTANT_FIELDS", "FIELDS", "ExportOutput", "export_case", "output_paths"]
+__all__ = ["CONSTANT_FIELDS", "FIELDS", "ExportOutput", "estimate_bytes", "export_case",
+           "output_paths", "size_text"]

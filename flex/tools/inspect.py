@@ -54,6 +54,7 @@ def describe(path: str | Path, spec: str | None = None) -> dict[str, Any]:
                                "attributes": root, "scene_toml": scene_toml,
                                "cases": {}, "summary": [], "other": []}
         base_scene = _parse_toml(scene_toml)
+        out["case_count"] = len(case_names(h5))
         for case in case_names(h5):
             group = h5[f"cases/{case}"]
             if not hasattr(group, "keys"):
@@ -215,8 +216,11 @@ def format_description(info: dict[str, Any]) -> str:
 
     cases = info["cases"]
     statuses = ", ".join(f"{name} {case['status']}" for name, case in cases.items())
+    total = info.get("case_count", len(cases))
+    shown = (f" (the {len(cases)} of the file's {total} cases that {info['selection']} "
+             f"matches)" if info.get("selection") and total != len(cases) else "")
     row("study", f"{prov.get('study', '?')} ({prov.get('flex_format', '?')})"
-        + (f"; cases: {statuses}" if statuses else ""))
+        + (f"; cases: {statuses}{shown}" if statuses else ""))
     dirty = {"yes": " (with uncommitted changes)", "no": " (clean)"}.get(
         str(prov.get("git_dirty")), "")
     row("flex", f"{prov.get('flex_version', '?')}, git {prov.get('git_commit', '?')}{dirty}")
@@ -239,11 +243,7 @@ def format_description(info: dict[str, Any]) -> str:
         if case["scene_changes"]:
             changes = ", ".join(f"{k} = {_short(v)}" for k, v in case["scene_changes"].items())
             lines.append(f"  scene: the file's scene with {changes}")
-        attrs = case["attributes"]
-        if attrs.get("solver_defaults_keys"):
-            lines.append(f"  solver: \"auto\" -> {attrs['solver_defaults_keys']} "
-                         f"({attrs.get('solver_defaults_entry', '?')}: "
-                         f"{attrs.get('solver_defaults_reason', '')})")
+        lines += _solver_lines(case)
         lines += _table(case["datasets"])
     for title, entries in (("summary", info["summary"]), ("other", info["other"])):
         if entries:
@@ -254,15 +254,40 @@ def format_description(info: dict[str, Any]) -> str:
     scene_toml, heading = info["scene_toml"], "scene (resolved; root attribute scene_toml)"
     if '= "auto"' in scene_toml:
         heading = 'scene (root attribute scene_toml; each case holds its "auto" keys resolved)'
-
-    if info.get("selection") and len(cases) == 1:
+    if len(cases) == 1:  # one case (in the file, or matching PATH): the settings it ran with
         (name, case), = cases.items()
         if case["scene_toml"]:
-            scene_toml, heading = case["scene_toml"], f"scene of case {name} (resolved)"
+            scene_toml, heading = case["scene_toml"], (
+                f"scene of case {name} (resolved: the settings it ran with"
+                f"{', after refinement' if case['attributes'].get('refine_status') else ''})")
     if scene_toml:
         lines += ["", heading]
         lines += [f"  {line}" if line else "" for line in scene_toml.rstrip().splitlines()]
     return "\n".join(lines)
+
+
+def _solver_lines(case: dict[str, Any]) -> list[str]:
+    """What the case's ``"auto"`` solver keys resolved to; after ``fidelity.refine`` that was
+    the first guess, and the settings the stored run used (its scene) follow."""
+    attrs = case["attributes"]
+    keys = str(attrs.get("solver_defaults_keys", ""))
+    if not keys:
+        return []
+    refined = bool(attrs.get("refine_status"))
+    lines = [f"  solver: \"auto\" -> {'first guess ' if refined else ''}{keys} "
+             f"({attrs.get('solver_defaults_entry', '?')}: "
+             f"{attrs.get('solver_defaults_reason', '')})"]
+    scene = _parse_toml(case["scene_toml"])
+    if refined and scene:
+        final = []
+        for item in keys.split(", "):
+            name = item.split(" = ")[0]
+            section, key = name.split(".") if "." in name else ("simulation", name)
+            if isinstance(scene.get(section), dict) and key in scene[section]:
+                final.append(f"{name} = {scene[section][key]!r}")
+        lines.append(f"  refined (fidelity.refine: {attrs['refine_status']}): the stored run "
+                     f"used {', '.join(final)}")
+    return lines
 
 
 def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
@@ -281,29 +306,20 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
         if attrs.get(PREFIX + key):
             lines.append(f"    {key.replace('_', ' ')}: {attrs[PREFIX + key]}")
     lines += [f"    crest gap of the {key.removeprefix('crest_gap_').split('_')[0]}'s peak "
-              f"deflection: {_shown_number(value, '.3g')} m (the second-largest crest lies "
-              f"this far below it)" for key, value in attrs.items()
-              if key.startswith("crest_gap_")]
+              f"deflection: {_quantity(value, 'm')} (the second-largest crest lies this far "
+              f"below it)" for key, value in attrs.items() if key.startswith("crest_gap_")]
     if attrs.get("refine_status"):
         lines.append(f"  refinement (fidelity.refine): {attrs['refine_status']}, "
-                     f"{float(attrs.get('refine_wall_time_s', 0.0)):.3g} s")
+                     f"{_quantity(attrs.get('refine_wall_time_s', 0.0), 's')}")
         lines += [f"    {line}" for line in str(attrs.get("refine_attempts", "")).splitlines()]
     return lines
-
-
-def _shown_number(value: Any, spec: str) -> str:
-    """A stored number for display; a value that is not one, shown as malformed."""
-    try:
-        return format(float(value), spec)
-    except (TypeError, ValueError):
-        return f"malformed ({type(value).__name__})"
 
 
 def stress_lines(attrs: dict[str, Any]) -> list[str]:
     """The peak von Mises stress of each FFRF link (case attributes of
     :func:`flex.bodies.stress.peak_attrs`), where and when, with its estimated error:
     one line per link."""
-    from flex.fidelity.error_budget import budget_rows
+    from flex.fidelity.error_estimate import PREFIX
 
     lines = []
     for link in ("coupler", "crank"):
@@ -312,21 +328,42 @@ def stress_lines(attrs: dict[str, Any]) -> list[str]:
             name = f"{link}_peak_von_mises{suffix}"
             if f"{name}_Pa" not in attrs:
                 continue
-            try:
-                x, y, z = (1e3 * float(v) for v in np.ravel(attrs[f"{name}_position_m"]))
-                value, at = float(attrs[f"{name}_Pa"]), float(attrs[f"{name}_time_s"])
-            except (KeyError, TypeError, ValueError):
-                parts.append(f"malformed attributes {name}_* {where}")
+            x, y, z = (1e3 * float(v) for v in np.ravel(attrs[f"{name}_position_m"]))
+            raw_error = attrs.get(f"{PREFIX}{name}_Pa")
+            error = _number(raw_error)
+            if _number(attrs[f"{name}_Pa"]) is None or _number(attrs.get(
+                    f"{name}_time_s")) is None or np.size(attrs.get(f"{name}_position_m")) != 3:
+                parts.append(f"{_short(attrs[f'{name}_Pa'])} Pa {where} at t = "
+                             f"{_short(attrs.get(f'{name}_time_s'))} s (attributes that are "
+                             f"not one number, shown as stored)")
                 continue
-            error = {row.quantity: row for row in budget_rows(attrs)}.get(f"{name}_Pa")
-            parts.append(f"{value / 1e6:.4g} MPa {where} at t = {at * 1e3:.4g} ms, (x, y, z) "
-                         f"= ({x:.3g}, {y:.3g}, {z:.3g}) mm on the plate"
-                         + (f" (estimated error {error.total / 1e6:.2g} MPa: the budget "
-                            f"above)" if error is not None and not error.problem else
-                            " (estimated error: see the budget above)" if error else ""))
+            if raw_error is not None and error is None:
+                parts.append(f"estimated error {_short(raw_error)} (not a number, as stored)")
+            parts.append(f"{attrs[f'{name}_Pa'] / 1e6:.4g} MPa {where} at t = "
+                         f"{attrs[f'{name}_time_s'] * 1e3:.4g} ms, (x, y, z) = ({x:.3g}, "
+                         f"{y:.3g}, {z:.3g}) mm on the plate"
+                         + (f" (estimated error {error / 1e6:.2g} MPa: the budget above)"
+                            if error is not None else ""))
         if parts:
             lines.append(f"peak von Mises stress, {link}: " + "; ".join(parts))
     return lines
+
+
+def _number(value: Any) -> float | None:
+    """``value`` as a float when it is one number (a stored attribute a hand may have made
+    a string or an array), else None."""
+    if isinstance(value, bool | str | bytes) or np.size(value) != 1:
+        return None
+    try:
+        return float(np.ravel(value)[0])
+    except (TypeError, ValueError):
+        return None
+
+
+def _quantity(value: Any, units: str) -> str:
+    """A stored number with its units, or the stored value as it is when it is not one."""
+    number = _number(value)
+    return f"{number:.3g} {units}" if number is not None else f"{_short(value)} (not a number)"
 
 
 def _case_line(case: dict[str, Any]) -> str:

@@ -323,6 +323,12 @@ def _ffrf_body(link: str, scene: Scene, data: dict[str, np.ndarray], attrs: dict
     problem = check_basis_identity(link, reduction, attrs)
     if problem:
         raise FlexError(f"{where}: {problem}")
+    found = np.shape(data[f"{link}/modal_coordinates"])
+    if len(found) != 2 or found[1] != reduction.n_modal_coordinates:
+        raise FlexError(f"{where}: {link}/modal_coordinates has shape {found}, expected "
+                        f"(samples, {reduction.n_modal_coordinates}): one column per mode of "
+                        f"the reduction; the file was changed after flex wrote it: rerun the "
+                        f"case")
     positions = reduction.fem.GetNodePositionsAsArray()
     corners = np.asarray(reduction.fem.elements[0]["Tet4"], dtype=np.int64)
     body = Body(link, FFRF, positions, tet10_cells(corners, positions), corners,
