@@ -387,10 +387,14 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
         return resolved, decisions
     criterion = criterion or criterion_of(calibration, "coupler")
     tolerance = float(resolved["fidelity"]["tolerance"])
-    delta_t_s, how, probe = deployment_probe(resolved, calibration)
+    links = " and ".join(f"{link}.model" for link, wants in
+                         (("coupler", wants_coupler), ("crank", wants_crank)) if wants)
+    try:
+        delta_t_s, how, probe = deployment_probe(resolved, calibration)
+    except SceneError as refused:  # say which links are "auto"
+        raise SceneError(f'{links} = "auto": '
+                         + str(refused).removeprefix('model = "auto": ')) from None
     if not delta_t_s > 0:  # a mechanism that does not move (no preload): no time scale
-        links = " and ".join(f"{link}.model" for link, wants in
-                             (("coupler", wants_coupler), ("crank", wants_crank)) if wants)
         raise SceneError(f'{links} = "auto": the rigid run does not deploy (delta_t = '
                          f"{delta_t_s:g} s: the crank angle's first maximum is at t = 0; "
                          f"drive.spring_preload_m = {resolved['drive']['spring_preload_m']:g} "

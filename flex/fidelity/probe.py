@@ -136,5 +136,12 @@ def deployment_probe(scene: Mapping[str, Mapping[str, Any]],
         data = {k: v[keep] if v.ndim and len(v) == len(keep) else v for k, v in data.items()}
         return delta_t, (f"delta_t = {delta_t:.5g} s (first crank-angle maximum of the rigid "
                          f"run)"), data
+    angle = data["crank/angle"]
+    if np.ptp(angle) <= 1e-9 * max(1.0, float(np.max(np.abs(angle)))):  # at rest
+        raise SceneError(f'model = "auto": the rigid run does not deploy (the crank does not '
+                         f"move within {end:g} s; drive.spring_preload_m = "
+                         f"{drive.get('spring_preload_m', 0.0):g} m), so the criterion has no "
+                         f'time scale; give the spring a preload > 0 or set the link model '
+                         f'("rigid", "ffrf")')
     raise SceneError(f'model = "auto": the crank angle has no maximum within {end:g} s: '
                      f"no deployment time; set the model explicitly")
