@@ -57,6 +57,11 @@ AUTO_KEYS = ("step_s", "spectral_radius", "newton", "newton_relative_tolerance")
 AUTO = "auto"
 #: the ``--set`` pairs that leave every solver key to flex (what the bundled scene does)
 AUTO_OVERRIDES = tuple((f"simulation.{key}", AUTO) for key in AUTO_KEYS)
+#: what a beam link's ``elements = "auto"`` resolves to (a link model with the ``beam`` flag,
+#: the geometrically exact beam coupler): fixed, not chosen by tolerance. Measured on the
+#: bundled deployment (1 mm coupler, h = 1e-5 s): see EXACT_BEAM_ELEMENTS_MEASURED in
+#: flex.dynamics.link_models
+EXACT_BEAM_ELEMENTS = 16
 #: what an uncertified flexible scene runs with, and what is known of it
 FALLBACK = ("the flexible fallback (the rigid model's 40x smaller step with modified Newton), "
             "not certified for it")
@@ -96,23 +101,37 @@ def has_auto(scene: Scene) -> bool:
     return any(scene["simulation"].get(key) == AUTO for key in AUTO_KEYS)
 
 
-def has_auto_link_keys(scene: Scene) -> bool:
-    """Whether a link's ``modes`` or ``mesh_size_m`` is ``"auto"`` (flex.config.ffrf_rule)."""
+def has_auto_link_keys(scene: Scene, *,
+                       link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> bool:
+    """Whether a link's ``modes`` or ``mesh_size_m`` is ``"auto"`` (flex.config.ffrf_rule),
+    or the ``elements`` of a beam link (:data:`EXACT_BEAM_ELEMENTS`)."""
     return any(scene[link].get(key) == AUTO for link in ("crank", "coupler")
-               for key in LINK_KEYS)
+               for key in LINK_KEYS) or any(_auto_elements(scene, link, link_models)
+                                            for link in ("crank", "coupler"))
 
 
-def resolve_link_keys(scene: Scene, calibration: Calibration | None = None
+def _auto_elements(scene: Scene, link: str, link_models: Mapping[str, Any]) -> bool:
+    """Whether ``link`` is a beam (its concrete model's flag) whose ``elements`` is auto."""
+    values = scene[link]
+    return (values.get("elements") == AUTO and values["model"] != AUTO
+            and getattr(link_model(link, values, link_models), "beam", False))
+
+
+def resolve_link_keys(scene: Scene, calibration: Calibration | None = None, *,
+                      link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
                       ) -> tuple[Scene, dict[str, Any]]:
     """``scene`` (a copy) with the links' ``"auto"`` modes and mesh size filled by the rule
     (:func:`flex.config.ffrf_rule.fill_link_keys` at ``fidelity.tolerance``, ``calibration``'s
-    rule; None: the bundled one), and what was filled (``"coupler.modes"`` -> value)."""
+    rule; None: the bundled one) and a beam link's ``"auto"`` elements
+    (:data:`EXACT_BEAM_ELEMENTS`), and what was filled (``"coupler.modes"`` -> value)."""
     resolved = copy.deepcopy(scene)
     filled: dict[str, Any] = {}
     tolerance = float(scene["fidelity"]["tolerance"])
     for link in ("crank", "coupler"):
         for key, value in fill_link_keys(resolved, link, tolerance, calibration).items():
             filled[f"{link}.{key}"] = value
+        if _auto_elements(resolved, link, link_models):
+            resolved[link]["elements"] = filled[f"{link}.elements"] = EXACT_BEAM_ELEMENTS
     return resolved, filled
 
 
@@ -197,9 +216,9 @@ def resolve_solver_settings(scene: Scene, calibration: Calibration | None = None
     """``scene`` with its ``"auto"`` solver and link keys filled in (see module doc), from
     ``calibration``'s solver defaults and rule (None: the bundled calibration);
     ``link_models``: the registry of its link models."""
-    if not (has_auto(scene) or has_auto_link_keys(scene)):
+    if not (has_auto(scene) or has_auto_link_keys(scene, link_models=link_models)):
         return scene, None
-    resolved, filled = resolve_link_keys(scene, calibration)
+    resolved, filled = resolve_link_keys(scene, calibration, link_models=link_models)
     name, reason, chosen = choose_entry(resolved, calibration, link_models=link_models)
     entry = solver_defaults(calibration)[name]
     values = dict(entry)
@@ -280,7 +299,8 @@ def check_concrete(scene: Scene, choice: SolverChoice | None = None, *,
         values = scene[link]
         if values["model"] == AUTO or (meshes(link, values, link_models)  # a lumped or
                                        and AUTO in (values.get(key)  # rigid link keeps its
-                                                    for key in LINK_KEYS)):  # unused "auto"s
+                                                    for key in LINK_KEYS)  # unused "auto"s
+                                       ) or _auto_elements(scene, link, link_models):
             raise ValueError(f"{link}: resolve its \"auto\" values first "
                              f"(flex.fidelity.auto.resolve)")
         check_meshed_plate(link, values, link_models)

@@ -242,3 +242,12 @@ def is_damped(values: dict[str, Any]) -> bool:
     ``"modal_bands"`` damping model (a reference without damping, the nonlinear FE body,
     cannot stand in for it)."""
     return values["damping_ratio"] > 0 or values.get("damping_model") == "modal_bands"
+
+
+def check_beam_plate(link: str, scene: Scene) -> None:
+    """A beam model of ``link`` (its registry entry's own check): the beam is the plate's, so
+    ``<link>.geometry`` must be ``"plate"`` (a lumped link has no section)."""
+    values = scene[link]
+    if values["geometry"] != "plate":
+        raise SceneError(f'{link}.model = "{values["model"]}" needs {link}.geometry = "plate" '
+                         "(the beam's section is the plate's thickness_m x width_m)")

@@ -384,25 +384,41 @@ class _Builder:
             self.mech.joint_frames = {"A": None, "B": None, "C": None, "P": None}
             return
         crank_ref = _rotation_z(self.init.crank_angle_rad)
-        coupler_ref = _rotation_z(self.init.coupler_angle_rad)
         # joint frames coincide with the global axes at t = 0; force outputs are in the frame
         # of marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where
         # it can; the links' markers are turned by copies (_turned_marker)
         self.joints = {
             "A": mbs.AddObject(eii.ObjectJointRevoluteZ(
                 markerNumbers=[m["ground_A"], _turned_marker(mbs, m["crank_A"], crank_ref.T)])),
-            "B": mbs.AddObject(eii.ObjectJointRevoluteZ(
-                markerNumbers=[_turned_marker(mbs, m["crank_B"], crank_ref.T),
-                               _turned_marker(mbs, m["coupler_B"], coupler_ref.T)])),
+            "B": self._joint_B(crank_ref),
             "C": mbs.AddObject(eii.ObjectJointSpherical(
                 markerNumbers=[m["slider_C"], m["coupler_C"]], constrainedAxes=[1, 1, 0])),
             "P": mbs.AddObject(eii.ObjectJointPrismaticX(
                 markerNumbers=[m["ground_C"], m["slider_C"]]))}
         # B's force is reported in the frame of the crank's marker at B (its joint face when
         # the crank is flexible), turned back by the initial crank angle: collect turns it
-        # with that marker's rotation since t = 0
-        self.mech.joint_frames = {"A": None, "B": "marker_crank_B", "C": None, "P": None}
+        # with that marker's rotation since t = 0 (a planar pin's in global axes)
+        self.mech.joint_frames = {"A": None, "B": None if self.planar_pins else
+                                  "marker_crank_B", "C": None, "P": None}
         self._add_geometric_stiffness()
+
+    @property
+    def planar_pins(self) -> bool:
+        """Whether the coupler's joint markers carry x and y only (a planar beam's nodes,
+        ``builder.coupler["planar_pins"]``): its pin at B then holds x and y, as the one at C
+        (the crank's z and tilts are held by its joint at A)."""
+        return bool(self.coupler.get("planar_pins", False))
+
+    def _joint_B(self, crank_ref: np.ndarray) -> int:
+        """The revolute joint at B (a pin in x and y on a planar coupler)."""
+        mbs, eii, m = self.mbs, self.eii, self.markers
+        if self.planar_pins:
+            return mbs.AddObject(eii.ObjectJointSpherical(
+                markerNumbers=[m["crank_B"], m["coupler_B"]], constrainedAxes=[1, 1, 0]))
+        coupler_ref = _rotation_z(self.init.coupler_angle_rad)
+        return mbs.AddObject(eii.ObjectJointRevoluteZ(
+            markerNumbers=[_turned_marker(mbs, m["crank_B"], crank_ref.T),
+                           _turned_marker(mbs, m["coupler_B"], coupler_ref.T)]))
 
     def add_drive(self) -> None:
         """The preloaded spring on the slider, or the crank held at constant speed."""
@@ -500,7 +516,8 @@ class _Builder:
         for name, joint in self.joints.items():
             # the spherical joint reports its force in global axes ("Force"), the others in
             # the frame of marker 0 ("ForceLocal")
-            output = "Force" if name == "C" or penalty else "ForceLocal"
+            global_axes = name == "C" or (name == "B" and self.planar_pins)
+            output = "Force" if global_axes or penalty else "ForceLocal"
             self.add(f"joint_{name}.Force", self.sensor("Object", output, objectNumber=joint))
         if not penalty:
             self.add("marker_crank_B.Rotation",

@@ -86,7 +86,7 @@ from flex.data.scene import (
 )
 
 #: the built-in models' names (for code that sets a model in a scene)
-RIGID, FFRF, NONLINEAR_FE = BUILTIN_LINK_SCHEMAS
+RIGID, FFRF, NONLINEAR_FE, EXACT_BEAM = BUILTIN_LINK_SCHEMAS
 
 
 def _nothing(*args: Any) -> None:
@@ -460,6 +460,111 @@ def _nonlinear_fe_solver(settings: dict[str, Any]) -> None:
 
 
 # ------------------------------------------------------------------------------------------
+# exact beam: a planar geometrically exact (Simo-Reissner) beam of the plate
+# ------------------------------------------------------------------------------------------
+#: Newton tolerances (relative, absolute) of a run with an exact beam link: 1e-8 / 1e-10
+#: stalled on round-off at 32 elements and more ("relative error 1.39e-8 after 25
+#: iterations"), 1e-7 / 1e-6 converged (docs/exudyn-ngsolve notes, measured 2026-11-28)
+EXACT_BEAM_NEWTON_TOLERANCES = (1e-7, 1e-6)
+#: wall time per step [s] of an exact beam link: (per link, per element); modified Newton,
+#: h = 1e-5 s, thesis deployment: 16 elements 45 us, 32: 65 us, 128: 215 us per step
+STEP_COST_EXACT_BEAM_S = (2e-5, 1.5e-6)
+
+
+def _beam_elements(link: str, values: dict[str, Any]) -> int:
+    if values["elements"] == AUTO:
+        raise ValueError(f'{link}: resolve its "auto" elements first '
+                         "(flex.fidelity.auto.resolve, flex.config.settings.resolve_link_keys)")
+    return int(values["elements"])
+
+
+def _prepare_beam(scene: Scene, link: str, given: Any, cache_dir: Path | None) -> Any:
+    """The link's :class:`flex.bodies.exact_beam.ExactBeamSection` (``given``: one built)."""
+    from flex.bodies.exact_beam import exact_beam_section
+
+    if given is not None:
+        return given
+    c = scene[link]
+    _beam_elements(link, c)
+    return exact_beam_section(c["length_m"], c["thickness_m"], c["width_m"],
+                              c["youngs_modulus_Pa"], c["density_kg_per_m3"],
+                              c["poisson_ratio"])
+
+
+def _add_exact_beam(builder: Any, link: str, section: Any) -> None:
+    from flex.bodies.exact_beam import add_exact_beam_link
+
+    init = builder.init
+    section = section if section is not None else _prepare_beam(builder.scene, link, None,
+                                                                None)
+    beam = add_exact_beam_link(
+        builder.mbs, section, _beam_elements(link, builder.scene[link]), init.joint_B_m,
+        init.coupler_angle_rad, init.joint_B_velocity_m_per_s, init.coupler_speed_rad_per_s)
+    builder.coupler = beam.handles()
+    builder.mech.coupler = dict(builder.coupler, section=section)
+
+
+def _exact_beam_sensors(builder: Any, link: str) -> None:
+    """Each element's section forces (axial and shear force, bending moment)."""
+    for index, element in enumerate(builder.mech.coupler["elements"]):
+        for output in ("ForceLocal", "TorqueLocal"):
+            builder.add(f"{link}.element_{index}.{output}",
+                        builder.sensor("Body", output, bodyNumber=element))
+
+
+def _exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
+    """The flexible coupler's datasets (chord angle, midpoint) and the beam's own: axial
+    force, peak bending and von Mises stresses away from the end faces (one thickness from
+    each, :func:`stress_window_m`'s window) and at the joints."""
+    from flex.bodies.exact_beam import element_centres_m, section_stress_peaks
+
+    out = _flexible_datasets(mech, link, time_s)
+    elements, section = mech.coupler["elements"], mech.coupler["section"]
+    count = len(elements)
+    force = np.stack([_sensor(mech, f"{link}.element_{i}.ForceLocal")[:, 1:3]
+                      for i in range(count)], axis=1)  # sample, element, (N, Q)
+    moment = np.stack([_sensor(mech, f"{link}.element_{i}.TorqueLocal")[:, 3]
+                       for i in range(count)], axis=1)
+    normal, von_mises = section_stress_peaks(section, force[..., 0], force[..., 1], moment)
+    centres = element_centres_m(section, count)
+    low, high = section.thickness_m, section.length_m - section.thickness_m
+    away = (centres >= low) & (centres <= high)
+    if not away.any():  # a stubby plate: the middle element(s)
+        away = np.abs(centres - 0.5 * section.length_m) <= 0.5 * section.length_m / count
+    out[f"{link}/axial_force"] = Dataset(
+        force[:, count // 2, 0] if count % 2 else force[:, count // 2 - 1:count // 2 + 1,
+                                                         0].mean(axis=1),
+        "N", "axial force at the midpoint (tension > 0)")
+    out[f"{link}/peak_bending_stress"] = Dataset(
+        normal[:, away].max(axis=1), "Pa",
+        "largest |sigma_xx| at the outer fibres away from the end faces (|N| / A + |M| c / I)")
+    out[f"{link}/peak_von_mises_stress"] = Dataset(
+        von_mises[:, away].max(axis=1), "Pa",
+        "largest von Mises stress away from the end faces (beam section)")
+    out[f"{link}/peak_von_mises_position"] = Dataset(
+        centres[away][np.argmax(von_mises[:, away], axis=1)], "m",
+        "where the peak von Mises stress away from the end faces is: distance from B")
+    if not away.all():
+        out[f"{link}/peak_von_mises_stress_at_joints"] = Dataset(
+            von_mises[:, ~away].max(axis=1), "Pa",
+            "largest von Mises stress within one thickness of the end faces (beam section)")
+    return out
+
+
+def _exact_beam_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
+    elements = values["elements"] if values["elements"] != AUTO else 16
+    return STEP_COST_EXACT_BEAM_S[0] + STEP_COST_EXACT_BEAM_S[1] * float(elements)
+
+
+def _exact_beam_solver(settings: dict[str, Any]) -> None:
+    relative, absolute = EXACT_BEAM_NEWTON_TOLERANCES
+    settings["newton_relative_tolerance"] = max(settings["newton_relative_tolerance"],
+                                                relative)
+    settings["newton_absolute_tolerance"] = max(settings["newton_absolute_tolerance"],
+                                                absolute)
+
+
+# ------------------------------------------------------------------------------------------
 # the registry
 # ------------------------------------------------------------------------------------------
 #: the built-in link models, by name (immutable; pass another mapping to add models)
@@ -478,7 +583,13 @@ BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
         energy=False, recorder=_nodal_recorder, time_scale=_nonlinear_fe_time_scale,
         step_cost_s=_nonlinear_fe_step_cost_s, adjust_solver=_nonlinear_fe_solver,
         own_progress=True),
+    EXACT_BEAM: LinkModel.extending(
+        BUILTIN_LINK_SCHEMAS[EXACT_BEAM], label="geometrically exact beam",
+        prepare=_prepare_beam, add=_add_exact_beam, sensors=_exact_beam_sensors,
+        datasets=_exact_beam_datasets, energy=False, time_scale=_nonlinear_fe_time_scale,
+        step_cost_s=_exact_beam_step_cost_s, adjust_solver=_exact_beam_solver),
 })
 
-__all__ = ["LinkModel", "BUILTIN_LINK_MODELS", "RIGID", "FFRF", "NONLINEAR_FE", "entry_of",
+__all__ = ["LinkModel", "BUILTIN_LINK_MODELS", "RIGID", "FFRF", "NONLINEAR_FE", "EXACT_BEAM",
+           "entry_of",
            "entries", "reduction_for_scene"]
