@@ -113,8 +113,9 @@ def has_auto_link_keys(scene: Scene, *,
 def _auto_elements(scene: Scene, link: str, link_models: Mapping[str, Any]) -> bool:
     """Whether ``link`` is a beam (its concrete model's flag) whose ``elements`` is auto."""
     values = scene[link]
-    return (values.get("elements") == AUTO and values["model"] != AUTO
-            and getattr(link_model(link, values, link_models), "beam", False))
+    return (values.get("elements") == AUTO and values["model"] in link_models
+            and link in link_models[values["model"]].links
+            and getattr(link_models[values["model"]], "beam", False))
 
 
 def resolve_link_keys(scene: Scene, calibration: Calibration | None = None, *,

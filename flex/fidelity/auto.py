@@ -149,7 +149,7 @@ def check(scene: Scene, calibration: Calibration | None = None, *,
     the ``"auto"`` values resolve from (None: the bundled calibration); ``link_models``: the
     registry of the scene's link models."""
     # an "auto" link's plate too: what it may mesh
-    linked, _ = resolve_link_keys(scene, calibration)
+    linked, _ = resolve_link_keys(scene, calibration, link_models=link_models)
     for link in LINKS:
         check_meshed_plate(link, linked[link], link_models)
     options = candidates(scene, link_models)
