@@ -172,7 +172,7 @@ def test_the_beam_needs_a_plate_and_other_models_do_not_read_elements():
                                          'coupler.geometry = "plate"'):
         flex.load_scene(overrides={"coupler.model": "exact_beam"})
     scene = flex.load_scene(overrides={"coupler.model": "ffrf", "coupler.geometry": "plate",
-                                       "coupler.elements": 16})
+                                       "coupler.elements": 32})
     with pytest.raises(SceneError, match="coupler.elements") as refused:
         flex.simulate(scene)
     assert '"exact_beam"' in str(refused.value)

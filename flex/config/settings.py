@@ -43,6 +43,7 @@ from flex.config.calibration import Calibration, calibration_of
 from flex.config.ffrf_rule import LINK_KEYS, RulePick, fill_link_keys, pick, rule_constants
 from flex.data.scene import (
     BUILTIN_LINK_SCHEMAS,
+    EXACT_BEAM_ELEMENTS,
     Scene,
     check_drive_steps,
     check_meshed_plate,
@@ -57,11 +58,6 @@ AUTO_KEYS = ("step_s", "spectral_radius", "newton", "newton_relative_tolerance")
 AUTO = "auto"
 #: the ``--set`` pairs that leave every solver key to flex (what the bundled scene does)
 AUTO_OVERRIDES = tuple((f"simulation.{key}", AUTO) for key in AUTO_KEYS)
-#: what a beam link's ``elements = "auto"`` resolves to (a link model with the ``beam`` flag,
-#: the geometrically exact beam coupler): fixed, not chosen by tolerance. Measured on the
-#: bundled deployment (1 mm coupler, h = 1e-5 s): see EXACT_BEAM_ELEMENTS_MEASURED in
-#: flex.dynamics.link_models
-EXACT_BEAM_ELEMENTS = 16
 #: what an uncertified flexible scene runs with, and what is known of it
 FALLBACK = ("the flexible fallback (the rigid model's 40x smaller step with modified Newton), "
             "not certified for it")

@@ -33,6 +33,7 @@ import tomli_w
 from flex.base.errors import SceneError
 from flex.data.plates import (  # noqa: F401 - the names callers import from here
     ESTIMATE_MODES,
+    EXACT_BEAM_ELEMENTS,
     MESH_ASPECT_LIMIT,
     MESH_MEMORY_LIMIT_BYTES,
     PLATE_SLENDERNESS_LIMIT,
@@ -157,8 +158,7 @@ class Field:
 
     def accepted(self) -> str:
         """Human-readable accepted range, used in error messages."""
-        text = self._accepted()
-        return text + ' or "auto"' if self.auto else text
+        return self._accepted() + (' or "auto"' if self.auto else "")
 
     def _accepted(self) -> str:
         if isinstance(self.kind, tuple):
@@ -214,8 +214,9 @@ def _plate_fields(link: str) -> dict[str, Field]:
                                "the reduced body (the commercial codes' default; "
                                "flex.bodies.reduction.damping)",
                                default="stiffness_proportional"),
-        "elements": Field(int, "model = exact_beam: beam elements along the link (auto: flex."
-                          "config.settings)", minimum=2, maximum=1024, auto=True, default="auto"),
+        "elements": Field(int, "model = exact_beam: beam elements along the link (auto: "
+                          f"{EXACT_BEAM_ELEMENTS})", minimum=2, maximum=1024, auto=True,
+                          default=EXACT_BEAM_ELEMENTS),
         "geometric_stiffness": Field(bool, "model = ffrf: soften the bending modes under the "
                                      "link's own axial force (flex.bodies.geometric_stiffness; "
                                      "false: the linear FFRF body, for comparison)",
@@ -231,9 +232,8 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "initial_angle_deg": Field(float, "crank angle at t = 0, from the slide line",
                                    minimum=-360.0, maximum=360.0),
         "model": Field((*model_names("crank"), AUTO),
-                       "rigid body or floating-frame flexible body (plate geometry); auto: "
-                       "rigid or ffrf (and modes) from the fitted criterion and "
-                       "fidelity.tolerance"),
+                       "rigid body or floating-frame flexible body (plate geometry); auto: rigid "
+                       "or ffrf (and modes) from the fitted criterion and fidelity.tolerance"),
         **_plate_fields("crank"),
     },
     "coupler": {

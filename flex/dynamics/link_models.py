@@ -76,6 +76,7 @@ from flex.data.results import Dataset
 from flex.data.scene import (
     AUTO,
     BUILTIN_LINK_SCHEMAS,
+    EXACT_BEAM_ELEMENTS,
     LINKS,
     LinkSchema,
     Scene,
@@ -552,7 +553,7 @@ def _exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, 
 
 
 def _exact_beam_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
-    elements = values["elements"] if values["elements"] != AUTO else 16
+    elements = values["elements"] if values["elements"] != AUTO else EXACT_BEAM_ELEMENTS
     return STEP_COST_EXACT_BEAM_S[0] + STEP_COST_EXACT_BEAM_S[1] * float(elements)
 
 
