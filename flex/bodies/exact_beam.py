@@ -31,6 +31,7 @@ import numpy as np
 
 from flex.base import physics
 from flex.bodies.beams import SHEAR_CORRECTION_RECTANGLE, check_positive, rectangle_section
+from flex.data.results import Dataset
 
 #: fibres across the section's height at which the von Mises stress is evaluated (odd: the
 #: neutral axis, where the shear stress peaks, is one of them)
@@ -164,3 +165,38 @@ def section_stress_peaks(section: ExactBeamSection, axial_N: np.ndarray, shear_N
     tau = 1.5 * shear[..., None] / area * (1.0 - (heights / c) ** 2)
     von_mises = np.sqrt(sigma**2 + 3.0 * tau**2).max(axis=-1)
     return normal, von_mises
+
+
+def section_datasets(link: str, section: ExactBeamSection, force_N: np.ndarray,
+                     moment_Nm: np.ndarray) -> dict[str, Dataset]:
+    """The stored series of a beam ``link`` from its elements' section forces ``force_N``
+    (samples, elements, 2: axial N, shear Q) and moments ``moment_Nm`` (samples, elements):
+    ``<link>/axial_force`` at the midpoint, ``peak_bending_stress`` and
+    ``peak_von_mises_stress`` away from the end faces (elements whose centre lies one
+    thickness or more from both, as the FFRF link's window; the middle element of a plate
+    too stubby for it), where that peak is (``peak_von_mises_position``, from the first
+    end) and ``peak_von_mises_stress_at_joints`` (the other elements)."""
+    count = force_N.shape[1]
+    normal, von_mises = section_stress_peaks(section, force_N[..., 0], force_N[..., 1],
+                                             moment_Nm)
+    centres = element_centres_m(section, count)
+    half = 0.5 * section.length_m
+    away = np.abs(centres - half) <= max(half - section.thickness_m, half / count)
+    middle = [count // 2] if count % 2 else [count // 2 - 1, count // 2]
+    out = {
+        f"{link}/axial_force": Dataset(force_N[:, middle, 0].mean(axis=1), "N",
+                                       "axial force at the midpoint (tension > 0)"),
+        f"{link}/peak_bending_stress": Dataset(
+            normal[:, away].max(axis=1), "Pa", "largest |sigma_xx| at the outer fibres away "
+            "from the end faces (|N| / A + |M| c / I)"),
+        f"{link}/peak_von_mises_stress": Dataset(
+            von_mises[:, away].max(axis=1), "Pa",
+            "largest von Mises stress away from the end faces (beam section)"),
+        f"{link}/peak_von_mises_position": Dataset(
+            centres[away][np.argmax(von_mises[:, away], axis=1)], "m",
+            "where the peak von Mises stress away from the end faces is, from the first end")}
+    if not away.all():
+        out[f"{link}/peak_von_mises_stress_at_joints"] = Dataset(
+            von_mises[:, ~away].max(axis=1), "Pa",
+            "largest von Mises stress within one thickness of the end faces (beam section)")
+    return out

@@ -3,10 +3,10 @@ under a written contract.
 
 :data:`BUILTIN_LINK_MODELS` is an immutable mapping (``types.MappingProxyType``) from a model's
 name to its :class:`LinkModel`, in the order messages list them: ``"rigid"``, ``"ffrf"``,
-``"nonlinear_fe"``. Every function that checks, resolves, builds or runs a scene takes the
-registry as an argument, ``link_models``, with the built-ins as its default; a caller with
-another model builds its own registry (``MappingProxyType({**BUILTIN_LINK_MODELS, "toy":
-toy})``) and passes it along. Nothing here is mutable and nothing registers itself. The layers
+``"nonlinear_fe"``, ``"exact_beam"``. Every function that checks, resolves, builds or runs a
+scene takes the registry as an argument, ``link_models``, with the built-ins as its default; a
+caller with another model builds its own registry (``MappingProxyType({**BUILTIN_LINK_MODELS,
+"toy": toy})``) and passes it along. Nothing here is mutable and nothing registers itself. The layers
 below (:mod:`flex.data`, :mod:`flex.config`) read only an entry's scene-level part,
 :class:`flex.data.scene.LinkSchema` (its fields are :class:`LinkModel`'s first ones), with
 :data:`flex.data.scene.BUILTIN_LINK_SCHEMAS` as their default (a test ties the two).
@@ -19,7 +19,8 @@ The contract of an entry -- what a link model declares, point by point:
    (:func:`flex.data.scene.validate`, :func:`entry_of`).
 2. **scene keys it reads**, as flags on ``[<link>]``: ``rigid`` (mass keys only),
    ``meshed`` (the plate's elastic keys and ``mesh_size_m``), ``modal`` (``modes``,
-   ``mode_selection``, ``geometric_stiffness``), ``damped`` (``damping_ratio``). A key a
+   ``mode_selection``, ``geometric_stiffness``), ``damped`` (``damping_ratio``), ``beam``
+   (the plate's keys and ``elements``, a beam of elements along the link). A key a
    model does not read and the user set is refused (:func:`flex.config.usage.unused_keys`).
 3. **checks on those keys** (SceneError, before anything runs): the flags' (a meshed model
    needs ``geometry = "plate"`` and a plate that can be meshed, an undamped one
@@ -31,8 +32,10 @@ The contract of an entry -- what a link model declares, point by point:
 5. **how it adds itself to the Exudyn builder**: ``add(builder, link, prepared)`` adds the
    link's bodies to :class:`flex.dynamics.builder._Builder` and leaves the joint markers in
    the builder (``crank_body`` for a rigid crank; ``mech.crank`` for a flexible one; the
-   coupler's ``builder.coupler["marker_B"|"marker_C"]``). A rigid crank is added before the
-   slider (the order numbers the coordinates), any other after the ground markers.
+   coupler's ``builder.coupler["marker_B"|"marker_C"]``; ``builder.coupler["planar_pins"]``
+   when those markers carry x and y only, as a planar beam's nodes: the builder then pins B
+   in x and y as it pins C). A rigid crank is added before the slider (the order numbers the
+   coordinates), any other after the ground markers.
 6. **its sensors and datasets**: ``sensors(builder, link)`` adds what its ``datasets(mech,
    link, time_s)`` reads after the run (the coupler's ``coupler/...`` datasets; a crank's
    motion is read from its joint markers or rigid body by :mod:`flex.dynamics.collect`);
@@ -514,41 +517,17 @@ def _exact_beam_sensors(builder: Any, link: str) -> None:
 
 
 def _exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
-    """The flexible coupler's datasets (chord angle, midpoint) and the beam's own: axial
-    force, peak bending and von Mises stresses away from the end faces (one thickness from
-    each, :func:`stress_window_m`'s window) and at the joints."""
-    from flex.bodies.exact_beam import element_centres_m, section_stress_peaks
+    """The flexible coupler's datasets (chord angle, midpoint) and the beam's own section
+    forces and stresses (:func:`flex.bodies.exact_beam.section_datasets`)."""
+    from flex.bodies.exact_beam import section_datasets
 
     out = _flexible_datasets(mech, link, time_s)
-    elements, section = mech.coupler["elements"], mech.coupler["section"]
-    count = len(elements)
+    count = len(mech.coupler["elements"])
     force = np.stack([_sensor(mech, f"{link}.element_{i}.ForceLocal")[:, 1:3]
                       for i in range(count)], axis=1)  # sample, element, (N, Q)
     moment = np.stack([_sensor(mech, f"{link}.element_{i}.TorqueLocal")[:, 3]
                        for i in range(count)], axis=1)
-    normal, von_mises = section_stress_peaks(section, force[..., 0], force[..., 1], moment)
-    centres = element_centres_m(section, count)
-    low, high = section.thickness_m, section.length_m - section.thickness_m
-    away = (centres >= low) & (centres <= high)
-    if not away.any():  # a stubby plate: the middle element(s)
-        away = np.abs(centres - 0.5 * section.length_m) <= 0.5 * section.length_m / count
-    out[f"{link}/axial_force"] = Dataset(
-        force[:, count // 2, 0] if count % 2 else force[:, count // 2 - 1:count // 2 + 1,
-                                                         0].mean(axis=1),
-        "N", "axial force at the midpoint (tension > 0)")
-    out[f"{link}/peak_bending_stress"] = Dataset(
-        normal[:, away].max(axis=1), "Pa",
-        "largest |sigma_xx| at the outer fibres away from the end faces (|N| / A + |M| c / I)")
-    out[f"{link}/peak_von_mises_stress"] = Dataset(
-        von_mises[:, away].max(axis=1), "Pa",
-        "largest von Mises stress away from the end faces (beam section)")
-    out[f"{link}/peak_von_mises_position"] = Dataset(
-        centres[away][np.argmax(von_mises[:, away], axis=1)], "m",
-        "where the peak von Mises stress away from the end faces is: distance from B")
-    if not away.all():
-        out[f"{link}/peak_von_mises_stress_at_joints"] = Dataset(
-            von_mises[:, ~away].max(axis=1), "Pa",
-            "largest von Mises stress within one thickness of the end faces (beam section)")
+    out.update(section_datasets(link, mech.coupler["section"], force, moment))
     return out
 
 
