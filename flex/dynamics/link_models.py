@@ -6,8 +6,8 @@ name to its :class:`LinkModel`, in the order messages list them: ``"rigid"``, ``
 ``"nonlinear_fe"``, ``"exact_beam"``. Every function that checks, resolves, builds or runs a
 scene takes the registry as an argument, ``link_models``, with the built-ins as its default; a
 caller with another model builds its own registry (``MappingProxyType({**BUILTIN_LINK_MODELS,
-"toy": toy})``) and passes it along. Nothing here is mutable and nothing registers itself. The layers
-below (:mod:`flex.data`, :mod:`flex.config`) read only an entry's scene-level part,
+"toy": toy})``) and passes it along. Nothing here is mutable and nothing registers itself. The
+layers below (:mod:`flex.data`, :mod:`flex.config`) read only an entry's scene-level part,
 :class:`flex.data.scene.LinkSchema` (its fields are :class:`LinkModel`'s first ones), with
 :data:`flex.data.scene.BUILTIN_LINK_SCHEMAS` as their default (a test ties the two).
 
