@@ -113,7 +113,10 @@ def test_thesis_deployment_follows_the_default_ffrf_coupler(reduction_cache):
     """1 mm plate, ``elements = "auto"`` (16), the bundled deployment (0.03 s) against the
     default FFRF coupler (its own step and modes). Measured: peak |midpoint deflection|
     0.17041 mm against 0.17149 (-0.63 %); crank angle within 3.3e-5 rad of the FFRF's at its
-    maximum; chord B-C and joint markers stay on the crank pin and the slide line."""
+    maximum; peak strain energy 2.347e-4 J against 2.357e-4 (-0.4 %); peak bending stress
+    28.98 MPa against 28.46 (+1.8 %; the FFRF's from its stress modes). The total energy
+    drifts by 1.1e-3 of the peak strain energy (the FFRF's by 2.6e-2): the pins at B and C
+    neither add nor take work."""
     common = {"coupler.geometry": "plate", "simulation.error_estimate": False}
     beam = flex.simulate(flex.load_scene(overrides=BEAM), "beam", cache_dir=reduction_cache)
     ffrf = flex.simulate(flex.load_scene(overrides={**common, "coupler.model": "ffrf"}),
@@ -126,11 +129,15 @@ def test_thesis_deployment_follows_the_default_ffrf_coupler(reduction_cache):
     crank = {name: run.datasets["crank/angle"].data.max()
              for name, run in (("beam", beam), ("ffrf", ffrf))}
     assert abs(crank["beam"] - crank["ffrf"]) < 1e-4
-    # the beam's own outputs: tension and bending of the right size, no energy claimed
-    stress = beam.datasets["coupler/peak_bending_stress"].data
-    assert 1e6 < stress.max() < 1e9
-    assert beam.datasets["coupler/peak_von_mises_stress"].data.max() >= 0.99 * stress.max()
-    assert not any(name.startswith("energy/") for name in beam.datasets)
+    strain = {name: run.datasets["energy/strain"].data.max()
+              for name, run in (("beam", beam), ("ffrf", ffrf))}
+    assert strain["beam"] == pytest.approx(strain["ffrf"], rel=0.02)
+    total = beam.datasets["energy/total"].data
+    assert np.abs(total - total[0]).max() < 5e-3 * strain["beam"]
+    stress = {name: run.datasets["coupler/peak_bending_stress"].data.max()
+              for name, run in (("beam", beam), ("ffrf", ffrf))}
+    assert stress["beam"] == pytest.approx(stress["ffrf"], rel=0.05)
+    assert beam.datasets["coupler/peak_von_mises_stress"].data.max() >= stress["beam"]
 
 
 def _filtered_first_crest(result) -> float:

@@ -75,8 +75,9 @@ class Mechanism:
     rigid_bodies: dict[str, tuple[float, np.ndarray]] = field(default_factory=dict)
     coupler: dict[str, Any] = field(default_factory=dict)
     crank: dict[str, Any] = field(default_factory=dict)
-    #: FFRF links whose energy Exudyn reports: name -> (kinetic sensor, strain sensor)
-    flexible_energy: dict[str, tuple[int, int]] = field(default_factory=dict)
+    #: flexible links whose energy Exudyn reports: name -> (kinetic sensor, strain sensor),
+    #: or lists of them to sum (a beam link's elements)
+    flexible_energy: dict[str, tuple[Any, Any]] = field(default_factory=dict)
     wing: dict[str, Any] = field(default_factory=dict)
     #: built by :mod:`flex.dynamics.planar` (2D bodies; joint loads read by its own rules)
     planar: bool = False

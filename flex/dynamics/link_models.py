@@ -509,11 +509,16 @@ def _add_exact_beam(builder: Any, link: str, section: Any) -> None:
 
 
 def _exact_beam_sensors(builder: Any, link: str) -> None:
-    """Each element's section forces (axial and shear force, bending moment)."""
-    for index, element in enumerate(builder.mech.coupler["elements"]):
+    """Each element's section forces (axial and shear force, bending moment) and energies
+    (kinetic, strain: summed by :mod:`flex.dynamics.collect`)."""
+    elements = builder.mech.coupler["elements"]
+    for index, element in enumerate(elements):
         for output in ("ForceLocal", "TorqueLocal"):
             builder.add(f"{link}.element_{index}.{output}",
                         builder.sensor("Body", output, bodyNumber=element))
+    builder.mech.flexible_energy[link] = tuple(
+        [builder.mbs.AddSensor(builder.sensor("Body", kind, bodyNumber=element))
+         for element in elements] for kind in ("KineticEnergy", "PotentialEnergy"))
 
 
 def _exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
@@ -566,7 +571,7 @@ BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
     EXACT_BEAM: LinkModel.extending(
         BUILTIN_LINK_SCHEMAS[EXACT_BEAM], label="geometrically exact beam",
         prepare=_prepare_beam, add=_add_exact_beam, sensors=_exact_beam_sensors,
-        datasets=_exact_beam_datasets, energy=False, time_scale=_nonlinear_fe_time_scale,
+        datasets=_exact_beam_datasets, time_scale=_nonlinear_fe_time_scale,
         step_cost_s=_exact_beam_step_cost_s, adjust_solver=_exact_beam_solver),
 })
 
