@@ -106,12 +106,16 @@ def has_auto_link_keys(scene: Scene, *,
                                             for link in ("crank", "coupler"))
 
 
+def _is_beam(scene: Scene, link: str, link_models: Mapping[str, Any]) -> bool:
+    """Whether ``link``'s concrete model is a beam of elements (its entry's ``beam`` flag)."""
+    model = scene[link]["model"]
+    return (model in link_models and link in link_models[model].links
+            and getattr(link_models[model], "beam", False))
+
+
 def _auto_elements(scene: Scene, link: str, link_models: Mapping[str, Any]) -> bool:
-    """Whether ``link`` is a beam (its concrete model's flag) whose ``elements`` is auto."""
-    values = scene[link]
-    return (values.get("elements") == AUTO and values["model"] in link_models
-            and link in link_models[values["model"]].links
-            and getattr(link_models[values["model"]], "beam", False))
+    """Whether ``link`` is a beam whose ``elements`` is auto."""
+    return scene[link].get("elements") == AUTO and _is_beam(scene, link, link_models)
 
 
 def resolve_link_keys(scene: Scene, calibration: Calibration | None = None, *,
@@ -119,16 +123,19 @@ def resolve_link_keys(scene: Scene, calibration: Calibration | None = None, *,
                       ) -> tuple[Scene, dict[str, Any]]:
     """``scene`` (a copy) with the links' ``"auto"`` modes and mesh size filled by the rule
     (:func:`flex.config.ffrf_rule.fill_link_keys` at ``fidelity.tolerance``, ``calibration``'s
-    rule; None: the bundled one) and a beam link's ``"auto"`` elements
-    (:data:`EXACT_BEAM_ELEMENTS`), and what was filled (``"coupler.modes"`` -> value)."""
+    rule; None: the bundled one; a beam link's, which it does not read, are left) and a beam
+    link's ``"auto"`` elements (:data:`EXACT_BEAM_ELEMENTS`), and what was filled
+    (``"coupler.modes"`` -> value)."""
     resolved = copy.deepcopy(scene)
     filled: dict[str, Any] = {}
     tolerance = float(scene["fidelity"]["tolerance"])
     for link in ("crank", "coupler"):
+        if _is_beam(scene, link, link_models):
+            if _auto_elements(resolved, link, link_models):
+                resolved[link]["elements"] = filled[f"{link}.elements"] = EXACT_BEAM_ELEMENTS
+            continue
         for key, value in fill_link_keys(resolved, link, tolerance, calibration).items():
             filled[f"{link}.{key}"] = value
-        if _auto_elements(resolved, link, link_models):
-            resolved[link]["elements"] = filled[f"{link}.elements"] = EXACT_BEAM_ELEMENTS
     return resolved, filled
 
 
