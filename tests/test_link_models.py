@@ -78,7 +78,7 @@ def test_an_unknown_model_is_refused_naming_the_accepted_ones():
     with pytest.raises(SceneError, match="must be one of"):
         flex.simulate(scene)  # the built-in registry: the toy is unknown there
     with pytest.raises(SceneError, match='crank.model = \'stiff\': must be one of "rigid", '
-                                         '"ffrf", "auto"'):
+                                         '"ffrf", "exact_beam", "auto"'):
         flex.load_scene(overrides={"crank.model": TOY}, link_models=REGISTRY)
 
 

@@ -253,8 +253,20 @@ def is_damped(values: dict[str, Any]) -> bool:
 
 def check_beam_plate(link: str, scene: Scene) -> None:
     """A beam model of ``link`` (its registry entry's own check): the beam is the plate's, so
-    ``<link>.geometry`` must be ``"plate"`` (a lumped link has no section)."""
-    values = scene[link]
+    ``<link>.geometry`` must be ``"plate"`` (a lumped link has no section). A beam crank's
+    nodes are planar: the coupler must be the same beam model (a 3D coupler's tilt is held by
+    a revolute joint at B on a crank that has a frame), and no wing is welded to it (the weld
+    needs a frame at A)."""
+    values, model = scene[link], scene[link]["model"]
     if values["geometry"] != "plate":
-        raise SceneError(f'{link}.model = "{values["model"]}" needs {link}.geometry = "plate" '
+        raise SceneError(f'{link}.model = "{model}" needs {link}.geometry = "plate" '
                          "(the beam's section is the plate's thickness_m x width_m)")
+    if link != "crank":
+        return
+    if scene["coupler"]["model"] != model:
+        raise SceneError(f'crank.model = "{model}" needs coupler.model = "{model}" (its planar '
+                         "nodes hold no 3D coupler's tilt at B); accepted: "
+                         f'coupler.model = "{model}"')
+    if scene["wing"]["enabled"]:
+        raise SceneError(f'crank.model = "{model}" carries no wing (the weld at A needs a '
+                         "frame its planar nodes do not have); accepted: wing.enabled = false")

@@ -93,7 +93,7 @@ BUILTIN_LINK_SCHEMAS: Mapping[str, LinkSchema] = MappingProxyType({
     "rigid": LinkSchema("rigid", LINKS, rigid=True),
     "ffrf": LinkSchema("ffrf", LINKS, meshed=True, modal=True),
     "nonlinear_fe": LinkSchema("nonlinear_fe", ("coupler",), meshed=True, damped=False),
-    "exact_beam": LinkSchema("exact_beam", ("coupler",), damped=False, beam=True,
+    "exact_beam": LinkSchema("exact_beam", LINKS, damped=False, beam=True,
                              check=check_beam_plate),
 })
 

@@ -389,7 +389,9 @@ class _Builder:
         # of marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where
         # it can; the links' markers are turned by copies (_turned_marker)
         self.joints = {
-            "A": mbs.AddObject(eii.ObjectJointRevoluteZ(
+            "A": mbs.AddObject(eii.ObjectJointSpherical(
+                markerNumbers=[m["ground_A"], m["crank_A"]], constrainedAxes=[1, 1, 0]))
+            if self.planar("crank") else mbs.AddObject(eii.ObjectJointRevoluteZ(
                 markerNumbers=[m["ground_A"], _turned_marker(mbs, m["crank_A"], crank_ref.T)])),
             "B": self._joint_B(crank_ref),
             "C": mbs.AddObject(eii.ObjectJointSpherical(
@@ -399,21 +401,27 @@ class _Builder:
         # B's force is reported in the frame of the crank's marker at B (its joint face when
         # the crank is flexible), turned back by the initial crank angle: collect turns it
         # with that marker's rotation since t = 0 (a planar pin's in global axes)
-        self.mech.joint_frames = {"A": None, "B": None if self.planar_pins else
+        self.mech.joint_frames = {"A": None, "B": None if self.planar_B else
                                   "marker_crank_B", "C": None, "P": None}
         self._add_geometric_stiffness()
 
+    def planar(self, link: str) -> bool:
+        """Whether ``link``'s joint markers carry x and y only (a planar beam's nodes, its
+        handles' ``planar_pins``): its pins then hold x and y (a 3D coupler's z and tilts are
+        held by its revolute joint at B, a 3D crank's by the one at A)."""
+        handles = self.coupler if link == "coupler" else self.mech.crank
+        return bool(handles.get("planar_pins", False))
+
     @property
-    def planar_pins(self) -> bool:
-        """Whether the coupler's joint markers carry x and y only (a planar beam's nodes,
-        ``builder.coupler["planar_pins"]``): its pin at B then holds x and y, as the one at C
-        (the crank's z and tilts are held by its joint at A)."""
-        return bool(self.coupler.get("planar_pins", False))
+    def planar_B(self) -> bool:
+        """Whether the pin at B holds x and y only: a planar coupler or crank (a planar crank
+        has a planar coupler: :func:`flex.data.plates.check_beam_plate`)."""
+        return self.planar("coupler") or self.planar("crank")
 
     def _joint_B(self, crank_ref: np.ndarray) -> int:
-        """The revolute joint at B (a pin in x and y on a planar coupler)."""
+        """The revolute joint at B (a pin in x and y on a planar link)."""
         mbs, eii, m = self.mbs, self.eii, self.markers
-        if self.planar_pins:
+        if self.planar_B:
             return mbs.AddObject(eii.ObjectJointSpherical(
                 markerNumbers=[m["crank_B"], m["coupler_B"]], constrainedAxes=[1, 1, 0]))
         coupler_ref = _rotation_z(self.init.coupler_angle_rad)
@@ -517,10 +525,11 @@ class _Builder:
         for name, joint in self.joints.items():
             # the spherical joint reports its force in global axes ("Force"), the others in
             # the frame of marker 0 ("ForceLocal")
-            global_axes = name == "C" or (name == "B" and self.planar_pins)
+            global_axes = (name == "C" or (name == "B" and self.planar_B)
+                           or (name == "A" and self.planar("crank")))
             output = "Force" if global_axes or penalty else "ForceLocal"
             self.add(f"joint_{name}.Force", self.sensor("Object", output, objectNumber=joint))
-        if not penalty:
+        if not (penalty or self.planar("crank")):  # a planar crank's marker has no frame
             self.add("marker_crank_B.Rotation",
                      self.sensor("Marker", "Rotation", markerNumber=self.markers["crank_B"]))
 

@@ -496,22 +496,35 @@ def _prepare_beam(scene: Scene, link: str, given: Any, cache_dir: Path | None) -
 
 
 def _add_exact_beam(builder: Any, link: str, section: Any) -> None:
+    """The beam from B to C (a coupler) or from A to B (a crank, its markers ``crank_A``,
+    ``crank_B``), moving as the rigid link at t = 0."""
     from flex.bodies.exact_beam import add_exact_beam_link
 
-    init = builder.init
+    init, elements = builder.init, _beam_elements(link, builder.scene[link])
     section = section if section is not None else _prepare_beam(builder.scene, link, None,
                                                                 None)
+    if link == "crank":
+        beam = add_exact_beam_link(builder.mbs, section, elements, (0.0, 0.0),
+                                   init.crank_angle_rad, (0.0, 0.0), init.crank_speed_rad_per_s)
+        builder.mech.crank = dict(beam.handles(), section=section)
+        builder.markers["crank_A"], builder.markers["crank_B"] = (beam.marker_start,
+                                                                  beam.marker_end)
+        return
     beam = add_exact_beam_link(
-        builder.mbs, section, _beam_elements(link, builder.scene[link]), init.joint_B_m,
-        init.coupler_angle_rad, init.joint_B_velocity_m_per_s, init.coupler_speed_rad_per_s)
+        builder.mbs, section, elements, init.joint_B_m, init.coupler_angle_rad,
+        init.joint_B_velocity_m_per_s, init.coupler_speed_rad_per_s)
     builder.coupler = beam.handles()
     builder.mech.coupler = dict(builder.coupler, section=section)
+
+
+def _link_handles(mech: Any, link: str) -> dict[str, Any]:
+    return mech.crank if link == "crank" else mech.coupler
 
 
 def _exact_beam_sensors(builder: Any, link: str) -> None:
     """Each element's section forces (axial and shear force, bending moment) and energies
     (kinetic, strain: summed by :mod:`flex.dynamics.collect`)."""
-    elements = builder.mech.coupler["elements"]
+    elements = _link_handles(builder.mech, link)["elements"]
     for index, element in enumerate(elements):
         for output in ("ForceLocal", "TorqueLocal"):
             builder.add(f"{link}.element_{index}.{output}",
@@ -522,17 +535,19 @@ def _exact_beam_sensors(builder: Any, link: str) -> None:
 
 
 def _exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
-    """The flexible coupler's datasets (chord angle, midpoint) and the beam's own section
-    forces and stresses (:func:`flex.bodies.exact_beam.section_datasets`)."""
+    """The flexible coupler's datasets (chord angle, midpoint; a crank's are read with its
+    motion) and the beam's own section forces and stresses
+    (:func:`flex.bodies.exact_beam.section_datasets`)."""
     from flex.bodies.exact_beam import section_datasets
 
     out = _flexible_datasets(mech, link, time_s)
-    count = len(mech.coupler["elements"])
+    handles = _link_handles(mech, link)
+    count = len(handles["elements"])
     force = np.stack([_sensor(mech, f"{link}.element_{i}.ForceLocal")[:, 1:3]
                       for i in range(count)], axis=1)  # sample, element, (N, Q)
     moment = np.stack([_sensor(mech, f"{link}.element_{i}.TorqueLocal")[:, 3]
                        for i in range(count)], axis=1)
-    out.update(section_datasets(link, mech.coupler["section"], force, moment))
+    out.update(section_datasets(link, handles["section"], force, moment))
     return out
 
 
