@@ -18,8 +18,8 @@ Scene = dict[str, dict[str, Any]]
 #: coupler) by default and for ``"auto"``: fixed, not chosen by tolerance. Measured on the
 #: bundled deployment with the 1 mm coupler (h = 1e-5 s): the first crest of the midpoint
 #: deflection (2 kHz low-pass) is 0.57 % below the 128-element value at 16 elements, 0.13 %
-#: at 32 (twice the cost: 1.4 against 3.0 s), 0.03 % at 64; the peak deflection within
-#: 0.63 % of the default FFRF coupler's (tests/test_exact_beam.py)
+#: at 32, 0.03 % at 64, at 0.6, 1.1 and 2.0 s CPU a run; the peak deflection within 0.63 %
+#: of the default FFRF coupler's (tests/test_exact_beam.py)
 EXACT_BEAM_ELEMENTS = 16
 
 # ------------------------------------------------------------------------------------------
