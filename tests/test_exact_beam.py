@@ -120,7 +120,7 @@ def test_static_end_moment_gives_the_closed_form_deflection_and_section_forces()
     settings.staticSolver.newton.relativeTolerance = 1e-8
     settings.staticSolver.newton.absoluteTolerance = 1e-10
     settings.staticSolver.verboseMode = 0
-    settings.solutionSettings.writeSolutionToFile = False  # no solution/ folder in the cwd
+    settings.solution.file.write = False  # no solution/ folder in the cwd
     mbs.SolveStatic(settings)
     deflection = mbs.GetNodeOutput(beam.midpoint_node, exu.OutputVariableType.Position)[1]
     assert deflection == pytest.approx(physics.pinned_beam_end_moment_midpoint_deflection_m(
