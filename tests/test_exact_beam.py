@@ -187,6 +187,27 @@ def test_thesis_deployment_follows_the_default_ffrf_coupler(reduction_cache):
     assert beam.datasets["coupler/peak_von_mises_stress"].data.max() >= stress["beam"]
 
 
+@pytest.mark.parametrize("crank_elements", [None, 2])
+def test_the_beam_joins_the_mechanism_without_redundant_or_free_constraints(crank_elements):
+    """Exudyn's count of the built mechanism (constraint Jacobian rank): one freedom of the
+    mechanism plus 3 (nodes - 1) elastic ones per beam, no redundant constraint: the pins at
+    A, B and C hold x and y of the planar nodes, nothing in z is left free or held twice."""
+    from exudyn.solver import ComputeSystemDegreeOfFreedom
+
+    from flex.dynamics.mechanism import build_mechanism
+
+    overrides = {**BEAM, "coupler.elements": 4}
+    if crank_elements:
+        overrides.update({"crank.model": "exact_beam", "crank.geometry": "plate",
+                          "crank.elements": crank_elements})
+    mech = build_mechanism(flex.load_scene(overrides=overrides))
+    mech.mbs.Assemble()
+    count = ComputeSystemDegreeOfFreedom(mech.mbs, verbose=False)
+    elastic = 3 * 4 + 3 * (crank_elements or 0)
+    assert count["redundantConstraints"] == 0
+    assert count["degreeOfFreedom"] == 1 + elastic
+
+
 def _filtered_first_crest(result) -> float:
     """The first crest of the midpoint deflection after a zero-phase 4th-order Butterworth
     low-pass at 2 kHz (the release's ~10 kHz ripple races between sub-crests otherwise)."""
