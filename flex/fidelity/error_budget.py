@@ -2,8 +2,8 @@
 flex can know, term by term, in the quantity's unit and relative to it.
 
 Contract of :func:`error_budget`: given a finished run of a concrete scene (links rigid,
-ffrf or nonlinear_fe; ``"auto"`` keys resolved) and a way to run companion scenes, it returns
-an :class:`ErrorBudget` with, for each headline quantity of the run
+ffrf, nonlinear_fe or exact_beam; ``"auto"`` keys resolved) and a way to run companion
+scenes, it returns an :class:`ErrorBudget` with, for each headline quantity of the run
 (:data:`flex.fidelity.error_estimate.HEADLINES`: crank angle and slider position at the end
 time, deployment time, peak joint forces, each flexible link's peak midpoint deflection and
 peak bending stress), four named terms and their total [the quantity's units]:
@@ -15,7 +15,10 @@ peak bending stress), four named terms and their total [the quantity's units]:
   convergence is fast, so the difference is the run's truncation error);
 - ``mesh``: the mesh of the FFRF links: the difference to a companion on a mesh
   :data:`MESH_FACTOR` times coarser, taken whole (first order assumed: the peak stress from
-  the nodes converges about that slowly, the deflection faster, so the term leans safe);
+  the nodes converges about that slowly, the deflection faster, so the term leans safe); a
+  beam link's elements: the difference to a companion with :data:`MESH_FACTOR` times more,
+  taken as converged (the beam converges at order 2: measured on the first crest; a
+  companion with fewer elements would put the racing peak of a coarse beam in the term);
 - ``model``: the link model against the next rung of flex's ladder (rigid, linear FFRF,
   FFRF with geometric stiffness, nonlinear FE). An FFRF link with geometric stiffness: its
   measured error against the nonlinear FE coupler as a fraction of what the elasticity
@@ -193,16 +196,31 @@ def _mesh_term(scene: Scene, result: CaseResult, companions: _Companions,
                link_models: Mapping[str, LinkModel]) -> tuple[dict[str, float], str]:
     meshed = [link for link in _links(scene, link_models, meshed=True)
               if scene[link]["geometry"] == "plate"]
-    if not meshed:
+    beams = _links(scene, link_models, beam=True)
+    if not (meshed or beams):
         return {}, "no meshed link"
-    sizes = {link: min(MESH_FACTOR * float(scene[link]["mesh_size_m"]),
-                       float(scene[link]["length_m"])) for link in meshed}
-    coarser = companions.run("mesh", _companion(
-        scene, [f"{link}.mesh_size_m={size!r}" for link, size in sizes.items()]))
-    how = ", ".join(f"{link} {scene[link]['mesh_size_m']:g} -> {size:g} m"
-                    for link, size in sizes.items())
-    return _differences(result, coarser), (f"difference to a companion on a {MESH_FACTOR:g}x "
-                                           f"coarser mesh ({how}), taken whole")
+    terms: dict[str, float] = {}
+    sentences = []
+    if meshed:
+        sizes = {link: min(MESH_FACTOR * float(scene[link]["mesh_size_m"]),
+                           float(scene[link]["length_m"])) for link in meshed}
+        coarser = companions.run("mesh", _companion(
+            scene, [f"{link}.mesh_size_m={size!r}" for link, size in sizes.items()]))
+        terms = _differences(result, coarser)
+        how = ", ".join(f"{link} {scene[link]['mesh_size_m']:g} -> {size:g} m"
+                        for link, size in sizes.items())
+        sentences.append(f"difference to a companion on a {MESH_FACTOR:g}x coarser mesh "
+                         f"({how}), taken whole")
+    if beams:
+        counts = {link: int(MESH_FACTOR * int(scene[link]["elements"])) for link in beams}
+        finer = companions.run("mesh", _companion(
+            scene, [f"{link}.elements={count}" for link, count in counts.items()]))
+        for name, value in _differences(result, finer).items():
+            terms[name] = terms.get(name, 0.0) + value
+        how = ", ".join(f"{link} {scene[link]['elements']} -> {count}"
+                        for link, count in counts.items())
+        sentences.append(f"difference to a companion with more beam elements ({how})")
+    return terms, "; ".join(sentences)
 
 
 def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
@@ -236,6 +254,11 @@ def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
     if _links(scene, link_models, reference=True):
         leaves_out.append("the nonlinear FE coupler's own model error (the top rung: "
                           "St. Venant-Kirchhoff continuum, deformable joint faces)")
+    beams = _links(scene, link_models, beam=True)
+    if beams:
+        leaves_out.append(f"the beam model error of the {' and '.join(beams)} (a "
+                          "geometrically exact beam: plane sections, pins at the section "
+                          "centres; not measured against the nonlinear FE coupler here)")
     rigid = _links(scene, link_models, rigid=True)
     if rigid:
         leaves_out.append(f"the elasticity of the rigid {' and '.join(rigid)} (predicted by "
