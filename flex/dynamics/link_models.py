@@ -3,11 +3,11 @@ under a written contract.
 
 :data:`BUILTIN_LINK_MODELS` is an immutable mapping (``types.MappingProxyType``) from a model's
 name to its :class:`LinkModel`, in the order messages list them: ``"rigid"``, ``"ffrf"``,
-``"nonlinear_fe"``. Every function that checks, resolves, builds or runs a scene takes the
-registry as an argument, ``link_models``, with the built-ins as its default; a caller with
-another model builds its own registry (``MappingProxyType({**BUILTIN_LINK_MODELS, "toy":
-toy})``) and passes it along. Nothing here is mutable and nothing registers itself. The layers
-below (:mod:`flex.data`, :mod:`flex.config`) read only an entry's scene-level part,
+``"nonlinear_fe"``, ``"exact_beam"``. Every function that checks, resolves, builds or runs a
+scene takes the registry as an argument, ``link_models``, with the built-ins as its default; a
+caller with another model builds its own registry (``MappingProxyType({**BUILTIN_LINK_MODELS,
+"toy": toy})``) and passes it along. Nothing here is mutable and nothing registers itself. The
+layers below (:mod:`flex.data`, :mod:`flex.config`) read only an entry's scene-level part,
 :class:`flex.data.scene.LinkSchema` (its fields are :class:`LinkModel`'s first ones), with
 :data:`flex.data.scene.BUILTIN_LINK_SCHEMAS` as their default (a test ties the two).
 
@@ -19,7 +19,8 @@ The contract of an entry -- what a link model declares, point by point:
    (:func:`flex.data.scene.validate`, :func:`entry_of`).
 2. **scene keys it reads**, as flags on ``[<link>]``: ``rigid`` (mass keys only),
    ``meshed`` (the plate's elastic keys and ``mesh_size_m``), ``modal`` (``modes``,
-   ``mode_selection``, ``geometric_stiffness``), ``damped`` (``damping_ratio``). A key a
+   ``mode_selection``, ``geometric_stiffness``), ``damped`` (``damping_ratio``), ``beam``
+   (the plate's keys and ``elements``, a beam of elements along the link). A key a
    model does not read and the user set is refused (:func:`flex.config.usage.unused_keys`).
 3. **checks on those keys** (SceneError, before anything runs): the flags' (a meshed model
    needs ``geometry = "plate"`` and a plate that can be meshed, an undamped one
@@ -33,9 +34,10 @@ The contract of an entry -- what a link model declares, point by point:
    a dict with ``joint_markers`` (the markers at the link's two joints: A and B for the
    crank, B and C for the coupler) and whatever its own sensors and datasets read (a rigid
    link's ``body`` and ``node``; an FFRF link's ``reduction``, ``node_modal``,
-   ``node_frame``, ``object``, ``marker_mid``); the builder keeps them as ``mech.crank`` and
-   ``mech.coupler``. A rigid crank is added before the slider (the order numbers the
-   coordinates), any other after the ground markers.
+   ``node_frame``, ``object``, ``marker_mid``; ``planar_pins``: true when its joint markers
+   carry x and y only, as a planar beam's nodes: the builder then pins them in x and y); the
+   builder keeps them as ``mech.crank`` and ``mech.coupler``. A rigid crank is added before
+   the slider (the order numbers the coordinates), any other after the ground markers.
 6. **its sensors and datasets**: ``sensors(builder, link, handles)`` adds what its
    ``datasets(mech,
    link, time_s)`` reads after the run (the coupler's ``coupler/...`` datasets; a crank's
@@ -86,6 +88,7 @@ from flex.data.results import Dataset
 from flex.data.scene import (
     AUTO,
     BUILTIN_LINK_SCHEMAS,
+    EXACT_BEAM_ELEMENTS,
     LINKS,
     LinkSchema,
     Scene,
@@ -95,6 +98,7 @@ from flex.data.scene import (
     plate_mass_properties,
 )
 from flex.dynamics.ladder import (
+    EXACT_BEAM_RUNG,
     NONLINEAR_FE_RUNG,
     RIGID_RUNG,
     Rung,
@@ -102,7 +106,7 @@ from flex.dynamics.ladder import (
 )
 
 #: the built-in models' names (for code that sets a model in a scene)
-RIGID, FFRF, NONLINEAR_FE = BUILTIN_LINK_SCHEMAS
+RIGID, FFRF, NONLINEAR_FE, EXACT_BEAM = BUILTIN_LINK_SCHEMAS
 
 
 def _nothing(*args: Any) -> None:
@@ -129,8 +133,9 @@ def _no_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]
 #: angle and joint positions: a box moved with them), ``"modal"`` (``<link>/modal_coordinates``
 #: and the floating frame's pose ``<link>/frame_position``, ``frame_angle``, on the basis of
 #: the link's reduction, rebuilt from the case's scene), ``"nodal"`` (every node's position,
-#: ``<link>/nodal/position`` at ``<link>/nodal/time``, on the link's plate mesh)
-STORED_MOTIONS = ("rigid", "modal", "nodal")
+#: ``<link>/nodal/position`` at ``<link>/nodal/time``, on the link's plate mesh), ``"none"``
+#: (not read back: export and animate refuse it, naming the model)
+STORED_MOTIONS = ("rigid", "modal", "nodal", "none")
 
 
 @dataclass(frozen=True)
@@ -540,6 +545,112 @@ def _nonlinear_fe_rung(values: Mapping[str, Any]) -> Rung:
     return NONLINEAR_FE_RUNG
 
 
+def _exact_beam_rung(values: Mapping[str, Any]) -> Rung:
+    return EXACT_BEAM_RUNG
+
+
+# ------------------------------------------------------------------------------------------
+# exact beam: a planar geometrically exact (Simo-Reissner) beam of the plate
+# ------------------------------------------------------------------------------------------
+#: Newton tolerances (relative, absolute) of a run with an exact beam link: 1e-8 / 1e-10
+#: stalled on round-off at 32 elements and more ("relative error 1.39e-8 after 25
+#: iterations"), 1e-7 / 1e-6 converged (docs/exudyn-ngsolve notes, measured 2026-11-28)
+EXACT_BEAM_NEWTON_TOLERANCES = (1e-7, 1e-6)
+#: wall time per step [s] of an exact beam link: (per link, per element). CPU time of a
+#: whole run (build, sensors, collection) per step, 10 ms of the thesis deployment at
+#: h = 1e-5 s, sparse LU, modified Newton: 16 elements 0.22 ms, 32: 0.30, 64: 0.51, 128: 1.13
+#: (a dense LU: 0.25, 0.48, 1.21, 3.40 ms, the same deflections to all digits)
+STEP_COST_EXACT_BEAM_S = (1e-4, 8e-6)
+
+
+def _beam_elements(link: str, values: dict[str, Any]) -> int:
+    if values["elements"] == AUTO:
+        raise ValueError(f'{link}: resolve its "auto" elements first '
+                         "(flex.fidelity.auto.resolve, flex.config.settings.resolve_link_keys)")
+    return int(values["elements"])
+
+
+def _prepare_beam(scene: Scene, link: str, given: Any, cache_dir: Path | None) -> Any:
+    """The link's :class:`flex.bodies.exact_beam.ExactBeamSection` (``given``: one built)."""
+    from flex.bodies.exact_beam import exact_beam_section
+
+    if given is not None:
+        return given
+    c = scene[link]
+    _beam_elements(link, c)
+    return exact_beam_section(c["length_m"], c["thickness_m"], c["width_m"],
+                              c["youngs_modulus_Pa"], c["density_kg_per_m3"],
+                              c["poisson_ratio"])
+
+
+def _add_exact_beam(builder: Any, link: str, section: Any) -> dict[str, Any]:
+    """The beam from B to C (a coupler) or from A to B (a crank), moving as the rigid link
+    at t = 0; its handles (its end markers are the link's joint markers)."""
+    from flex.bodies.exact_beam import add_exact_beam_link
+
+    init, elements = builder.init, _beam_elements(link, builder.scene[link])
+    section = section if section is not None else _prepare_beam(builder.scene, link, None,
+                                                                None)
+    if link == "crank":
+        beam = add_exact_beam_link(builder.mbs, section, elements, (0.0, 0.0),
+                                   init.crank_angle_rad, (0.0, 0.0), init.crank_speed_rad_per_s)
+    else:
+        beam = add_exact_beam_link(
+            builder.mbs, section, elements, init.joint_B_m, init.coupler_angle_rad,
+            init.joint_B_velocity_m_per_s, init.coupler_speed_rad_per_s)
+    return dict(beam.handles(), section=section,
+                joint_markers=(beam.marker_start, beam.marker_end))
+
+
+def _link_handles(mech: Any, link: str) -> dict[str, Any]:
+    return mech.crank if link == "crank" else mech.coupler
+
+
+def _exact_beam_sensors(builder: Any, link: str, handles: dict[str, Any]) -> None:
+    """Each element's section forces (axial and shear force, bending moment) and energies
+    (kinetic, strain: summed by :mod:`flex.dynamics.collect`); a crank's joint-marker
+    velocities (its chord's turning rate) and every flexible link's midpoint marker."""
+    _flexible_sensors(builder, link, handles)
+    for index, element in enumerate(handles["elements"]):
+        for output in ("ForceLocal", "TorqueLocal"):
+            builder.add(f"{link}.element_{index}.{output}",
+                        builder.sensor("Body", output, bodyNumber=element))
+    builder.mech.flexible_energy[link] = tuple(
+        [builder.mbs.AddSensor(builder.sensor("Body", kind, bodyNumber=element))
+         for element in handles["elements"]] for kind in ("KineticEnergy", "PotentialEnergy"))
+
+
+def _exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
+    """The flexible coupler's datasets (chord angle, midpoint; a crank's are read with its
+    motion) and the beam's own section forces and stresses
+    (:func:`flex.bodies.exact_beam.section_datasets`)."""
+    from flex.bodies.exact_beam import section_datasets
+
+    out = _flexible_datasets(mech, link, time_s)
+    handles = _link_handles(mech, link)
+    count = len(handles["elements"])
+    force = np.stack([sensor_data(mech, f"{link}.element_{i}.ForceLocal")[:, 1:3]
+                      for i in range(count)], axis=1)  # sample, element, (N, Q)
+    moment = np.stack([sensor_data(mech, f"{link}.element_{i}.TorqueLocal")[:, 3]
+                       for i in range(count)], axis=1)
+    out.update(section_datasets(link, handles["section"], force, moment))
+    return out
+
+
+def _exact_beam_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
+    elements = values["elements"] if values["elements"] != AUTO else EXACT_BEAM_ELEMENTS
+    return STEP_COST_EXACT_BEAM_S[0] + STEP_COST_EXACT_BEAM_S[1] * float(elements)
+
+
+def _exact_beam_solver(settings: dict[str, Any]) -> None:
+    settings["linear_solver"] = "EigenSparse"
+    relative, absolute = EXACT_BEAM_NEWTON_TOLERANCES
+    settings["newton_relative_tolerance"] = max(settings["newton_relative_tolerance"],
+                                                relative)
+    settings["newton_absolute_tolerance"] = max(settings["newton_absolute_tolerance"],
+                                                absolute)
+
+
 # ------------------------------------------------------------------------------------------
 # the registry
 # ------------------------------------------------------------------------------------------
@@ -560,7 +671,13 @@ BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
         energy=False, recorder=_nodal_recorder, time_scale=_nonlinear_fe_time_scale,
         step_cost_s=_nonlinear_fe_step_cost_s, adjust_solver=_nonlinear_fe_solver,
         own_progress=True, rung=_nonlinear_fe_rung, stored_motion="nodal"),
+    EXACT_BEAM: LinkModel.extending(
+        BUILTIN_LINK_SCHEMAS[EXACT_BEAM], label="geometrically exact beam", auto_choice=True,
+        prepare=_prepare_beam, add=_add_exact_beam, sensors=_exact_beam_sensors,
+        datasets=_exact_beam_datasets, time_scale=_nonlinear_fe_time_scale,
+        step_cost_s=_exact_beam_step_cost_s, adjust_solver=_exact_beam_solver,
+        rung=_exact_beam_rung, stored_motion="none"),
 })
 
 __all__ = ["LinkModel", "BUILTIN_LINK_MODELS", "STORED_MOTIONS", "RIGID", "FFRF",
-           "NONLINEAR_FE", "entry_of", "entries", "reduction_for_scene"]
+           "NONLINEAR_FE", "EXACT_BEAM", "entry_of", "entries", "reduction_for_scene"]

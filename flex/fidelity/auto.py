@@ -152,7 +152,7 @@ def check(scene: Scene, calibration: Calibration | None = None, *,
                          "refinement follows the error budget; set error_estimate = true or "
                          "refine = false")
     # an "auto" link's plate too: what it may mesh
-    linked, _ = resolve_link_keys(scene, calibration)
+    linked, _ = resolve_link_keys(scene, calibration, link_models=link_models)
     for link in LINKS:
         check_meshed_plate(link, linked[link], link_models)
     options = candidates(scene, link_models)
