@@ -156,7 +156,7 @@ NOTHING_TO_REFINE = ("nothing to refine: no flexible link's deflection to certif
 
 #: the knobs refinement turns: scene keys (``<link>.`` ones for each link)
 KNOBS = ("simulation.step_s", "coupler.model", "crank.modes", "coupler.modes",
-         "crank.mesh_size_m", "coupler.mesh_size_m")
+         "crank.mesh_size_m", "coupler.mesh_size_m", "crank.elements", "coupler.elements")
 
 
 def free_knobs(scene: Scene) -> frozenset[str]:
