@@ -16,11 +16,11 @@ from flex.base.progress import duration_text
 Scene = dict[str, dict[str, Any]]
 #: the beam elements of a beam link (``<link>.elements``, the geometrically exact beam
 #: coupler) by default and for ``"auto"``: fixed, not chosen by tolerance. Measured on the
-#: bundled deployment with the 1 mm coupler (h = 1e-5 s): the first crest of the midpoint
-#: deflection (2 kHz low-pass) is 0.57 % below the 128-element value at 16 elements, 0.13 %
-#: at 32, 0.03 % at 64, at 0.6, 1.1 and 2.0 s CPU a run; the peak deflection within 0.63 %
-#: of the default FFRF coupler's (tests/test_exact_beam.py)
-EXACT_BEAM_ELEMENTS = 16
+#: bundled deployment with the 1 mm coupler (h = 1e-5 s) against the nonlinear FE coupler
+#: (the reference rung, 10.6 min): first crest of the midpoint deflection -1.06 / -0.07 /
+#: +0.08 % at 16 / 32 / 64 elements, peak deflection -0.70 / -0.52 / +0.19 %, at 0.6, 1.1
+#: and 2.0 s CPU a run: 16 would spend the default 1 % tolerance on the elements alone
+EXACT_BEAM_ELEMENTS = 32
 
 # ------------------------------------------------------------------------------------------
 # meshed plates: what makes sense, and what this machine can mesh
