@@ -12,8 +12,7 @@ The link models a scene may name (``crank.model``, ``coupler.model``) are an arg
 ``link_models``, of every function here that checks a scene: a mapping from a model's name to
 its entry, of which this layer reads only the scene-level part, :class:`LinkSchema` (links,
 flags, extra check). Its default, :data:`BUILTIN_LINK_SCHEMAS`, names the built-in models once;
-their full entries (how they build, sense, advise) are
-:data:`flex.dynamics.link_models.BUILTIN_LINK_MODELS`, whose keys a test ties to these.
+their full entries are :data:`flex.dynamics.link_models.BUILTIN_LINK_MODELS`, built from these.
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ import numpy as np
 from flex.data.results import Dataset
 from flex.dynamics import planar
 from flex.dynamics.builder import Mechanism
-from flex.dynamics.link_models import (  # noqa: F401 - stress_window_m: re-exported
+from flex.dynamics.link_outputs import (  # noqa: F401 - stress_window_m: re-exported
     elastic_datasets,
     sensor_data,
     stress_window_m,

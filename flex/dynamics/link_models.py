@@ -88,7 +88,6 @@ from flex.data.results import Dataset
 from flex.data.scene import (
     AUTO,
     BUILTIN_LINK_SCHEMAS,
-    EXACT_BEAM_ELEMENTS,
     LINKS,
     LinkSchema,
     Scene,
@@ -97,12 +96,27 @@ from flex.data.scene import (
     link_model,
     plate_mass_properties,
 )
+from flex.dynamics.exact_beam_link import (
+    add_exact_beam,
+    exact_beam_datasets,
+    exact_beam_sensors,
+    exact_beam_solver,
+    exact_beam_step_cost_s,
+    prepare_beam,
+)
 from flex.dynamics.ladder import (
     EXACT_BEAM_RUNG,
     NONLINEAR_FE_RUNG,
     RIGID_RUNG,
     Rung,
     ffrf_rung,
+)
+from flex.dynamics.link_outputs import (  # noqa: F401 - the names callers import from here
+    elastic_datasets,
+    flexible_datasets,
+    flexible_sensors,
+    sensor_data,
+    stress_window_m,
 )
 
 #: the built-in models' names (for code that sets a model in a scene)
@@ -201,76 +215,6 @@ def entries(scene: Scene, link_models: Mapping[str, LinkModel]) -> dict[str, Lin
 
 
 # ------------------------------------------------------------------------------------------
-# what a flexible link's markers and modal coordinates give (FFRF and nonlinear FE)
-# ------------------------------------------------------------------------------------------
-def sensor_data(mech: Any, name: str) -> np.ndarray:
-    """The stored data of ``mech``'s sensor ``name`` (time in column 0, then its values)."""
-    return np.asarray(mech.mbs.GetSensorStoredData(mech.sensors[name]))
-
-
-def elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
-                      chord_name: str, time_s: np.ndarray) -> dict[str, Dataset]:
-    """Midpoint motion and elastic response of a flexible ``link`` (FFRF or nonlinear FE).
-
-    From its joint markers (``start_marker``, ``end_marker``: sensor names) and its midpoint
-    marker; an FFRF link adds its modal coordinates and bending stress.
-    """
-    from flex.bodies.reduction import bending_stress_history, midpoint_deflection
-    from flex.bodies.stress import peak_datasets
-
-    position_start = sensor_data(mech, f"{start_marker}.Position")[:, 1:4]
-    position_end = sensor_data(mech, f"{end_marker}.Position")[:, 1:4]
-    position_mid = sensor_data(mech, f"marker_{link}_mid.Position")[:, 1:4]
-    velocity_mid = sensor_data(mech, f"marker_{link}_mid.Velocity")[:, 1:3]
-    deflection = midpoint_deflection(position_start, position_end, position_mid)
-    out: dict[str, Dataset] = {}
-    out[f"{link}/midpoint_position"] = Dataset(position_mid[:, :2], "m",
-                                               f"{link} midpoint x, y")
-    # the superelement marker reports no acceleration: differentiate its velocity (2nd order)
-    out[f"{link}/midpoint_acceleration"] = Dataset(
-        np.gradient(velocity_mid, time_s, axis=0), "m/s^2",
-        f"{link} midpoint acceleration x, y (thesis figs. 35-42), from the marker velocity")
-    out[f"{link}/midpoint_deflection"] = Dataset(
-        deflection.transverse_m, "m",
-        f"transverse elastic deflection of the midpoint from the chord {chord_name}, 0 at t = 0")
-    out[f"{link}/chord_change"] = Dataset(deflection.chord_change_m, "m",
-                                          f"change of the distance {chord_name} (axial strain "
-                                          "x length)")
-    body = mech.crank if link == "crank" else mech.coupler
-    if not mech.models[link].modal:  # nonlinear FE: nodal coordinates, no modes, no stress
-        return out
-    modal = sensor_data(mech, f"{link}.modal_coordinates")[:, 1:]
-    out[f"{link}/modal_coordinates"] = Dataset(
-        modal, "1", "elastic coordinates: the static modes, then the fixed-interface eigenmodes")
-    reduction = body["reduction"]
-    if reduction.has_stress_modes:
-        out[f"{link}/peak_bending_stress"] = Dataset(
-            bending_stress_history(reduction, modal, stress_window_m(reduction)), "Pa",
-            "largest |sigma_xx| away from the end faces (bending + membrane)")
-        out.update(peak_datasets(link, reduction, modal))
-    out.update(_frame_datasets(mech, link))
-    return out
-
-
-def _frame_datasets(mech: Any, link: str) -> dict[str, Dataset]:
-    """The pose of an FFRF link's floating frame (what :mod:`flex.tools.export` places the
-    nodal field with): origin x, y [m] and angle about z [rad]."""
-    origin = sensor_data(mech, f"{link}.frame_Position")[:, 1:3]
-    angle = np.unwrap(sensor_data(mech, f"{link}.frame_Rotation")[:, 3])
-    return {f"{link}/frame_position": Dataset(origin, "m", "floating frame origin x, y"),
-            f"{link}/frame_angle": Dataset(angle, "rad", "floating frame angle from +x")}
-
-
-def stress_window_m(reduction: Any) -> tuple[float, float]:
-    """Where a link's peak bending stress is read [m along it]: one thickness from each end
-    face (Saint-Venant), but never narrower than one element about the midpoint, so a plate
-    as thick as half its length (the stubbiest accepted) still has mesh nodes in it."""
-    length, half = reduction.length_m, 0.5 * reduction.length_m - reduction.thickness_m
-    half = max(half, 0.5 * min(reduction.mesh_size_m, length))
-    return (0.5 * length - half, 0.5 * length + half)
-
-
-# ------------------------------------------------------------------------------------------
 # rigid: a rigid body of the link's mass properties
 # ------------------------------------------------------------------------------------------
 def _add_rigid(builder: Any, link: str, prepared: Any) -> dict[str, Any]:
@@ -313,48 +257,6 @@ def _rigid_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Datas
                                                "elastic midpoint deflection (rigid: 0)"),
         "coupler/angle": Dataset(sensor_data(mech, "coupler.Rotation")[:, 3], "rad",
                                  "coupler angle from +x (B to C)")}
-
-
-# ------------------------------------------------------------------------------------------
-# flexible links: the coupler's datasets from its markers
-# ------------------------------------------------------------------------------------------
-def _flexible_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
-    """A flexible coupler's chord angle and elastic response from its B, C and midpoint
-    markers (a flexible crank's are read with its motion, :mod:`flex.dynamics.collect`)."""
-    if link != "coupler":
-        return {}
-    position_b = sensor_data(mech, "marker_coupler_B.Position")[:, 1:4]
-    position_c = sensor_data(mech, "marker_coupler_C.Position")[:, 1:4]
-    chord = position_c - position_b
-    out = {"coupler/angle": Dataset(np.unwrap(np.arctan2(chord[:, 1], chord[:, 0])), "rad",
-                                    "angle of the chord B-C from +x")}
-    out.update(elastic_datasets(mech, "coupler", "marker_coupler_B", "marker_coupler_C",
-                                 "B-C", time_s))
-    return out
-
-
-def _flexible_sensors(builder: Any, link: str, handles: dict[str, Any]) -> None:
-    """A flexible link's midpoint marker (position, velocity; a flexible crank's joint-marker
-    velocities too, its chord's turning rate) and, for a modal (FFRF) link, its modal
-    coordinates, floating frame pose (:mod:`flex.tools.export`) and energies (Exudyn's FFRF
-    body reports its kinetic and strain energy)."""
-    if link == "crank":
-        for name in ("crank_A", "crank_B"):
-            builder.add(f"marker_{name}.Velocity", builder.sensor(
-                "Marker", "Velocity", markerNumber=builder.markers[name]))
-    for output in ("Position", "Velocity"):
-        builder.add(f"marker_{link}_mid.{output}",
-                    builder.sensor("Marker", output, markerNumber=handles["marker_mid"]))
-    if not builder.models[link].modal:  # nonlinear FE: nodal coordinates only
-        return
-    builder.add(f"{link}.modal_coordinates",
-                builder.sensor("Node", "Coordinates", nodeNumber=handles["node_modal"]))
-    for output in ("Position", "Rotation"):
-        builder.add(f"{link}.frame_{output}",
-                    builder.sensor("Node", output, nodeNumber=handles["node_frame"]))
-    sensors = [builder.mbs.AddSensor(builder.sensor("Body", kind, bodyNumber=handles["object"]))
-               for kind in ("KineticEnergy", "PotentialEnergy")]
-    builder.mech.flexible_energy[link] = (sensors[0], sensors[1])
 
 
 # ------------------------------------------------------------------------------------------
@@ -498,7 +400,7 @@ def _add_nonlinear_fe(builder: Any, link: str, plate: Any) -> dict[str, Any]:
 
 
 def _nonlinear_fe_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
-    out = _flexible_datasets(mech, link, time_s)
+    out = flexible_datasets(mech, link, time_s)
     # the face markers' linearised rotation can tilt the faces out of plane (see
     # flex.bodies.nonlinear): record how far the midpoint leaves the plane
     position_mid = sensor_data(mech, f"marker_{link}_mid.Position")[:, 1:4]
@@ -550,108 +452,6 @@ def _exact_beam_rung(values: Mapping[str, Any]) -> Rung:
 
 
 # ------------------------------------------------------------------------------------------
-# exact beam: a planar geometrically exact (Simo-Reissner) beam of the plate
-# ------------------------------------------------------------------------------------------
-#: Newton tolerances (relative, absolute) of a run with an exact beam link: 1e-8 / 1e-10
-#: stalled on round-off at 32 elements and more ("relative error 1.39e-8 after 25
-#: iterations"), 1e-7 / 1e-6 converged (docs/exudyn-ngsolve notes, measured 2026-11-28)
-EXACT_BEAM_NEWTON_TOLERANCES = (1e-7, 1e-6)
-#: wall time per step [s] of an exact beam link: (per link, per element). CPU time of a
-#: whole run (build, sensors, collection) per step, 10 ms of the thesis deployment at
-#: h = 1e-5 s, sparse LU, modified Newton: 16 elements 0.22 ms, 32: 0.30, 64: 0.51, 128: 1.13
-#: (a dense LU: 0.25, 0.48, 1.21, 3.40 ms, the same deflections to all digits)
-STEP_COST_EXACT_BEAM_S = (1e-4, 8e-6)
-
-
-def _beam_elements(link: str, values: dict[str, Any]) -> int:
-    if values["elements"] == AUTO:
-        raise ValueError(f'{link}: resolve its "auto" elements first '
-                         "(flex.fidelity.auto.resolve, flex.config.settings.resolve_link_keys)")
-    return int(values["elements"])
-
-
-def _prepare_beam(scene: Scene, link: str, given: Any, cache_dir: Path | None) -> Any:
-    """The link's :class:`flex.bodies.exact_beam.ExactBeamSection` (``given``: one built)."""
-    from flex.bodies.exact_beam import exact_beam_section
-
-    if given is not None:
-        return given
-    c = scene[link]
-    _beam_elements(link, c)
-    return exact_beam_section(c["length_m"], c["thickness_m"], c["width_m"],
-                              c["youngs_modulus_Pa"], c["density_kg_per_m3"],
-                              c["poisson_ratio"])
-
-
-def _add_exact_beam(builder: Any, link: str, section: Any) -> dict[str, Any]:
-    """The beam from B to C (a coupler) or from A to B (a crank), moving as the rigid link
-    at t = 0; its handles (its end markers are the link's joint markers)."""
-    from flex.bodies.exact_beam import add_exact_beam_link
-
-    init, elements = builder.init, _beam_elements(link, builder.scene[link])
-    section = section if section is not None else _prepare_beam(builder.scene, link, None,
-                                                                None)
-    if link == "crank":
-        beam = add_exact_beam_link(builder.mbs, section, elements, (0.0, 0.0),
-                                   init.crank_angle_rad, (0.0, 0.0), init.crank_speed_rad_per_s)
-    else:
-        beam = add_exact_beam_link(
-            builder.mbs, section, elements, init.joint_B_m, init.coupler_angle_rad,
-            init.joint_B_velocity_m_per_s, init.coupler_speed_rad_per_s)
-    return dict(beam.handles(), section=section,
-                joint_markers=(beam.marker_start, beam.marker_end))
-
-
-def _link_handles(mech: Any, link: str) -> dict[str, Any]:
-    return mech.crank if link == "crank" else mech.coupler
-
-
-def _exact_beam_sensors(builder: Any, link: str, handles: dict[str, Any]) -> None:
-    """Each element's section forces (axial and shear force, bending moment) and energies
-    (kinetic, strain: summed by :mod:`flex.dynamics.collect`); a crank's joint-marker
-    velocities (its chord's turning rate) and every flexible link's midpoint marker."""
-    _flexible_sensors(builder, link, handles)
-    for index, element in enumerate(handles["elements"]):
-        for output in ("ForceLocal", "TorqueLocal"):
-            builder.add(f"{link}.element_{index}.{output}",
-                        builder.sensor("Body", output, bodyNumber=element))
-    builder.mech.flexible_energy[link] = tuple(
-        [builder.mbs.AddSensor(builder.sensor("Body", kind, bodyNumber=element))
-         for element in handles["elements"]] for kind in ("KineticEnergy", "PotentialEnergy"))
-
-
-def _exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
-    """The flexible coupler's datasets (chord angle, midpoint; a crank's are read with its
-    motion) and the beam's own section forces and stresses
-    (:func:`flex.bodies.exact_beam.section_datasets`)."""
-    from flex.bodies.exact_beam import section_datasets
-
-    out = _flexible_datasets(mech, link, time_s)
-    handles = _link_handles(mech, link)
-    count = len(handles["elements"])
-    force = np.stack([sensor_data(mech, f"{link}.element_{i}.ForceLocal")[:, 1:3]
-                      for i in range(count)], axis=1)  # sample, element, (N, Q)
-    moment = np.stack([sensor_data(mech, f"{link}.element_{i}.TorqueLocal")[:, 3]
-                       for i in range(count)], axis=1)
-    out.update(section_datasets(link, handles["section"], force, moment))
-    return out
-
-
-def _exact_beam_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
-    elements = values["elements"] if values["elements"] != AUTO else EXACT_BEAM_ELEMENTS
-    return STEP_COST_EXACT_BEAM_S[0] + STEP_COST_EXACT_BEAM_S[1] * float(elements)
-
-
-def _exact_beam_solver(settings: dict[str, Any]) -> None:
-    settings["linear_solver"] = "EigenSparse"
-    relative, absolute = EXACT_BEAM_NEWTON_TOLERANCES
-    settings["newton_relative_tolerance"] = max(settings["newton_relative_tolerance"],
-                                                relative)
-    settings["newton_absolute_tolerance"] = max(settings["newton_absolute_tolerance"],
-                                                absolute)
-
-
-# ------------------------------------------------------------------------------------------
 # the registry
 # ------------------------------------------------------------------------------------------
 #: the built-in link models, by name (immutable; pass another mapping to add models)
@@ -662,20 +462,20 @@ BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
     FFRF: LinkModel.extending(
         BUILTIN_LINK_SCHEMAS[FFRF], label="FFRF (flex's default: geometric stiffness)",
         linear_elastic=True, auto_choice=True, prepare=_prepare_reduction, add=_add_ffrf,
-        sensors=_flexible_sensors, datasets=_flexible_datasets, time_scale=_ffrf_time_scale,
+        sensors=flexible_sensors, datasets=flexible_datasets, time_scale=_ffrf_time_scale,
         step_cost_s=_ffrf_step_cost_s, rung=ffrf_rung, stored_motion="modal"),
     NONLINEAR_FE: LinkModel.extending(
         BUILTIN_LINK_SCHEMAS[NONLINEAR_FE], label="nonlinear FE (reference)", reference=True,
-        auto_choice=True, add=_add_nonlinear_fe, sensors=_flexible_sensors,
+        auto_choice=True, add=_add_nonlinear_fe, sensors=flexible_sensors,
         datasets=_nonlinear_fe_datasets,
         energy=False, recorder=_nodal_recorder, time_scale=_nonlinear_fe_time_scale,
         step_cost_s=_nonlinear_fe_step_cost_s, adjust_solver=_nonlinear_fe_solver,
         own_progress=True, rung=_nonlinear_fe_rung, stored_motion="nodal"),
     EXACT_BEAM: LinkModel.extending(
         BUILTIN_LINK_SCHEMAS[EXACT_BEAM], label="geometrically exact beam", auto_choice=True,
-        prepare=_prepare_beam, add=_add_exact_beam, sensors=_exact_beam_sensors,
-        datasets=_exact_beam_datasets, time_scale=_nonlinear_fe_time_scale,
-        step_cost_s=_exact_beam_step_cost_s, adjust_solver=_exact_beam_solver,
+        prepare=prepare_beam, add=add_exact_beam, sensors=exact_beam_sensors,
+        datasets=exact_beam_datasets, time_scale=_nonlinear_fe_time_scale,
+        step_cost_s=exact_beam_step_cost_s, adjust_solver=exact_beam_solver,
         rung=_exact_beam_rung, stored_motion="none"),
 })
 
