@@ -454,30 +454,34 @@ def _exact_beam_rung(values: Mapping[str, Any]) -> Rung:
 # ------------------------------------------------------------------------------------------
 # the registry
 # ------------------------------------------------------------------------------------------
-#: the built-in link models, by name (immutable; pass another mapping to add models)
-BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
-    RIGID: LinkModel.extending(
-        BUILTIN_LINK_SCHEMAS[RIGID], label="rigid twin", auto_choice=True, add=_add_rigid,
-        sensors=_rigid_sensors, datasets=_rigid_datasets, rung=_rigid_rung),
-    FFRF: LinkModel.extending(
-        BUILTIN_LINK_SCHEMAS[FFRF], label="FFRF (flex's default: geometric stiffness)",
-        linear_elastic=True, auto_choice=True, prepare=_prepare_reduction, add=_add_ffrf,
-        sensors=flexible_sensors, datasets=flexible_datasets, time_scale=_ffrf_time_scale,
-        step_cost_s=_ffrf_step_cost_s, rung=ffrf_rung, stored_motion="modal"),
-    NONLINEAR_FE: LinkModel.extending(
-        BUILTIN_LINK_SCHEMAS[NONLINEAR_FE], label="nonlinear FE (reference)", reference=True,
-        auto_choice=True, add=_add_nonlinear_fe, sensors=flexible_sensors,
-        datasets=_nonlinear_fe_datasets,
-        energy=False, recorder=_nodal_recorder, time_scale=_nonlinear_fe_time_scale,
-        step_cost_s=_nonlinear_fe_step_cost_s, adjust_solver=_nonlinear_fe_solver,
-        own_progress=True, rung=_nonlinear_fe_rung, stored_motion="nodal"),
-    EXACT_BEAM: LinkModel.extending(
-        BUILTIN_LINK_SCHEMAS[EXACT_BEAM], label="geometrically exact beam", auto_choice=True,
-        prepare=prepare_beam, add=add_exact_beam, sensors=exact_beam_sensors,
-        datasets=exact_beam_datasets, time_scale=_nonlinear_fe_time_scale,
-        step_cost_s=exact_beam_step_cost_s, adjust_solver=exact_beam_solver,
-        rung=_exact_beam_rung, stored_motion="none"),
+#: what each built-in model does in a run (points 4-10), by name: one entry per schema of
+#: :data:`flex.data.scene.BUILTIN_LINK_SCHEMAS` (the scene-level part, points 1-3)
+_BEHAVIOUR: Mapping[str, dict[str, Any]] = MappingProxyType({
+    RIGID: dict(label="rigid twin", auto_choice=True, add=_add_rigid, sensors=_rigid_sensors,
+                datasets=_rigid_datasets, rung=_rigid_rung),
+    FFRF: dict(label="FFRF (flex's default: geometric stiffness)", linear_elastic=True,
+               auto_choice=True, prepare=_prepare_reduction, add=_add_ffrf,
+               sensors=flexible_sensors, datasets=flexible_datasets,
+               time_scale=_ffrf_time_scale, step_cost_s=_ffrf_step_cost_s, rung=ffrf_rung,
+               stored_motion="modal"),
+    NONLINEAR_FE: dict(label="nonlinear FE (reference)", reference=True, auto_choice=True,
+                       add=_add_nonlinear_fe, sensors=flexible_sensors,
+                       datasets=_nonlinear_fe_datasets, energy=False, recorder=_nodal_recorder,
+                       time_scale=_nonlinear_fe_time_scale,
+                       step_cost_s=_nonlinear_fe_step_cost_s,
+                       adjust_solver=_nonlinear_fe_solver, own_progress=True,
+                       rung=_nonlinear_fe_rung, stored_motion="nodal"),
+    EXACT_BEAM: dict(label="geometrically exact beam", auto_choice=True, prepare=prepare_beam,
+                     add=add_exact_beam, sensors=exact_beam_sensors,
+                     datasets=exact_beam_datasets, time_scale=_nonlinear_fe_time_scale,
+                     step_cost_s=exact_beam_step_cost_s, adjust_solver=exact_beam_solver,
+                     rung=_exact_beam_rung, stored_motion="none"),
 })
+#: the built-in link models, by name (immutable; pass another mapping to add models): one
+#: registry, generated from the schemas (a schema without its behaviour fails here, at import)
+BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
+    name: LinkModel.extending(schema, **_BEHAVIOUR[name])
+    for name, schema in BUILTIN_LINK_SCHEMAS.items()})
 
 __all__ = ["LinkModel", "BUILTIN_LINK_MODELS", "STORED_MOTIONS", "RIGID", "FFRF",
            "NONLINEAR_FE", "EXACT_BEAM", "entry_of", "entries", "reduction_for_scene"]
