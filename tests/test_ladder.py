@@ -31,6 +31,7 @@ from flex.config.settings import pinned_overrides
 from flex.data.results import write_results
 from flex.data.scene import load_scene
 from flex.dynamics.ladder import (
+    EXACT_BEAM_RUNG,
     FFRF_RUNG,
     LINEAR_FFRF_RUNG,
     NONLINEAR_FE_RUNG,
@@ -49,7 +50,7 @@ PLATE = [*pinned_overrides(), 'coupler.geometry="plate"', "coupler.thickness_m=0
          "simulation.output_step_s=1e-4"]
 TOY = "toy_beam"
 TOY_BOUND = 0.0005
-TOY_RUNG = Rung(5, "toy beam", bound=lambda load_ratio: TOY_BOUND, own_fraction=0.002,
+TOY_RUNG = Rung(3, "toy beam", bound=lambda values, load_ratio: TOY_BOUND, own_fraction=0.002,
                 motion_fraction=0.05, measured_by="toy beam against the rung above: 0.002 "
                 "of its own quantities, 0.05 of the motion's elastic part",
                 leaves_out="the toy beam's idealization of the {links}")
@@ -117,8 +118,10 @@ def test_a_model_on_no_rung_says_its_model_error_is_left_out():
     assert any("stands on no rung of the ladder" in line for line in leaves_out)
 
 
-def test_auto_climbs_onto_the_toy_rung_where_the_builtins_take_the_nonlinear_fe_coupler():
-    """At 0.1 % the FFRF body's bound (0.5 %) fails and the toy's (0.05 %) meets it."""
+def test_auto_climbs_onto_the_toy_rung_below_the_builtins_choice():
+    """At 0.1 % the FFRF body's bound (0.5 %) fails; the toy's (0.05 %, level 3) meets it
+    before the exact beam's (level 5: 0.05 t / L, 0.0625 % at 1 mm), which the built-ins
+    take."""
     from flex.fidelity.auto import resolve
 
     overrides = ['coupler.geometry="plate"', "coupler.thickness_m=0.001",
@@ -126,7 +129,7 @@ def test_auto_climbs_onto_the_toy_rung_where_the_builtins_take_the_nonlinear_fe_
     builtin = resolve(load_scene(overrides=overrides), quiet=True)
     toy = resolve(load_scene(overrides=overrides, link_models=REGISTRY), quiet=True,
                   link_models=REGISTRY)
-    assert builtin.scene["coupler"]["model"] == "nonlinear_fe"
+    assert builtin.scene["coupler"]["model"] == "exact_beam"
     assert toy.scene["coupler"]["model"] == TOY
     reason = next(d.reason for d in toy.decisions if d.link == "coupler")
     assert f"toy beam model error {TOY_BOUND:g} of the deflection" in reason
@@ -134,9 +137,10 @@ def test_auto_climbs_onto_the_toy_rung_where_the_builtins_take_the_nonlinear_fe_
 
 def test_the_refinement_climbs_to_the_next_rung_up():
     values = load_scene(overrides=PLATE)["coupler"] | {"model": "ffrf"}
-    assert next_rung("coupler", values, BUILTIN_LINK_MODELS) == "nonlinear_fe"
+    assert next_rung("coupler", values, BUILTIN_LINK_MODELS) == "exact_beam"
     assert next_rung("coupler", values, REGISTRY) == TOY
-    assert next_rung("coupler", values | {"model": TOY}, REGISTRY) == "nonlinear_fe"
+    assert next_rung("coupler", values | {"model": TOY}, REGISTRY) == "exact_beam"
+    assert next_rung("coupler", values | {"model": "exact_beam"}, REGISTRY) == "nonlinear_fe"
     assert next_rung("coupler", values | {"model": "nonlinear_fe"}, REGISTRY) is None
     # a rigid link has no model term to refine: the refinement does not climb from it
     assert next_rung("crank", load_scene()["crank"] | {"model": "rigid"}, REGISTRY) is None
@@ -181,20 +185,27 @@ def test_the_toy_headline_is_in_the_budget_inspect_and_the_report(runs, toy_file
     (RIGID_RUNG, "rigid", {}),
     (LINEAR_FFRF_RUNG, "ffrf", {"geometric_stiffness": False}),
     (FFRF_RUNG, "ffrf", {"geometric_stiffness": True}),
+    (EXACT_BEAM_RUNG, "exact_beam", {}),
     (NONLINEAR_FE_RUNG, "nonlinear_fe", {}),
 ])
 def test_each_builtin_model_stands_on_its_rung(rung, model, values):
     assert BUILTIN_LINK_MODELS[model].rung(values) is rung
-    assert rung.bounded == (model == "ffrf")  # the measured bounds: the FFRF bodies'
+    # the measured bounds: the FFRF bodies' and the exact beam's
+    assert rung.bounded == (model in ("ffrf", "exact_beam"))
 
 
 def test_the_ladder_orders_the_builtin_rungs_and_climbs_by_their_bounds():
     levels = [RIGID_RUNG.level, LINEAR_FFRF_RUNG.level, FFRF_RUNG.level,
-              NONLINEAR_FE_RUNG.level]
+              EXACT_BEAM_RUNG.level, NONLINEAR_FE_RUNG.level]
     assert levels == sorted(levels)
-    values = {"geometric_stiffness": True, "model": "ffrf"}
+    plate = {"length_m": 0.08, "model": "ffrf"}
+    thin, thick = plate | {"thickness_m": 0.001}, plate | {"thickness_m": 0.003}
+    values = {"geometric_stiffness": True, **thin}
     assert climb("coupler", values, 0.1, 0.01, BUILTIN_LINK_MODELS).model == "ffrf"
-    assert climb("coupler", values, 0.1, 0.001, BUILTIN_LINK_MODELS).model == "nonlinear_fe"
-    linear = {"geometric_stiffness": False, "model": "ffrf"}  # 0.005 + 1.0 x load ratio
+    # 0.1 %: the exact beam's bound 0.05 t / L is 0.0625 % at 1 mm, 0.19 % at 3 mm
+    assert climb("coupler", values, 0.1, 0.001, BUILTIN_LINK_MODELS).model == "exact_beam"
+    assert climb("coupler", values | thick, 0.1, 0.001,
+                 BUILTIN_LINK_MODELS).model == "nonlinear_fe"
+    linear = {"geometric_stiffness": False, **thin}  # 0.005 + 1.0 x load ratio
     assert climb("coupler", linear, 0.004, 0.01, BUILTIN_LINK_MODELS).model == "ffrf"
-    assert climb("coupler", linear, 0.006, 0.01, BUILTIN_LINK_MODELS).model == "nonlinear_fe"
+    assert climb("coupler", linear, 0.006, 0.01, BUILTIN_LINK_MODELS).model == "exact_beam"

@@ -71,13 +71,14 @@ def test_a_toy_model_runs_through_the_public_api_as_the_rigid_model_it_copies(re
 
 def test_an_unknown_model_is_refused_naming_the_accepted_ones():
     with pytest.raises(SceneError, match='coupler.model = \'stiff\': must be one of "rigid", '
-                                         '"ffrf", "nonlinear_fe", "auto"'):
+                                         '"ffrf", "nonlinear_fe", "exact_beam", '
+                                         '"auto"'):
         flex.load_scene(overrides={"coupler.model": TOY})
     scene = flex.load_scene(overrides={"coupler.model": TOY}, link_models=REGISTRY)
     with pytest.raises(SceneError, match="must be one of"):
         flex.simulate(scene)  # the built-in registry: the toy is unknown there
     with pytest.raises(SceneError, match='crank.model = \'stiff\': must be one of "rigid", '
-                                         '"ffrf", "auto"'):
+                                         '"ffrf", "exact_beam", "auto"'):
         flex.load_scene(overrides={"crank.model": TOY}, link_models=REGISTRY)
 
 

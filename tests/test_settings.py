@@ -217,9 +217,9 @@ def test_one_simulate_resolves_each_scene_once(monkeypatch, reduction_cache):
         seen["solver"].append(to_toml(scene))
         return real_solver(scene, calibration, **kwargs)
 
-    def counting_links(scene, calibration=None):
+    def counting_links(scene, calibration=None, **kwargs):
         seen["links"].append(to_toml(scene))
-        return real_links(scene, calibration)
+        return real_links(scene, calibration, **kwargs)
 
     monkeypatch.setattr("flex.fidelity.simulation.resolve", counting_resolve)
     monkeypatch.setattr("flex.fidelity.auto.resolve_solver_settings", counting_solver)

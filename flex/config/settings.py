@@ -43,6 +43,7 @@ from flex.config.calibration import Calibration, calibration_of
 from flex.config.ffrf_rule import LINK_KEYS, RulePick, fill_link_keys, pick, rule_constants
 from flex.data.scene import (
     BUILTIN_LINK_SCHEMAS,
+    EXACT_BEAM_ELEMENTS,
     LINKS,
     Scene,
     check_drive_steps,
@@ -97,21 +98,43 @@ def has_auto(scene: Scene) -> bool:
     return any(scene["simulation"].get(key) == AUTO for key in AUTO_KEYS)
 
 
-def has_auto_link_keys(scene: Scene) -> bool:
-    """Whether a link's ``modes`` or ``mesh_size_m`` is ``"auto"`` (flex.config.ffrf_rule)."""
+def has_auto_link_keys(scene: Scene, *,
+                       link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> bool:
+    """Whether a link's ``modes`` or ``mesh_size_m`` is ``"auto"`` (flex.config.ffrf_rule),
+    or the ``elements`` of a beam link (:data:`EXACT_BEAM_ELEMENTS`)."""
     return any(scene[link].get(key) == AUTO for link in LINKS
-               for key in LINK_KEYS)
+               for key in LINK_KEYS) or any(_auto_elements(scene, link, link_models)
+                                            for link in LINKS)
 
 
-def resolve_link_keys(scene: Scene, calibration: Calibration | None = None
+def _is_beam(scene: Scene, link: str, link_models: Mapping[str, Any]) -> bool:
+    """Whether ``link``'s concrete model is a beam of elements (its entry's ``beam`` flag)."""
+    model = scene[link]["model"]
+    return (model in link_models and link in link_models[model].links
+            and getattr(link_models[model], "beam", False))
+
+
+def _auto_elements(scene: Scene, link: str, link_models: Mapping[str, Any]) -> bool:
+    """Whether ``link`` is a beam whose ``elements`` is auto."""
+    return scene[link].get("elements") == AUTO and _is_beam(scene, link, link_models)
+
+
+def resolve_link_keys(scene: Scene, calibration: Calibration | None = None, *,
+                      link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
                       ) -> tuple[Scene, dict[str, Any]]:
     """``scene`` (a copy) with the links' ``"auto"`` modes and mesh size filled by the rule
     (:func:`flex.config.ffrf_rule.fill_link_keys` at ``fidelity.tolerance``, ``calibration``'s
-    rule; None: the bundled one), and what was filled (``"coupler.modes"`` -> value)."""
+    rule; None: the bundled one; a beam link's, which it does not read, are left) and a beam
+    link's ``"auto"`` elements (:data:`EXACT_BEAM_ELEMENTS`), and what was filled
+    (``"coupler.modes"`` -> value)."""
     resolved = copy.deepcopy(scene)
     filled: dict[str, Any] = {}
     tolerance = float(scene["fidelity"]["tolerance"])
     for link in LINKS:
+        if _is_beam(scene, link, link_models):
+            if _auto_elements(resolved, link, link_models):
+                resolved[link]["elements"] = filled[f"{link}.elements"] = EXACT_BEAM_ELEMENTS
+            continue
         for key, value in fill_link_keys(resolved, link, tolerance, calibration).items():
             filled[f"{link}.{key}"] = value
     return resolved, filled
@@ -198,9 +221,9 @@ def resolve_solver_settings(scene: Scene, calibration: Calibration | None = None
     """``scene`` with its ``"auto"`` solver and link keys filled in (see module doc), from
     ``calibration``'s solver defaults and rule (None: the bundled calibration);
     ``link_models``: the registry of its link models."""
-    if not (has_auto(scene) or has_auto_link_keys(scene)):
+    if not (has_auto(scene) or has_auto_link_keys(scene, link_models=link_models)):
         return scene, None
-    resolved, filled = resolve_link_keys(scene, calibration)
+    resolved, filled = resolve_link_keys(scene, calibration, link_models=link_models)
     name, reason, chosen = choose_entry(resolved, calibration, link_models=link_models)
     entry = solver_defaults(calibration)[name]
     values = dict(entry)
@@ -281,7 +304,8 @@ def check_concrete(scene: Scene, choice: SolverChoice | None = None, *,
         values = scene[link]
         if values["model"] == AUTO or (meshes(link, values, link_models)  # a lumped or
                                        and AUTO in (values.get(key)  # rigid link keeps its
-                                                    for key in LINK_KEYS)):  # unused "auto"s
+                                                    for key in LINK_KEYS)  # unused "auto"s
+                                       ) or _auto_elements(scene, link, link_models):
             raise ValueError(f"{link}: resolve its \"auto\" values first "
                              f"(flex.fidelity.auto.resolve)")
         check_meshed_plate(link, values, link_models)

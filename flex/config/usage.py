@@ -147,6 +147,15 @@ def _link_unused(link: str, scene: Scene, link_models: Mapping[str, Any]) -> dic
             mark(("thickness_m",), f'{link}.model = "auto" with geometry = "lumped" analyses '
                                    f"the plate of the {link}'s mass_kg (its thickness follows "
                                    f'from it); used with geometry = "plate"')
+    if entry is None or not getattr(entry, "beam", False):
+        beams = model_names(link, link_models, beam=True)
+        mark(("elements",), f'{link}.model = "{model}" is no beam of elements; '
+                            + (f"used with model = {quoted(beams)}" if beams
+                               else f"no {link} model reads it"))
+    elif not entry.meshed:
+        mark(("mesh_size_m",), f'{link}.model = "{model}" meshes no plate (its beam has '
+                               f"{link}.elements); used with model = "
+                               f"{used_with(meshed=True)}")
     if entry is not None and not entry.modal:
         mark(("geometric_stiffness",),
              f'{link}.model = "{model}": only an FFRF body takes the geometric stiffness of '

@@ -12,8 +12,7 @@ The link models a scene may name (``crank.model``, ``coupler.model``) are an arg
 ``link_models``, of every function here that checks a scene: a mapping from a model's name to
 its entry, of which this layer reads only the scene-level part, :class:`LinkSchema` (links,
 flags, extra check). Its default, :data:`BUILTIN_LINK_SCHEMAS`, names the built-in models once;
-their full entries (how they build, sense, advise) are
-:data:`flex.dynamics.link_models.BUILTIN_LINK_MODELS`, whose keys a test ties to these.
+their full entries are :data:`flex.dynamics.link_models.BUILTIN_LINK_MODELS`, built from these.
 """
 
 from __future__ import annotations
@@ -33,11 +32,13 @@ import tomli_w
 from flex.base.errors import SceneError
 from flex.data.plates import (  # noqa: F401 - the names callers import from here
     ESTIMATE_MODES,
+    EXACT_BEAM_ELEMENTS,
     MESH_ASPECT_LIMIT,
     MESH_MEMORY_LIMIT_BYTES,
     PLATE_SLENDERNESS_LIMIT,
     PLATE_STUBBINESS_LIMIT,
     MeshEstimate,
+    check_beam_plate,
     check_damping_model,
     estimate_mesh,
     modes_cost_factor,
@@ -80,6 +81,8 @@ class LinkSchema:
     modal: bool = False
     #: (2) reads ``damping_ratio`` (False: it has no damping model, the key must be 0)
     damped: bool = True
+    #: (2) a beam of elements along the plate: reads its keys and ``elements`` (a plate)
+    beam: bool = False
     #: (3) its own checks on the scene's keys beyond the flags' (raise SceneError), or None
     check: Callable[[str, Scene], None] | None = None
 
@@ -89,6 +92,8 @@ BUILTIN_LINK_SCHEMAS: Mapping[str, LinkSchema] = MappingProxyType({
     "rigid": LinkSchema("rigid", LINKS, rigid=True),
     "ffrf": LinkSchema("ffrf", LINKS, meshed=True, modal=True),
     "nonlinear_fe": LinkSchema("nonlinear_fe", ("coupler",), meshed=True, damped=False),
+    "exact_beam": LinkSchema("exact_beam", LINKS, damped=False, beam=True,
+                             check=check_beam_plate),
 })
 
 
@@ -152,8 +157,7 @@ class Field:
 
     def accepted(self) -> str:
         """Human-readable accepted range, used in error messages."""
-        text = self._accepted()
-        return text + ' or "auto"' if self.auto else text
+        return self._accepted() + (' or "auto"' if self.auto else "")
 
     def _accepted(self) -> str:
         if isinstance(self.kind, tuple):
@@ -209,6 +213,9 @@ def _plate_fields(link: str) -> dict[str, Field]:
                                "the reduced body (the commercial codes' default; "
                                "flex.bodies.reduction.damping)",
                                default="stiffness_proportional"),
+        "elements": Field(int, "model = exact_beam: beam elements along the link (auto: "
+                          f"{EXACT_BEAM_ELEMENTS})", minimum=2, maximum=1024, auto=True,
+                          default=EXACT_BEAM_ELEMENTS),
         "geometric_stiffness": Field(bool, "model = ffrf: soften the bending modes under the "
                                      "link's own axial force (flex.bodies.geometric_stiffness; "
                                      "false: the linear FFRF body, for comparison)",
@@ -224,9 +231,8 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "initial_angle_deg": Field(float, "crank angle at t = 0, from the slide line",
                                    minimum=-360.0, maximum=360.0),
         "model": Field((*model_names("crank"), AUTO),
-                       "rigid body or floating-frame flexible body (plate geometry); auto: "
-                       "rigid or ffrf (and modes) from the fitted criterion and "
-                       "fidelity.tolerance"),
+                       "rigid body or floating-frame flexible body (plate geometry); auto: rigid "
+                       "or ffrf (and modes) from the fitted criterion and fidelity.tolerance"),
         **_plate_fields("crank"),
     },
     "coupler": {
@@ -234,9 +240,9 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "mass_kg": Field(doc="coupler mass (geometry = lumped)", **_POS),
         "inertia_kgm2": Field(doc="coupler inertia about its centre of mass (lumped)", **_POS),
         "model": Field((*model_names("coupler"), AUTO),
-                       "rigid body, floating-frame flexible body, or fully nonlinear FE body "
-                       "(accuracy reference, ~50x slower per step); auto: rigid or "
-                       "ffrf (and modes) from the fitted criterion and fidelity.tolerance"),
+                       "rigid body, floating-frame flexible body, fully nonlinear FE body "
+                       "(accuracy reference, ~50x slower per step) or geometrically exact beam; "
+                       "auto: rigid or ffrf (and modes) from the fitted criterion and tolerance"),
         **_plate_fields("coupler"),
     },
     "wing": {
@@ -275,8 +281,7 @@ SCHEMA: dict[str, dict[str, Field]] = {
     "simulation": {
         "end_time_s": Field(doc="simulated time span", **_POS),
         "step_s": Field(doc="fixed time step of the integrator (auto: by model, "
-                            "flex.config.settings)",
-                        auto=True, **_POS),
+                            "flex.config.settings)", auto=True, **_POS),
         "output_step_s": Field(float, "interval of the stored samples (>= step_s; 0: every "
                                "step)", minimum=0.0),
         "spectral_radius": Field(float, "generalized-alpha spectral radius at infinity",
@@ -290,11 +295,9 @@ SCHEMA: dict[str, dict[str, Field]] = {
                              "spectral_radius)"),
         "newton": Field(("full", "modified", "jacobian_per_step"),
                         "Newton iteration: Jacobian every iteration, reused while it converges "
-                        "(modified), or computed once per step and reused within it",
-                        auto=True),
+                        "(modified), or computed once per step and reused within it", auto=True),
         "error_estimate": Field(bool, "estimate the run's own step error on its headline "
-                                      "quantities with a companion run at twice (or half) the "
-                                      "step (false: no companion, for speed)"),
+                                      "quantities by a companion run at 2x (or 1/2) the step"),
         "newton_relative_tolerance": Field(float, "Newton residual reduction per step "
                                            "(absolute tolerance: 1e-2 of it)", positive=True,
                                            maximum=1e-3, auto=True),
@@ -394,8 +397,7 @@ def read_toml(path: Path, label: str) -> Scene:
     for section, table in parsed.items():
         if not isinstance(table, dict):
             raise SceneError(f"scene file '{label}': '{_name(section)}' must be a [section] "
-                             f"table; "
-                             f"accepted sections: {', '.join(SCHEMA)}")
+                             f"table; accepted sections: {', '.join(SCHEMA)}")
     return parsed
 
 
@@ -467,8 +469,7 @@ def validate(scene: Scene, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
         for key, value in table.items():
             if key not in SCHEMA[section]:
                 raise SceneError(f"unknown key {_name(section)}.{_name(key)}; accepted keys in "
-                                 f"[{section}]: "
-                                 f"{', '.join(SCHEMA[section])}")
+                                 f"[{section}]: {', '.join(SCHEMA[section])}")
             field = SCHEMA[section][key]
             if section in LINKS and key == "model":  # the models of the registry given
                 field = replace(field, kind=(*model_names(section, link_models), AUTO))
@@ -492,11 +493,8 @@ def _check_value(name: str, field: Field, value: Any) -> None:
             raise SceneError(f"{name} = {_show(value)}: must be true or false")
         return
     is_number = isinstance(value, int | float) and not isinstance(value, bool)
-    if field.kind is int and not (isinstance(value, int) and not isinstance(value, bool)):
-        raise SceneError(f"{name} = {_show(value)}: must be {field.accepted()}")
-    if not is_number or not _finite(value):
-        raise SceneError(f"{name} = {_show(value)}: must be {field.accepted()}")
-    if ((field.positive and not value > 0)
+    if (not is_number or (field.kind is int and not isinstance(value, int))
+            or not _finite(value) or (field.positive and not value > 0)
             or (field.minimum is not None and value < field.minimum)
             or (field.maximum is not None and value > field.maximum)
             or (field.below is not None and not value < field.below)):

@@ -75,8 +75,9 @@ class Mechanism:
     rigid_bodies: dict[str, tuple[float, np.ndarray]] = field(default_factory=dict)
     coupler: dict[str, Any] = field(default_factory=dict)
     crank: dict[str, Any] = field(default_factory=dict)
-    #: FFRF links whose energy Exudyn reports: name -> (kinetic sensor, strain sensor)
-    flexible_energy: dict[str, tuple[int, int]] = field(default_factory=dict)
+    #: flexible links whose energy Exudyn reports: name -> (kinetic sensor, strain sensor),
+    #: or lists of them to sum (a beam link's elements)
+    flexible_energy: dict[str, tuple[Any, Any]] = field(default_factory=dict)
     wing: dict[str, Any] = field(default_factory=dict)
     #: built by :mod:`flex.dynamics.planar` (2D bodies; joint loads read by its own rules)
     planar: bool = False
@@ -370,25 +371,49 @@ class Builder:
             self.mech.joint_frames = {"A": None, "B": None, "C": None, "P": None}
             return
         crank_ref = rotation_z(self.init.crank_angle_rad)
-        coupler_ref = rotation_z(self.init.coupler_angle_rad)
         # joint frames coincide with the global axes at t = 0; force outputs are in the frame
         # of marker 0, so marker 0 sits on a body that does not rotate (ground, slider) where
         # it can; the links' markers are turned by copies (_turned_marker)
         self.joints = {
-            "A": mbs.AddObject(eii.ObjectJointRevoluteZ(
+            "A": mbs.AddObject(eii.ObjectJointSpherical(
+                markerNumbers=[m["ground_A"], m["crank_A"]], constrainedAxes=[1, 1, 0]))
+            if self.planar("crank") else mbs.AddObject(eii.ObjectJointRevoluteZ(
                 markerNumbers=[m["ground_A"], _turned_marker(mbs, m["crank_A"], crank_ref.T)])),
-            "B": mbs.AddObject(eii.ObjectJointRevoluteZ(
-                markerNumbers=[_turned_marker(mbs, m["crank_B"], crank_ref.T),
-                               _turned_marker(mbs, m["coupler_B"], coupler_ref.T)])),
+            "B": self._joint_B(crank_ref),
             "C": mbs.AddObject(eii.ObjectJointSpherical(
                 markerNumbers=[m["slider_C"], m["coupler_C"]], constrainedAxes=[1, 1, 0])),
             "P": mbs.AddObject(eii.ObjectJointPrismaticX(
                 markerNumbers=[m["ground_C"], m["slider_C"]]))}
         # B's force is reported in the frame of the crank's marker at B (its joint face when
         # the crank is flexible), turned back by the initial crank angle: collect turns it
-        # with that marker's rotation since t = 0
-        self.mech.joint_frames = {"A": None, "B": "marker_crank_B", "C": None, "P": None}
+        # with that marker's rotation since t = 0 (a planar pin's in global axes)
+        self.mech.joint_frames = {"A": None, "B": None if self.planar_B else
+                                  "marker_crank_B", "C": None, "P": None}
         self._add_geometric_stiffness()
+
+    def planar(self, link: str) -> bool:
+        """Whether ``link``'s joint markers carry x and y only (a planar beam's nodes, its
+        handles' ``planar_pins``): its pins then hold x and y (a 3D coupler's z and tilts are
+        held by its revolute joint at B, a 3D crank's by the one at A)."""
+        handles = self.mech.coupler if link == "coupler" else self.mech.crank
+        return bool(handles.get("planar_pins", False))
+
+    @property
+    def planar_B(self) -> bool:
+        """Whether the pin at B holds x and y only: a planar coupler or crank (a planar crank
+        has a planar coupler: :func:`flex.data.plates.check_beam_plate`)."""
+        return self.planar("coupler") or self.planar("crank")
+
+    def _joint_B(self, crank_ref: np.ndarray) -> int:
+        """The revolute joint at B (a pin in x and y on a planar link)."""
+        mbs, eii, m = self.mbs, self.eii, self.markers
+        if self.planar_B:
+            return mbs.AddObject(eii.ObjectJointSpherical(
+                markerNumbers=[m["crank_B"], m["coupler_B"]], constrainedAxes=[1, 1, 0]))
+        coupler_ref = rotation_z(self.init.coupler_angle_rad)
+        return mbs.AddObject(eii.ObjectJointRevoluteZ(
+            markerNumbers=[_turned_marker(mbs, m["crank_B"], crank_ref.T),
+                           _turned_marker(mbs, m["coupler_B"], coupler_ref.T)]))
 
     def add_drive(self) -> None:
         """The preloaded spring on the slider, or the crank held at constant speed."""
@@ -485,9 +510,11 @@ class Builder:
         for name, joint in self.joints.items():
             # the spherical joint reports its force in global axes ("Force"), the others in
             # the frame of marker 0 ("ForceLocal")
-            output = "Force" if name == "C" or penalty else "ForceLocal"
+            global_axes = (name == "C" or (name == "B" and self.planar_B)
+                           or (name == "A" and self.planar("crank")))
+            output = "Force" if global_axes or penalty else "ForceLocal"
             self.add(f"joint_{name}.Force", self.sensor("Object", output, objectNumber=joint))
-        if not penalty:
+        if not (penalty or self.planar("crank")):  # a planar crank's marker has no frame
             self.add("marker_crank_B.Rotation",
                      self.sensor("Marker", "Rotation", markerNumber=self.markers["crank_B"]))
 

@@ -14,7 +14,7 @@ import numpy as np
 from flex.data.results import Dataset
 from flex.dynamics import planar
 from flex.dynamics.builder import Mechanism
-from flex.dynamics.link_models import (  # noqa: F401 - stress_window_m: re-exported
+from flex.dynamics.link_outputs import (  # noqa: F401 - stress_window_m: re-exported
     elastic_datasets,
     sensor_data,
     stress_window_m,
@@ -136,6 +136,13 @@ def _crank_datasets(mech: Mechanism) -> dict[str, Any]:
     return out
 
 
+def _summed(mech: Mechanism, sensors: int | list[int]) -> np.ndarray:
+    """The sum of the first stored column of one sensor or a list of them (a beam link's
+    energy: one sensor per element)."""
+    return sum(np.asarray(mech.mbs.GetSensorStoredData(sensor))[:, 1]
+               for sensor in np.atleast_1d(sensors))
+
+
 def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s: np.ndarray
                      ) -> dict[str, Dataset]:
     """Kinetic, strain, spring and total energy; none when a link's energy is unknown.
@@ -143,8 +150,8 @@ def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s:
     Rigid bodies from their sensed velocities; FFRF links from Exudyn's body outputs
     (kinetic energy of rigid and elastic motion, linear strain energy) and, with geometric
     stiffness, its energy (:meth:`flex.bodies.geometric_stiffness.GeometricStiffness.
-    energy_J`). The nonlinear FE coupler reports no energy, so its runs have no energy
-    datasets.
+    energy_J`); a beam link from its elements' outputs (summed). The nonlinear FE coupler
+    reports no energy, so its runs have no energy datasets.
     """
     scene = mech.scene
     if not all(model.energy for model in mech.models.values()):
@@ -156,9 +163,9 @@ def _energy_datasets(mech: Mechanism, slider_displacement_m: np.ndarray, time_s:
         omega = sensor_data(mech, f"{name}.AngularVelocity")[:, 1:4]
         kinetic += 0.5 * mass_kg * np.sum(velocity**2, axis=1)
         kinetic += 0.5 * np.einsum("ij,jk,ik->i", omega, inertia, omega)
-    for link, (kinetic_sensor, strain_sensor) in mech.flexible_energy.items():
-        kinetic += np.asarray(mech.mbs.GetSensorStoredData(kinetic_sensor))[:, 1]
-        strain += np.asarray(mech.mbs.GetSensorStoredData(strain_sensor))[:, 1]
+    for link, (kinetic_sensors, strain_sensors) in mech.flexible_energy.items():
+        kinetic += _summed(mech, kinetic_sensors)
+        strain += _summed(mech, strain_sensors)
         stiffness = (mech.crank if link == "crank" else mech.coupler).get("geometric_data")
         if stiffness is not None:  # the geometric stiffness's energy: not in Exudyn's body
             strain += stiffness.energy_J(sensor_data(mech, f"{link}.modal_coordinates")[:, 1:])

@@ -3,11 +3,11 @@ under a written contract.
 
 :data:`BUILTIN_LINK_MODELS` is an immutable mapping (``types.MappingProxyType``) from a model's
 name to its :class:`LinkModel`, in the order messages list them: ``"rigid"``, ``"ffrf"``,
-``"nonlinear_fe"``. Every function that checks, resolves, builds or runs a scene takes the
-registry as an argument, ``link_models``, with the built-ins as its default; a caller with
-another model builds its own registry (``MappingProxyType({**BUILTIN_LINK_MODELS, "toy":
-toy})``) and passes it along. Nothing here is mutable and nothing registers itself. The layers
-below (:mod:`flex.data`, :mod:`flex.config`) read only an entry's scene-level part,
+``"nonlinear_fe"``, ``"exact_beam"``. Every function that checks, resolves, builds or runs a
+scene takes the registry as an argument, ``link_models``, with the built-ins as its default; a
+caller with another model builds its own registry (``MappingProxyType({**BUILTIN_LINK_MODELS,
+"toy": toy})``) and passes it along. Nothing here is mutable and nothing registers itself. The
+layers below (:mod:`flex.data`, :mod:`flex.config`) read only an entry's scene-level part,
 :class:`flex.data.scene.LinkSchema` (its fields are :class:`LinkModel`'s first ones), with
 :data:`flex.data.scene.BUILTIN_LINK_SCHEMAS` as their default (a test ties the two).
 
@@ -19,7 +19,8 @@ The contract of an entry -- what a link model declares, point by point:
    (:func:`flex.data.scene.validate`, :func:`entry_of`).
 2. **scene keys it reads**, as flags on ``[<link>]``: ``rigid`` (mass keys only),
    ``meshed`` (the plate's elastic keys and ``mesh_size_m``), ``modal`` (``modes``,
-   ``mode_selection``, ``geometric_stiffness``), ``damped`` (``damping_ratio``). A key a
+   ``mode_selection``, ``geometric_stiffness``), ``damped`` (``damping_ratio``), ``beam``
+   (the plate's keys and ``elements``, a beam of elements along the link). A key a
    model does not read and the user set is refused (:func:`flex.config.usage.unused_keys`).
 3. **checks on those keys** (SceneError, before anything runs): the flags' (a meshed model
    needs ``geometry = "plate"`` and a plate that can be meshed, an undamped one
@@ -33,9 +34,10 @@ The contract of an entry -- what a link model declares, point by point:
    a dict with ``joint_markers`` (the markers at the link's two joints: A and B for the
    crank, B and C for the coupler) and whatever its own sensors and datasets read (a rigid
    link's ``body`` and ``node``; an FFRF link's ``reduction``, ``node_modal``,
-   ``node_frame``, ``object``, ``marker_mid``); the builder keeps them as ``mech.crank`` and
-   ``mech.coupler``. A rigid crank is added before the slider (the order numbers the
-   coordinates), any other after the ground markers.
+   ``node_frame``, ``object``, ``marker_mid``; ``planar_pins``: true when its joint markers
+   carry x and y only, as a planar beam's nodes: the builder then pins them in x and y); the
+   builder keeps them as ``mech.crank`` and ``mech.coupler``. A rigid crank is added before
+   the slider (the order numbers the coordinates), any other after the ground markers.
 6. **its sensors and datasets**: ``sensors(builder, link, handles)`` adds what its
    ``datasets(mech,
    link, time_s)`` reads after the run (the coupler's ``coupler/...`` datasets; a crank's
@@ -94,15 +96,31 @@ from flex.data.scene import (
     link_model,
     plate_mass_properties,
 )
+from flex.dynamics.exact_beam_link import (
+    add_exact_beam,
+    exact_beam_datasets,
+    exact_beam_sensors,
+    exact_beam_solver,
+    exact_beam_step_cost_s,
+    prepare_beam,
+)
 from flex.dynamics.ladder import (
+    EXACT_BEAM_RUNG,
     NONLINEAR_FE_RUNG,
     RIGID_RUNG,
     Rung,
     ffrf_rung,
 )
+from flex.dynamics.link_outputs import (  # noqa: F401 - the names callers import from here
+    elastic_datasets,
+    flexible_datasets,
+    flexible_sensors,
+    sensor_data,
+    stress_window_m,
+)
 
 #: the built-in models' names (for code that sets a model in a scene)
-RIGID, FFRF, NONLINEAR_FE = BUILTIN_LINK_SCHEMAS
+RIGID, FFRF, NONLINEAR_FE, EXACT_BEAM = BUILTIN_LINK_SCHEMAS
 
 
 def _nothing(*args: Any) -> None:
@@ -129,8 +147,9 @@ def _no_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]
 #: angle and joint positions: a box moved with them), ``"modal"`` (``<link>/modal_coordinates``
 #: and the floating frame's pose ``<link>/frame_position``, ``frame_angle``, on the basis of
 #: the link's reduction, rebuilt from the case's scene), ``"nodal"`` (every node's position,
-#: ``<link>/nodal/position`` at ``<link>/nodal/time``, on the link's plate mesh)
-STORED_MOTIONS = ("rigid", "modal", "nodal")
+#: ``<link>/nodal/position`` at ``<link>/nodal/time``, on the link's plate mesh), ``"none"``
+#: (not read back: export and animate refuse it, naming the model)
+STORED_MOTIONS = ("rigid", "modal", "nodal", "none")
 
 
 @dataclass(frozen=True)
@@ -196,76 +215,6 @@ def entries(scene: Scene, link_models: Mapping[str, LinkModel]) -> dict[str, Lin
 
 
 # ------------------------------------------------------------------------------------------
-# what a flexible link's markers and modal coordinates give (FFRF and nonlinear FE)
-# ------------------------------------------------------------------------------------------
-def sensor_data(mech: Any, name: str) -> np.ndarray:
-    """The stored data of ``mech``'s sensor ``name`` (time in column 0, then its values)."""
-    return np.asarray(mech.mbs.GetSensorStoredData(mech.sensors[name]))
-
-
-def elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
-                      chord_name: str, time_s: np.ndarray) -> dict[str, Dataset]:
-    """Midpoint motion and elastic response of a flexible ``link`` (FFRF or nonlinear FE).
-
-    From its joint markers (``start_marker``, ``end_marker``: sensor names) and its midpoint
-    marker; an FFRF link adds its modal coordinates and bending stress.
-    """
-    from flex.bodies.reduction import bending_stress_history, midpoint_deflection
-    from flex.bodies.stress import peak_datasets
-
-    position_start = sensor_data(mech, f"{start_marker}.Position")[:, 1:4]
-    position_end = sensor_data(mech, f"{end_marker}.Position")[:, 1:4]
-    position_mid = sensor_data(mech, f"marker_{link}_mid.Position")[:, 1:4]
-    velocity_mid = sensor_data(mech, f"marker_{link}_mid.Velocity")[:, 1:3]
-    deflection = midpoint_deflection(position_start, position_end, position_mid)
-    out: dict[str, Dataset] = {}
-    out[f"{link}/midpoint_position"] = Dataset(position_mid[:, :2], "m",
-                                               f"{link} midpoint x, y")
-    # the superelement marker reports no acceleration: differentiate its velocity (2nd order)
-    out[f"{link}/midpoint_acceleration"] = Dataset(
-        np.gradient(velocity_mid, time_s, axis=0), "m/s^2",
-        f"{link} midpoint acceleration x, y (thesis figs. 35-42), from the marker velocity")
-    out[f"{link}/midpoint_deflection"] = Dataset(
-        deflection.transverse_m, "m",
-        f"transverse elastic deflection of the midpoint from the chord {chord_name}, 0 at t = 0")
-    out[f"{link}/chord_change"] = Dataset(deflection.chord_change_m, "m",
-                                          f"change of the distance {chord_name} (axial strain "
-                                          "x length)")
-    body = mech.crank if link == "crank" else mech.coupler
-    if not mech.models[link].modal:  # nonlinear FE: nodal coordinates, no modes, no stress
-        return out
-    modal = sensor_data(mech, f"{link}.modal_coordinates")[:, 1:]
-    out[f"{link}/modal_coordinates"] = Dataset(
-        modal, "1", "elastic coordinates: the static modes, then the fixed-interface eigenmodes")
-    reduction = body["reduction"]
-    if reduction.has_stress_modes:
-        out[f"{link}/peak_bending_stress"] = Dataset(
-            bending_stress_history(reduction, modal, stress_window_m(reduction)), "Pa",
-            "largest |sigma_xx| away from the end faces (bending + membrane)")
-        out.update(peak_datasets(link, reduction, modal))
-    out.update(_frame_datasets(mech, link))
-    return out
-
-
-def _frame_datasets(mech: Any, link: str) -> dict[str, Dataset]:
-    """The pose of an FFRF link's floating frame (what :mod:`flex.tools.export` places the
-    nodal field with): origin x, y [m] and angle about z [rad]."""
-    origin = sensor_data(mech, f"{link}.frame_Position")[:, 1:3]
-    angle = np.unwrap(sensor_data(mech, f"{link}.frame_Rotation")[:, 3])
-    return {f"{link}/frame_position": Dataset(origin, "m", "floating frame origin x, y"),
-            f"{link}/frame_angle": Dataset(angle, "rad", "floating frame angle from +x")}
-
-
-def stress_window_m(reduction: Any) -> tuple[float, float]:
-    """Where a link's peak bending stress is read [m along it]: one thickness from each end
-    face (Saint-Venant), but never narrower than one element about the midpoint, so a plate
-    as thick as half its length (the stubbiest accepted) still has mesh nodes in it."""
-    length, half = reduction.length_m, 0.5 * reduction.length_m - reduction.thickness_m
-    half = max(half, 0.5 * min(reduction.mesh_size_m, length))
-    return (0.5 * length - half, 0.5 * length + half)
-
-
-# ------------------------------------------------------------------------------------------
 # rigid: a rigid body of the link's mass properties
 # ------------------------------------------------------------------------------------------
 def _add_rigid(builder: Any, link: str, prepared: Any) -> dict[str, Any]:
@@ -308,48 +257,6 @@ def _rigid_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Datas
                                                "elastic midpoint deflection (rigid: 0)"),
         "coupler/angle": Dataset(sensor_data(mech, "coupler.Rotation")[:, 3], "rad",
                                  "coupler angle from +x (B to C)")}
-
-
-# ------------------------------------------------------------------------------------------
-# flexible links: the coupler's datasets from its markers
-# ------------------------------------------------------------------------------------------
-def _flexible_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
-    """A flexible coupler's chord angle and elastic response from its B, C and midpoint
-    markers (a flexible crank's are read with its motion, :mod:`flex.dynamics.collect`)."""
-    if link != "coupler":
-        return {}
-    position_b = sensor_data(mech, "marker_coupler_B.Position")[:, 1:4]
-    position_c = sensor_data(mech, "marker_coupler_C.Position")[:, 1:4]
-    chord = position_c - position_b
-    out = {"coupler/angle": Dataset(np.unwrap(np.arctan2(chord[:, 1], chord[:, 0])), "rad",
-                                    "angle of the chord B-C from +x")}
-    out.update(elastic_datasets(mech, "coupler", "marker_coupler_B", "marker_coupler_C",
-                                 "B-C", time_s))
-    return out
-
-
-def _flexible_sensors(builder: Any, link: str, handles: dict[str, Any]) -> None:
-    """A flexible link's midpoint marker (position, velocity; a flexible crank's joint-marker
-    velocities too, its chord's turning rate) and, for a modal (FFRF) link, its modal
-    coordinates, floating frame pose (:mod:`flex.tools.export`) and energies (Exudyn's FFRF
-    body reports its kinetic and strain energy)."""
-    if link == "crank":
-        for name in ("crank_A", "crank_B"):
-            builder.add(f"marker_{name}.Velocity", builder.sensor(
-                "Marker", "Velocity", markerNumber=builder.markers[name]))
-    for output in ("Position", "Velocity"):
-        builder.add(f"marker_{link}_mid.{output}",
-                    builder.sensor("Marker", output, markerNumber=handles["marker_mid"]))
-    if not builder.models[link].modal:  # nonlinear FE: nodal coordinates only
-        return
-    builder.add(f"{link}.modal_coordinates",
-                builder.sensor("Node", "Coordinates", nodeNumber=handles["node_modal"]))
-    for output in ("Position", "Rotation"):
-        builder.add(f"{link}.frame_{output}",
-                    builder.sensor("Node", output, nodeNumber=handles["node_frame"]))
-    sensors = [builder.mbs.AddSensor(builder.sensor("Body", kind, bodyNumber=handles["object"]))
-               for kind in ("KineticEnergy", "PotentialEnergy")]
-    builder.mech.flexible_energy[link] = (sensors[0], sensors[1])
 
 
 # ------------------------------------------------------------------------------------------
@@ -493,7 +400,7 @@ def _add_nonlinear_fe(builder: Any, link: str, plate: Any) -> dict[str, Any]:
 
 
 def _nonlinear_fe_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
-    out = _flexible_datasets(mech, link, time_s)
+    out = flexible_datasets(mech, link, time_s)
     # the face markers' linearised rotation can tilt the faces out of plane (see
     # flex.bodies.nonlinear): record how far the midpoint leaves the plane
     position_mid = sensor_data(mech, f"marker_{link}_mid.Position")[:, 1:4]
@@ -540,27 +447,41 @@ def _nonlinear_fe_rung(values: Mapping[str, Any]) -> Rung:
     return NONLINEAR_FE_RUNG
 
 
+def _exact_beam_rung(values: Mapping[str, Any]) -> Rung:
+    return EXACT_BEAM_RUNG
+
+
 # ------------------------------------------------------------------------------------------
 # the registry
 # ------------------------------------------------------------------------------------------
-#: the built-in link models, by name (immutable; pass another mapping to add models)
-BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
-    RIGID: LinkModel.extending(
-        BUILTIN_LINK_SCHEMAS[RIGID], label="rigid twin", auto_choice=True, add=_add_rigid,
-        sensors=_rigid_sensors, datasets=_rigid_datasets, rung=_rigid_rung),
-    FFRF: LinkModel.extending(
-        BUILTIN_LINK_SCHEMAS[FFRF], label="FFRF (flex's default: geometric stiffness)",
-        linear_elastic=True, auto_choice=True, prepare=_prepare_reduction, add=_add_ffrf,
-        sensors=_flexible_sensors, datasets=_flexible_datasets, time_scale=_ffrf_time_scale,
-        step_cost_s=_ffrf_step_cost_s, rung=ffrf_rung, stored_motion="modal"),
-    NONLINEAR_FE: LinkModel.extending(
-        BUILTIN_LINK_SCHEMAS[NONLINEAR_FE], label="nonlinear FE (reference)", reference=True,
-        auto_choice=True, add=_add_nonlinear_fe, sensors=_flexible_sensors,
-        datasets=_nonlinear_fe_datasets,
-        energy=False, recorder=_nodal_recorder, time_scale=_nonlinear_fe_time_scale,
-        step_cost_s=_nonlinear_fe_step_cost_s, adjust_solver=_nonlinear_fe_solver,
-        own_progress=True, rung=_nonlinear_fe_rung, stored_motion="nodal"),
+#: what each built-in model does in a run (points 4-10), by name: one entry per schema of
+#: :data:`flex.data.scene.BUILTIN_LINK_SCHEMAS` (the scene-level part, points 1-3)
+_BEHAVIOUR: Mapping[str, dict[str, Any]] = MappingProxyType({
+    RIGID: dict(label="rigid twin", auto_choice=True, add=_add_rigid, sensors=_rigid_sensors,
+                datasets=_rigid_datasets, rung=_rigid_rung),
+    FFRF: dict(label="FFRF (flex's default: geometric stiffness)", linear_elastic=True,
+               auto_choice=True, prepare=_prepare_reduction, add=_add_ffrf,
+               sensors=flexible_sensors, datasets=flexible_datasets,
+               time_scale=_ffrf_time_scale, step_cost_s=_ffrf_step_cost_s, rung=ffrf_rung,
+               stored_motion="modal"),
+    NONLINEAR_FE: dict(label="nonlinear FE (reference)", reference=True, auto_choice=True,
+                       add=_add_nonlinear_fe, sensors=flexible_sensors,
+                       datasets=_nonlinear_fe_datasets, energy=False, recorder=_nodal_recorder,
+                       time_scale=_nonlinear_fe_time_scale,
+                       step_cost_s=_nonlinear_fe_step_cost_s,
+                       adjust_solver=_nonlinear_fe_solver, own_progress=True,
+                       rung=_nonlinear_fe_rung, stored_motion="nodal"),
+    EXACT_BEAM: dict(label="geometrically exact beam", auto_choice=True, prepare=prepare_beam,
+                     add=add_exact_beam, sensors=exact_beam_sensors,
+                     datasets=exact_beam_datasets, time_scale=_nonlinear_fe_time_scale,
+                     step_cost_s=exact_beam_step_cost_s, adjust_solver=exact_beam_solver,
+                     rung=_exact_beam_rung, stored_motion="none"),
 })
+#: the built-in link models, by name (immutable; pass another mapping to add models): one
+#: registry, generated from the schemas (a schema without its behaviour fails here, at import)
+BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
+    name: LinkModel.extending(schema, **_BEHAVIOUR[name])
+    for name, schema in BUILTIN_LINK_SCHEMAS.items()})
 
 __all__ = ["LinkModel", "BUILTIN_LINK_MODELS", "STORED_MOTIONS", "RIGID", "FFRF",
-           "NONLINEAR_FE", "entry_of", "entries", "reduction_for_scene"]
+           "NONLINEAR_FE", "EXACT_BEAM", "entry_of", "entries", "reduction_for_scene"]

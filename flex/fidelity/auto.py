@@ -58,7 +58,6 @@ from flex.dynamics.ladder import climb
 from flex.dynamics.link_models import (
     BUILTIN_LINK_MODELS,
     FFRF,
-    NONLINEAR_FE,
     RIGID,
     LinkModel,
 )
@@ -152,7 +151,7 @@ def check(scene: Scene, calibration: Calibration | None = None, *,
                          "refinement follows the error budget; set error_estimate = true or "
                          "refine = false")
     # an "auto" link's plate too: what it may mesh
-    linked, _ = resolve_link_keys(scene, calibration)
+    linked, _ = resolve_link_keys(scene, calibration, link_models=link_models)
     for link in LINKS:
         check_meshed_plate(link, linked[link], link_models)
     options = candidates(scene, link_models)
@@ -370,8 +369,9 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
     :func:`_crank_by_loads`): ``"rigid"``, or ``"ffrf"`` with its modes for a plate crank; a
     lumped crank the criterion calls flexible, or a flexible one with a constant-speed drive, is
     refused with a :class:`SceneError`. A coupler loaded beyond :data:`EULER_LOAD_LIMIT` of its
-    Euler load is refused too (outside the fit). ``drive.spring_model = "auto"`` must be
-    resolved before (:func:`resolve` does it first, with
+    Euler load is not offered rigid (outside the fit): the ladder's rungs decide, each within
+    the compression its bound was measured at (:func:`flex.dynamics.ladder.climb`).
+    ``drive.spring_model = "auto"`` must be resolved before (:func:`resolve` does it first, with
     :func:`flex.fidelity.spring_choice.decide_spring`). Scenes without ``auto`` are returned
     unchanged (a copy). ``cache_dir``: the reduction cache folder of the crank's frequency
     analysis (None: its reduction is built in memory, no disk cache).
@@ -436,7 +436,8 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
                     calibration: Calibration | None = None,
                     link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
                     ) -> tuple[FidelityDecision, str]:
-    """The coupler's decision (refused near buckling); returns it and ``how`` with the
+    """The coupler's decision (near buckling, beyond :data:`EULER_LOAD_LIMIT` x its Euler
+    load, rigid is not offered and the ladder decides); returns it and ``how`` with the
     compressive load added."""
     coupler = resolved["coupler"]
     omega = pinned_pinned_omega(coupler["length_m"], coupler["thickness_m"],
@@ -445,19 +446,18 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
                              probe["joints/C/force_on_coupler"], probe["coupler/angle"],
                              coupler["length_m"], coupler["thickness_m"],
                              coupler["width_m"], coupler["youngs_modulus_Pa"])
-    if ratio > EULER_LOAD_LIMIT:
-        raise SceneError(
-            f'coupler.model = "auto": the coupler carries {ratio:.3g} x its Euler '
-            f"buckling load (pi^2 E I / L^2) during the deployment; the criterion is "
-            f"fitted up to {EULER_LOAD_LIMIT:g} x, and near buckling the error depends on "
-            f'that ratio, not on n (the linear "{FFRF}" model does not represent buckling '
-            f'either): use a thicker coupler, or coupler.model = "{NONLINEAR_FE}"')
     how += f"; compressive load {ratio:.3g} x Euler load"
     decision, k_phys = _decide("coupler", omega, delta_t_s, how, tolerance, criterion,
                                float(coupler["damping_ratio"]))
-    _decide_by_loads(decision, predict_deflection(probe, coupler).relative_error(
-        coupler["length_m"]), tolerance)
-    if not BUILTIN_LINK_MODELS[decision.model].rigid:
+    if ratio > EULER_LOAD_LIMIT:  # the fitted laws stop here: no rigid, the ladder decides
+        decision.model = FFRF
+        decision.reason += (f"; beyond {EULER_LOAD_LIMIT:g} x the Euler load the fitted laws "
+                            f"do not hold and the rigid model is not offered (near buckling "
+                            f"the error depends on the load, not on n)")
+    else:
+        _decide_by_loads(decision, predict_deflection(probe, coupler).relative_error(
+            coupler["length_m"]), tolerance)
+    if not link_models[decision.model].rigid:
         _climb(decision, coupler, ratio, tolerance, link_models)
     coupler["model"] = decision.model
     if link_models[decision.model].modal:

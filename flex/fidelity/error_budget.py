@@ -2,8 +2,8 @@
 flex can know, term by term, in the quantity's unit and relative to it.
 
 Contract of :func:`error_budget`: given a finished run of a concrete scene (links rigid,
-ffrf or nonlinear_fe; ``"auto"`` keys resolved) and a way to run companion scenes, it returns
-an :class:`ErrorBudget` with, for each headline quantity of the run
+ffrf, nonlinear_fe or exact_beam; ``"auto"`` keys resolved) and a way to run companion
+scenes, it returns an :class:`ErrorBudget` with, for each headline quantity of the run
 (:data:`flex.fidelity.headlines.BUILTIN_HEADLINES`: crank angle and slider position at the end
 time, deployment time, peak joint forces, each flexible link's peak midpoint deflection and
 peak bending stress), four named terms and their total [the quantity's units]:
@@ -15,7 +15,11 @@ peak bending stress), four named terms and their total [the quantity's units]:
   convergence is fast, so the difference is the run's truncation error);
 - ``mesh``: the mesh of the FFRF links: the difference to a companion on a mesh
   :data:`MESH_FACTOR` times coarser, taken whole (first order assumed: the peak stress from
-  the nodes converges about that slowly, the deflection faster, so the term leans safe);
+  the nodes converges about that slowly, the deflection faster, so the term leans safe); a
+  beam link's elements: the difference to a companion with :data:`MESH_FACTOR` times more,
+  extrapolated with the beam's order :data:`BEAM_ORDER` (measured on its frequency and its
+  first crest; a companion with fewer elements would put the racing peak of a coarse beam
+  in the term);
 - ``model``: the link model against the next rung of flex's ladder, read from the rung each
   link's model entry names (:mod:`flex.dynamics.ladder`; no model is named here): a link on
   a bounded rung (the FFRF bodies) gets its rung's ``own_fraction`` of what its elasticity
@@ -54,8 +58,12 @@ from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline, crest_gap
 
 #: the named terms of a budget, in the order they are printed
 TERMS = ("step", "modes", "mesh", "model")
-#: the mesh companion's element size over the run's
+#: the mesh companion's element size over the run's (a beam companion: its elements over the
+#: run's)
 MESH_FACTOR = 2.0
+#: order of convergence of a beam link under element refinement (tests/test_exact_beam.py:
+#: 2.0 on the pinned-pinned frequency, 1.98 on the first crest of the deployment)
+BEAM_ORDER = 2
 #: case attribute prefix of a headline quantity's value
 HEADLINE_PREFIX = "headline_"
 
@@ -207,16 +215,33 @@ def _mesh_term(scene: Scene, result: CaseResult, companions: _Companions,
                link_models: Mapping[str, LinkModel]) -> tuple[dict[str, float], str]:
     meshed = [link for link in _links(scene, link_models, meshed=True)
               if scene[link]["geometry"] == "plate"]
-    if not meshed:
+    beams = _links(scene, link_models, beam=True)
+    if not (meshed or beams):
         return {}, "no meshed link"
-    sizes = {link: min(MESH_FACTOR * float(scene[link]["mesh_size_m"]),
-                       float(scene[link]["length_m"])) for link in meshed}
-    coarser = companions.run("mesh", _companion(
-        scene, [f"{link}.mesh_size_m={size!r}" for link, size in sizes.items()]))
-    how = ", ".join(f"{link} {scene[link]['mesh_size_m']:g} -> {size:g} m"
-                    for link, size in sizes.items())
-    return companions.differences(result, coarser), (
-        f"difference to a companion on a {MESH_FACTOR:g}x coarser mesh ({how}), taken whole")
+    terms: dict[str, float] = {}
+    sentences = []
+    if meshed:
+        sizes = {link: min(MESH_FACTOR * float(scene[link]["mesh_size_m"]),
+                           float(scene[link]["length_m"])) for link in meshed}
+        coarser = companions.run("mesh", _companion(
+            scene, [f"{link}.mesh_size_m={size!r}" for link, size in sizes.items()]))
+        terms = companions.differences(result, coarser)
+        how = ", ".join(f"{link} {scene[link]['mesh_size_m']:g} -> {size:g} m"
+                        for link, size in sizes.items())
+        sentences.append(f"difference to a companion on a {MESH_FACTOR:g}x coarser mesh "
+                         f"({how}), taken whole")
+    if beams:
+        counts = {link: int(MESH_FACTOR * int(scene[link]["elements"])) for link in beams}
+        finer = companions.run("mesh", _companion(
+            scene, [f"{link}.elements={count}" for link, count in counts.items()]))
+        factor = MESH_FACTOR**BEAM_ORDER / (MESH_FACTOR**BEAM_ORDER - 1)  # Richardson
+        for name, value in companions.differences(result, finer).items():
+            terms[name] = terms.get(name, 0.0) + factor * value
+        how = ", ".join(f"{link} {scene[link]['elements']} -> {count}"
+                        for link, count in counts.items())
+        sentences.append(f"difference to a companion with more beam elements ({how}) x "
+                         f"{factor:.3g} (order {BEAM_ORDER})")
+    return terms, "; ".join(sentences)
 
 
 def _rungs(scene: Scene, link_models: Mapping[str, LinkModel]) -> dict[str, Rung | None]:
@@ -249,7 +274,8 @@ def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
         motion = max(rung.motion_fraction for rung in bounded.values())
         for name, value in companions.differences(result, twin).items():
             owner = companions.headlines[name].link
-            terms[name] = value * (bounded[owner].own_fraction if owner in bounded else motion)
+            terms[name] = value * (bounded[owner].own(scene[owner]) if owner in bounded
+                                   else motion)
         sentences += _grouped(bounded, "measured_by")
         steps_up = {link: rung for link, rung in bounded.items() if rung.companion}
         if steps_up:

@@ -26,7 +26,7 @@ from flex.base.errors import FlexError, SceneError
 from flex.config.calibration import Calibration
 from flex.config.settings import tolerance_beyond_reach
 from flex.data.results import CaseResult
-from flex.data.scene import LINKS, Scene, to_toml
+from flex.data.scene import LINKS, SCHEMA, Scene, to_toml
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.ladder import next_rung
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
@@ -35,6 +35,9 @@ from flex.fidelity.auto import Resolution, resolve
 from flex.fidelity.error_budget import error_budget
 from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 from flex.fidelity.laws import Criterion
+
+#: the most elements a beam link's refinement gives it (the scene key's maximum)
+MAX_ELEMENTS = SCHEMA["coupler"]["elements"].maximum
 
 
 def simulate(scene: Scene, name: str = "case", reduction: Any = None,
@@ -153,7 +156,7 @@ NOTHING_TO_REFINE = ("nothing to refine: no flexible link's deflection to certif
 
 #: the knobs refinement turns: scene keys (``<link>.`` ones for each link)
 KNOBS = ("simulation.step_s", "coupler.model", "crank.modes", "coupler.modes",
-         "crank.mesh_size_m", "coupler.mesh_size_m")
+         "crank.mesh_size_m", "coupler.mesh_size_m", "crank.elements", "coupler.elements")
 
 
 def free_knobs(scene: Scene) -> frozenset[str]:
@@ -310,6 +313,8 @@ def _settings_text(scene: Scene, link_models: Mapping[str, LinkModel]) -> str:
         if entry.meshed:
             modes = f", {values['modes']} modes" if entry.modal else ""
             parts.append(f"{link} {values['model']}{modes}, mesh {values['mesh_size_m']:g} m")
+        elif entry.beam:
+            parts.append(f"{link} {values['model']}, {values['elements']} elements")
     return "; ".join(parts)
 
 
@@ -353,9 +358,14 @@ def _refined_any(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
                 if modal else "the modes term dominates and no link can take more modes")
     if term == "mesh":
         meshed = [link for link, entry in links.items() if entry.meshed]
+        beams = [link for link, entry in links.items()  # a beam's elements: doubled
+                 if entry.beam and 2 * int(scene[link]["elements"]) <= MAX_ELEMENTS]
         return ([f"{link}.mesh_size_m={scene[link]['mesh_size_m'] / 2!r}" for link in meshed]
-                or None, "mesh halved (" + ", ".join(meshed) + ")" if meshed
-                else "the mesh term dominates and no link is meshed")
+                + [f"{link}.elements={2 * int(scene[link]['elements'])}" for link in beams]
+                or None, "mesh halved (" + ", ".join(meshed) + ")" if meshed and not beams
+                else "mesh refined (" + ", ".join(meshed + [f"{link} elements doubled"
+                                                            for link in beams]) + ")"
+                if beams else "the mesh term dominates and no link is meshed")
     for link in ("coupler", "crank"):
         higher = next_rung(link, scene[link], link_models)
         if higher is not None:

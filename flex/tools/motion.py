@@ -296,6 +296,11 @@ def case_motion(path: str | Path, case: str | None = None, *,
     if all(model.stored_motion == "rigid" for model in models.values()):
         raise FlexError(f"{where} has no flexible link (crank and coupler rigid): flex export "
                         f"and animate show FFRF and nonlinear FE links")
+    unread = [f"the {model.label} {link}" for link, model in models.items()
+              if model.stored_motion == "none"]
+    if unread:
+        raise FlexError(f"{where}: {' and '.join(unread)} stores no motion that flex export "
+                        f"and animate read back (they show FFRF and nonlinear FE links)")
     bodies, extra = [], {}
     for link, model in models.items():
         if model.stored_motion == "modal":

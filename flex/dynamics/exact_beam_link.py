@@ -1,0 +1,124 @@
+"""The geometrically exact planar beam as a link model's behaviour (points 4-8 of the
+contract in :mod:`flex.dynamics.link_models`): its section prepared from the plate, its
+elements added between the link's joints, their section forces and energies sensed, the
+flexible link's datasets plus the beam's own section forces and stresses
+(:mod:`flex.bodies.exact_beam`), its cost per step and its solver settings."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flex.data.results import Dataset
+from flex.data.scene import AUTO, EXACT_BEAM_ELEMENTS, Scene
+from flex.dynamics.link_outputs import flexible_datasets, flexible_sensors, sensor_data
+
+# ------------------------------------------------------------------------------------------
+# exact beam: a planar geometrically exact (Simo-Reissner) beam of the plate
+# ------------------------------------------------------------------------------------------
+#: Newton tolerances (relative, absolute) of a run with an exact beam link: 1e-8 / 1e-10
+#: stalled on round-off at 32 elements and more ("relative error 1.39e-8 after 25
+#: iterations"), 1e-7 / 1e-6 converged (docs/exudyn-ngsolve notes, measured 2026-11-28)
+EXACT_BEAM_NEWTON_TOLERANCES = (1e-7, 1e-6)
+
+
+#: wall time per step [s] of an exact beam link: (per link, per element). CPU time of a
+#: whole run (build, sensors, collection) per step, 10 ms of the thesis deployment at
+#: h = 1e-5 s, sparse LU, modified Newton: 16 elements 0.22 ms, 32: 0.30, 64: 0.51, 128: 1.13
+#: (a dense LU: 0.25, 0.48, 1.21, 3.40 ms, the same deflections to all digits)
+STEP_COST_EXACT_BEAM_S = (1e-4, 8e-6)
+
+
+def beam_elements(link: str, values: dict[str, Any]) -> int:
+    if values["elements"] == AUTO:
+        raise ValueError(f'{link}: resolve its "auto" elements first '
+                         "(flex.fidelity.auto.resolve, flex.config.settings.resolve_link_keys)")
+    return int(values["elements"])
+
+
+def prepare_beam(scene: Scene, link: str, given: Any, cache_dir: Path | None) -> Any:
+    """The link's :class:`flex.bodies.exact_beam.ExactBeamSection` (``given``: one built)."""
+    from flex.bodies.exact_beam import exact_beam_section
+
+    if given is not None:
+        return given
+    c = scene[link]
+    beam_elements(link, c)
+    return exact_beam_section(c["length_m"], c["thickness_m"], c["width_m"],
+                              c["youngs_modulus_Pa"], c["density_kg_per_m3"],
+                              c["poisson_ratio"])
+
+
+def add_exact_beam(builder: Any, link: str, section: Any) -> dict[str, Any]:
+    """The beam from B to C (a coupler) or from A to B (a crank), moving as the rigid link
+    at t = 0; its handles (its end markers are the link's joint markers)."""
+    from flex.bodies.exact_beam import add_exact_beam_link
+
+    init, elements = builder.init, beam_elements(link, builder.scene[link])
+    section = section if section is not None else prepare_beam(builder.scene, link, None,
+                                                                None)
+    if link == "crank":
+        beam = add_exact_beam_link(builder.mbs, section, elements, (0.0, 0.0),
+                                   init.crank_angle_rad, (0.0, 0.0), init.crank_speed_rad_per_s)
+    else:
+        beam = add_exact_beam_link(
+            builder.mbs, section, elements, init.joint_B_m, init.coupler_angle_rad,
+            init.joint_B_velocity_m_per_s, init.coupler_speed_rad_per_s)
+    return dict(beam.handles(), section=section,
+                joint_markers=(beam.marker_start, beam.marker_end))
+
+
+def _link_handles(mech: Any, link: str) -> dict[str, Any]:
+    return mech.crank if link == "crank" else mech.coupler
+
+
+def exact_beam_sensors(builder: Any, link: str, handles: dict[str, Any]) -> None:
+    """Each element's section forces (axial and shear force, bending moment) and energies
+    (kinetic, strain: summed by :mod:`flex.dynamics.collect`); a crank's joint-marker
+    velocities (its chord's turning rate) and every flexible link's midpoint marker."""
+    flexible_sensors(builder, link, handles)
+    for index, element in enumerate(handles["elements"]):
+        for output in ("ForceLocal", "TorqueLocal"):
+            builder.add(f"{link}.element_{index}.{output}",
+                        builder.sensor("Body", output, bodyNumber=element))
+    builder.mech.flexible_energy[link] = tuple(
+        [builder.mbs.AddSensor(builder.sensor("Body", kind, bodyNumber=element))
+         for element in handles["elements"]] for kind in ("KineticEnergy", "PotentialEnergy"))
+
+
+def exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]:
+    """The flexible coupler's datasets (chord angle, midpoint; a crank's are read with its
+    motion) and the beam's own section forces and stresses
+    (:func:`flex.bodies.exact_beam.section_datasets`)."""
+    from flex.bodies.exact_beam import section_datasets
+
+    out = flexible_datasets(mech, link, time_s)
+    handles = _link_handles(mech, link)
+    count = len(handles["elements"])
+    force = np.stack([sensor_data(mech, f"{link}.element_{i}.ForceLocal")[:, 1:3]
+                      for i in range(count)], axis=1)  # sample, element, (N, Q)
+    moment = np.stack([sensor_data(mech, f"{link}.element_{i}.TorqueLocal")[:, 3]
+                       for i in range(count)], axis=1)
+    out.update(section_datasets(link, handles["section"], force, moment))
+    return out
+
+
+def exact_beam_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
+    elements = values["elements"] if values["elements"] != AUTO else EXACT_BEAM_ELEMENTS
+    return STEP_COST_EXACT_BEAM_S[0] + STEP_COST_EXACT_BEAM_S[1] * float(elements)
+
+
+def exact_beam_solver(settings: dict[str, Any]) -> None:
+    settings["linear_solver"] = "EigenSparse"
+    relative, absolute = EXACT_BEAM_NEWTON_TOLERANCES
+    settings["newton_relative_tolerance"] = max(settings["newton_relative_tolerance"],
+                                                relative)
+    settings["newton_absolute_tolerance"] = max(settings["newton_absolute_tolerance"],
+                                                absolute)
+
+
+__all__ = ["EXACT_BEAM_NEWTON_TOLERANCES", "STEP_COST_EXACT_BEAM_S", "add_exact_beam",
+           "beam_elements", "exact_beam_datasets", "exact_beam_sensors", "exact_beam_solver",
+           "exact_beam_step_cost_s", "prepare_beam"]
