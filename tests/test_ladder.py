@@ -130,6 +130,10 @@ def test_auto_climbs_onto_the_toy_rung_below_the_builtins_choice():
     toy = resolve(load_scene(overrides=overrides, link_models=REGISTRY), quiet=True,
                   link_models=REGISTRY)
     assert builtin.scene["coupler"]["model"] == "exact_beam"
+    # the exact beam's first guess at 0.1 % (EXACT_BEAM_SETTINGS: measured to state 0.067 %
+    # on the 0.7 mm plate's first crest)
+    assert builtin.scene["coupler"]["elements"] == 64
+    assert builtin.scene["simulation"]["step_s"] == pytest.approx(5e-6)
     assert toy.scene["coupler"]["model"] == TOY
     reason = next(d.reason for d in toy.decisions if d.link == "coupler")
     assert f"toy beam model error {TOY_BOUND:g} of the deflection" in reason

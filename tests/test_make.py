@@ -59,8 +59,11 @@ study=$1
 mkdir -p results
 case "$FAKE_MODE" in
   ok) echo "run $study" > results/$study.h5
-      [ "$study" = kfit ] && echo "fit = 1" > results/kfit-criterion.toml
-      [ "$study" = crank ] && echo "crank_fit = 1" > results/crank-criterion.toml
+      # a law as the studies write it (the bundled one: install checks every value)
+      [ "$study" = kfit ] && { echo "# fitted"; cat "$LAWS/criteria_fit.toml"; } \
+          > results/kfit-criterion.toml
+      [ "$study" = crank ] && { echo "# fitted"; cat "$LAWS/crank_criteria_fit.toml"; } \
+          > results/crank-criterion.toml
       exit 0 ;;
   failed) # flex: a failed run is written beside an earlier result, else in its place
       if [ -e results/$study.h5 ]; then echo failed > results/$study.failed.h5
@@ -90,7 +93,8 @@ def tree(tmp_path: Path) -> Path:
 
 def make(tree: Path, *args: str, mode: str = "ok") -> subprocess.CompletedProcess:
     env = {k: v for k, v in os.environ.items() if not k.startswith("MAKE")}
-    env.update(FAKE_MODE=mode, LC_ALL="C")  # make's own messages in English
+    env.update(FAKE_MODE=mode, LC_ALL="C",  # make's own messages in English
+               LAWS=str(ROOT / "flex" / "config"))  # the fake run's laws: the bundled ones
     return subprocess.run(["make", "--no-print-directory", "-C", str(tree), "PYTHON=false",
                            f"RUN=sh {tree / 'fake_run.sh'}", *args], capture_output=True,
                           text=True, env=env, timeout=60)
@@ -258,7 +262,7 @@ def test_no_law_is_installed_from_a_run_that_failed(tree):
     assert installed.stat().st_mtime == before
     assert make(tree, "kfit", "FORCE=1").returncode == 0  # a good run: installed again
     assert install(tree, "FITS=kfit").returncode == 0
-    assert installed.read_text() == "fit = 1\n"
+    assert installed.read_text() == (tree / "results" / "kfit-criterion.toml").read_text()
 
 
 def test_clean_removes_results_figures_and_reports(tree):

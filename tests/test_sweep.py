@@ -264,7 +264,11 @@ def test_case_hash_follows_the_criterion_of_auto_links(tmp_path):
     rigid = load_scene(None, ['coupler.geometry="plate"', *settings.pinned_overrides()])
     before = case_hash(auto, simulate_case), case_hash(rigid, simulate_case)
     # a re-fit installed as the calibration's criterion file
-    refit = _calibration_copy(tmp_path / "refit", coupler_criterion="# another fit\n")
+    from flex.config.calibration import BUNDLED_FOLDER, FILES
+
+    bundled = (BUNDLED_FOLDER / FILES["coupler_criterion"]).read_text(encoding="utf-8")
+    refit = _calibration_copy(tmp_path / "refit",  # the same law, another file: a re-fit
+                              coupler_criterion="# another fit\n" + bundled)
     with_refit = functools.partial(simulate_case, calibration=refit)
     assert case_hash(auto, with_refit) != before[0]
     assert case_hash(rigid, with_refit) == before[1]

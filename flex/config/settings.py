@@ -119,13 +119,30 @@ def _auto_elements(scene: Scene, link: str, link_models: Mapping[str, Any]) -> b
     return scene[link].get("elements") == AUTO and _is_beam(scene, link, link_models)
 
 
+#: the exact beam's first-guess settings by tolerance: (tolerance at or above, elements,
+#: step [s]), tightest last. Measured on the thesis deployment (0.5-1 mm plates, the run's
+#: own budget): 32 elements at 1e-5 s stated 0.14-0.31 % on the first crest and 0.05-0.23 %
+#: on the deployment time (step and element terms); 64 elements at 5e-6 s on the 0.7 mm
+#: plate stated 0.067 % on the first crest (step 0.051 %, elements 0.004 %, model 0.044 %)
+#: and 0.045 % on the deployment time, with its whole budget in 31 s on a loaded 2-core
+#: machine. A first guess like the FFRF rule's: each run's budget says what it achieved.
+EXACT_BEAM_SETTINGS = ((0.005, EXACT_BEAM_ELEMENTS, 1e-5), (0.0, 64, 5e-6))
+
+
+def exact_beam_settings(tolerance: float) -> tuple[int, float]:
+    """The exact beam's elements and step [s] at ``fidelity.tolerance`` (dimensionless):
+    the first row of :data:`EXACT_BEAM_SETTINGS` whose tolerance it reaches."""
+    return next((elements, step) for floor, elements, step in EXACT_BEAM_SETTINGS
+                if tolerance >= floor)
+
+
 def resolve_link_keys(scene: Scene, calibration: Calibration | None = None, *,
                       link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
                       ) -> tuple[Scene, dict[str, Any]]:
     """``scene`` (a copy) with the links' ``"auto"`` modes and mesh size filled by the rule
     (:func:`flex.config.ffrf_rule.fill_link_keys` at ``fidelity.tolerance``, ``calibration``'s
     rule; None: the bundled one; a beam link's, which it does not read, are left) and a beam
-    link's ``"auto"`` elements (:data:`EXACT_BEAM_ELEMENTS`), and what was filled
+    link's ``"auto"`` elements (:func:`exact_beam_settings`), and what was filled
     (``"coupler.modes"`` -> value)."""
     resolved = copy.deepcopy(scene)
     filled: dict[str, Any] = {}
@@ -133,7 +150,8 @@ def resolve_link_keys(scene: Scene, calibration: Calibration | None = None, *,
     for link in LINKS:
         if _is_beam(scene, link, link_models):
             if _auto_elements(resolved, link, link_models):
-                resolved[link]["elements"] = filled[f"{link}.elements"] = EXACT_BEAM_ELEMENTS
+                resolved[link]["elements"] = filled[f"{link}.elements"] = \
+                    exact_beam_settings(tolerance)[0]
             continue
         for key, value in fill_link_keys(resolved, link, tolerance, calibration).items():
             filled[f"{link}.{key}"] = value
@@ -182,13 +200,17 @@ def finest_certified_accuracy(calibration: Calibration | None = None) -> tuple[f
 
 def reads_tolerance(scene: Scene, *, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> bool:
     """Whether ``fidelity.tolerance`` is read: by an ``auto`` link or spring model (validated:
-    only with a spring drive), or by ``"auto"`` solver keys choosing the FFRF coupler's entry
-    (:func:`choose_entry`)."""
+    only with a spring drive), by ``"auto"`` solver keys choosing the FFRF coupler's entry
+    (:func:`choose_entry`), or by an exact beam coupler's ``"auto"`` step or elements
+    (:func:`exact_beam_settings`)."""
     if AUTO in (scene["crank"]["model"], scene["coupler"]["model"]) \
             or scene["drive"]["spring_model"] == AUTO:
         return True
-    return (has_auto(scene) and link_model("coupler", scene["coupler"], link_models).modal
-            and link_model("crank", scene["crank"], link_models).rigid)
+    if not link_model("crank", scene["crank"], link_models).rigid:
+        return False
+    if _is_beam(scene, "coupler", link_models):  # its step and elements (exact_beam_settings)
+        return has_auto(scene) or _auto_elements(scene, "coupler", link_models)
+    return has_auto(scene) and link_model("coupler", scene["coupler"], link_models).modal
 
 
 def tolerance_beyond_reach(scene: Scene, calibration: Calibration | None = None, *,
@@ -234,6 +256,12 @@ def resolve_solver_settings(scene: Scene, calibration: Calibration | None = None
             chosen.step_s, float(resolved["simulation"]["end_time_s"]), 4), chosen.level
         reason += (f"; step rounded down to {values['step_s']:.6g} s, a whole number of 4 "
                    f"steps in the end time")
+    elif name == "flexible_fallback" and _is_beam(resolved, "coupler", link_models) \
+            and not _is_beam(resolved, "crank", link_models):
+        tolerance = float(resolved["fidelity"]["tolerance"])
+        values["step_s"] = exact_beam_settings(tolerance)[1]
+        reason += (f"; the exact beam's step at tolerance {tolerance:g}: {values['step_s']:g} s "
+                   f"(EXACT_BEAM_SETTINGS, measured; a first guess)")
     for key in AUTO_KEYS:
         if resolved["simulation"][key] == AUTO:
             resolved["simulation"][key] = filled[key] = values[key]

@@ -213,9 +213,9 @@ def _plate_fields(link: str) -> dict[str, Field]:
                                "the reduced body (the commercial codes' default; "
                                "flex.bodies.reduction.damping)",
                                default="stiffness_proportional"),
-        "elements": Field(int, "model = exact_beam: beam elements along the link (auto: "
-                          f"{EXACT_BEAM_ELEMENTS})", minimum=2, maximum=1024, auto=True,
-                          default=EXACT_BEAM_ELEMENTS),
+        "elements": Field(int, "model = exact_beam: beam elements along the link (auto, and "
+                          "when auto picks the beam: from fidelity.tolerance)", minimum=2,
+                          maximum=1024, auto=True, default=EXACT_BEAM_ELEMENTS),
         "geometric_stiffness": Field(bool, "model = ffrf: soften the bending modes under the "
                                      "link's own axial force (flex.bodies.geometric_stiffness; "
                                      "false: the linear FFRF body, for comparison)",

@@ -53,7 +53,14 @@ from flex.config.settings import (
     resolve_link_keys,
     resolve_solver_settings,
 )
-from flex.data.scene import LINKS, Scene, check_meshed_plate, model_names, to_toml
+from flex.data.scene import (
+    EXACT_BEAM_ELEMENTS,
+    LINKS,
+    Scene,
+    check_meshed_plate,
+    model_names,
+    to_toml,
+)
 from flex.dynamics.ladder import climb
 from flex.dynamics.link_models import (
     BUILTIN_LINK_MODELS,
@@ -462,6 +469,8 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
     coupler["model"] = decision.model
     if link_models[decision.model].modal:
         _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s, calibration)
+    if link_models[decision.model].beam and coupler.get("elements") == EXACT_BEAM_ELEMENTS:
+        coupler["elements"] = AUTO  # auto picked the beam: its elements follow the tolerance
     return decision, how
 
 

@@ -315,6 +315,15 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
     return lines
 
 
+def _position(value: Any) -> bool:
+    """Whether a stored position is three real numbers (x, y, z)."""
+    try:
+        return np.size(value) == 3 and bool(np.all(np.isfinite(np.asarray(value,
+                                                                          dtype=float))))
+    except (TypeError, ValueError):
+        return False
+
+
 def stress_lines(attrs: dict[str, Any]) -> list[str]:
     """The peak von Mises stress of each FFRF link (case attributes of
     :func:`flex.bodies.stress.peak_attrs`), where and when, with its estimated error:
@@ -328,15 +337,16 @@ def stress_lines(attrs: dict[str, Any]) -> list[str]:
             name = f"{link}_peak_von_mises{suffix}"
             if f"{name}_Pa" not in attrs:
                 continue
-            x, y, z = (1e3 * float(v) for v in np.ravel(attrs[f"{name}_position_m"]))
             raw_error = attrs.get(f"{PREFIX}{name}_Pa")
             error = _number(raw_error)
             if _number(attrs[f"{name}_Pa"]) is None or _number(attrs.get(
-                    f"{name}_time_s")) is None or np.size(attrs.get(f"{name}_position_m")) != 3:
+                    f"{name}_time_s")) is None or not _position(attrs.get(
+                        f"{name}_position_m")):
                 parts.append(f"{_short(attrs[f'{name}_Pa'])} Pa {where} at t = "
                              f"{_short(attrs.get(f'{name}_time_s'))} s (attributes that are "
                              f"not one number, shown as stored)")
                 continue
+            x, y, z = (1e3 * float(v) for v in np.ravel(attrs[f"{name}_position_m"]))
             if raw_error is not None and error is None:
                 parts.append(f"estimated error {_short(raw_error)} (not a number, as stored)")
             parts.append(f"{attrs[f'{name}_Pa'] / 1e6:.4g} MPa {where} at t = "
