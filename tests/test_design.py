@@ -131,6 +131,7 @@ def test_rest_angle_and_travel_follow_the_attached_spring(scene, sweep):
                                2 * rows["preload_m"][simulated], rtol=1e-4)
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_report_and_figures_come_from_the_datasets(scene, sweep, tmp_path):
     datasets = design_summary.summary_datasets(scene, TINY, sweep, {})
     text = report_text(datasets)

@@ -11,6 +11,8 @@ import ast
 import os
 from pathlib import Path
 
+import pytest
+
 from flex.bodies.reduction import reduction_cache_dir
 
 FLEX = Path(__file__).resolve().parent.parent / "flex"
@@ -122,6 +124,7 @@ COARSE_FFRF = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.thic
                "coupler.mesh_size_m=0.005", "coupler.modes=2", "simulation.end_time_s=0.001"]
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_the_api_reads_the_cache_folder_and_a_study_run_passes_it_on(tmp_path, monkeypatch):
     import flex
     from flex.study import execute, load_study, study_scene

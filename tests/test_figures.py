@@ -153,6 +153,7 @@ def test_modal_figures_synthetic(tmp_path, reviewed):
                                  "modal-convergence.png"})
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_flexible_figures_synthetic(tmp_path, reviewed):
     from studies import flexible
 
@@ -183,6 +184,7 @@ def test_flexible_figures_synthetic(tmp_path, reviewed):
                | {f"flexible-midpoint-acceleration-{m}.png" for m in flexible.MODELS})
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_crank_figures_synthetic(tmp_path, reviewed):
     from studies import crank
 
@@ -205,6 +207,7 @@ def test_crank_figures_synthetic(tmp_path, reviewed):
     check_pngs(paths, tmp_path, {"crank-deflection.png", "crank-validation.png"})
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_kfit_figures_synthetic(tmp_path, reviewed):
     from flex.experiments.fitting.kfit import label
     from studies import kfit

@@ -414,6 +414,7 @@ def test_fewest_joint_markers_give_the_motion_of_all_face_nodes(reduction, cache
         assert np.max(np.abs(curves["fewest"][key] - full)) <= 1e-5 * scale, key
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_in_plane_selection_keeps_the_in_plane_modes_of_the_full_basis(reduction):
     """The default reduction (in-plane modes) holds exactly the in-plane members of a basis of
     any kind computed with enough modes: the same fixed-interface frequencies (to the

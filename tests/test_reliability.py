@@ -87,6 +87,7 @@ def kill_run(out: Path, sig: signal.Signals, when: str | float
                                        stderr.decode()), proc.pid
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_killed_runs_leave_the_previous_file_intact(tmp_path):
     out = tmp_path / "kinematics.h5"
     previous = write_previous(out)

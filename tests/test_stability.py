@@ -185,6 +185,7 @@ def test_the_stability_study_declares_its_forced_divergences():
                                            "diverge_thin_plate_h1e-3", "long_rigid_rho1"}
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_the_thin_plate_built_to_diverge_does_diverge_and_names_its_step():
     from studies import stability
 

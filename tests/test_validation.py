@@ -89,6 +89,7 @@ def test_mass_matrix_derivatives_match_finite_differences():
         np.testing.assert_allclose(dm[k], fd, atol=1e-9 * np.abs(fd).max() + 1e-14)
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_independent_model_reproduces_the_published_solution():
     # published reference at t = 0.1 s: angles, slider and lateral coordinates to 1e-6
     # relative, axial coordinates q3, q4 to 1e-5, rates to 1e-4 (the stiff axial rates are
