@@ -167,6 +167,7 @@ def test_auto_stores_the_crank_s_prediction_and_it_meets_the_ffrf_crank(reductio
     assert 0.8 <= predicted / measured["deflection"] <= 1.25
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_with_the_wing_the_prediction_meets_the_deflection_not_the_governing_error(
         reduction_cache):
     """A 2 mm crank carrying the wing: the prediction (the crank's in-mechanism mode) is

@@ -143,6 +143,7 @@ def test_report_and_figures_come_from_the_datasets(scene, sweep, tmp_path):
 
 # --- the optimiser ---------------------------------------------------------------------------
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_optimiser_finds_the_closed_form_preload(scene):
     """The smallest preload that brings the crank (from 34.19 deg) to rest at 80 deg or
     beyond: half the slider travel between the two angles, x(theta0) - x(theta_f)."""

@@ -118,6 +118,7 @@ def summary(**datasets) -> Summary:
 TIME = np.linspace(0.0, 0.03, 301)
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_modal_figures_synthetic(tmp_path, reviewed):
     from studies import modal
 

@@ -167,6 +167,7 @@ def _pinned_vibration_Hz(reduction, stiffness, compression_N: float, geometric: 
     return (len(crossings) - 1) / (crossings[-1] - crossings[0])
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_exudyn_body_with_geometric_force_vibrates_at_the_closed_form(reduction, stiffness):
     # the ObjectGenericODE2 on the modal coordinates, integrated with the FFRF body: the
     # measured frequency follows sqrt(1 - P / P_E); without it the linear body in its chord

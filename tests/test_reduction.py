@@ -141,6 +141,7 @@ def _copy_entry(reduction, directory):
     return target
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_truncated_entry_is_rebuilt_and_replaced(reduction, tmp_path):
     entry = _copy_entry(reduction, tmp_path)
     entry.write_bytes(entry.read_bytes()[: entry.stat().st_size // 2])
@@ -150,6 +151,7 @@ def test_truncated_entry_is_rebuilt_and_replaced(reduction, tmp_path):
     assert build_reduction(*ARGS, cache_dir=tmp_path).from_cache  # the entry is whole again
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_entry_of_another_key_is_not_trusted(reduction, tmp_path):
     entry = _copy_entry(reduction, tmp_path)
     with h5py.File(entry, "r+") as h5:
@@ -158,6 +160,7 @@ def test_entry_of_another_key_is_not_trusted(reduction, tmp_path):
     assert not build_reduction(*ARGS, cache_dir=tmp_path).from_cache
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_damaged_data_in_a_readable_entry_is_rebuilt(reduction, tmp_path):
     entry = _copy_entry(reduction, tmp_path)
     with h5py.File(entry, "r+") as h5:
