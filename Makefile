@@ -93,7 +93,7 @@ calibration-install: $(FIT_FILES) | $(STAMP)
 	$(PY) -m flex.config.calibration install --into flex/config $^
 
 test: $(STAMP)
-	$(PY) -m pytest -q -n 2
+	$(PY) -m pytest -q -n 2 --dist worksteal
 
 test-slow: $(STAMP)
 	$(PY) -m pytest -q -n 2 -m slow

@@ -40,6 +40,7 @@ def test_ffrf_crank_conserves_energy(stiff_pair):
     assert flexible["energy/strain"].max() > 0
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_ffrf_coupler_reports_energy(reduction_cache):
     scene = load_scene(None, ['coupler.geometry="plate"', 'coupler.model="ffrf"',
                               "simulation.step_s=2e-5", "simulation.end_time_s=0.01"])

@@ -274,6 +274,7 @@ def test_bad_elements_are_refused_in_one_line(value):
     assert message.endswith('must be an integer >= 2 and <= 1024 or "auto"')
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_a_beam_crank_follows_an_ffrf_crank(reduction_cache):
     """Crank and coupler plates (the bundled crank plate: 40 x 4.56 x 10 mm), beam coupler,
     crank as a beam (32 elements, the default) or as the default FFRF body. Measured: crank

@@ -115,6 +115,7 @@ def crank_angle_deviation_from_rigid_twin(youngs_modulus_Pa: float) -> float:
     return float(np.abs(angles[0] - angles[1]).max())
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_stiff_ffrf_coupler_converges_to_its_rigid_twin():
     steel = crank_angle_deviation_from_rigid_twin(200e9)
     stiff = crank_angle_deviation_from_rigid_twin(200e12)
@@ -140,6 +141,7 @@ def test_reference_file_states_the_tolerance_of_this_test():
             171e-6, rel=0.01)  # the study's peak, 171 um (the nonlinear FE coupler's: 171.6)
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_study_settings_match_the_converged_curve(tmp_path):
     # the cheapest check of the default suite: the study's 6 modes and 1e-5 s step over the
     # first 10 ms (three and a half deflection periods); measured 0.89 % of that span's peak

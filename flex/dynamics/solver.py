@@ -220,7 +220,8 @@ def run_profiled(mech: Mechanism) -> tuple[dict[str, float], str]:
     """Integrate ``mech`` once (implicit integrator) with Exudyn's CPU-time statistics on, for
     benchmarks (:mod:`flex.experiments.workprecision.benchmark`; :func:`run` is the production
     path): counters (``steps``, ``newton_iterations``, ``jacobian_updates``; ``wall_time_s`` [s],
-    the solve alone) and the statistics text Exudyn printed. Raises SimulationError if it fails."""
+    the solve alone) and the statistics text of Exudyn's solver timer. Raises SimulationError
+    if it fails."""
     import exudyn as exu
 
     settings = _exudyn_settings(solver_settings(mech.scene, mech.link_models))
@@ -234,9 +235,11 @@ def run_profiled(mech: Mechanism) -> tuple[dict[str, float], str]:
     wall = time.perf_counter() - start
     if not ok:
         raise SimulationError("profiled run failed")
+    # the statistics from the solver's own timer (the printed copy goes to whatever
+    # sys.stdout is at print time, which another part of a long process may have replaced)
     return {"wall_time_s": wall, "steps": float(solver.it.currentStepIndex),
             "newton_iterations": float(solver.it.newtonStepsCount),
-            "jacobian_updates": float(solver.it.newtonJacobiCount)}, captured.getvalue()
+            "jacobian_updates": float(solver.it.newtonJacobiCount)}, solver.timer.ToString()
 
 
 def scene_reductions(scene: Scene, reduction: Any = None, crank_reduction: Any = None, *,
