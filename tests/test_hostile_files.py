@@ -309,6 +309,17 @@ def test_good_scheduler_addresses_pass_the_check(address):
     check_scheduler(address)
 
 
+def test_an_auto_link_on_a_constant_speed_crank_at_rest_is_refused_in_one_line(tmp_path):
+    """drive.crank_speed_rad_per_s = 0 with an auto coupler: refused before anything runs
+    (exit 2), naming the key and what is accepted (the probe refuses it too, for callers of
+    the library that skip the scene's checks)."""
+    check_refused(["run", "simulate", "--no-figures", "--out", str(tmp_path / "p.h5"),
+                   "--set", 'drive.kind="constant_speed"', "--set",
+                   "drive.crank_speed_rad_per_s=0", "--set", 'coupler.geometry="plate"',
+                   "--set", 'coupler.model="auto"', "--set", "simulation.end_time_s=0.004"],
+                  ["drive.crank_speed_rad_per_s", "!= 0"])
+
+
 PRELOAD_ZERO = [
     ("crank-auto-with-wing", ["wing.enabled=true", 'crank.model="auto"'], "crank.model"),
     ("coupler-auto", ['coupler.geometry="plate"', 'coupler.model="auto"'], "coupler.model"),

@@ -123,6 +123,11 @@ def deployment_probe(scene: Mapping[str, Mapping[str, Any]],
         result = integrate(probe_scene(scene, end, calibration), "fidelity_probe")
         data = {k: np.asarray(v.data) for k, v in result.datasets.items()}
         if drive["kind"] == "constant_speed":
+            if drive["crank_speed_rad_per_s"] == 0:  # half a turn never ends: no time scale
+                raise SceneError('model = "auto": a constant-speed crank at rest '
+                                 "(drive.crank_speed_rad_per_s = 0) has no deployment time "
+                                 "for the criterion; accepted: a speed other than 0 rad/s, "
+                                 'or the link model set ("rigid", "ffrf")')
             return (math.pi / abs(drive["crank_speed_rad_per_s"]),
                     "constant-speed drive: delta_t = half a crank turn", data)
         try:
