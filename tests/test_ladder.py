@@ -1,4 +1,4 @@
-"""The model ladder and the headline quantities as data (flex.dynamics.ladder,
+"""The model ladder and the headline quantities as data (flex.config.ladder,
 flex.fidelity.headlines), from outside the library.
 
 - A toy rung (an FFRF body under another name, its own registry entry and ladder row,
@@ -27,10 +27,7 @@ import pytest
 
 import flex
 from flex.base.errors import FlexError
-from flex.config.settings import pinned_overrides
-from flex.data.results import write_results
-from flex.data.scene import load_scene
-from flex.dynamics.ladder import (
+from flex.config.ladder import (
     EXACT_BEAM_RUNG,
     FFRF_RUNG,
     LINEAR_FFRF_RUNG,
@@ -40,6 +37,9 @@ from flex.dynamics.ladder import (
     climb,
     next_rung,
 )
+from flex.config.settings import pinned_overrides
+from flex.data.results import write_results
+from flex.data.scene import load_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 from flex.fidelity.error_budget import budget_rows
 from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline

@@ -53,7 +53,7 @@ The contract of an entry -- what a link model declares, point by point:
 8. **solver adjustments**: ``adjust_solver(settings)`` changes the integrator settings in
    place (a sparse solver, a looser absolute tolerance); ``own_progress``: the model prints
    its own progress during a solve.
-9. **its rung on the ladder**: ``rung(values)`` -> a :class:`flex.dynamics.ladder.Rung` (or
+9. **its rung on the ladder**: ``rung(values)`` -> a :class:`flex.config.ladder.Rung` (or
    None: on no rung): what bounds its model error against the rung above, what that leaves
    out, and whether ``auto`` and the refinement may climb onto it. The error budget,
    ``auto``'s climb and the refinement read it and name no model.
@@ -84,6 +84,13 @@ import numpy as np
 
 from flex.base.errors import SceneError
 from flex.base.progress import heartbeat
+from flex.config.ladder import (
+    EXACT_BEAM_RUNG,
+    NONLINEAR_FE_RUNG,
+    RIGID_RUNG,
+    Rung,
+    ffrf_rung,
+)
 from flex.data.results import Dataset
 from flex.data.scene import (
     AUTO,
@@ -103,13 +110,6 @@ from flex.dynamics.exact_beam_link import (
     exact_beam_solver,
     exact_beam_step_cost_s,
     prepare_beam,
-)
-from flex.dynamics.ladder import (
-    EXACT_BEAM_RUNG,
-    NONLINEAR_FE_RUNG,
-    RIGID_RUNG,
-    Rung,
-    ffrf_rung,
 )
 from flex.dynamics.link_outputs import (  # noqa: F401 - the names callers import from here
     elastic_datasets,

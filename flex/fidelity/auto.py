@@ -8,7 +8,7 @@ the reasons, as one value.
 2. the links' ``model`` (:func:`decide_links`): rigid when the deflection the probe's loads
    predict meets ``fidelity.tolerance`` (relative to the link's length), else the lowest
    flexible rung of the ladder whose measured model error meets the tolerance relative to
-   the deflection (:func:`flex.dynamics.ladder.climb`: the FFRF body), else the highest (the
+   the deflection (:func:`flex.config.ladder.climb`: the FFRF body), else the highest (the
    nonlinear FE coupler); an FFRF link's modes with it;
 3. the links' ``modes`` and ``mesh_size_m`` and the ``[simulation]`` solver keys
    (:func:`flex.config.settings.resolve_solver_settings`: the FFRF settings rule, the solver
@@ -46,6 +46,7 @@ from flex.base.physics import (
     plate_thickness_for_mass_m,
 )
 from flex.config.calibration import Calibration
+from flex.config.ladder import climb
 from flex.config.settings import (
     AUTO,
     SolverChoice,
@@ -61,7 +62,6 @@ from flex.data.scene import (
     model_names,
     to_toml,
 )
-from flex.dynamics.ladder import climb
 from flex.dynamics.link_models import (
     BUILTIN_LINK_MODELS,
     FFRF,
@@ -377,7 +377,7 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
     lumped crank the criterion calls flexible, or a flexible one with a constant-speed drive, is
     refused with a :class:`SceneError`. A coupler loaded beyond :data:`EULER_LOAD_LIMIT` of its
     Euler load is not offered rigid (outside the fit): the ladder's rungs decide, each within
-    the compression its bound was measured at (:func:`flex.dynamics.ladder.climb`).
+    the compression its bound was measured at (:func:`flex.config.ladder.climb`).
     ``drive.spring_model = "auto"`` must be resolved before (:func:`resolve` does it first, with
     :func:`flex.fidelity.spring_choice.decide_spring`). Scenes without ``auto`` are returned
     unchanged (a copy). ``cache_dir``: the reduction cache folder of the crank's frequency
@@ -478,7 +478,7 @@ def _climb(decision: FidelityDecision, coupler: dict[str, Any], load_ratio: floa
            tolerance: float, link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
            ) -> None:
     """Past rigid, the lowest rung of the ladder whose measured model error relative to the
-    deflection meets ``tolerance`` (:func:`flex.dynamics.ladder.climb`), else the highest
+    deflection meets ``tolerance`` (:func:`flex.config.ladder.climb`), else the highest
     (in place: ``decision.model``; refused when that model has no damping and the coupler
     is damped)."""
     chosen = climb("coupler", coupler, load_ratio, tolerance, link_models)

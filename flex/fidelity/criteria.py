@@ -40,7 +40,7 @@ from flex.base.thesis import (  # noqa: F401 - part of this module's face
     THESIS_K,  # thesis sec. 6.2, in the thesis convention (n = delta_t * omega)
     THESIS_YOUNGS_MODULUS_PA,
 )
-from flex.dynamics.ladder import (  # noqa: F401 - the measured bounds, part of this face
+from flex.config.ladder import (  # noqa: F401 - the measured bounds, part of this face
     FFRF_MOTION_ERROR_FRACTION,
     FFRF_RUNG,
     GEOMETRIC_FFRF_ERROR,

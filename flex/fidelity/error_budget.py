@@ -21,7 +21,7 @@ peak bending stress), four named terms and their total [the quantity's units]:
   first crest; a companion with fewer elements would put the racing peak of a coarse beam
   in the term);
 - ``model``: the link model against the next rung of flex's ladder, read from the rung each
-  link's model entry names (:mod:`flex.dynamics.ladder`; no model is named here): a link on
+  link's model entry names (:mod:`flex.config.ladder`; no model is named here): a link on
   a bounded rung (the FFRF bodies) gets its rung's ``own_fraction`` of what its elasticity
   changes in its own quantities and the ``motion_fraction`` of what it changes in the
   motion and the joint forces (the difference to a companion whose bounded links are rigid
@@ -49,9 +49,9 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import FlexError
+from flex.config.ladder import Rung
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, apply_overrides, model_names
-from flex.dynamics.ladder import Rung
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.fidelity.error_estimate import PREFIX, estimate_step_error, headline_difference
 from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline, crest_gap
@@ -260,7 +260,7 @@ def _grouped(links: dict[str, Rung], text: str, joiner: str = " and ") -> list[s
 def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
                 leaves_out: list[str], link_models: Mapping[str, LinkModel]
                 ) -> tuple[dict[str, float], str]:
-    """The links' model errors from their rungs (:mod:`flex.dynamics.ladder`): a bounded
+    """The links' model errors from their rungs (:mod:`flex.config.ladder`): a bounded
     rung's fractions of what the elasticity changes (the difference to rigid twins), plus
     its companion's difference; every rung's ``leaves_out`` line, highest first."""
     rungs = _rungs(scene, link_models)

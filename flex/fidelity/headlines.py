@@ -24,7 +24,7 @@ The contract of an entry:
    from (peaks and crests);
 5. ``window``: the part of the run it is read over, in words;
 6. ``link``: the link whose own elastic response it is (its model term is the link's rung's
-   ``own_fraction``, :mod:`flex.dynamics.ladder`), or None for a quantity of the motion (the
+   ``own_fraction``, :mod:`flex.config.ladder`), or None for a quantity of the motion (the
    rungs' ``motion_fraction``);
 7. ``certified``: :func:`flex.fidelity.simulation.refine` refines until it meets the
    tolerance; ``crest_gap``: its budget stores the peak's crest gap (:func:`crest_gap`).

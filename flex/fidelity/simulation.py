@@ -24,11 +24,11 @@ from typing import Any
 
 from flex.base.errors import FlexError, SceneError
 from flex.config.calibration import Calibration
+from flex.config.ladder import next_rung
 from flex.config.settings import tolerance_beyond_reach
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, SCHEMA, Scene, to_toml
 from flex.data.scene_edit import derive_scene
-from flex.dynamics.ladder import next_rung
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.dynamics.solver import VALIDITY_WARNING, integrate, scene_reductions, time_scales
 from flex.fidelity.auto import Resolution, resolve
@@ -185,7 +185,7 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     ``fidelity.tolerance`` relative to itself, refine the knob whose term dominates it (the
     step halved, the modes of the modal links raised as the modes companion's, the mesh of
     the meshed links halved, a link climbed to the next rung of the ladder,
-    :func:`flex.dynamics.ladder.next_rung`) and run again, until every one meets
+    :func:`flex.config.ladder.next_rung`) and run again, until every one meets
     it, the next run's estimated cost (:func:`_attempt_cost_s`) would pass
     ``fidelity.refine_limit_s`` [s], :data:`MAX_ATTEMPTS` runs are made or no knob can move.
     Returns the last run, with ``refine_status`` (``met``, or why not),
