@@ -50,17 +50,21 @@ def test_refinement_meets_the_tolerance_against_a_finer_reference(reduction_cach
 
 def test_a_refinement_that_cannot_meet_the_tolerance_says_so_and_keeps_its_best(
         reduction_cache, capsys):
-    """0.1 %: the FFRF body's own model term (0.5 % of the deflection) dominates once the
-    step is fine; with a limit too short to climb, it stops and says so in one line."""
+    """0.1 %: the FFRF body's own model term (0.5 % of the deflection) dominates; the model
+    was set in the scene, so the refinement does not climb: it stops, says which set value
+    blocks the tolerance and what it would take, in one line (or, on a slow machine, stops
+    at its cost limit first)."""
     result = simulate(load_scene(overrides=[*PLATE[:2], "fidelity.tolerance=0.001",
                                             "simulation.end_time_s=0.005",
                                             "fidelity.refine=true",
                                             "fidelity.refine_limit_s=0.001"]),
                       cache_dir=reduction_cache)
-    assert result.attrs["refine_status"].startswith("cost limit")
+    status = result.attrs["refine_status"]
+    assert status.startswith("cost limit") or (
+        "coupler.model = ffrf was set in the scene" in status and "exact_beam" in status), status
     assert "estimated_error_coupler_peak_deflection_m" in result.attrs
     err = capsys.readouterr().err
-    assert "not met by refinement (cost limit" in err
+    assert "not met by refinement (" in err and status in err
 
 
 def test_a_rigid_scene_has_nothing_to_refine_and_refinement_needs_the_budget():
@@ -80,15 +84,15 @@ def test_a_refine_limit_without_refine_would_be_ignored_and_is_refused():
 
 
 def test_a_refinement_whose_next_run_would_exceed_the_limit_stops_before_it(reduction_cache):
-    """3 mm at 1 %: the budget does not shrink as the settings are refined (the peak races,
-    docs/criterion.md), so the refinement runs until its cost limit: the next mesh halving
+    """3 mm at 0.4 %: the mesh term (the coarser mesh's difference, taken whole) dominates the
+    first run's budget, so the refinement runs until its cost limit: the next mesh halving
     alone would mesh and reduce ~2.7e5 DOF twice (flex's mesh estimate, minutes). Which knob
     the limit stops depends on how fast this machine ran the earlier attempts (the limit is
     wall time: 10 s here), so the test asks for the class of stop, not the knob: a cost
     limit, stated with what the refused attempt would have cost (an estimate) or the time
     already spent, the attempts listed, the last run kept with its budget."""
     result = simulate(load_scene(overrides=[*PLATE[:2], "coupler.thickness_m=0.003",
-                                            "fidelity.tolerance=0.01", "fidelity.refine=true",
+                                            "fidelity.tolerance=0.004", "fidelity.refine=true",
                                             "fidelity.refine_limit_s=10"]),
                       cache_dir=reduction_cache)
     status = result.attrs["refine_status"]

@@ -176,6 +176,68 @@ def time_scales(scene: Scene, reductions: dict[str, Any] | None = None,
     return sorted((float(period), need, what) for period, need, what in out)
 
 
+#: the headline channel's cut-off over the lowest first bending frequency of the scene's
+#: flexible links: passes a link's first bending mode (gain 0.9998 forward-backward) and
+#: stops its third, the next one that moves the midpoint (9x the first: gain 1.5e-4), and
+#: the links' axial ringing above it (docs/criterion.md, "The headline channel")
+CHANNEL_FACTOR = 3.0
+
+
+def channel_cutoff_Hz(scene: Scene,
+                      link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
+                      ) -> float | None:
+    """Cut-off [Hz] of the zero-phase low-pass channel the deployment's headline peaks are
+    read on (:mod:`flex.fidelity.headlines`): :data:`CHANNEL_FACTOR` times the lowest
+    pinned-pinned first bending frequency of the scene's flexible plate links (Euler-
+    Bernoulli, :func:`flex.base.physics.euler_bernoulli_omega`); None when no link is
+    flexible (a rigid mechanism has no elastic ringing to filter)."""
+    from flex.base.physics import euler_bernoulli_omega
+
+    omegas = [euler_bernoulli_omega(np.pi, values["length_m"], values["thickness_m"],
+                                    values["youngs_modulus_Pa"], values["density_kg_per_m3"])
+              for values in (scene[link] for link in LINKS)
+              if not link_models[values["model"]].rigid and values["geometry"] == "plate"]
+    return CHANNEL_FACTOR * min(omegas) / (2.0 * np.pi) if omegas else None
+
+
+#: the series read on the headline channel, where the run has them (``channel/<path>``)
+CHANNEL_SERIES = ("crank/angle", "coupler/midpoint_deflection", "crank/midpoint_deflection",
+                  "coupler/peak_bending_stress", "crank/peak_bending_stress",
+                  "coupler/peak_von_mises_stress", "crank/peak_von_mises_stress",
+                  "joints/A/force_modulus", "joints/B/force_modulus", "joints/C/force_modulus")
+#: order of the channel's Butterworth low-pass (run forward and backward: zero phase, twice
+#: the attenuation)
+CHANNEL_ORDER = 4
+#: a cut-off above this fraction of the sampling's Nyquist frequency leaves the series as they
+#: are: the samples hold no content above it worth filtering
+CHANNEL_NYQUIST_FRACTION = 0.8
+#: case attribute holding the channel's cut-off [Hz]
+CHANNEL_ATTR = "channel_cutoff_Hz"
+
+
+def channel_datasets(datasets: Mapping[str, Dataset], cutoff_Hz: float | None
+                     ) -> dict[str, Dataset]:
+    """The :data:`CHANNEL_SERIES` a run has, on its headline channel (``channel/<path>``):
+    low-passed forward and backward (zero phase; SAE J211 / ISO 6487 read crash-test peaks
+    on such channels) at ``cutoff_Hz`` (:func:`channel_cutoff_Hz`) by a
+    :data:`CHANNEL_ORDER`-th order Butterworth filter; none without a cut-off (nothing
+    flexible) or when the sampling holds nothing above it."""
+    from scipy.signal import butter, sosfiltfilt
+
+    time_s = np.asarray(datasets["time"].data, dtype=float)
+    if cutoff_Hz is None or time_s.size < 16:
+        return {}
+    sample_s = float(np.median(np.diff(time_s)))
+    if not cutoff_Hz < CHANNEL_NYQUIST_FRACTION * 0.5 / sample_s:
+        return {}
+    sos = butter(CHANNEL_ORDER, cutoff_Hz, fs=1.0 / sample_s, output="sos")
+    return {f"channel/{path}": Dataset(
+        sosfiltfilt(sos, np.asarray(datasets[path].data, dtype=float), axis=0),
+        datasets[path].units, f"{datasets[path].description}, on the headline channel "
+        f"(zero-phase {CHANNEL_ORDER}th-order Butterworth low-pass at {cutoff_Hz:.4g} Hz)")
+        for path in CHANNEL_SERIES if path in datasets}
+
+
 def extreme_inputs(scene: Scene,
                    link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> list[str]:
     """The inputs the scene's models use that are not finite or lie :data:`EXTREME_FACTOR`

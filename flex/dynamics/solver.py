@@ -53,11 +53,14 @@ from flex.config.settings import check_concrete
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import LINKS, Scene, to_toml
 from flex.dynamics.advice import (  # noqa: F401 - the names callers import from here
+    CHANNEL_ATTR,
     CONSTRAINT_NORM_LIMIT_M,
     EXTREME_FACTOR,
     FFRF_DEFLECTION_LIMIT,
     STEPS_PER_PERIOD,
     VALIDITY_WARNING,
+    channel_cutoff_Hz,
+    channel_datasets,
     check_finite,
     divergence_advice,
     extreme_inputs,
@@ -299,11 +302,15 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     check_finite(datasets, settings, scene, mechanism_reductions(mech), link_models)
     for recorder in recorders:  # its own time: after the check of the sampled datasets
         datasets.update(recorder.datasets())
+    cutoff_Hz = channel_cutoff_Hz(scene, link_models)
+    datasets.update(channel_datasets(datasets, cutoff_Hz))
     import tomli_w
 
     result = CaseResult(name, to_toml(scene), datasets, counters=counters,
                         solver_settings_toml=tomli_w.dumps(settings))
     result.attrs.update(flexible_link_attrs(scene, datasets, mechanism_reductions(mech)))
+    if cutoff_Hz is not None:
+        result.attrs[CHANNEL_ATTR] = cutoff_Hz
     warning = validity_warning(scene, datasets, link_models)
     if warning:
         result.attrs[VALIDITY_WARNING] = warning

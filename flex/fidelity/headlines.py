@@ -90,7 +90,7 @@ def first_crest_value(path: str) -> Callable[[Mapping[str, Any]], float | None]:
 
         if path not in datasets:
             return None
-        values = np.asarray(datasets[path].data, dtype=float)
+        values = channel(datasets, path)
         if not values.size or not np.any(values):
             return None
         return float(abs(values[first_peak_index(values)]))
@@ -110,19 +110,49 @@ def crest_gap(values: np.ndarray) -> float | None:
     return float(top - second)
 
 
+def channel(datasets: Mapping[str, Any], path: str) -> np.ndarray:
+    """Series ``path`` on the run's headline channel, ``channel/<path>`` (zero-phase
+    low-pass at the cut-off the run stores as ``channel_cutoff_Hz``,
+    :func:`flex.dynamics.advice.channel_datasets`), or the series itself where the run has
+    none (nothing flexible, or a sampling that holds nothing above the cut-off) [the series'
+    unit]."""
+    return np.asarray(datasets.get(f"channel/{path}", datasets[path]).data, dtype=float)
+
+
+def deployment_end(datasets: Mapping[str, Any]) -> int | None:
+    """Index of the deployment's last sample: the crank angle's first maximum
+    (:func:`flex.fidelity.criteria.first_maximum_index`); None when it has none (a constant-
+    speed crank, a deployment not reached: the deployment is then the whole run)."""
+    from flex.fidelity.criteria import first_maximum_index
+
+    if "crank/angle" not in datasets:
+        return None
+    top = first_maximum_index(channel(datasets, "crank/angle"))
+    return None if top is None or top == 0 else top
+
+
+def deployment_peak_value(path: str) -> Callable[[Mapping[str, Any]], float | None]:
+    """Reader of the largest ``|path|`` over the deployment (release to the crank's first
+    maximum, :func:`deployment_end`; the whole run without one) on the headline channel
+    (:func:`channel`); None without the series, or all zero."""
+    def read(datasets: Mapping[str, Any]) -> float | None:
+        if path not in datasets:
+            return None
+        end = deployment_end(datasets)
+        values = np.abs(channel(datasets, path))[:None if end is None else end + 1]
+        return float(np.max(values)) if values.size and np.any(values) else None
+    return read
+
+
 def deployment_time_s(datasets: Mapping[str, Any]) -> float | None:
     """Time of the first maximum of the crank angle [s] (delta_t, docs/criterion.md;
     :func:`flex.fidelity.criteria.first_maximum_index`, which ignores round-off); None
     when the crank angle has no maximum within the run (a deployment not reached, a
     constant-speed crank, a crank that never moves): missing, not the end time."""
-    from flex.fidelity.criteria import first_maximum_index
-
-    if "crank/angle" not in datasets:
+    top = deployment_end(datasets)
+    if top is None:
         return None
-    angle = np.asarray(datasets["crank/angle"].data, dtype=float)
-    top = first_maximum_index(angle)
-    if top is None or top == 0:
-        return None
+    angle = channel(datasets, "crank/angle")
     time_s = np.asarray(datasets["time"].data, dtype=float)
     # the parabola through the top sample and its neighbours: the maximum between samples
     # (a sample time alone is off by up to half a step, more than the run's own error)
@@ -132,38 +162,53 @@ def deployment_time_s(datasets: Mapping[str, Any]) -> float | None:
     return float(time_s[top] + np.clip(offset, -0.5, 0.5) * (time_s[top + 1] - time_s[top]))
 
 
-def _link_headlines(link: str) -> list[Headline]:
+DEPLOYMENT = "release to the first crank maximum, on the headline channel"
+_CHANNEL_TEXT = " (low-pass channel)"
+
+
+def _link_headlines(link: str) -> list[list[Headline]]:
     """A flexible link's own quantities: its peak deflection, bending and von Mises stress
-    over the whole run, and its deflection's first crest."""
+    over the deployment on the headline channel (the primary ones: they converge), and the
+    same raw over the whole run (the return swing included; a raw maximum races between the
+    sub-crests of undamped ringing)."""
     deflection = f"{link}/midpoint_deflection"
     away = " (away from the joint faces)"
-    return [
-        Headline(f"{link}_peak_deflection_m", "m",
-                 f"peak elastic midpoint deflection of the {link}",
-                 peak_value(deflection), "peak", deflection, link=link, certified=True,
-                 crest_gap=True),
-        Headline(f"{link}_peak_bending_stress_Pa", "Pa", f"peak bending stress of the {link}",
-                 peak_value(f"{link}/peak_bending_stress"), "peak",
-                 f"{link}/peak_bending_stress", link=link),
-        Headline(f"{link}_peak_von_mises_Pa", "Pa", f"peak von Mises stress of the {link}{away}",
-                 peak_value(f"{link}/peak_von_mises_stress"), "peak",
-                 f"{link}/peak_von_mises_stress", link=link),
-    ]
+    series = [(deflection, "deflection_m", f"peak elastic midpoint deflection of the {link}"),
+              (f"{link}/peak_bending_stress", "bending_stress_Pa",
+               f"peak bending stress of the {link}"),
+              (f"{link}/peak_von_mises_stress", "von_mises_Pa",
+               f"peak von Mises stress of the {link}{away}")]
+    deployment = [Headline(f"{link}_deployment_peak_{suffix}", suffix.rsplit("_", 1)[1], what
+                           + " over the deployment" + _CHANNEL_TEXT,
+                           deployment_peak_value(path), "value", path, window=DEPLOYMENT,
+                           link=link, certified=path == deflection)
+                  for path, suffix, what in series]
+    whole = [Headline(f"{link}_peak_{suffix}", suffix.rsplit("_", 1)[1],
+                      what + " over the whole run (raw)", peak_value(path), "peak", path,
+                      link=link, crest_gap=path == deflection)
+             for path, suffix, what in series]
+    return [deployment, whole]
 
 
 def _first_crest(link: str) -> Headline:
     deflection = f"{link}/midpoint_deflection"
     return Headline(f"{link}_first_crest_deflection_m", "m",
                     f"first crest of the elastic midpoint deflection of the {link} (largest "
-                    f"|deflection| of the first lobe)", first_crest_value(deflection),
-                    "first_crest", deflection, window="the first lobe of the deflection",
-                    link=link, certified=True)
+                    f"|deflection| of the first lobe){_CHANNEL_TEXT}",
+                    first_crest_value(deflection), "first_crest", deflection,
+                    window="the first lobe of the deflection, on the headline channel",
+                    link=link)
 
 
-def _joint_force(joint: str) -> Headline:
+def _joint_force(joint: str, deployment: bool) -> Headline:
     path = f"joints/{joint}/force_modulus"
-    return Headline(f"joint_{joint}_peak_force_N", "N", f"peak force of joint {joint}",
-                    peak_value(path), "peak", path)
+    if deployment:
+        return Headline(f"joint_{joint}_deployment_peak_force_N", "N",
+                        f"peak force of joint {joint} over the deployment{_CHANNEL_TEXT}",
+                        deployment_peak_value(path), "value", path, window=DEPLOYMENT)
+    return Headline(f"joint_{joint}_peak_force_N", "N",
+                    f"peak force of joint {joint} over the whole run (raw)", peak_value(path),
+                    "peak", path)
 
 
 def _builtin() -> dict[str, Headline]:
@@ -175,10 +220,13 @@ def _builtin() -> dict[str, Headline]:
                  final_value("slider/position"), window="the end time"),
         Headline("deployment_time_s", "s", "deployment time (first maximum of the crank angle)",
                  deployment_time_s, window="release to the first crank maximum"),
-        # the printed order: deflections, bending stresses, von Mises, joint forces, crests
-        *(own[link][k] for k in range(3) for link in ("coupler", "crank")),
-        *(_joint_force(joint) for joint in "ABC"),
+        # the printed order: over the deployment (deflections, bending stresses, von Mises,
+        # joint forces), then the first crests, then the same over the whole run
+        *(own[link][0][k] for k in range(3) for link in ("coupler", "crank")),
+        *(_joint_force(joint, True) for joint in "ABC"),
         *(_first_crest(link) for link in ("coupler", "crank")),
+        *(own[link][1][k] for k in range(3) for link in ("coupler", "crank")),
+        *(_joint_force(joint, False) for joint in "ABC"),
     ]
     return {entry.name: entry for entry in entries}
 
@@ -186,5 +234,6 @@ def _builtin() -> dict[str, Headline]:
 #: the built-in headline quantities, by name, in the order they are printed (immutable)
 BUILTIN_HEADLINES: Mapping[str, Headline] = MappingProxyType(_builtin())
 
-__all__ = ["BUILTIN_HEADLINES", "KINDS", "Headline", "crest_gap", "deployment_time_s",
+__all__ = ["BUILTIN_HEADLINES", "KINDS", "Headline", "channel", "crest_gap", "deployment_end",
+           "deployment_peak_value", "deployment_time_s",
            "final_value", "first_crest_value", "peak_value"]
