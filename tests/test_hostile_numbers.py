@@ -64,6 +64,8 @@ def _series(scale: float = 1.0, rising: bool = False) -> dict[str, Dataset]:
 
 
 def _kind(scene, base) -> str:
+    if scene["coupler"]["model"] != base["coupler"]["model"]:  # (the beam: its own step too)
+        return "model"
     if scene["simulation"]["step_s"] != base["simulation"]["step_s"]:
         return "step"
     if scene["coupler"]["modes"] != base["coupler"]["modes"]:

@@ -257,6 +257,28 @@ def _grouped(links: dict[str, Rung], text: str, joiner: str = " and ") -> list[s
     return [line.format(links=joiner.join(names)) for line, names in out.items() if line]
 
 
+def _measured_model_term(scene: Scene, result: CaseResult, companions: _Companions,
+                         bounded: dict[str, Rung]) -> tuple[dict[str, Any], list[str]]:
+    """The model term of the links whose rung measures it on the run's scene (a companion
+    one rung up, :attr:`flex.config.ladder.Rung.measured_against`): each headline quantity's
+    difference to that companion, the sentence, and under ``""`` the links it measured. A
+    companion the scene cannot run (a model the rung above does not offer for it, e.g. a
+    damped link) leaves its links to the fractions, and says so."""
+    measured = {link: rung for link, rung in bounded.items() if rung.measured_against}
+    if not measured:
+        return {}, []
+    overrides = [override.format(link=link) for link, rung in measured.items()
+                 for override in rung.measured_against(scene)]
+    failures = len(companions.failures)
+    above = companions.run("model", _companion(scene, list(dict.fromkeys(overrides))))
+    if above is None:
+        reason = companions.failures.pop(failures).split(": ", 1)[1]
+        return {}, [f"not measured on the scene ({reason}): the measured fractions instead"]
+    terms: dict[str, Any] = dict(companions.differences(result, above))
+    terms[""] = set(measured)
+    return terms, _grouped(measured, "measured_against_text")
+
+
 def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
                 leaves_out: list[str], link_models: Mapping[str, LinkModel]
                 ) -> tuple[dict[str, float], str]:
@@ -265,8 +287,8 @@ def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
     its companion's difference; every rung's ``leaves_out`` line, highest first."""
     rungs = _rungs(scene, link_models)
     bounded = {link: rung for link, rung in rungs.items() if rung is not None and rung.bounded}
-    terms: dict[str, float] = {}
-    sentences: list[str] = []
+    terms, sentences = _measured_model_term(scene, result, companions, bounded)
+    bounded = {link: rung for link, rung in bounded.items() if link not in terms.pop("", {})}
     if bounded:
         twin = companions.run("model", _companion(
             scene, [f'{link}.model="{model_names(link, link_models, rigid=True)[0]}"'
@@ -274,8 +296,8 @@ def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
         motion = max(rung.motion_fraction for rung in bounded.values())
         for name, value in companions.differences(result, twin).items():
             owner = companions.headlines[name].link
-            terms[name] = value * (bounded[owner].own(scene[owner]) if owner in bounded
-                                   else motion)
+            terms[name] = math.hypot(terms.get(name, 0.0), value * (
+                bounded[owner].own(scene[owner]) if owner in bounded else motion))
         sentences += _grouped(bounded, "measured_by")
         steps_up = {link: rung for link, rung in bounded.items() if rung.companion}
         if steps_up:
