@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from flex.fidelity.error_estimate import (
+    BOUND_FACTOR,
     MIN_STEPS_PER_PERIOD,
-    companion_step_s,
+    finer_estimate,
     integrator_order,
     richardson_error,
     unresolved_time_scales,
@@ -32,10 +33,32 @@ def test_richardson_is_exact_for_a_pure_power_law(order, coarser):
     assert estimate == pytest.approx(abs(constant) * step ** order, rel=1e-9)
 
 
-def test_the_companion_doubles_the_step_when_the_end_time_allows_it_else_halves_it():
-    assert companion_step_s(1e-5, 0.03) == pytest.approx(2e-5)
-    assert companion_step_s(4e-4, 0.03) == pytest.approx(2e-4)  # 0.03 / 8e-4 = 37.5 steps
-    assert companion_step_s(0.01, 0.05) == pytest.approx(0.005)
+@pytest.mark.parametrize("order", [1, 2, 4])
+def test_the_finer_companions_estimate_is_exact_for_a_pure_power_law(order):
+    """q(h) = q* + C h^p: one companion at h/2 gives the run's error C h^p exactly; a second at
+    h/4 observes the order p and gives it too."""
+    exact, constant, step = 1.25, -3.0e4, 1e-3
+    values = [exact + constant * (step / 2**k) ** order for k in range(3)]
+    differences = [abs(values[0] - values[1]), abs(values[1] - values[2])]
+    assert finer_estimate(differences[:1], order) == (
+        pytest.approx(abs(constant) * step ** order, rel=1e-9), None)
+    assert finer_estimate(differences, order) == (
+        pytest.approx(abs(constant) * step ** order, rel=1e-9), None)
+
+
+def test_an_order_outside_the_window_makes_the_term_a_bound():
+    """q(h) = q* + c h (first order where the integrator's is 2, as under-resolved content
+    converges): the three runs show order 1, outside the window: the term is a bound,
+    BOUND_FACTOR times the larger difference, which covers the true error c h; a lucky
+    agreement of the two finer runs is a bound too, never a zero."""
+    exact, c, h = 1.0, 30.0, 1e-4
+    values = [exact + c * h / 2**k for k in range(3)]
+    estimate, observed = finer_estimate([abs(values[0] - values[1]),
+                                         abs(values[1] - values[2])], 2)
+    assert observed == pytest.approx(1.0)
+    assert estimate == pytest.approx(BOUND_FACTOR * c * h / 2) and estimate >= c * h
+    lucky, observed = finer_estimate([1e-6, 0.0], 2)
+    assert lucky == pytest.approx(BOUND_FACTOR * 1e-6) and math.isnan(observed)
 
 
 def test_integrator_orders():
@@ -66,7 +89,7 @@ def test_a_rigid_run_estimates_its_own_error_against_the_reference_dae():
 
     result = simulate(load_scene(), cache_dir=None)
     assert result.attrs["estimated_error_validity"].startswith("asymptotic")
-    assert "companion runs at h = 2e-05, 4e-05 s" in result.attrs["estimated_error_method"]
+    assert "a companion run at h = 5e-06 s" in result.attrs["estimated_error_method"]
     time_s = np.asarray(result.datasets["time"].data)
     reference = solve_reference(load_scene(), time_s[[0, -1]], rtol=1e-12, atol=1e-14)
     true = abs(result.datasets["crank/angle"].data[-1] - reference.q[-1, 2])
@@ -86,7 +109,7 @@ def test_inspect_prints_the_estimated_error(tmp_path):
     text = format_description(describe(path))
     assert "estimated error (total = the root-sum-square of the terms):" in text
     assert "crank angle at the end time: " in text and "(root-sum-square of step " in text
-    assert "method: step: step doubling" in text and "validity: asymptotic" in text
+    assert "method: step: step halving" in text and "validity: asymptotic" in text
     assert "leaves out: " in text and "the elasticity of the rigid crank and coupler" in text
 
 
@@ -96,34 +119,6 @@ def test_no_estimate_when_switched_off():
     result = simulate(load_scene(overrides={"simulation.error_estimate": False,
                                             "simulation.end_time_s": 0.005}), cache_dir=None)
     assert not any(key.startswith("estimated_error") for key in result.attrs)
-
-
-def test_a_second_pair_guards_against_a_lucky_first_one():
-    """q(h) = q* + c h^2 exactly: both pairs give c h^2; a run whose 2h companion agrees with
-    it by luck still gets the (2h, 4h) pair's estimate scaled to h."""
-    from flex.fidelity.error_estimate import _estimate
-
-    exact, c, h = 1.0, 3.0e4, 1e-4
-    values = [exact + c * (k * h) ** 2 for k in (1, 2, 4)]
-    assert _estimate(values, [h, 2 * h, 4 * h], 2) == pytest.approx(c * h**2, rel=1e-9)
-    lucky = [values[1], values[1], values[2]]  # the run equals its 2h companion
-    assert _estimate(lucky, [h, 2 * h, 4 * h], 2) == pytest.approx(
-        abs(values[1] - values[2]) / 3.0 / 4.0, rel=1e-12)
-    assert _estimate(values[:2], [h, 2 * h], 2) == pytest.approx(c * h**2, rel=1e-9)
-
-
-def test_the_observed_order_replaces_the_formal_one():
-    """q(h) = q* + c h exactly (first order, as under-resolved content converges): the three
-    runs show order 1 and the estimate is c h, where the formal order 2 would give c h / 3;
-    a third-order sequence is clipped to the formal 2."""
-    from flex.fidelity.error_estimate import _estimate, observed_order
-
-    exact, c, h = 1.0, 30.0, 1e-4
-    first = [exact + c * k * h for k in (1, 2, 4)]
-    assert observed_order(first, 2) == pytest.approx(1.0)
-    assert _estimate(first, [h, 2 * h, 4 * h], 2) == pytest.approx(c * h, rel=1e-9)
-    third = [exact + c * (k * h) ** 3 for k in (1, 2, 4)]
-    assert observed_order(third, 2) == 2.0
 
 
 def _datasets(time_s, values):

@@ -201,15 +201,14 @@ def test_flex_design_says_a_tolerance_is_beyond_reach_before_it_starts(tmp_path)
 
 
 # --- messages that are right ----------------------------------------------------------------
-@pytest.mark.parametrize("step, end, companions", [
-    (1e-3, 2e-3, [2e-3]),            # one doubling only: a second would repeat the run's step
-    (1e-3, 4e-3, [2e-3, 4e-3]),
-    (1e-3, 8e-3, [2e-3, 4e-3]),
-    (1e-3, 3e-3, [5e-4]),            # an odd count: halving
-    (1e-5, 0.03, [2e-5, 4e-5]),
-    (2e-3, 2e-3, [1e-3]),
+@pytest.mark.parametrize("step, end, scales, companions", [
+    (1e-3, 2e-3, [], [5e-4]),               # every time scale resolved: one finer companion
+    (1e-3, 3e-3, [], [5e-4]),
+    (1e-5, 0.03, [], [5e-6]),
+    (2e-3, 2e-3, [], [1e-3]),
+    (1e-3, 4e-3, [(4e-3, 20.0, "a mode")], [5e-4, 2.5e-4]),  # unresolved: the order observed
 ])
-def test_the_error_estimate_names_its_companion_steps_truly(step, end, companions):
+def test_the_error_estimate_names_its_companion_steps_truly(step, end, scales, companions):
     from flex.fidelity.error_estimate import estimate_step_error
 
     scene = load_scene(overrides=[f"simulation.step_s={step}", f"simulation.end_time_s={end}",
@@ -223,7 +222,7 @@ def test_the_error_estimate_names_its_companion_steps_truly(step, end, companion
         return CaseResult("c", "", {"time": Dataset(np.array([0.0, end]), "s")})
 
     result = CaseResult("c", "", {"time": Dataset(np.array([0.0, end]), "s")})
-    estimate = estimate_step_error(scene, result, companion, [])
+    estimate = estimate_step_error(scene, result, companion, scales)
     assert ran == pytest.approx(companions)
     assert step not in ran
     shown = ", ".join(f"{h:g}" for h in companions)

@@ -8,8 +8,8 @@ scenes, it returns an :class:`ErrorBudget` with, for each headline quantity of t
 time, deployment time, peak joint forces, each flexible link's peak midpoint deflection and
 peak bending stress), four named terms and their total [the quantity's units]:
 
-- ``step``: the time step, by Richardson extrapolation over companions at 2 h and 4 h (or
-  h / 2) (:func:`flex.fidelity.error_estimate.estimate_step_error`);
+- ``step``: the time step, by Richardson extrapolation from finer companions at h / 2 (and
+  h / 4, observing the order) (:func:`flex.fidelity.error_estimate.estimate_step_error`);
 - ``modes``: the modal truncation of the FFRF links: the difference to a companion whose
   FFRF links keep :func:`richer_modes` modes (the richer basis taken as converged: modal
   convergence is fast, so the difference is the run's truncation error);
@@ -21,8 +21,10 @@ peak bending stress), four named terms and their total [the quantity's units]:
   first crest; a companion with fewer elements would put the racing peak of a coarse beam
   in the term);
 - ``model``: the link model against the next rung of flex's ladder, read from the rung each
-  link's model entry names (:mod:`flex.config.ladder`; no model is named here): a link on
-  a bounded rung (the FFRF bodies) gets its rung's ``own_fraction`` of what its elasticity
+  link's model entry names (:mod:`flex.config.ladder`; no model is named here): a rung that
+  measures its term on the scene (``measured_against``: the FFRF bodies, against the exact
+  beam) gets the difference to that companion; a link on another
+  bounded rung (the exact beam) gets its rung's ``own_fraction`` of what its elasticity
   changes in its own quantities and the ``motion_fraction`` of what it changes in the
   motion and the joint forces (the difference to a companion whose bounded links are rigid
   twins), plus the difference to the rung's companion one step up (the linear FFRF body:

@@ -1,31 +1,30 @@
-"""An estimate of a run's own step (time discretization) error on its headline quantities.
+"""An estimate of a run's own step (time discretization) error on its headline quantities,
+measured on *finer* companions.
 
 Contract of :func:`estimate_step_error`: given a finished run of a concrete scene (links
-rigid, ffrf or nonlinear_fe; ``"auto"`` solver keys resolved) and a way to run a companion
-scene, it runs companions that differ only in the step -- at twice and four times the step
-when the end time is a whole number of doubled steps, else one at half the step -- and
-returns an :class:`ErrorEstimate`:
+rigid, ffrf, exact_beam or nonlinear_fe; ``"auto"`` solver keys resolved) and a way to run a
+companion scene, it runs companions that differ only in the step -- at half the step, and at
+a quarter when the run's step leaves a time scale of the scene unresolved (the order must
+then be observed) -- and returns an :class:`ErrorEstimate`:
 
 - ``values``: for each headline quantity (``headlines``, default
-  :data:`flex.fidelity.headlines.BUILTIN_HEADLINES`: the crank angle and the slider position
-  at the end time, the peak elastic midpoint deflection of each flexible link, the peak von
-  Mises stress of each FFRF link away from its joint faces), the
-  estimated error of the run's value [the quantity's units], by Richardson extrapolation.
-  With the runs at h, 2h and 4h: the larger of ``|q_h - q_2h| / (2^p - 1)`` and the pair
-  (2h, 4h)'s, scaled to h by ``2^-p``, with p the order the three runs show
-  (:func:`observed_order`, clipped to 1..the integrator's order). The second pair guards
-  against two runs that agree by the phase of a crest (measured by ``make estimates``: 27x
-  optimistic on a 5 mm plate's crank angle with one pair), and the observed order against
-  the formal one's optimism outside the asymptotic range. With one companion at h/2:
-  ``|q_h - q_h/2| * 2^p / (2^p - 1)`` with the integrator's order p
-  (:func:`integrator_order`: 2 for generalized-alpha);
+  :data:`flex.fidelity.headlines.BUILTIN_HEADLINES`), the estimated error of the run's value
+  [the quantity's unit], by Richardson extrapolation from the finer runs: with the run at h
+  and its companion at h/2, ``|q_h - q_h/2| 2^p / (2^p - 1)`` with the integrator's order p
+  (:func:`integrator_order`: 2 for generalized-alpha). With a third run at h/4 the order is
+  observed, ``p_obs = log2(|q_h - q_h/2| / |q_h/2 - q_h/4|)``: inside :data:`ORDER_WINDOW`
+  of p the estimate uses it; outside, the quantity is not in the asymptotic range and its
+  value is a *bound*, :data:`BOUND_FACTOR` times the larger of the two differences (named so
+  in ``bounds``). Coarser companions are not used: the content a coarser step cannot
+  resolve (a thin plate's ringing) would put their damping in the estimate (make estimates
+  measured it 3-60x pessimistic, and on the deployment time 4x optimistic);
+- ``bounds``: the quantities whose value is such a bound, each with its observed order;
 - ``method``: that sentence, with the companions' steps;
 - ``validity``: ``"asymptotic"`` when every time scale of the scene
   (:func:`flex.dynamics.solver.time_scales`: the spring or crank period, the highest
   retained mode of each flexible link) has at least :data:`MIN_STEPS_PER_PERIOD` steps per
-  period at the run's step; otherwise the sentence names the time scales below it: their
-  content is numerically damped in both runs, so the estimate does not cover it (it may be
-  optimistic there);
+  period at the run's step; otherwise the sentence names the time scales below it, and the
+  quantities whose observed order left the window;
 - ``companion_wall_time_s``: what the estimate cost [s].
 
 It covers the step only: modal truncation and mesh errors are not estimated here. A
@@ -54,6 +53,11 @@ EXPLICIT_ORDERS = {"RK44": 4, "RK67": 6, "ExplicitMidpoint": 2}
 MIN_STEPS_PER_PERIOD = 10.0
 #: case attribute prefix
 PREFIX = "estimated_error_"
+#: an observed order within this distance of the integrator's is in the asymptotic range
+ORDER_WINDOW = 0.5
+#: outside the window the step term is a bound: this many times the larger difference of
+#: the three runs (a grid convergence index's safety factor for an unproven order)
+BOUND_FACTOR = 3.0
 
 
 def headline_difference(headline: Headline, run: Mapping[str, Any], other: Mapping[str, Any]
@@ -84,6 +88,9 @@ class ErrorEstimate:
     method: str = ""
     validity: str = ""
     companion_wall_time_s: float = 0.0
+    #: the quantities whose value is a bound (outside the asymptotic range), with the order
+    #: their three runs showed
+    bounds: dict[str, float] = field(default_factory=dict)
 
     def attrs(self) -> dict[str, Any]:
         """Case attributes: ``estimated_error_<quantity>`` [its units, in the name] and
@@ -104,13 +111,6 @@ def integrator_order(simulation: dict[str, Any]) -> int:
     if simulation["formulation"] == "index2" and simulation["spectral_radius"] < 1.0:
         return 1
     return 2
-
-
-def companion_step_s(step_s: float, end_time_s: float) -> float:
-    """Twice ``step_s`` if the end time is a whole number of doubled steps, else half."""
-    doubled = 2.0 * step_s
-    count = end_time_s / doubled
-    return doubled if abs(count - round(count)) < 1e-9 * max(count, 1.0) else step_s / 2.0
 
 
 def richardson_error(value: float, companion: float, step_s: float, companion_step: float,
@@ -139,29 +139,20 @@ def estimate_step_error(scene: Scene, result: CaseResult,
                         time_scales: list[tuple[float, float, str]],
                         headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> ErrorEstimate:
     """The estimated step error of ``result``, the run of ``scene`` (concrete models, solver
-    keys resolved), from one companion run made by ``run_companion`` (see the module doc).
-    ``time_scales``: the scene's (:func:`flex.dynamics.solver.time_scales`); ``headlines``:
-    the quantities estimated (:mod:`flex.fidelity.headlines`)."""
+    keys resolved), from finer companion runs made by ``run_companion`` (see the module
+    doc). ``time_scales``: the scene's (:func:`flex.dynamics.solver.time_scales`);
+    ``headlines``: the quantities estimated (:mod:`flex.fidelity.headlines`)."""
     sim = scene["simulation"]
     step = float(sim["step_s"])
-    other = companion_step_s(step, float(sim["end_time_s"]))
     unresolved = unresolved_time_scales(time_scales, step)
-    validity = ("asymptotic: every time scale of the scene has at least "
-                f"{MIN_STEPS_PER_PERIOD:g} steps per period" if not unresolved else
-                "outside the asymptotic range for " + "; ".join(unresolved)
-                + ": that content is numerically damped in both runs and the estimate does "
-                  "not cover it")
     order = integrator_order(sim)
-    steps = [step, other]
-    further = companion_step_s(other, float(sim["end_time_s"])) if other > step else 0.0
-    if further > other:  # a second pair: guards against a lucky first one, shows the order
-        steps.append(further)  # (only a doubling: a halving would repeat the run's own step)
+    steps = [step, step / 2.0] + ([step / 4.0] if unresolved else [])
     at = ", ".join(f"{h:g}" for h in steps[1:])
-    method = (f"step doubling: {'companion runs' if len(steps) > 2 else 'a companion run'} "
-              f"at h = {at} s (the run: {step:g} s), Richardson extrapolation with the "
-              f"integrator's order "
-              f"{order}{'; the larger of the two pairs, scaled to h' if len(steps) > 2 else ''}"
-              f".")
+    method = (f"step halving: {'companion runs' if len(steps) > 2 else 'a companion run'} at "
+              f"h = {at} s (the run: {step:g} s), Richardson extrapolation with the "
+              + (f"observed order (within {ORDER_WINDOW:g} of the integrator's {order}; "
+                 f"outside it a bound, {BOUND_FACTOR:g}x the larger difference)"
+                 if len(steps) > 2 else f"integrator's order {order}") + ".")
     start = time.perf_counter()
     runs = [result.datasets]
     for companion_step in steps[1:]:
@@ -173,7 +164,8 @@ def estimate_step_error(scene: Scene, result: CaseResult,
             return ErrorEstimate({}, method, f"not estimated: the companion run at "
                                  f"{companion_step:g} s failed ({exc})",
                                  time.perf_counter() - start)
-    values = {}
+    values: dict[str, float] = {}
+    bounds: dict[str, float] = {}
     for name, headline in headlines.items():
         read_values = [headline.read(datasets) for datasets in runs]
         if read_values[0] is None:
@@ -181,13 +173,49 @@ def estimate_step_error(scene: Scene, result: CaseResult,
         if any(value is None for value in read_values):  # a companion lacks it: unknown
             values[name] = math.nan
             continue
-        if headline.kind == "peak":
-            differences = [peak_difference(runs[k], runs[k + 1], headline.series)
-                           for k in range(len(runs) - 1)]
-            values[name] = _estimate_from_differences(differences, steps, order)
-        else:
-            values[name] = _estimate(read_values, steps, order)
-    return ErrorEstimate(values, method, validity, time.perf_counter() - start)
+        differences = [_difference(headline, runs[k], runs[k + 1], read_values[k:k + 2])
+                       for k in range(len(runs) - 1)]
+        values[name], observed = finer_estimate(differences, order)
+        if observed is not None:
+            bounds[name] = observed
+    return ErrorEstimate(values, method, _validity(unresolved, bounds),
+                         time.perf_counter() - start, bounds)
+
+
+def _difference(headline: Headline, run: Mapping[str, Any], other: Mapping[str, Any],
+                values: list[float]) -> float:
+    if headline.kind == "peak":
+        return peak_difference(run, other, headline.series)
+    return abs(values[0] - values[1])
+
+
+def finer_estimate(differences: list[float], order: int) -> tuple[float, float | None]:
+    """The run's step error from ``|q_h - q_h/2|`` (and ``|q_h/2 - q_h/4|``) for an
+    integrator of ``order`` (module doc), and the observed order when the value is a bound
+    (None: an estimate)."""
+    first = differences[0]
+    if len(differences) < 2:
+        return richardson_error(first, 0.0, 1.0, 0.5, order), None
+    second = differences[1]
+    if first == 0.0 and second == 0.0:
+        return 0.0, None
+    observed = math.log2(first / second) if first > 0 and second > 0 else math.nan
+    if abs(observed - order) <= ORDER_WINDOW:
+        return richardson_error(first, 0.0, 1.0, 0.5, observed), None
+    return BOUND_FACTOR * max(first, second), observed
+
+
+def _validity(unresolved: list[str], bounds: dict[str, float]) -> str:
+    if not unresolved:
+        return (f"asymptotic: every time scale of the scene has at least "
+                f"{MIN_STEPS_PER_PERIOD:g} steps per period")
+    text = ("outside the asymptotic range for " + "; ".join(unresolved)
+            + ": the order was observed on a second, finer companion")
+    if bounds:
+        text += (" and left the window for " + ", ".join(
+            f"{name} (observed order {order:.2g})" for name, order in bounds.items())
+            + ": their step terms are bounds")
+    return text
 
 
 def peak_difference(run: dict[str, Any], other: dict[str, Any], path: str) -> float:
@@ -233,48 +261,6 @@ def _crest(magnitude: np.ndarray) -> np.ndarray:
     return np.arange(start, end)
 
 
-def _estimate_from_differences(differences: list[float], steps: list[float], order: int
-                               ) -> float:
-    """:func:`_estimate` from the pairs' differences ``|q_h - q_2h|`` (and ``|q_2h -
-    q_4h|``) or ``|q_h - q_h/2|``."""
-    if len(differences) < 2:
-        return richardson_error(differences[0], 0.0, steps[0], steps[1], order)
-    p = _order(differences[0], differences[1], order)
-    first = richardson_error(differences[0], 0.0, steps[0], steps[1], p)
-    second = richardson_error(differences[1], 0.0, steps[1], steps[2], p)
-    return max(first, second * (steps[0] / steps[1]) ** p)
-
-
-def _estimate(values: list[float], steps: list[float], order: int) -> float:
-    """The run's (``values[0]`` at ``steps[0]``) estimated error from its companions: the
-    first pair's Richardson estimate; with a third run (steps h, 2h, 4h) the larger of it and
-    the second pair's scaled to the run's step by ``2^-p``, both with the observed order
-    (:func:`observed_order`) in place of the formal one."""
-    if len(values) < 3:
-        return richardson_error(values[0], values[1], steps[0], steps[1], order)
-    p = observed_order(values, order)
-    first = richardson_error(values[0], values[1], steps[0], steps[1], p)
-    second = richardson_error(values[1], values[2], steps[1], steps[2], p)
-    return max(first, second * (steps[0] / steps[1]) ** p)
-
-
-def observed_order(values: list[float], order: int) -> float:
-    """The order of convergence three runs at h, 2h, 4h show, ``log2(|q_2h - q_4h| / |q_h -
-    q_2h|)``, clipped to [1, ``order``]: outside the asymptotic range the error falls more
-    slowly than the formal order says (unresolved content damped step by step), and a
-    formal-order Richardson estimate is then optimistic; an agreement by luck (a vanishing
-    first difference) reads as the formal order."""
-    return _order(abs(values[0] - values[1]), abs(values[1] - values[2]), order)
-
-
-def _order(near: float, far: float, order: int) -> float:
-    """:func:`observed_order` from the two differences."""
-    if near == 0.0 or far == 0.0:
-        return float(order)
-    return float(min(max(math.log2(far / near), 1.0), order))
-
-
-__all__ = ["ErrorEstimate", "MIN_STEPS_PER_PERIOD", "companion_step_s", "crest_gap",
-           "headline_difference", "peak_difference",
-           "estimate_step_error", "integrator_order", "observed_order", "richardson_error",
-           "unresolved_time_scales"]
+__all__ = ["BOUND_FACTOR", "ErrorEstimate", "MIN_STEPS_PER_PERIOD", "ORDER_WINDOW", "crest_gap",
+           "estimate_step_error", "finer_estimate", "headline_difference", "integrator_order",
+           "peak_difference", "richardson_error", "unresolved_time_scales"]

@@ -163,7 +163,7 @@ def deployment_time_s(datasets: Mapping[str, Any]) -> float | None:
 
 
 DEPLOYMENT = "release to the first crank maximum, on the headline channel"
-_CHANNEL_TEXT = " (low-pass channel)"
+_CHANNEL_TEXT = " (headline channel)"
 
 
 def _link_headlines(link: str) -> list[list[Headline]]:

@@ -279,9 +279,9 @@ def _say_status(name: str, status: str, tolerance: float) -> None:
               flush=True)
 
 
-#: runs of an attempt's error budget, in run-equivalents (companions at 2 h and 4 h, more
-#: modes, a coarser mesh, a rigid twin; rough: the coarser ones cost less)
-BUDGET_RUNS = 4.0
+#: runs of an attempt's error budget, in run-equivalents (a companion at h / 2, more modes, a
+#: coarser mesh, the rung above; rough: the coarser ones cost less, one at h / 4 more)
+BUDGET_RUNS = 5.0
 
 
 def _attempt_cost_s(scene: Scene, link_models: Mapping[str, LinkModel]) -> float:
