@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from flex.base.physics import (
+    Plate,
     pinned_beam_end_moment_midpoint_deflection_m,
     pinned_beam_midpoint_deflection_m,
 )
@@ -83,7 +84,8 @@ def test_the_crank_s_quasi_static_deflection_against_ritz(force_b):
     pivot_moment = per_length * alpha * L**3 / 3 - force * L  # moments about A vanish
     expected = _ritz_deflection(np.array([L / 2]), lambda x: -per_length * alpha * x,
                                 pivot_moment)[0]
-    deflection, compression = _crank_history(_synthetic_crank(alpha, force, 0.7), plate)
+    deflection, compression = _crank_history(_synthetic_crank(alpha, force, 0.7),
+                                             Plate.of(plate))
     np.testing.assert_allclose(deflection, expected, rtol=1e-6)
     np.testing.assert_allclose(compression, 0.0, atol=1e-12)
     prediction = predict_deflection(_synthetic_crank(alpha, force, 0.7), plate, "crank")
@@ -100,7 +102,7 @@ def test_the_pivot_moment_from_statics_is_the_wing_s_weld_moment():
                                               "wing.enabled=true",
                                               "simulation.end_time_s=0.01"])
     series = {k: v.data for k, v in simulate(scene).datasets.items()}
-    deflection, _ = _crank_history(series, scene["crank"])
+    deflection, _ = _crank_history(series, Plate.of(scene["crank"]))
     crank = scene["crank"]
     sizes = (crank["length_m"], crank["thickness_m"], crank["width_m"],
              crank["youngs_modulus_Pa"])

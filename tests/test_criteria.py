@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from flex.base.errors import FlexError, SceneError
+from flex.base.physics import Plate
 from flex.data.scene import load_scene
 from flex.fidelity import auto, criteria, laws
 from flex.fidelity.auto import decide_links
@@ -107,7 +108,7 @@ def test_error_measures_are_relative_and_use_the_window():
                          "coupler/peak_bending_stress": np.full(400, 1.5 * qs_peak)})
     ffrf["coupler/midpoint_deflection"][-1] = 1.0  # outside the window: ignored
     window = rigid["time"][-2]
-    e = criteria.error_measures(rigid, ffrf, 0.08, 0.002, 0.01, window)
+    e = criteria.error_measures(rigid, ffrf, Plate(0.08, 0.002, 0.01, 200e9, 7850.0), window)
     swing = np.max(np.abs(rigid["crank/angle"][:-1] - rigid["crank/angle"][0]))
     travel = np.max(np.abs(rigid["slider/position"][:-1] - rigid["slider/position"][0]))
     assert e["deflection"] == pytest.approx(8e-6 / 0.08)
@@ -300,11 +301,10 @@ def test_auto_climbs_past_the_ffrf_body_for_a_coupler_near_buckling():
 def test_euler_load_ratio_of_a_compressed_link():
     axis = np.array([[1.0, 0.0]])
     euler = math.pi**2 * 200e9 * 0.01 * 0.001**3 / 12 / 0.08**2  # 257 N
-    ratio = criteria.euler_load_ratio(128.5 * axis, -128.5 * axis, np.zeros(1), 0.08, 0.001,
-                                      0.01, 200e9)
+    plate = Plate(0.08, 0.001, 0.01, 200e9, 7850.0)
+    ratio = criteria.euler_load_ratio(128.5 * axis, -128.5 * axis, np.zeros(1), plate)
     assert ratio == pytest.approx(128.5 / euler)
-    assert criteria.euler_load_ratio(-axis, axis, np.zeros(1), 0.08, 0.001, 0.01,
-                                     200e9) == 0.0  # tension
+    assert criteria.euler_load_ratio(-axis, axis, np.zeros(1), plate) == 0.0  # tension
 
 
 def test_auto_crank_is_rigid_ffrf_or_refused_with_a_reason(reduction_cache):

@@ -47,7 +47,7 @@ def _observed_order(coarse: float, middle: float, fine: float) -> float:
 
 
 def test_section_is_the_plates_closed_forms():
-    section = exact_beam_section(**PLATE)
+    section = exact_beam_section(physics.Plate(**PLATE))
     length, t, w = PLATE["length_m"], PLATE["thickness_m"], PLATE["width_m"]
     e, rho, nu = PLATE["youngs_modulus_Pa"], PLATE["density_kg_per_m3"], PLATE["poisson_ratio"]
     mass = physics.cuboid_mass_kg(length, t, w, rho)
@@ -65,7 +65,7 @@ def test_section_is_the_plates_closed_forms():
 
 
 def test_section_stresses_are_the_outer_fibres_and_the_neutral_axis():
-    section = exact_beam_section(**PLATE)
+    section = exact_beam_section(physics.Plate(**PLATE))
     area, inertia, c = section.area_m2, section.second_moment_m4, 0.5 * PLATE["thickness_m"]
     axial, shear, moment = np.array([[20.0, -5.0]]), np.array([[0.0, 40.0]]), \
         np.array([[-0.1, 0.0]])
@@ -84,7 +84,8 @@ def _pinned_frequency(thickness_m: float, elements: int) -> float:
 
     system = exu.SystemContainer()
     mbs = system.AddSystem()
-    add_exact_beam_link(mbs, exact_beam_section(**dict(PLATE, thickness_m=thickness_m)),
+    plate = physics.Plate(**dict(PLATE, thickness_m=thickness_m))
+    add_exact_beam_link(mbs, exact_beam_section(plate),
                         elements, [0.01, 0.02], 0.6)  # turned: frame-independent
     mbs.Assemble()
     held = [0, 1, 3 * elements, 3 * elements + 1]
@@ -103,7 +104,7 @@ def test_static_end_moment_gives_the_closed_form_deflection_and_section_forces()
     import exudyn.itemInterface as eii
 
     elements, moment_Nm = 16, 0.01
-    section = exact_beam_section(**PLATE)
+    section = exact_beam_section(physics.Plate(**PLATE))
     system = exu.SystemContainer()  # holds the system: kept while it is used
     mbs = system.AddSystem()
     beam = add_exact_beam_link(mbs, section, elements, [0.0, 0.0], 0.0)

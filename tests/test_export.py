@@ -248,10 +248,8 @@ def test_export_refuses_a_basis_that_does_not_match(ffrf_file, tmp_path, capsys,
 def test_a_rebuilt_reduction_is_the_same_basis(ffrf_file, reduction):
     from flex.bodies.reduction import build_reduction
 
-    rebuilt = build_reduction(reduction.length_m, reduction.thickness_m, reduction.width_m,
-                              reduction.youngs_modulus_Pa, reduction.density_kg_per_m3,
-                              reduction.poisson_ratio, reduction.mesh_size_m, reduction.modes,
-                              None, mode_selection=reduction.mode_selection)
+    rebuilt = build_reduction(reduction.plate, reduction.mesh_size_m, reduction.modes, None,
+                              mode_selection=reduction.mode_selection)
     with h5py.File(ffrf_file) as h5:
         attrs = dict(h5["cases/case"].attrs)
     assert check_basis_identity("coupler", rebuilt, attrs) is None

@@ -39,6 +39,7 @@ import h5py
 import numpy as np
 import pytest
 
+from flex.base.physics import Plate
 from flex.bodies.nonlinear import nonlinear_plate_for_scene
 from flex.bodies.reduction import reduction_cache_dir
 from flex.config.settings import pinned_overrides
@@ -67,7 +68,8 @@ PLATE_1MM = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.thickn
 # a coarse 5 mm plate (maxh 5 mm, 1.4k coordinates) for the quick checks; the other values
 # are the bundled scene's
 COARSE_PLATE = dict(length_m=0.08, thickness_m=0.005, width_m=0.01, youngs_modulus_Pa=200e9,
-                    density_kg_per_m3=7850.0, poisson_ratio=0.3, mesh_size_m=0.005)
+                    density_kg_per_m3=7850.0, poisson_ratio=0.3)
+COARSE_MESH_M = 0.005
 COARSE_PLATE_SCENE = ['coupler.geometry="plate"', "coupler.thickness_m=0.005",
                       "coupler.mesh_size_m=0.005"]
 REFERENCE_MODES = 12
@@ -174,7 +176,7 @@ def test_nonlinear_plate_has_the_reductions_mesh_and_node_sets(reduction_cache):
     from flex.bodies.nonlinear import build_nonlinear_plate
     from flex.dynamics.solver import reduction_for_scene
 
-    plate = build_nonlinear_plate(**COARSE_PLATE)
+    plate = build_nonlinear_plate(Plate(**COARSE_PLATE), COARSE_MESH_M)
     # the stiff-limit test's steel plate: the reduction comes from the cache
     reduction = reduction_for_scene(load_scene(overrides=COARSE_PLATE_SCENE + ["coupler.modes=2"]),
                                     cache_dir=reduction_cache)
@@ -192,9 +194,9 @@ def test_nonlinear_plate_refuses_bad_sizes():
     from flex.bodies.nonlinear import build_nonlinear_plate
 
     with pytest.raises(SceneError, match="thickness_m"):
-        build_nonlinear_plate(**{**COARSE_PLATE, "thickness_m": -1.0})
+        build_nonlinear_plate(Plate(**{**COARSE_PLATE, "thickness_m": -1.0}), COARSE_MESH_M)
     with pytest.raises(SceneError, match="poisson_ratio"):
-        build_nonlinear_plate(**{**COARSE_PLATE, "poisson_ratio": 0.5})
+        build_nonlinear_plate(Plate(**{**COARSE_PLATE, "poisson_ratio": 0.5}), COARSE_MESH_M)
 
 
 def test_nonlinear_fe_scene_needs_a_plate_and_no_damping():
@@ -347,14 +349,15 @@ def test_first_peak_is_the_first_lobe_not_the_ripple_or_the_largest_swing():
 
 
 def test_coupler_compression_is_the_joint_C_force_toward_B():
-    from flex.fidelity.softening import coupler_compression_N, coupler_euler_load_N
+    from flex.fidelity.softening import coupler_compression_N
 
     data = {"coupler/angle": np.array([0.0, np.pi / 2, 0.0]),
             "joints/C/force_on_coupler": np.array([[-5.0, 0.0], [0.0, -3.0], [2.0, 0.0]])}
     assert np.allclose(coupler_compression_N(data), [5.0, 3.0, -2.0], rtol=0, atol=1e-12)
     assert np.allclose(coupler_compression_N(data, 2), [5.0, 3.0], rtol=0, atol=1e-12)
-    coupler = dict(length_m=0.08, thickness_m=0.001, width_m=0.01, youngs_modulus_Pa=200e9)
-    assert coupler_euler_load_N(coupler) == pytest.approx(
+    coupler = dict(length_m=0.08, thickness_m=0.001, width_m=0.01, youngs_modulus_Pa=200e9,
+                   density_kg_per_m3=7850.0)
+    assert Plate.of(coupler).euler_load_N == pytest.approx(
         np.pi ** 2 * 200e9 * 0.01 * 0.001 ** 3 / 12 / 0.08 ** 2, rel=1e-12)  # 257 N
 
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from flex.base.errors import SceneError
-from flex.base.physics import euler_buckling_load_N
+from flex.base.physics import Plate, euler_buckling_load_N
 from flex.bodies.geometric_stiffness import (
     add_geometric_stiffness,
     geometric_stiffness,
@@ -37,7 +37,11 @@ HINGED_DISTRIBUTED_LOAD_FACTOR = 18.6
 
 @pytest.fixture(scope="module")
 def reduction(reduction_cache):
-    return build_reduction(**PLATE, cache_dir=reduction_cache)
+    sizes = {key: PLATE[key] for key in ("length_m", "thickness_m", "width_m",
+                                         "youngs_modulus_Pa", "density_kg_per_m3",
+                                         "poisson_ratio")}
+    return build_reduction(Plate(**sizes), PLATE["mesh_size_m"], PLATE["modes"],
+                           cache_dir=reduction_cache)
 
 
 @pytest.fixture(scope="module")

@@ -23,6 +23,7 @@ import h5py
 import numpy as np
 import pytest
 
+from flex.base.physics import Plate
 from flex.bodies import reduction as red
 from flex.bodies.reduction import cache as red_cache
 from flex.data import cache as cache_module
@@ -31,7 +32,7 @@ from flex.data.results import CaseResult, Dataset
 from flex.data.scene import load_scene
 from flex.sweep import case_path, run_sweep
 
-PLATE = (0.04, 0.004, 0.01, 2.1e11, 7850.0, 0.3, 0.008, 1)
+PLATE = (Plate(0.04, 0.004, 0.01, 2.1e11, 7850.0, 0.3), 0.008, 1)
 
 
 @pytest.fixture(scope="module")

@@ -122,3 +122,18 @@ def test_only_the_registry_and_the_schema_name_the_nonlinear_fe_model():
              for path in sorted(FLEX.rglob("*.py")) if path not in allowed
              for line, text in _strings_outside_docstrings(path) if "nonlinear_fe" in text]
     assert not found, f"model name written outside the registry: {found}"
+
+
+def test_stored_motion_is_read_back_through_the_entrys_reader():
+    """The contract's point 10: each entry names its reader of stored motion; flex.tools.motion
+    calls through it and names no kind."""
+    from flex.dynamics.link_outputs import MotionReader
+
+    for model in BUILTIN_LINK_MODELS.values():
+        assert isinstance(model.stored_motion, MotionReader)
+    assert BUILTIN_LINK_MODELS["rigid"].stored_motion.kind == "rigid"
+    assert BUILTIN_LINK_MODELS["ffrf"].stored_motion.kind == "modal"
+    with pytest.raises(ValueError, match="MotionReader"):
+        dataclasses.replace(BUILTIN_LINK_MODELS["rigid"], stored_motion="modal")
+    text = (FLEX / "tools" / "motion.py").read_text()
+    assert not any(f'"{kind}"' in text for kind in ("modal", "nodal", "none"))

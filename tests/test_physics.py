@@ -230,3 +230,19 @@ def test_thesis_constants_agree_with_the_tables_they_came_from():
         thesis.THESIS_K_COUPLER
     assert set(thesis.THESIS_TABLE5["coupler_length_m"]) == {thesis.THESIS_COUPLER_LENGTH_M}
     assert set(thesis.THESIS_TABLE5["coupler_width_m"]) == {thesis.THESIS_TABLE5_WIDTH_M}
+
+
+def test_a_plate_value_reads_a_scene_link_and_calls_the_closed_forms():
+    from flex.data.scene import default_scene
+
+    values = dict(default_scene()["coupler"], thickness_m=0.002)
+    plate = physics.Plate.of(values)
+    assert plate.sizes_m == (0.08, 0.002, 0.01) and plate.poisson_ratio == 0.3
+    assert plate.mass_kg == physics.cuboid_mass_kg(0.08, 0.002, 0.01, 7850.0)
+    assert plate.inertia_kgm2 == physics.cuboid_inertia_kgm2(plate.mass_kg, 0.08, 0.002)
+    assert plate.euler_load_N == physics.euler_buckling_load_N(0.08, 0.002, 0.01, 200e9)
+    assert plate.pinned_pinned_omega == physics.pinned_pinned_omega(0.08, 0.002, 200e9, 7850.0)
+    assert plate.in_plane_omegas(3) == physics.in_plane_fixed_interface_omegas(
+        0.08, 0.002, 0.01, 200e9, 7850.0, 0.3, 3)
+    assert plate.clamped_frequencies(5) == physics.clamped_plate_frequencies(
+        0.08, 0.002, 0.01, 200e9, 7850.0, 0.3, 5)

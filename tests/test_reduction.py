@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from flex.base.errors import SceneError
+from flex.base.physics import Plate
 from flex.bodies.reduction import (
     add_ffrf_link,
     bending_stress_history,
@@ -26,7 +27,7 @@ E, RHO, NU = 200e9, 7850.0, 0.3
 MESH_SIZE, MODES = 0.003, 6
 INERTIA = WIDTH * THICKNESS**3 / 12  # m^4
 AREA = WIDTH * THICKNESS
-ARGS = (LENGTH, THICKNESS, WIDTH, E, RHO, NU, MESH_SIZE, MODES)
+ARGS = (Plate(LENGTH, THICKNESS, WIDTH, E, RHO, NU), MESH_SIZE, MODES)
 
 # a pose that is neither axis-aligned nor at the origin, to catch frame mix-ups
 POSITION_B = np.array([0.01, 0.02, 0.0])
@@ -88,10 +89,10 @@ def dynamic_settings(end_time: float, step: float):
     (6, 0.1, "<= length_m"), (7, 0, ">= 1"), (7, 2.5, ">= 1"),
 ])
 def test_bad_inputs_raise_scene_error_naming_the_range(index, value, words, tmp_path):
-    args = list(ARGS)
+    args = [LENGTH, THICKNESS, WIDTH, E, RHO, NU, MESH_SIZE, MODES]
     args[index] = value
     with pytest.raises(SceneError, match=re.escape(words)):
-        build_reduction(*args, cache_dir=tmp_path)
+        build_reduction(Plate(*args[:6]), *args[6:], cache_dir=tmp_path)
 
 
 # ------------------------------------------------------------------------------------------
@@ -353,7 +354,7 @@ def test_bending_stress_history_checks_columns(reduction):
 ])
 def test_thesis_plates_pinned_pinned_frequency(thickness, mesh_size, low, high, tmp_path):
     """The four Table 5 plates at the recommended mesh sizes against Euler-Bernoulli."""
-    reduction = build_reduction(LENGTH, thickness, WIDTH, E, RHO, NU, mesh_size, MODES,
+    reduction = build_reduction(Plate(LENGTH, thickness, WIDTH, E, RHO, NU), mesh_size, MODES,
                                 cache_dir=tmp_path)
     inertia, area = WIDTH * thickness**3 / 12, WIDTH * thickness
     euler_bernoulli = (np.pi / LENGTH) ** 2 * np.sqrt(E * inertia / (RHO * area)) / (2 * np.pi)

@@ -18,7 +18,8 @@ section.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
@@ -326,6 +327,73 @@ def in_plane_fixed_interface_omegas(length_m: float, thickness_m: float, width_m
     axial = [axial_omega(index + 1, length_m, youngs_modulus_Pa, density_kg_per_m3)
              for index in range(count)]
     return sorted(bending + axial)[:count]
+
+
+
+@dataclass(frozen=True)
+class Plate:
+    """A plate link's geometry and material: the one value the closed forms above are read
+    from (instead of six loose numbers).
+
+    Sizes [m]: ``length_m`` along the link, ``thickness_m`` in the mechanism plane (the
+    in-plane bending height), ``width_m`` across it; ``youngs_modulus_Pa`` [Pa],
+    ``density_kg_per_m3`` [kg/m^3], ``poisson_ratio`` [-]. The derived values call the
+    module's formulas (each exists once, as a function of loose numbers)."""
+
+    length_m: float
+    thickness_m: float
+    width_m: float
+    youngs_modulus_Pa: float
+    density_kg_per_m3: float
+    poisson_ratio: float = 0.3
+
+    @classmethod
+    def of(cls, values: Mapping[str, Any]) -> Plate:
+        """The plate of a scene link's values (``scene["coupler"]``, ``scene["crank"]``: the
+        keys of the same names; ``poisson_ratio`` 0.3 where absent)."""
+        return cls(values["length_m"], values["thickness_m"], values["width_m"],
+                   values["youngs_modulus_Pa"], values["density_kg_per_m3"],
+                   values.get("poisson_ratio", 0.3))
+
+    @property
+    def sizes_m(self) -> tuple[float, float, float]:
+        """``(length_m, thickness_m, width_m)`` [m]."""
+        return self.length_m, self.thickness_m, self.width_m
+
+    @property
+    def mass_kg(self) -> float:
+        """Its mass [kg] (:func:`cuboid_mass_kg`)."""
+        return cuboid_mass_kg(*self.sizes_m, self.density_kg_per_m3)
+
+    @property
+    def inertia_kgm2(self) -> float:
+        """Its in-plane inertia about the centre of mass [kg m^2] (:func:`cuboid_inertia_kgm2`)."""
+        return cuboid_inertia_kgm2(self.mass_kg, self.length_m, self.thickness_m)
+
+    @property
+    def euler_load_N(self) -> float:
+        """Its pinned-pinned in-plane Euler buckling load [N] (:func:`euler_buckling_load_N`)."""
+        return euler_buckling_load_N(*self.sizes_m, self.youngs_modulus_Pa)
+
+    @property
+    def pinned_pinned_omega(self) -> float:
+        """Its first pinned-pinned in-plane bending circular frequency [rad/s]
+        (:func:`pinned_pinned_omega`)."""
+        return pinned_pinned_omega(self.length_m, self.thickness_m, self.youngs_modulus_Pa,
+                                   self.density_kg_per_m3)
+
+    def clamped_frequencies(self, count: int = 40) -> list[tuple[float, str]]:
+        """Its ``count`` lowest fixed-interface ``(omega [rad/s], kind)`` estimates
+        (:func:`clamped_plate_frequencies`)."""
+        return clamped_plate_frequencies(*self.sizes_m, self.youngs_modulus_Pa,
+                                         self.density_kg_per_m3, self.poisson_ratio, count)
+
+    def in_plane_omegas(self, count: int) -> list[float]:
+        """Its ``count`` lowest in-plane fixed-interface circular frequencies [rad/s]
+        (:func:`in_plane_fixed_interface_omegas`)."""
+        return in_plane_fixed_interface_omegas(*self.sizes_m, self.youngs_modulus_Pa,
+                                               self.density_kg_per_m3, self.poisson_ratio,
+                                               count)
 
 
 # --- the deployment spring as a rod: Rayleigh's effective mass, the released coil ------------

@@ -73,6 +73,11 @@ class Material:
     density_kg_per_m3: float
     poissons_ratio: float
 
+    @classmethod
+    def of(cls, plate: physics.Plate) -> Material:
+        """The material of a plate link (its E [Pa], rho [kg/m^3], nu)."""
+        return cls(plate.youngs_modulus_Pa, plate.density_kg_per_m3, plate.poisson_ratio)
+
     @property
     def shear_modulus_Pa(self) -> float:
         """G = E / (2 (1 + nu)), Pa."""

@@ -59,18 +59,18 @@ class ExactBeamSection:
         return 0.5 * self.thickness_m
 
 
-def exact_beam_section(length_m: float, thickness_m: float, width_m: float,
-                       youngs_modulus_Pa: float, density_kg_per_m3: float,
-                       poisson_ratio: float,
+def exact_beam_section(plate: physics.Plate,
                        shear_correction: float = SHEAR_CORRECTION_RECTANGLE
                        ) -> ExactBeamSection:
-    """The beam section of a ``length_m`` x ``thickness_m`` x ``width_m`` plate of the given
+    """The beam section of a ``length_m`` x ``thickness_m`` x ``width_m`` plate [m] of its
     material: E A, E I, kappa G A, rho A, rho I (see the module doc)."""
+    length_m, thickness_m, width_m = plate.sizes_m
+    youngs_modulus_Pa, density_kg_per_m3 = plate.youngs_modulus_Pa, plate.density_kg_per_m3
     check_positive(length_m=length_m, youngs_modulus_Pa=youngs_modulus_Pa,
                    density_kg_per_m3=density_kg_per_m3)
     section = rectangle_section(thickness_m, width_m)
     area, inertia = section.area_m2, section.second_moment_m4
-    shear_modulus = physics.shear_modulus_Pa(youngs_modulus_Pa, poisson_ratio)
+    shear_modulus = physics.shear_modulus_Pa(youngs_modulus_Pa, plate.poisson_ratio)
     return ExactBeamSection(
         length_m, thickness_m, width_m, area, inertia, youngs_modulus_Pa * area,
         youngs_modulus_Pa * inertia, shear_correction * shear_modulus * area,

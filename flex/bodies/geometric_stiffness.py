@@ -138,8 +138,7 @@ def unit_axial_stress_matrices(reduction: Any, rising: bool = False) -> Any:
     from flex.bodies.nonlinear import build_nonlinear_plate
 
     r = reduction
-    plate = build_nonlinear_plate(r.length_m, r.thickness_m, r.width_m, r.youngs_modulus_Pa,
-                                  r.density_kg_per_m3, r.poisson_ratio, r.mesh_size_m)
+    plate = build_nonlinear_plate(r.plate, r.mesh_size_m)
     positions = r.fem.GetNodePositionsAsArray()
     if plate.node_positions_m.shape != positions.shape or not np.allclose(
             plate.node_positions_m, positions, rtol=0, atol=1e-9 * r.length_m):

@@ -61,6 +61,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
+from flex.base.physics import Plate
 from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction.body import add_plate_markers, as_vector3
 from flex.bodies.reduction.build import END_A, END_B, mid_set, ngsolve_thread_count
@@ -101,13 +102,12 @@ class NonlinearPlate(PlateLink):
         return 3 * self.n_nodes
 
 
-def build_nonlinear_plate(length_m: float, thickness_m: float, width_m: float,
-                          youngs_modulus_Pa: float, density_kg_per_m3: float,
-                          poisson_ratio: float, mesh_size_m: float, *,
+def build_nonlinear_plate(plate: Plate, mesh_size_m: float, *,
                           ngsolve_threads: int | None = 1) -> NonlinearPlate:
     """Mesh the plate and find its joint and midpoint node sets.
 
-    Contract: sizes in metres, E in Pa, density in kg/m^3, ``mesh_size_m`` is netgen's maxh;
+    Contract: ``plate`` its sizes in metres, E in Pa, density in kg/m^3, Poisson's ratio
+    (:class:`flex.base.physics.Plate`), ``mesh_size_m`` is netgen's maxh [m];
     the same arguments as :func:`flex.bodies.reduction.build_reduction` (without ``modes``) give the
     same mesh, node numbering and node sets. Bad values raise
     :class:`flex.base.errors.SceneError`. ``ngsolve_threads`` as in ``build_reduction`` (1: the
@@ -116,6 +116,9 @@ def build_nonlinear_plate(length_m: float, thickness_m: float, width_m: float,
     bodies are made per system by :func:`add_nonlinear_fe_coupler`.
     """
     start = time.perf_counter()
+    length_m, thickness_m, width_m = plate.sizes_m
+    density_kg_per_m3, poisson_ratio = plate.density_kg_per_m3, plate.poisson_ratio
+    youngs_modulus_Pa = plate.youngs_modulus_Pa
     sizes = {"length_m": length_m, "thickness_m": thickness_m, "width_m": width_m,
              "youngs_modulus_Pa": youngs_modulus_Pa, "density_kg_per_m3": density_kg_per_m3,
              "mesh_size_m": mesh_size_m}
@@ -446,9 +449,7 @@ class NodalRecorder:
 def nonlinear_plate_for_scene(scene: dict[str, dict[str, Any]]) -> NonlinearPlate:
     """The meshed plate of the scene's coupler (``coupler.geometry = "plate"``)."""
     c = scene["coupler"]
-    plate = build_nonlinear_plate(c["length_m"], c["thickness_m"], c["width_m"],
-                                  c["youngs_modulus_Pa"], c["density_kg_per_m3"],
-                                  c["poisson_ratio"], c["mesh_size_m"])
+    plate = build_nonlinear_plate(Plate.of(c), c["mesh_size_m"])
     end = scene.get("simulation", {}).get("end_time_s")
     if isinstance(end, int | float) and not isinstance(end, bool):
         plate.end_time_s = float(end)  # for progress lines only

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flex.base.errors import SceneError
+from flex.base.physics import Plate
 
 
 def plate_mesh(length_m: float, thickness_m: float, width_m: float, mesh_size_m: float):
@@ -58,3 +59,58 @@ class PlateLink:
     centre_end_a: np.ndarray
     centre_end_b: np.ndarray
     centre_mid: np.ndarray
+
+    @property
+    def plate(self) -> Plate:
+        """Its geometry and material as one :class:`~flex.base.physics.Plate`."""
+        return Plate(self.length_m, self.thickness_m, self.width_m, self.youngs_modulus_Pa,
+                     self.density_kg_per_m3, self.poisson_ratio)
+
+
+# ------------------------------------------------------------------------------------------
+# quadratic tetrahedra of a plate (what export and animate draw)
+# ------------------------------------------------------------------------------------------
+#: VTK/XDMF order of a quadratic tetrahedron's mid-edge nodes (corner pairs)
+TET10_EDGES = ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
+
+
+def tet10_cells(corners: np.ndarray, positions_m: np.ndarray) -> np.ndarray:
+    """Quadratic tetrahedra (VTK node order) from corner tetrahedra of a second-order mesh
+    whose mid-edge nodes lie at the edge midpoints (straight edges: a plate box), oriented
+    positively; ``positions_m`` the node positions [m]; raises ValueError when a midpoint has
+    no node."""
+    from scipy.spatial import cKDTree
+
+    corners = np.array(corners, dtype=np.int64)
+    p = positions_m[corners]
+    volume = np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]),
+                       p[:, 3] - p[:, 0])
+    corners[volume < 0] = corners[volume < 0][:, [0, 2, 1, 3]]
+    midpoints = np.stack([(positions_m[corners[:, a]] + positions_m[corners[:, b]]) / 2
+                          for a, b in TET10_EDGES], axis=1)
+    distance, nodes = cKDTree(positions_m).query(midpoints.reshape(-1, 3))
+    if np.max(distance) > 1e-9 * np.ptp(positions_m, axis=0).max():
+        raise ValueError("the mesh has a curved or missing mid-edge node")
+    return np.hstack([corners, nodes.reshape(-1, 6)])
+
+
+def box_mesh(length_m: float, height_m: float, width_m: float, centred: bool = False
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """A box x in [0, length] (or centred on 0), y and z centred (sizes [m]), as 5
+    tetrahedra: node positions [m] (8 corners) and the corner cells (5, 4)."""
+    x0 = -length_m / 2 if centred else 0.0
+    corners = np.array([[x0 + i * length_m, (j - 0.5) * height_m, (k - 0.5) * width_m]
+                        for k in (0, 1) for j in (0, 1) for i in (0, 1)])
+    # corner i + 2 j + 4 k at (x_i, y_j, z_k): four corner tetrahedra and the middle one
+    cells = np.array([[0, 1, 2, 4], [3, 1, 2, 7], [5, 1, 4, 7], [6, 2, 4, 7], [1, 2, 4, 7]])
+    return corners, cells
+
+
+def quadratic_box(length_m: float, height_m: float, width_m: float, centred: bool
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`box_mesh` with mid-edge nodes: positions [m], Tet10 cells, corner cells."""
+    points, corners = box_mesh(length_m, height_m, width_m, centred)
+    edges = sorted({tuple(sorted((int(c[a]), int(c[b])))) for c in corners
+                    for a, b in TET10_EDGES})
+    points = np.vstack([points, [(points[a] + points[b]) / 2 for a, b in edges]])
+    return points, tet10_cells(corners, points), corners

@@ -41,7 +41,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from flex.base.physics import in_plane_fixed_interface_omegas, pinned_pinned_omega
+from flex.base.physics import Plate
 from flex.config.calibration import Calibration, calibration_of
 from flex.data.scene import LINKS, MESH_ASPECT_LIMIT, plate_mass_properties
 
@@ -76,9 +76,7 @@ class RulePick:
 
 def first_period_s(link: Mapping[str, Any]) -> float:
     """First in-plane bending period [s] of a plate link, pinned-pinned (Euler-Bernoulli)."""
-    omega = pinned_pinned_omega(link["length_m"], link["thickness_m"],
-                                link["youngs_modulus_Pa"], link["density_kg_per_m3"])
-    return 2.0 * math.pi / omega
+    return 2.0 * math.pi / Plate.of(link).pinned_pinned_omega
 
 
 def rule_mesh_size_m(link: Mapping[str, Any], mesh: Mapping[str, float] | None = None,
@@ -183,9 +181,7 @@ def level_modes(level: Mapping[str, Any], link: Mapping[str, Any],
     ``modes`` count keeps that.)"""
     if "mode_cutoff_ratio" not in level:
         return int(level["modes"])
-    omegas = in_plane_fixed_interface_omegas(
-        link["length_m"], link["thickness_m"], link["width_m"], link["youngs_modulus_Pa"],
-        link["density_kg_per_m3"], link.get("poisson_ratio", 0.3), MODE_GRID[-1] + 1)
+    omegas = Plate.of(link).in_plane_omegas(MODE_GRID[-1] + 1)
     cut = mode_cutoff(level, n_load)
     below = sum(1 for omega in omegas if omega <= cut * omegas[0])
     return next((m for m in MODE_GRID if m >= below), MODE_GRID[-1])
@@ -196,9 +192,7 @@ def top_mode_ratio(level: Mapping[str, Any], link: Mapping[str, Any],
     """Estimated frequency of the highest in-plane mode the level keeps for ``link`` (with
     ``n_load``, :func:`level_modes`) over the first's (1 for one mode)."""
     modes = level_modes(level, link, n_load)
-    omegas = in_plane_fixed_interface_omegas(
-        link["length_m"], link["thickness_m"], link["width_m"], link["youngs_modulus_Pa"],
-        link["density_kg_per_m3"], link.get("poisson_ratio", 0.3), modes)
+    omegas = Plate.of(link).in_plane_omegas(modes)
     return omegas[-1] / omegas[0]
 
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from flex.base.errors import SceneError
+from flex.base.physics import Plate
 from flex.base.progress import duration_text
 
 Scene = dict[str, dict[str, Any]]
@@ -212,15 +213,11 @@ def plate_mass_properties(scene: Scene, link: str = "coupler") -> tuple[float, f
     ``mass_kg`` and ``inertia_kgm2``; plate geometry computes them from length x thickness x
     width and density (a cuboid: m (L^2 + t^2)/12).
     """
-    from flex.base.physics import cuboid_inertia_kgm2, cuboid_mass_kg
-
     values = scene[link]
     if values["geometry"] == "lumped":
         return values["mass_kg"], values["inertia_kgm2"]
-    length_m, thickness_m = values["length_m"], values["thickness_m"]
-    mass_kg = cuboid_mass_kg(length_m, thickness_m, values["width_m"],
-                             values["density_kg_per_m3"])
-    return mass_kg, cuboid_inertia_kgm2(mass_kg, length_m, thickness_m)
+    plate = Plate.of(values)
+    return plate.mass_kg, plate.inertia_kgm2
 
 
 def check_damping_model(link: str, values: dict[str, Any], entry: Any) -> None:

@@ -39,7 +39,7 @@ def _buckling_warnings(scene: Scene, datasets: dict[str, Dataset],
     """An FFRF coupler compressed beyond its Euler load pi^2 E I / L^2: its geometric
     stiffness is linear in the load and holds no buckled shape."""
     from flex.base.kinematics import chord_components
-    from flex.base.physics import euler_buckling_load_N
+    from flex.base.physics import Plate
 
     coupler = scene["coupler"]
     if (not link_models[coupler["model"]].linear_elastic
@@ -47,9 +47,7 @@ def _buckling_warnings(scene: Scene, datasets: dict[str, Dataset],
         return []
     axial, _ = chord_components(datasets["joints/C/force_on_coupler"].data,
                                 datasets["coupler/angle"].data)
-    ratio = float(np.max(-axial, initial=0.0)) / euler_buckling_load_N(
-        coupler["length_m"], coupler["thickness_m"], coupler["width_m"],
-        coupler["youngs_modulus_Pa"])
+    ratio = float(np.max(-axial, initial=0.0)) / Plate.of(coupler).euler_load_N
     if ratio <= 1.0:
         return []
     return [f"coupler: compressed to {ratio:.3g} x its Euler load (pi^2 E I / L^2): the FFRF "

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from flex.base.physics import Plate
 from flex.data.results import Dataset
 from flex.data.scene import AUTO, EXACT_BEAM_ELEMENTS, Scene
 from flex.dynamics.link_outputs import flexible_datasets, flexible_sensors, sensor_data
@@ -46,9 +47,7 @@ def prepare_beam(scene: Scene, link: str, given: Any, cache_dir: Path | None) ->
         return given
     c = scene[link]
     beam_elements(link, c)
-    return exact_beam_section(c["length_m"], c["thickness_m"], c["width_m"],
-                              c["youngs_modulus_Pa"], c["density_kg_per_m3"],
-                              c["poisson_ratio"])
+    return exact_beam_section(Plate.of(c))
 
 
 def add_exact_beam(builder: Any, link: str, section: Any) -> dict[str, Any]:

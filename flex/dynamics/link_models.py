@@ -58,7 +58,13 @@ The contract of an entry -- what a link model declares, point by point:
    out, and whether ``auto`` and the refinement may climb onto it. The error budget,
    ``auto``'s climb and the refinement read it and name no model.
 10. **how its stored motion is read back** (``flex export``, ``flex animate``):
-    ``stored_motion``, one of :data:`STORED_MOTIONS`.
+    ``stored_motion``, a :class:`flex.dynamics.link_outputs.MotionReader` that rebuilds the
+    link's mesh from the case (its ``body``) and its state at each sample (its ``state``):
+    :data:`~flex.dynamics.link_outputs.RIGID_MOTION` (a box of the plate moved with the
+    stored angles and joints), ``MODAL_MOTION`` (a reduction's modal coordinates in its
+    floating frame), ``NODAL_MOTION`` (every node's stored position) or ``NO_MOTION`` (not
+    read back: export and animate refuse it, naming the model). :mod:`flex.tools.motion`
+    calls through it and names no kind.
 
 Capability flags the callers read: ``rigid``, ``meshed``, ``modal``, ``damped`` (above);
 ``linear_elastic``: its results are trusted only for small elastic deflections and loads
@@ -83,6 +89,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
+from flex.base.physics import Plate
 from flex.base.progress import heartbeat
 from flex.config.ladder import (
     EXACT_BEAM_RUNG,
@@ -112,6 +119,11 @@ from flex.dynamics.exact_beam_link import (
     prepare_beam,
 )
 from flex.dynamics.link_outputs import (  # noqa: F401 - the names callers import from here
+    MODAL_MOTION,
+    NO_MOTION,
+    NODAL_MOTION,
+    RIGID_MOTION,
+    MotionReader,
     elastic_datasets,
     flexible_datasets,
     flexible_sensors,
@@ -143,13 +155,9 @@ def _no_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]
     return {}
 
 
-#: how a model's run stores its motion (the contract's point 10): ``"rigid"`` (the link's
-#: angle and joint positions: a box moved with them), ``"modal"`` (``<link>/modal_coordinates``
-#: and the floating frame's pose ``<link>/frame_position``, ``frame_angle``, on the basis of
-#: the link's reduction, rebuilt from the case's scene), ``"nodal"`` (every node's position,
-#: ``<link>/nodal/position`` at ``<link>/nodal/time``, on the link's plate mesh), ``"none"``
-#: (not read back: export and animate refuse it, naming the model)
-STORED_MOTIONS = ("rigid", "modal", "nodal", "none")
+#: the readers of stored motion a built-in model names (the contract's point 10), by kind
+STORED_MOTIONS: Mapping[str, MotionReader] = MappingProxyType(
+    {reader.kind: reader for reader in (RIGID_MOTION, MODAL_MOTION, NODAL_MOTION, NO_MOTION)})
 
 
 @dataclass(frozen=True)
@@ -185,13 +193,13 @@ class LinkModel(LinkSchema):
     #: (9) its rung on the model ladder for a link's scene values (:mod:`flex.dynamics.
     #: ladder`), or None: a model on no rung (its budget then says its model error is left out)
     rung: Callable[[Mapping[str, Any]], Rung | None] = _no_rung
-    #: (10) how its stored motion is read back (export, animate): one of STORED_MOTIONS
-    stored_motion: str = "rigid"
+    #: (10) how its stored motion is read back (export, animate)
+    stored_motion: MotionReader = RIGID_MOTION
 
     def __post_init__(self) -> None:
-        if self.stored_motion not in STORED_MOTIONS:
+        if not isinstance(self.stored_motion, MotionReader):
             raise ValueError(f"link model {self.name}: stored_motion {self.stored_motion!r} "
-                             f"is not one of {', '.join(STORED_MOTIONS)}")
+                             f"is not a MotionReader (flex.dynamics.link_outputs)")
 
     @classmethod
     def extending(cls, schema: LinkSchema, **behaviour: Any) -> LinkModel:
@@ -303,9 +311,7 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
     announce_mesh(link, c, f"reduction with {c['modes']} modes (instant if cached)",
                    c["modes"])
     with heartbeat(f"{link} reduction ({c['modes']} modes)"):
-        return build_reduction(c["length_m"], c["thickness_m"], c["width_m"],
-                               c["youngs_modulus_Pa"], c["density_kg_per_m3"],
-                               c["poisson_ratio"], c["mesh_size_m"], c["modes"], cache_dir,
+        return build_reduction(Plate.of(c), c["mesh_size_m"], c["modes"], cache_dir,
                                mode_selection=c["mode_selection"], mesh_order=mesh_order)
 
 
@@ -346,13 +352,10 @@ def _add_ffrf(builder: Any, link: str, reduction: Any) -> dict[str, Any]:
 def highest_retained_omega(values: dict[str, Any]) -> float:
     """Beam estimate of the highest fixed-interface circular frequency [rad/s] a link's
     reduction keeps (its ``modes`` lowest of the kinds its ``mode_selection`` keeps)."""
-    from flex.base.physics import clamped_plate_frequencies, in_plane_fixed_interface_omegas
-
-    plate = (values["length_m"], values["thickness_m"], values["width_m"],
-             values["youngs_modulus_Pa"], values["density_kg_per_m3"], values["poisson_ratio"])
+    plate = Plate.of(values)
     if values["mode_selection"] == "in_plane":
-        return in_plane_fixed_interface_omegas(*plate, count=values["modes"])[-1]
-    return clamped_plate_frequencies(*plate, count=values["modes"])[-1][0]
+        return plate.in_plane_omegas(values["modes"])[-1]
+    return plate.clamped_frequencies(values["modes"])[-1][0]
 
 
 def _ffrf_time_scale(link: str, values: dict[str, Any], reduction: Any
@@ -420,11 +423,7 @@ def _nodal_recorder(mech: Any, link: str, settings: dict[str, Any]) -> Any:
 
 def _nonlinear_fe_time_scale(link: str, values: dict[str, Any], plate: Any
                              ) -> tuple[float, str]:
-    from flex.base.physics import pinned_pinned_omega
-
-    return (pinned_pinned_omega(values["length_m"], values["thickness_m"],
-                                values["youngs_modulus_Pa"], values["density_kg_per_m3"]),
-            "first bending mode")
+    return Plate.of(values).pinned_pinned_omega, "first bending mode"
 
 
 def _nonlinear_fe_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
@@ -463,19 +462,19 @@ _BEHAVIOUR: Mapping[str, dict[str, Any]] = MappingProxyType({
                auto_choice=True, prepare=_prepare_reduction, add=_add_ffrf,
                sensors=flexible_sensors, datasets=flexible_datasets,
                time_scale=_ffrf_time_scale, step_cost_s=_ffrf_step_cost_s, rung=ffrf_rung,
-               stored_motion="modal"),
+               stored_motion=MODAL_MOTION),
     NONLINEAR_FE: dict(label="nonlinear FE (reference)", reference=True, auto_choice=True,
                        add=_add_nonlinear_fe, sensors=flexible_sensors,
                        datasets=_nonlinear_fe_datasets, energy=False, recorder=_nodal_recorder,
                        time_scale=_nonlinear_fe_time_scale,
                        step_cost_s=_nonlinear_fe_step_cost_s,
                        adjust_solver=_nonlinear_fe_solver, own_progress=True,
-                       rung=_nonlinear_fe_rung, stored_motion="nodal"),
+                       rung=_nonlinear_fe_rung, stored_motion=NODAL_MOTION),
     EXACT_BEAM: dict(label="geometrically exact beam", auto_choice=True, prepare=prepare_beam,
                      add=add_exact_beam, sensors=exact_beam_sensors,
                      datasets=exact_beam_datasets, time_scale=_nonlinear_fe_time_scale,
                      step_cost_s=exact_beam_step_cost_s, adjust_solver=exact_beam_solver,
-                     rung=_exact_beam_rung, stored_motion="none"),
+                     rung=_exact_beam_rung, stored_motion=NO_MOTION),
 })
 #: the built-in link models, by name (immutable; pass another mapping to add models): one
 #: registry, generated from the schemas (a schema without its behaviour fails here, at import)

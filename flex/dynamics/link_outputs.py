@@ -2,14 +2,25 @@
 as the datasets every flexible link has (midpoint motion and deflection from the chord, chord
 change, an FFRF link's modal coordinates, stresses and floating frame), and the sensors that
 feed them. Shared by the link models' entries (:mod:`flex.dynamics.link_models`,
-:mod:`flex.dynamics.exact_beam_link`) and :mod:`flex.dynamics.collect`."""
+:mod:`flex.dynamics.exact_beam_link`) and :mod:`flex.dynamics.collect`.
+
+And how a link's stored motion is read back from a result file (the link models' contract,
+point 10): each entry names its :class:`MotionReader` (:data:`RIGID_MOTION`,
+:data:`MODAL_MOTION`, :data:`NODAL_MOTION`, :data:`NO_MOTION`), which rebuilds the link's
+mesh (:class:`Body`) and its state at a sample (:class:`BodyState`);
+:func:`flex.tools.motion.case_motion` calls through it."""
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from flex.base.errors import FlexError
 from flex.data.results import Dataset
 
 
@@ -127,3 +138,172 @@ def flexible_sensors(builder: Any, link: str, handles: dict[str, Any]) -> None:
 
 __all__ = ["elastic_datasets", "flexible_datasets", "flexible_sensors", "frame_datasets",
            "sensor_data", "stress_window_m"]
+
+
+# ------------------------------------------------------------------------------------------
+# how a link's stored motion is read back (export, animate): the contract's point 10
+# ------------------------------------------------------------------------------------------
+@dataclass
+class Body:
+    """One body of the mechanism as a tetrahedral mesh: ``reference_m`` (nodes, 3) in body
+    coordinates [m], ``cells`` (cells, 10) quadratic tetrahedra (node indices, VTK order),
+    ``corners`` (cells, 4) their corner nodes."""
+
+    name: str
+    model: str  #: the name of its link model (the slider: the rigid model's; set by the caller)
+    reference_m: np.ndarray
+    cells: np.ndarray
+    corners: np.ndarray
+    has_stress: bool = False
+    facts: dict[str, Any] = field(default_factory=dict)  #: provenance (reduction key, ...)
+    #: how its motion is stored (its reader's kind: rigid, modal, nodal)
+    kind: str = "rigid"
+
+
+@dataclass
+class BodyState:
+    """A body at one sample: global node positions [m] (nodes, 3), elastic displacement in
+    its link frame [m] (nodes, 3; zero for a rigid body) and, for an FFRF link, the nodal
+    stress [Pa] (nodes, 6; body axes; None otherwise)."""
+
+    position_m: np.ndarray
+    elastic_m: np.ndarray
+    stress_Pa: np.ndarray | None
+
+
+#: a stored case's datasets by path below ``cases/<case>/`` (time, ``<link>/...``)
+CaseData = dict[str, np.ndarray]
+#: the rigid frame of a link at a sample, computed only when asked: (origin [m] (x, y),
+#: angle [rad]) from the stored angles and joint positions
+RigidFrame = Callable[[], tuple[np.ndarray, float]]
+
+
+@dataclass(frozen=True)
+class MotionReader:
+    """How one kind of stored motion is read back (the link model's ``stored_motion``).
+
+    ``body(link, scene, data, attrs, where, cache_dir)`` -> ``(Body, source)``: the link's
+    mesh and what its states need (a reduction, a meshed plate; refused with
+    :class:`~flex.base.errors.FlexError`, naming ``where``, when the case does not hold it);
+    ``state(body, source, data, sample, index, frame)`` -> :class:`BodyState` at case sample
+    ``sample`` (motion sample ``index``; ``frame``: the link's rigid frame). ``body`` None:
+    the kind is not read back (export and animate refuse it, naming the model)."""
+
+    kind: str
+    body: Callable[[str, Any, CaseData, dict[str, Any], str, Path | None],
+                   tuple[Body, Any]] | None
+    state: Callable[[Body, Any, CaseData, int, int, RigidFrame], BodyState] | None
+
+
+def place(points_m: np.ndarray, origin_m: np.ndarray, angle_rad: float) -> np.ndarray:
+    """Body points [m] turned by ``angle_rad`` about z and moved to ``origin_m`` (x, y) [m]."""
+    c, s = math.cos(angle_rad), math.sin(angle_rad)
+    out = np.array(points_m, dtype=float)
+    out[:, 0] = c * points_m[:, 0] - s * points_m[:, 1] + origin_m[0]
+    out[:, 1] = s * points_m[:, 0] + c * points_m[:, 1] + origin_m[1]
+    return out
+
+
+def _rigid_body(link: str, scene: Any, data: CaseData, attrs: dict[str, Any], where: str,
+                cache_dir: Path | None) -> tuple[Body, Any]:
+    from flex.bodies.plate import quadratic_box
+
+    values = scene[link]
+    points, cells, corners = quadratic_box(values["length_m"], values["thickness_m"],
+                                           values["width_m"], centred=False)
+    return Body(link, "", points, cells, corners), None
+
+
+def _rigid_state(body: Body, source: Any, data: CaseData, sample: int, index: int,
+                 frame: RigidFrame) -> BodyState:
+    origin, angle = frame()
+    return BodyState(place(body.reference_m, origin, angle), np.zeros_like(body.reference_m),
+                     None)
+
+
+def _modal_body(link: str, scene: Any, data: CaseData, attrs: dict[str, Any], where: str,
+                cache_dir: Path | None) -> tuple[Body, Any]:
+    from flex.bodies.plate import tet10_cells
+    from flex.bodies.stress import check_basis_identity
+    from flex.dynamics.solver import reduction_for_scene
+
+    missing = [name for name in ("modal_coordinates", "frame_position", "frame_angle")
+               if f"{link}/{name}" not in data]
+    if missing:
+        raise FlexError(f"{where}: the FFRF {link} has no {', '.join(missing)} (written "
+                        f"before flex stored them): rerun the case")
+    reduction = reduction_for_scene(scene, link, cache_dir=cache_dir)
+    problem = check_basis_identity(link, reduction, attrs)
+    if problem:
+        raise FlexError(f"{where}: {problem}")
+    found = np.shape(data[f"{link}/modal_coordinates"])
+    if len(found) != 2 or found[1] != reduction.n_modal_coordinates:
+        raise FlexError(f"{where}: {link}/modal_coordinates has shape {found}, expected "
+                        f"(samples, {reduction.n_modal_coordinates}): one column per mode of "
+                        f"the reduction; the file was changed after flex wrote it: rerun the "
+                        f"case")
+    positions = reduction.fem.GetNodePositionsAsArray()
+    corners = np.asarray(reduction.fem.elements[0]["Tet4"], dtype=np.int64)
+    body = Body(link, "", positions, tet10_cells(corners, positions), corners,
+                has_stress=reduction.has_stress_modes,
+                facts={"reduction_key": reduction.key, "from_cache": reduction.from_cache},
+                kind="modal")
+    return body, reduction
+
+
+def _modal_state(body: Body, reduction: Any, data: CaseData, sample: int, index: int,
+                 frame: RigidFrame) -> BodyState:
+    """A reduction's modal coordinates in its floating frame."""
+    from flex.bodies.stress import nodal_displacement, nodal_stress
+
+    q = data[f"{body.name}/modal_coordinates"][sample]
+    elastic = nodal_displacement(reduction, q)
+    position = place(body.reference_m + elastic, data[f"{body.name}/frame_position"][sample],
+                     data[f"{body.name}/frame_angle"][sample])
+    stress = nodal_stress(reduction, q) if body.has_stress else None
+    return BodyState(position, elastic, stress)
+
+
+def _nodal_body(link: str, scene: Any, data: CaseData, attrs: dict[str, Any], where: str,
+                cache_dir: Path | None) -> tuple[Body, Any]:
+    from flex.bodies.nonlinear import nonlinear_plate_for_scene
+    from flex.bodies.plate import tet10_cells
+
+    key = f"{link}/nodal/position"
+    if key not in data:
+        raise FlexError(f"{where}: the nonlinear FE {link} has no nodal field "
+                        f"({key}: written before flex stored it): rerun the case")
+    plate = nonlinear_plate_for_scene(scene)
+    if data[key].shape[1] != plate.n_nodes:
+        raise FlexError(f"{where}: the stored nodal field has {data[key].shape[1]} nodes, the "
+                        f"plate's mesh {plate.n_nodes} (another netgen version?): rerun the "
+                        f"case")
+    corners = np.array([[v.nr - 1 for v in element.vertices]
+                        for element in plate.mesh.ngmesh.Elements3D()], dtype=np.int64)
+    positions = plate.node_positions_m
+    return Body(link, "", positions, tet10_cells(corners, positions), corners,
+                kind="nodal"), plate
+
+
+def _nodal_state(body: Body, plate: Any, data: CaseData, sample: int, index: int,
+                 frame: RigidFrame) -> BodyState:
+    """Every node of the mesh, at the nodal snapshot ``index``; the elastic part in the chord
+    frame (origin at the joint face ``end_a``'s centre, x toward ``end_b``'s)."""
+    position = np.asarray(data[f"{body.name}/nodal/position"][index], dtype=float)
+    b = plate.weights_end_a @ position[plate.nodes_end_a]
+    c = plate.weights_end_b @ position[plate.nodes_end_b]
+    angle = math.atan2(c[1] - b[1], c[0] - b[0])
+    local = place(position - b, np.zeros(2), -angle)  # turned back into the chord frame
+    return BodyState(position, local - body.reference_m, None)
+
+
+#: the rigid model's: the link's angle and joint positions, a box of its plate moved with them
+RIGID_MOTION = MotionReader("rigid", _rigid_body, _rigid_state)
+#: ``<link>/modal_coordinates`` and the floating frame's pose ``<link>/frame_position``,
+#: ``frame_angle``, on the basis of the link's reduction (rebuilt from the case's scene)
+MODAL_MOTION = MotionReader("modal", _modal_body, _modal_state)
+#: every node's position, ``<link>/nodal/position`` at ``<link>/nodal/time``, on the link's
+#: plate mesh
+NODAL_MOTION = MotionReader("nodal", _nodal_body, _nodal_state)
+#: not read back: export and animate refuse it, naming the model
+NO_MOTION = MotionReader("none", None, None)

@@ -40,9 +40,8 @@ from flex.base.errors import SceneError
 from flex.base.physics import (
     IN_PLANE_KINDS,
     TWO_PI,
-    clamped_plate_frequencies,
+    Plate,
     n_values,
-    pinned_pinned_omega,
     plate_thickness_for_mass_m,
 )
 from flex.config.calibration import Calibration
@@ -239,10 +238,7 @@ def modes_for_cutoff(scene: Mapping[str, Mapping[str, Any]], omega_cut_rad_per_s
     """
     c = scene[link]
     in_plane = c.get("mode_selection") == "in_plane"  # the reduction keeps only these kinds
-    estimates = clamped_plate_frequencies(c["length_m"], c["thickness_m"], c["width_m"],
-                                          c["youngs_modulus_Pa"], c["density_kg_per_m3"],
-                                          c["poisson_ratio"],
-                                          count=(4 if in_plane else 1) * (MAX_AUTO_MODES + 10))
+    estimates = Plate.of(c).clamped_frequencies((4 if in_plane else 1) * (MAX_AUTO_MODES + 10))
     if in_plane:
         estimates = [(omega, kind) for omega, kind in estimates if kind in IN_PLANE_KINDS]
     first_in_plane = next(i for i, (_, kind) in enumerate(estimates) if kind == "in_plane")
@@ -320,9 +316,7 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]], *,
     analysis = copy.deepcopy({k: dict(v) for k, v in scene.items()})
     analysis["coupler"]["model"] = RIGID
     crank = analysis["crank"]
-    estimates = clamped_plate_frequencies(crank["length_m"], crank["thickness_m"],
-                                          crank["width_m"], crank["youngs_modulus_Pa"],
-                                          crank["density_kg_per_m3"], crank["poisson_ratio"])
+    estimates = Plate.of(crank).clamped_frequencies()
     first_in_plane = next(i for i, (_, kind) in enumerate(estimates) if kind == "in_plane")
     crank["modes"] = max(4, first_in_plane + 2)
 
@@ -447,12 +441,10 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
     load, rigid is not offered and the ladder decides); returns it and ``how`` with the
     compressive load added."""
     coupler = resolved["coupler"]
-    omega = pinned_pinned_omega(coupler["length_m"], coupler["thickness_m"],
-                                coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"])
+    plate = Plate.of(coupler)
+    omega = plate.pinned_pinned_omega
     ratio = euler_load_ratio(probe["joints/B/force_on_coupler"],
-                             probe["joints/C/force_on_coupler"], probe["coupler/angle"],
-                             coupler["length_m"], coupler["thickness_m"],
-                             coupler["width_m"], coupler["youngs_modulus_Pa"])
+                             probe["joints/C/force_on_coupler"], probe["coupler/angle"], plate)
     how += f"; compressive load {ratio:.3g} x Euler load"
     decision, k_phys = _decide("coupler", omega, delta_t_s, how, tolerance, criterion,
                                float(coupler["damping_ratio"]))

@@ -29,6 +29,7 @@ from flex.base.kinematics import chord_components
 from flex.base.physics import (  # noqa: F401 - part of this module's face
     IN_PLANE_KINDS,
     TWO_PI,
+    Plate,
     clamped_plate_frequencies,
     euler_buckling_load_N,
     n_values,
@@ -217,19 +218,18 @@ def flexible_rung(load_ratio: float, tolerance: float, geometric_stiffness: bool
 
 
 def euler_load_ratio(force_B_N: np.ndarray, force_C_N: np.ndarray,
-                     coupler_angle_rad: np.ndarray, length_m: float, thickness_m: float,
-                     width_m: float, youngs_modulus_Pa: float) -> float:
+                     coupler_angle_rad: np.ndarray, plate: Plate) -> float:
     """Largest compressive axial force in the coupler / its Euler load pi^2 E I / L^2.
 
     Contract: joint forces on the coupler at B and C (n, 2) [N] and the angle of B -> C
-    [rad], as :func:`quasi_static_stress`; I = w t^3 / 12 (in-plane bending). The axial
+    [rad], as :func:`quasi_static_stress`; ``plate`` the coupler's (its
+    :attr:`~flex.base.physics.Plate.euler_load_N`, I = w t^3 / 12, in-plane bending). The axial
     force is linear between the joints, so its largest compression is at one of them.
     """
     axial_b, _ = chord_components(force_B_N, coupler_angle_rad)
     axial_c, _ = chord_components(force_C_N, coupler_angle_rad)
     compression = max(float(np.max(axial_b)), float(np.max(-axial_c)), 0.0)
-    return compression / euler_buckling_load_N(length_m, thickness_m, width_m,
-                                               youngs_modulus_Pa)
+    return compression / plate.euler_load_N
 
 
 def _window(data: Mapping[str, np.ndarray], end_s: float) -> np.ndarray:
@@ -251,10 +251,9 @@ def _common_samples(rigid: Mapping[str, np.ndarray], ffrf: Mapping[str, np.ndarr
 
 
 def error_measures(rigid: Mapping[str, np.ndarray], ffrf: Mapping[str, np.ndarray],
-                   length_m: float, thickness_m: float, width_m: float,
-                   window_end_s: float, youngs_modulus_Pa: float = THESIS_YOUNGS_MODULUS_PA
-                   ) -> dict[str, float]:
-    """The error measures of :data:`MEASURES` plus their absolute values.
+                   plate: Plate, window_end_s: float) -> dict[str, float]:
+    """The error measures of :data:`MEASURES` plus their absolute values; ``plate``: the
+    coupler's (sizes and Young's modulus read).
 
     Contract: ``rigid`` and ``ffrf`` map result paths (``time``, ``crank/angle``,
     ``slider/position``, ``coupler/midpoint_deflection``, ``coupler/peak_bending_stress``,
@@ -281,20 +280,18 @@ def error_measures(rigid: Mapping[str, np.ndarray], ffrf: Mapping[str, np.ndarra
     slider_dev = float(np.max(np.abs(slider_f - slider_r)))
     stress_qs = quasi_static_stress(series(rigid, "joints/B/force_on_coupler"),
                                     series(rigid, "joints/C/force_on_coupler"),
-                                    series(rigid, "coupler/angle"), length_m, thickness_m,
-                                    width_m)
+                                    series(rigid, "coupler/angle"), *plate.sizes_m)
     peak_qs = float(stress_qs.max())
     peak_ffrf = float(series(ffrf, "coupler/peak_bending_stress").max())
     out = {
-        "deflection": deflection / length_m,
+        "deflection": deflection / plate.length_m,
         "crank_angle": crank_dev / swing,
         "slider_position": slider_dev / travel,
         "stress_amplification": abs(peak_ffrf / peak_qs - 1.0),
         "stress_ratio": peak_ffrf / peak_qs,
         "euler_load_ratio": euler_load_ratio(series(rigid, "joints/B/force_on_coupler"),
                                              series(rigid, "joints/C/force_on_coupler"),
-                                             series(rigid, "coupler/angle"), length_m,
-                                             thickness_m, width_m, youngs_modulus_Pa),
+                                             series(rigid, "coupler/angle"), plate),
         "deflection_abs_m": deflection,
         "crank_angle_abs_rad": crank_dev,
         "slider_position_abs_m": slider_dev,

@@ -44,11 +44,10 @@ import numpy as np
 
 from flex.base.kinematics import chord_components
 from flex.base.physics import (
+    Plate,
     axial_load_amplification,
-    euler_buckling_load_N,
     pinned_beam_end_moment_midpoint_deflection_m,
     pinned_beam_midpoint_deflection_m,
-    pinned_pinned_omega,
     ramp_load_factor,
 )
 
@@ -80,12 +79,12 @@ class DeflectionPrediction:
         return self.peak_deflection_m / length_m
 
 
-def _sizes(plate: Mapping[str, Any]) -> tuple[float, float, float, float]:
-    return (plate["length_m"], plate["thickness_m"], plate["width_m"],
-            plate["youngs_modulus_Pa"])
+def _sizes(plate: Plate) -> tuple[float, float, float, float]:
+    """What the beam formulas read: ``(length_m, thickness_m, width_m, youngs_modulus_Pa)``."""
+    return (*plate.sizes_m, plate.youngs_modulus_Pa)
 
 
-def _coupler_history(series: Mapping[str, np.ndarray], plate: Mapping[str, Any]
+def _coupler_history(series: Mapping[str, np.ndarray], plate: Plate
                      ) -> tuple[np.ndarray, np.ndarray]:
     """Signed quasi-static midpoint deflection [m] and midspan compression [N] per sample of
     a rigid coupler B-C: its d'Alembert load's total is the sum of the transverse joint
@@ -98,7 +97,7 @@ def _coupler_history(series: Mapping[str, np.ndarray], plate: Mapping[str, Any]
             (axial_b - axial_c) / 2)
 
 
-def _crank_history(series: Mapping[str, np.ndarray], plate: Mapping[str, Any]
+def _crank_history(series: Mapping[str, np.ndarray], plate: Plate
                    ) -> tuple[np.ndarray, np.ndarray]:
     """Signed quasi-static midpoint deflection [m] and midspan compression [N] per sample of
     a rigid crank A-B (x from the pivot A; ``plate``: the crank's plate, or the equivalent
@@ -113,8 +112,8 @@ def _crank_history(series: Mapping[str, np.ndarray], plate: Mapping[str, Any]
     drive torque; zero for a bare plate crank under the spring. Midspan compression: minus
     the axial force of B on the crank minus the centrifugal pull of the outer half, ``mu w^2
     (3/8) L^2``."""
-    length = plate["length_m"]
-    per_length = plate["density_kg_per_m3"] * plate["thickness_m"] * plate["width_m"]
+    length = plate.length_m
+    per_length = plate.density_kg_per_m3 * plate.thickness_m * plate.width_m
     alpha = np.asarray(series["crank/angular_acceleration"], dtype=float)
     rate = np.asarray(series["crank/angular_velocity"], dtype=float)
     axial_b, transverse_b = chord_components(series["joints/B/force_on_crank"],
@@ -140,13 +139,12 @@ def predict_deflection(series: Mapping[str, np.ndarray], plate: Mapping[str, Any
         raise ValueError(f"link {link!r}: must be 'coupler' or 'crank'")
     time_s = np.asarray(series["time"], dtype=float)
     keep = time_s <= window_end_s * (1 + 1e-12)
+    shape = Plate.of(plate)
     signed_static, compression = (np.asarray(values)[keep]
-                                  for values in histories[link](series, plate))
+                                  for values in histories[link](series, shape))
     if omega_rad_per_s is None:
-        omega_rad_per_s = pinned_pinned_omega(plate["length_m"], plate["thickness_m"],
-                                              plate["youngs_modulus_Pa"],
-                                              plate["density_kg_per_m3"])
-    euler = euler_buckling_load_N(*_sizes(plate))
+        omega_rad_per_s = shape.pinned_pinned_omega
+    euler = shape.euler_load_N
     return _respond(time_s[keep], signed_static, compression, euler, float(omega_rad_per_s),
                     float(plate.get("damping_ratio", 0.0)))
 

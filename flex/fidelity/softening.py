@@ -1,7 +1,8 @@
 """How far a coupler model is from the nonlinear FE reference, and how loaded the link is.
 
-- :func:`coupler_compression_N` / :func:`coupler_euler_load_N`: the link's compression
-  along its chord B-C against the pinned-pinned Euler load pi^2 E I / L^2 (I = w t^3 / 12);
+- :func:`coupler_compression_N`: the link's compression along its chord B-C, against the
+  pinned-pinned Euler load pi^2 E I / L^2 (I = w t^3 / 12) of its plate
+  (:attr:`flex.base.physics.Plate.euler_load_N`);
   near 1 the axial force changes the bending stiffness (the linear FFRF body is blind to
   it, flex's default FFRF body carries it: :mod:`flex.bodies.geometric_stiffness`);
 - :func:`compare_with_reference`: the runs of one plate as several models (FFRF, linear
@@ -19,7 +20,6 @@ from typing import Any
 import numpy as np
 
 from flex.base.kinematics import chord_components
-from flex.base.physics import euler_buckling_load_N
 from flex.data.results import CaseResult, Dataset
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, RIGID
 
@@ -34,12 +34,6 @@ def coupler_compression_N(data: dict[str, np.ndarray], samples: int | None = Non
     axial, _ = chord_components(data["joints/C/force_on_coupler"][:samples],
                                 data["coupler/angle"][:samples])
     return -axial
-
-
-def coupler_euler_load_N(coupler: dict[str, Any]) -> float:
-    """Pinned-pinned Euler load [N] of a scene's ``[coupler]`` plate (in-plane buckling)."""
-    return euler_buckling_load_N(coupler["length_m"], coupler["thickness_m"],
-                                 coupler["width_m"], coupler["youngs_modulus_Pa"])
 
 
 def first_peak_index(deflection: np.ndarray) -> int:

@@ -69,9 +69,9 @@ from flex.sweep.executors import (
     Executor,
     ProcessExecutor,
     SerialExecutor,
-    _guarded,
-    _prepare_guarded,
     check_scheduler,
+    guarded_case,
+    guarded_preparation,
     make_executor,
     simulate_scene_case,
 )
@@ -312,8 +312,8 @@ class _SweepRun:
     def submit(self, job: _Job, where: Executor) -> None:
         job.started = time.perf_counter()
         pending = self.pending
-        pending[where.submit(*((_prepare_guarded, job.function) if job.kind == "prepare"
-                               else (_guarded, job.function)), *job.args)] = job
+        pending[where.submit(*((guarded_preparation, job.function) if job.kind == "prepare"
+                               else (guarded_case, job.function)), *job.args)] = job
 
     def case_job(self, name: str) -> _Job:
         return _Job("case", name, self.case_function, (name, self.scenes[name]))
@@ -419,8 +419,8 @@ def _run_isolated(jobs: list[_Job], executor: Executor, scenes: Mapping[str, Sce
         alone = executor.isolated()
         try:
             job.started = time.perf_counter()
-            future = alone.submit(*((_prepare_guarded, job.function) if job.kind == "prepare"
-                                    else (_guarded, job.function)), *job.args)
+            future = alone.submit(*((guarded_preparation, job.function) if job.kind == "prepare"
+                                    else (guarded_case, job.function)), *job.args)
             try:
                 value = future.result()
             except BrokenProcessPool:

@@ -27,7 +27,7 @@ def simulate_scene_case(name: str, scene: Scene, *, cache_dir: Path | None = Non
     return simulate_case(scene, name, cache_dir=cache_dir)
 
 
-def _guarded(function: Callable[..., Any], name: str, scene: Scene) -> Any:
+def guarded_case(function: Callable[..., Any], name: str, scene: Scene) -> Any:
     """Run ``function(name, scene)``; any exception becomes a failed :class:`CaseResult`."""
     try:
         result = function(name, scene)
@@ -46,7 +46,9 @@ def _guarded(function: Callable[..., Any], name: str, scene: Scene) -> Any:
     return result
 
 
-def _prepare_guarded(function: Callable[[Scene], Any], scene: Scene) -> tuple[bool, Any]:
+def guarded_preparation(function: Callable[[Scene], Any], scene: Scene) -> tuple[bool, Any]:
+    """Run ``function(scene)`` (a shared preparation): ``(True, its result)``, or ``(False,
+    the exception as one line)``, recorded on the cases that needed it."""
     try:
         return True, function(scene)
     except Exception as exc:  # noqa: BLE001 - recorded on the cases that needed it

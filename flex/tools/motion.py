@@ -1,7 +1,9 @@
 """The motion of a stored case, body by body and node by node: what ``flex export`` writes
 and ``flex animate`` draws.
 
-:func:`case_motion` reads one case of a result file and rebuilds what its bodies need:
+:func:`case_motion` reads one case of a result file and rebuilds what its bodies need, each
+link through its model's reader of stored motion (the registry entry's ``stored_motion``,
+:class:`flex.dynamics.link_outputs.MotionReader`; the built-in readers there):
 
 - an FFRF link (coupler or crank): its plate mesh from the reduction (from the cache, rebuilt
   if missing: :func:`flex.dynamics.solver.reduction_for_scene` with the case's stored
@@ -28,58 +30,36 @@ from __future__ import annotations
 import math
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from flex.base.errors import FlexError
+from flex.bodies.plate import quadratic_box
 from flex.data.results import case_names, reading
 from flex.data.scene import LINKS, Scene, default_scene, merge
-from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, NONLINEAR_FE, RIGID, LinkModel
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, RIGID, LinkModel
+from flex.dynamics.link_outputs import RIGID_MOTION, Body, BodyState, MotionReader
 
-#: VTK/XDMF order of a quadratic tetrahedron's mid-edge nodes (corner pairs)
-TET10_EDGES = ((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
+__all__ = ["Body", "BodyState", "CaseMotion", "case_motion", "case_scene", "model_entry",
+           "pick_case", "sample_indices", "top_faces", "SLIDER_BLOCK"]
+
 #: the slider block's length and height as fractions of the coupler length (drawing only)
 SLIDER_BLOCK = (0.25, 0.12)
-
-
-@dataclass
-class Body:
-    """One body of the mechanism as a tetrahedral mesh: ``reference_m`` (nodes, 3) in body
-    coordinates [m], ``cells`` (cells, 10) quadratic tetrahedra (node indices, VTK order),
-    ``corners`` (cells, 4) their corner nodes."""
-
-    name: str
-    model: str  #: the name of its link model (the slider: the rigid model's)
-    reference_m: np.ndarray
-    cells: np.ndarray
-    corners: np.ndarray
-    has_stress: bool = False
-    facts: dict[str, Any] = field(default_factory=dict)  #: provenance (reduction key, ...)
-    #: how its motion is stored (its model's ``stored_motion``: rigid, modal, nodal)
-    kind: str = "rigid"
-
-
-@dataclass
-class BodyState:
-    """A body at one sample: global node positions [m] (nodes, 3), elastic displacement in
-    its link frame [m] (nodes, 3; zero for a rigid body) and, for an FFRF link, the nodal
-    stress [Pa] (nodes, 6; body axes; None otherwise)."""
-
-    position_m: np.ndarray
-    elastic_m: np.ndarray
-    stress_Pa: np.ndarray | None
 
 
 class CaseMotion:
     """The bodies of one stored case and their state at its samples (see the module doc)."""
 
     def __init__(self, source: Path, case: str, scene: Scene, data: dict[str, np.ndarray],
-                 attrs: dict[str, Any], bodies: list[Body], extra: dict[str, Any]) -> None:
+                 attrs: dict[str, Any], bodies: list[Body], extra: dict[str, Any],
+                 readers: Mapping[str, MotionReader] | None = None) -> None:
         self.source, self.case, self.scene = source, case, scene
         self._data, self.attrs, self.bodies, self._extra = data, attrs, bodies, extra
+        #: each body's reader of stored motion, by body name (absent: the rigid one's)
+        self._readers = dict(readers or {})
         nodal = data.get("coupler/nodal/time")
         case_time = data["time"]
         if nodal is not None:  # the nonlinear FE coupler's snapshots govern
@@ -121,93 +101,29 @@ class CaseMotion:
         return {body.name: self._state(body, index) for body in self.bodies}
 
     def _state(self, body: Body, index: int) -> BodyState:
+        """The body's state through its link model's reader of stored motion (the slider:
+        the rigid one's)."""
         d, s = self._data, self.sample[index]
-        if body.kind == "modal":  # a reduction's modal coordinates in its floating frame
-            reduction = self._extra[body.name]
-            from flex.bodies.stress import nodal_displacement, nodal_stress
 
-            q = d[f"{body.name}/modal_coordinates"][s]
-            elastic = nodal_displacement(reduction, q)
-            position = _place(body.reference_m + elastic, d[f"{body.name}/frame_position"][s],
-                              d[f"{body.name}/frame_angle"][s])
-            stress = nodal_stress(reduction, q) if body.has_stress else None
-            return BodyState(position, elastic, stress)
-        if body.kind == "nodal":  # every node of the mesh (the nonlinear FE coupler)
-            position = np.asarray(d[f"{body.name}/nodal/position"][index], dtype=float)
-            plate = self._extra[body.name]
-            b = plate.weights_end_a @ position[plate.nodes_end_a]
-            c = plate.weights_end_b @ position[plate.nodes_end_b]
-            angle = math.atan2(c[1] - b[1], c[0] - b[0])
-            local = _place(position - b, np.zeros(2), -angle)  # turned back into the chord frame
-            return BodyState(position, local - body.reference_m, None)
-        joints = self.joints(index)
-        if body.name == "slider":
-            origin, angle = joints["C"], 0.0
-        elif body.name == "crank":
-            origin, angle = joints["A"], d["crank/angle"][s]
-        else:
-            origin, angle = joints["B"], d["coupler/angle"][s]
-        return BodyState(_place(body.reference_m, origin, angle),
-                         np.zeros_like(body.reference_m), None)
+        def frame() -> tuple[np.ndarray, float]:  # the rigid frame: origin at its first joint
+            joints = self.joints(index)
+            if body.name == "slider":
+                return joints["C"], 0.0
+            if body.name == "crank":
+                return joints["A"], float(d["crank/angle"][s])
+            return joints["B"], float(d["coupler/angle"][s])
+
+        reader = self._readers.get(body.name, RIGID_MOTION)
+        return reader.state(body, self._extra.get(body.name), d, s, index, frame)
 
 
 def _along(angle_rad: float, length_m: float) -> np.ndarray:
     return length_m * np.array([math.cos(angle_rad), math.sin(angle_rad)])
 
 
-def _place(points_m: np.ndarray, origin_m: np.ndarray, angle_rad: float) -> np.ndarray:
-    """Body points turned by ``angle_rad`` about z and moved to ``origin_m`` (x, y) [m]."""
-    c, s = math.cos(angle_rad), math.sin(angle_rad)
-    out = np.array(points_m, dtype=float)
-    out[:, 0] = c * points_m[:, 0] - s * points_m[:, 1] + origin_m[0]
-    out[:, 1] = s * points_m[:, 0] + c * points_m[:, 1] + origin_m[1]
-    return out
-
-
 # ------------------------------------------------------------------------------------------
 # meshes
 # ------------------------------------------------------------------------------------------
-def tet10_cells(corners: np.ndarray, positions_m: np.ndarray) -> np.ndarray:
-    """Quadratic tetrahedra (VTK node order) from corner tetrahedra of a second-order mesh
-    whose mid-edge nodes lie at the edge midpoints (straight edges: a plate box), oriented
-    positively; raises ValueError when a midpoint has no node."""
-    from scipy.spatial import cKDTree
-
-    corners = np.array(corners, dtype=np.int64)
-    p = positions_m[corners]
-    volume = np.einsum("ij,ij->i", np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]),
-                       p[:, 3] - p[:, 0])
-    corners[volume < 0] = corners[volume < 0][:, [0, 2, 1, 3]]
-    midpoints = np.stack([(positions_m[corners[:, a]] + positions_m[corners[:, b]]) / 2
-                          for a, b in TET10_EDGES], axis=1)
-    distance, nodes = cKDTree(positions_m).query(midpoints.reshape(-1, 3))
-    if np.max(distance) > 1e-9 * np.ptp(positions_m, axis=0).max():
-        raise ValueError("the mesh has a curved or missing mid-edge node")
-    return np.hstack([corners, nodes.reshape(-1, 6)])
-
-
-def box_mesh(length_m: float, height_m: float, width_m: float, centred: bool = False
-             ) -> tuple[np.ndarray, np.ndarray]:
-    """A box x in [0, length] (or centred on 0), y and z centred, as 5 tetrahedra: node
-    positions (8 corners) and the corner cells (5, 4)."""
-    x0 = -length_m / 2 if centred else 0.0
-    corners = np.array([[x0 + i * length_m, (j - 0.5) * height_m, (k - 0.5) * width_m]
-                        for k in (0, 1) for j in (0, 1) for i in (0, 1)])
-    # corner i + 2 j + 4 k at (x_i, y_j, z_k): four corner tetrahedra and the middle one
-    cells = np.array([[0, 1, 2, 4], [3, 1, 2, 7], [5, 1, 4, 7], [6, 2, 4, 7], [1, 2, 4, 7]])
-    return corners, cells
-
-
-def _quadratic_box(length_m: float, height_m: float, width_m: float, centred: bool
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`box_mesh` with mid-edge nodes: positions, Tet10 cells, corner cells."""
-    points, corners = box_mesh(length_m, height_m, width_m, centred)
-    edges = sorted({tuple(sorted((int(c[a]), int(c[b])))) for c in corners
-                    for a, b in TET10_EDGES})
-    points = np.vstack([points, [(points[a] + points[b]) / 2 for a, b in edges]])
-    return points, tet10_cells(corners, points), corners
-
-
 def _top_faces(corners: np.ndarray, reference_m: np.ndarray) -> np.ndarray:
     """Boundary triangles (corner nodes) of a tetrahedral mesh that lie in its top face
     (z = max z): what a view from +z sees of a plate."""
@@ -293,87 +209,27 @@ def case_motion(path: str | Path, case: str | None = None, *,
     scene = case_scene(attrs, where)
     models = {link: model_entry(scene[link]["model"], where, link_models)
               for link in LINKS}
-    if all(model.stored_motion == "rigid" for model in models.values()):
+    readers = {link: model.stored_motion for link, model in models.items()}
+    if all(reader.kind == RIGID_MOTION.kind for reader in readers.values()):
         raise FlexError(f"{where} has no flexible link (crank and coupler rigid): flex export "
                         f"and animate show FFRF and nonlinear FE links")
-    unread = [f"the {model.label} {link}" for link, model in models.items()
-              if model.stored_motion == "none"]
+    unread = [f"the {models[link].label} {link}" for link, reader in readers.items()
+              if reader.body is None or reader.state is None]
     if unread:
         raise FlexError(f"{where}: {' and '.join(unread)} stores no motion that flex export "
                         f"and animate read back (they show FFRF and nonlinear FE links)")
     bodies, extra = [], {}
-    for link, model in models.items():
-        if model.stored_motion == "modal":
-            body, extra[link] = _ffrf_body(link, scene, data, attrs, where, cache_dir)
-        elif model.stored_motion == "nodal":
-            body, extra[link] = _nonlinear_body(scene, data, where)
-        else:
-            body = _rigid_body(link, scene)
-        bodies.append(replace(body, model=model.name))
+    for link, reader in readers.items():
+        body, extra[link] = reader.body(link, scene, data, attrs, where, cache_dir)
+        bodies.append(replace(body, model=models[link].name))
     bodies.append(_slider_body(scene))
-    return CaseMotion(path, case, scene, data, attrs, bodies, extra)
-
-
-def _ffrf_body(link: str, scene: Scene, data: dict[str, np.ndarray], attrs: dict[str, Any],
-               where: str, cache_dir: Path | None) -> tuple[Body, Any]:
-    from flex.bodies.stress import check_basis_identity
-    from flex.dynamics.solver import reduction_for_scene
-
-    missing = [name for name in ("modal_coordinates", "frame_position", "frame_angle")
-               if f"{link}/{name}" not in data]
-    if missing:
-        raise FlexError(f"{where}: the FFRF {link} has no {', '.join(missing)} (written "
-                        f"before flex stored them): rerun the case")
-    reduction = reduction_for_scene(scene, link, cache_dir=cache_dir)
-    problem = check_basis_identity(link, reduction, attrs)
-    if problem:
-        raise FlexError(f"{where}: {problem}")
-    found = np.shape(data[f"{link}/modal_coordinates"])
-    if len(found) != 2 or found[1] != reduction.n_modal_coordinates:
-        raise FlexError(f"{where}: {link}/modal_coordinates has shape {found}, expected "
-                        f"(samples, {reduction.n_modal_coordinates}): one column per mode of "
-                        f"the reduction; the file was changed after flex wrote it: rerun the "
-                        f"case")
-    positions = reduction.fem.GetNodePositionsAsArray()
-    corners = np.asarray(reduction.fem.elements[0]["Tet4"], dtype=np.int64)
-    body = Body(link, FFRF, positions, tet10_cells(corners, positions), corners,
-                has_stress=reduction.has_stress_modes,
-                facts={"reduction_key": reduction.key, "from_cache": reduction.from_cache},
-                kind="modal")
-    return body, reduction
-
-
-def _nonlinear_body(scene: Scene, data: dict[str, np.ndarray], where: str
-                    ) -> tuple[Body, Any]:
-    from flex.bodies.nonlinear import nonlinear_plate_for_scene
-
-    if "coupler/nodal/position" not in data:
-        raise FlexError(f"{where}: the nonlinear FE coupler has no nodal field "
-                        f"(coupler/nodal/position: written before flex stored it): rerun "
-                        f"the case")
-    plate = nonlinear_plate_for_scene(scene)
-    if data["coupler/nodal/position"].shape[1] != plate.n_nodes:
-        raise FlexError(f"{where}: the stored nodal field has "
-                        f"{data['coupler/nodal/position'].shape[1]} nodes, the plate's mesh "
-                        f"{plate.n_nodes} (another netgen version?): rerun the case")
-    corners = np.array([[v.nr - 1 for v in element.vertices]
-                        for element in plate.mesh.ngmesh.Elements3D()], dtype=np.int64)
-    positions = plate.node_positions_m
-    return Body("coupler", NONLINEAR_FE, positions, tet10_cells(corners, positions),
-                corners, kind="nodal"), plate
-
-
-def _rigid_body(link: str, scene: Scene) -> Body:
-    values = scene[link]
-    points, cells, corners = _quadratic_box(values["length_m"], values["thickness_m"],
-                                            values["width_m"], centred=False)
-    return Body(link, RIGID, points, cells, corners)
+    return CaseMotion(path, case, scene, data, attrs, bodies, extra, readers)
 
 
 def _slider_body(scene: Scene) -> Body:
     length = scene["coupler"]["length_m"]
-    points, cells, corners = _quadratic_box(SLIDER_BLOCK[0] * length, SLIDER_BLOCK[1] * length,
-                                            scene["coupler"]["width_m"], centred=True)
+    points, cells, corners = quadratic_box(SLIDER_BLOCK[0] * length, SLIDER_BLOCK[1] * length,
+                                           scene["coupler"]["width_m"], centred=True)
     return Body("slider", RIGID, points, cells, corners)
 
 

@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
+from flex.base.physics import Plate
 from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction.basis import (
     craig_bampton_basis,
@@ -226,9 +227,7 @@ def ngsolve_thread_count(threads: int | None) -> Iterator[None]:
         ngsolve.SetNumThreads(previous)
 
 
-def build_reduction(length_m: float, thickness_m: float, width_m: float,
-                    youngs_modulus_Pa: float, density_kg_per_m3: float, poisson_ratio: float,
-                    mesh_size_m: float, modes: int,
+def build_reduction(plate: Plate, mesh_size_m: float, modes: int,
                     cache_dir: str | os.PathLike | None, *,
                     mode_selection: str = "in_plane",
                     ngsolve_threads: int | None = 1,
@@ -236,7 +235,8 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
     """Mesh, reduce and cache a plate link; return the :class:`Reduction`.
 
     Contract:
-      - sizes in metres, E in Pa, density in kg/m^3; ``mesh_size_m`` is netgen's maxh
+      - ``plate``: its sizes in metres, E in Pa, density in kg/m^3, Poisson's ratio
+        (:class:`flex.base.physics.Plate`); ``mesh_size_m`` is netgen's maxh
         (recommendation: about the thickness, at most 2 x thickness); ``modes`` >= 1 is the
         number of fixed-interface (both faces clamped) eigenmodes added to the static modes
         of ``end_b``. Bad values raise :class:`flex.base.errors.SceneError`.
@@ -263,9 +263,10 @@ def build_reduction(length_m: float, thickness_m: float, width_m: float,
         eigensolver); eigenmode signs are normalised so modal coordinates keep their sign.
     """
     start = time.perf_counter()
-    sizes = {"length_m": length_m, "thickness_m": thickness_m, "width_m": width_m,
-             "youngs_modulus_Pa": youngs_modulus_Pa, "density_kg_per_m3": density_kg_per_m3,
-             "mesh_size_m": mesh_size_m}
+    sizes = {"length_m": plate.length_m, "thickness_m": plate.thickness_m,
+             "width_m": plate.width_m, "youngs_modulus_Pa": plate.youngs_modulus_Pa,
+             "density_kg_per_m3": plate.density_kg_per_m3, "mesh_size_m": mesh_size_m}
+    poisson_ratio = plate.poisson_ratio
     parameters = _reduction_parameters(sizes, poisson_ratio, modes, mode_selection, mesh_order)
     key = cache_key(parameters)
     cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"

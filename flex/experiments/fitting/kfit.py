@@ -33,12 +33,13 @@ from __future__ import annotations
 import functools
 import math
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from flex.base.physics import euler_buckling_load_N
+from flex.base.physics import Plate
 from flex.base.thesis import THESIS_ANGLE_MAX_TIME_S
 from flex.base.thesis import THESIS_COMPRESSION_M as THESIS_PRELOAD_M  # sec. 6.1
 from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M as THESIS_SPRING_N_PER_M  # Table 2
@@ -56,7 +57,6 @@ from flex.fidelity.criteria import (
     deployment_times,
     error_measures,
     n_values,
-    pinned_pinned_omega,
     quasi_static_stress,
 )
 from flex.fidelity.predictor import predict_deflection
@@ -101,8 +101,7 @@ def tuned(scene: Scene) -> Scene:
     estimate/400) with T = 2 pi / omega (Euler-Bernoulli, pinned-pinned).
     """
     coupler, drive = scene["coupler"], scene["drive"]
-    omega = pinned_pinned_omega(coupler["length_m"], coupler["thickness_m"],
-                                coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"])
+    omega = Plate.of(coupler).pinned_pinned_omega
     estimate = THESIS_ANGLE_MAX_TIME_S * math.sqrt(THESIS_SPRING_N_PER_M
                                                    / drive["spring_stiffness_N_per_m"])
     estimate *= max(1.0, drive["spring_preload_m"] / THESIS_PRELOAD_M) ** 0.25
@@ -126,8 +125,7 @@ def _plate(scene: Scene, thickness_m: float, zeta: float, spring_N_per_m: float,
 
 
 def _euler_N(scene: Scene, thickness_m: float) -> float:
-    c = scene["coupler"]
-    return euler_buckling_load_N(c["length_m"], thickness_m, c["width_m"], c["youngs_modulus_Pa"])
+    return replace(Plate.of(scene["coupler"]), thickness_m=thickness_m).euler_load_N
 
 
 def estimated_euler_ratio(scene: Scene, thickness_m: float, spring_N_per_m: float,
@@ -215,17 +213,15 @@ def geometry_key(scene: Scene) -> tuple | None:
     c = scene["coupler"]
     if c["model"] not in (FFRF, "auto"):
         return None
-    return (c["length_m"], c["thickness_m"], c["width_m"], c["youngs_modulus_Pa"],
-            c["density_kg_per_m3"], c["poisson_ratio"], c["mesh_size_m"], c["modes"],
-            c["mode_selection"])
+    return Plate.of(c), c["mesh_size_m"], c["modes"], c["mode_selection"]
 
 
 @functools.lru_cache(maxsize=3)
 def _reduction(key: tuple, cache_dir: Path | None) -> Any:
     from flex.bodies.reduction import build_reduction
 
-    *sizes, selection = key
-    return build_reduction(*sizes, cache_dir, mode_selection=selection)
+    plate, mesh_size_m, modes, selection = key
+    return build_reduction(plate, mesh_size_m, modes, cache_dir, mode_selection=selection)
 
 
 def reduction_of(scene: Scene, cache_dir: Path | None = None) -> Any:
@@ -383,10 +379,9 @@ def fit_case(name: str, scene: Scene, *, cache_dir: Path | None = None) -> CaseR
     coupler = scene["coupler"]
     reduction = reduction_of(scene, cache_dir)
     rigid, ffrf, times, walls = _run_pair(scene, reduction, cache_dir)
-    measures = error_measures(rigid, ffrf, coupler["length_m"], coupler["thickness_m"],
-                              coupler["width_m"], times["stop"], coupler["youngs_modulus_Pa"])
-    omega = pinned_pinned_omega(coupler["length_m"], coupler["thickness_m"],
-                                coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"])
+    plate = Plate.of(coupler)
+    measures = error_measures(rigid, ffrf, plate, times["stop"])
+    omega = plate.pinned_pinned_omega
     out = _case_parameters(scene, reduction, omega, walls)
     for definition, delta_t in times.items():
         n = n_values(delta_t, omega)

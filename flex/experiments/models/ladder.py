@@ -19,13 +19,13 @@ from pathlib import Path
 
 import numpy as np
 
-from flex.base.physics import pinned_pinned_omega
+from flex.base.physics import Plate
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import EXACT_BEAM, FFRF, NONLINEAR_FE
 from flex.fidelity.simulation import simulate_case
-from flex.fidelity.softening import coupler_compression_N, coupler_euler_load_N
+from flex.fidelity.softening import coupler_compression_N
 
 #: the models, cheapest first: name -> coupler overrides (the exact beam at 64 elements,
 #: within 0.03 % of its element limit on the first crest: its idealization, not its
@@ -63,10 +63,7 @@ class Rung:
 
 def first_period_s(scene: Scene) -> float:
     """Euler-Bernoulli pinned-pinned first bending period of the scene's coupler plate [s]."""
-    c = scene["coupler"]
-    omega = pinned_pinned_omega(c["length_m"], c["thickness_m"], c["youngs_modulus_Pa"],
-                                c["density_kg_per_m3"])
-    return 2 * math.pi / omega
+    return 2 * math.pi / Plate.of(scene["coupler"]).pinned_pinned_omega
 
 
 def rung_scenes(scene: Scene, thickness_m: float, mesh_size_m: float, step_s: float,
@@ -110,7 +107,7 @@ def rung_from_cases(cases: dict[str, CaseResult], scene: Scene) -> Rung:
         rung.wall_time_s[name] = float(case.counters["wall_time_s"])
         if name == "linear":
             rung.compression_over_euler_load = float(
-                coupler_compression_N(data).max() / coupler_euler_load_N(scene["coupler"]))
+                coupler_compression_N(data).max() / Plate.of(scene["coupler"]).euler_load_N)
     reference = rung.peak_deflection_m.get(REFERENCE, math.nan)
     for name, peak in rung.peak_deflection_m.items():
         rung.difference_to_reference[name] = peak / reference - 1.0

@@ -33,7 +33,7 @@ import numpy as np
 
 from flex.base.errors import FlexError
 from flex.base.kinematics import constant_speed_motion
-from flex.base.physics import pinned_pinned_omega
+from flex.base.physics import Plate, pinned_pinned_omega
 from flex.base.plotting import decade_ticks, figure, legend_below, relative_drift
 from flex.base.thesis import (
     THESIS_COUPLER_LENGTH_M,
@@ -54,7 +54,7 @@ from flex.experiments.workprecision.measurement import (
 )
 from flex.fidelity.caseloop import Progress, run_each
 from flex.fidelity.simulation import simulate_case
-from flex.fidelity.softening import coupler_compression_N, coupler_euler_load_N
+from flex.fidelity.softening import coupler_compression_N
 
 Verdict = dict[str, Any]
 
@@ -224,7 +224,7 @@ def run_measures(scene: Scene, data: dict[str, np.ndarray]) -> Verdict:
         out["peak_deflection_first_tenth"] = float(deflection[:tenth].max())
         out["peak_deflection_last_tenth"] = float(deflection[-tenth:].max())
         out["axial_force_over_euler_load"] = float(
-            max(coupler_compression_N(data).max(), 0.0) / coupler_euler_load_N(scene["coupler"]))
+            max(coupler_compression_N(data).max(), 0.0) / Plate.of(scene["coupler"]).euler_load_N)
     return out
 
 

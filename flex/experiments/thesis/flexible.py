@@ -20,12 +20,13 @@ draws them.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from flex.base.physics import n_values
+from flex.base.physics import Plate, n_values
 from flex.base.plotting import MICRO, figure, legend_below, panels
 from flex.bodies.nonlinear import nonlinear_plate_for_scene
 from flex.data.plates import is_damped
@@ -37,7 +38,7 @@ from flex.dynamics.solver import reduction_for_scene
 from flex.fidelity.caseloop import Progress, run_each
 from flex.fidelity.error_budget import budget_rows
 from flex.fidelity.simulation import simulate_case
-from flex.fidelity.softening import compare_with_reference, coupler_euler_load_N
+from flex.fidelity.softening import compare_with_reference
 
 Plates = dict[str, tuple[float, float]]  # model -> (thickness [m], mesh size [m])
 #: what the summary reports of each FFRF case's reduction (``notes["reductions"][case]``)
@@ -202,7 +203,7 @@ def _reference_lines(scene: Scene, results: dict[str, CaseResult], plates: Plate
         reference = results.get(f"{model}_{NONLINEAR_FE}")
         if reference is None:
             continue
-        euler_load_N = coupler_euler_load_N({**scene["coupler"], "thickness_m": thickness_m})
+        euler_load_N = replace(Plate.of(scene["coupler"]), thickness_m=thickness_m).euler_load_N
         runs = {kind: results[f"{model}_{kind}"] for kind in KINDS
                 if kind != NONLINEAR_FE and f"{model}_{kind}" in results}
         found, more = compare_with_reference(model, runs, reference, euler_load_N,

@@ -14,11 +14,13 @@ datasets stored under ``/summary`` (units from the keys: ``_m``, ``_s``, ``_Hz``
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from flex.base.physics import Plate
 from flex.base.thesis import THESIS_TABLE5
 from flex.bodies.beams import Material, beam_link_modes
 from flex.bodies.fe_modes import plate_modes
@@ -45,9 +47,7 @@ Progress = Callable[[str, int, int], None]
 
 def scene_material(scene: Any) -> Material:
     """The coupler's material of a scene (E [Pa], rho [kg/m^3], nu), used for every link."""
-    coupler = scene["coupler"]
-    return Material(coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"],
-                    coupler["poisson_ratio"])
+    return Material.of(Plate.of(scene["coupler"]))
 
 
 def _unit(key: str) -> str:
@@ -94,10 +94,10 @@ def survey(scene: Any, progress: Progress | None = None) -> tuple[dict[str, Data
         _store(datasets, f"table_{link}", table)
         lines.append(link_table_line(link, table))
     lines.append("  first five modes [Hz] (FE | Timoshenko beam), kinds from the mode shapes:")
-    for name, plate in links.items():
+    for name, (plate, mesh_m) in links.items():
         for condition in CONDITIONS:
             step()
-            lines.append(link_modes(datasets, name, plate, condition, material))
+            lines.append(link_modes(datasets, name, plate, mesh_m, condition))
     lines.append(f"  mesh convergence (pinned-pinned in-plane bending, tolerance "
                  f"{CONVERGENCE_TOLERANCE:.1%}):")
     for thickness_m in thicknesses_m:
@@ -143,26 +143,27 @@ def link_table_line(link: str, table: dict[str, np.ndarray]) -> str:
             f"k Timoshenko {float(table['timoshenko_k']):.0f}")
 
 
-def link_plates(scene: Any, thicknesses_m: np.ndarray
-                ) -> dict[str, tuple[float, float, float, float]]:
-    """The surveyed plates, ``name: (length, thickness, width, netgen maxh)`` in m: each
-    Table 5 coupler (``coupler_t<t>mm``) at its production mesh, and the crank."""
-    coupler = scene["coupler"]
-    links = {f"coupler_t{t * 1e3:g}mm": (coupler["length_m"], t, coupler["width_m"], h)
+def link_plates(scene: Any, thicknesses_m: np.ndarray) -> dict[str, tuple[Plate, float]]:
+    """The surveyed plates, ``name: (plate, netgen maxh [m])``, all of the coupler's material
+    (:func:`scene_material`): each Table 5 coupler (``coupler_t<t>mm``) at its production
+    mesh, and the crank."""
+    coupler = Plate.of(scene["coupler"])
+    links = {f"coupler_t{t * 1e3:g}mm": (replace(coupler, thickness_m=t), h)
              for t, h in zip(thicknesses_m, TABLE5_FE_MESH_SIZES_M, strict=True)}
-    links["crank"] = (scene["crank"]["length_m"], *CRANK_SECTION_M, CRANK_SECTION_M[0] / 3)
+    thickness_m, width_m = CRANK_SECTION_M
+    links["crank"] = (replace(coupler, length_m=scene["crank"]["length_m"],
+                              thickness_m=thickness_m, width_m=width_m), thickness_m / 3)
     return links
 
 
-def link_modes(datasets: dict[str, Dataset], name: str,
-               plate: tuple[float, float, float, float], condition: str,
-               material: Material) -> str:
-    """Store the first five FE and Timoshenko modes of one plate under
-    ``links/<name>/<condition>/`` (pinned-pinned also the mesh and the mode shapes); return
-    the report line."""
-    length_m, thickness_m, width_m, mesh_m = plate
-    fe = plate_modes(length_m, thickness_m, width_m, mesh_m, condition, material=material)
-    beam = beam_link_modes(length_m, thickness_m, width_m, condition, material=material)
+def link_modes(datasets: dict[str, Dataset], name: str, plate: Plate, mesh_size_m: float,
+               condition: str) -> str:
+    """Store the first five FE and Timoshenko modes of one plate (meshed at netgen maxh
+    ``mesh_size_m`` [m]) under ``links/<name>/<condition>/`` (pinned-pinned also the mesh and
+    the mode shapes); return the report line."""
+    material = Material.of(plate)
+    fe = plate_modes(*plate.sizes_m, mesh_size_m, condition, material=material)
+    beam = beam_link_modes(*plate.sizes_m, condition, material=material)
     group = f"links/{name}/{condition}"
     datasets[f"{group}/fe_frequencies"] = Dataset(fe.frequencies_Hz, "Hz", "3D FE")
     datasets[f"{group}/fe_mode_kinds"] = Dataset(

@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import FlexError
+from flex.base.physics import Plate
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.dynamics.link_models import NONLINEAR_FE
@@ -414,8 +415,7 @@ def bench_reduction(scene: Scene, say: Say, notes: dict[str, Any]) -> None:
     from flex.bodies.reduction import build_reduction
 
     c = scene["coupler"]
-    args = (c["length_m"], c["thickness_m"], c["width_m"], c["youngs_modulus_Pa"],
-            c["density_kg_per_m3"], c["poisson_ratio"], c["mesh_size_m"], c["modes"])
+    args = (Plate.of(c), c["mesh_size_m"], c["modes"])
     selection = {"mode_selection": c["mode_selection"]}
     cold, cached, interface = [], [], []
     for _ in range(2):

@@ -16,7 +16,7 @@ import math
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from flex.base.physics import in_plane_fixed_interface_omegas
+from flex.base.physics import Plate
 from flex.config.ffrf_rule import first_period_s
 from flex.data.scene import Scene
 from flex.experiments.workprecision.convergence import converged_reference
@@ -44,10 +44,7 @@ def coupler_setting(label: str, step_s: float, modes: int, mesh_m: float) -> Set
 
 def reference_discretization(coupler: Mapping[str, Any]) -> tuple[float, int, float]:
     """Step [s], modes and mesh size [m] of a scene's reference (see the module doc)."""
-    omegas = in_plane_fixed_interface_omegas(
-        coupler["length_m"], coupler["thickness_m"], coupler["width_m"],
-        coupler["youngs_modulus_Pa"], coupler["density_kg_per_m3"], coupler["poisson_ratio"],
-        REFERENCE_MODES)
+    omegas = Plate.of(coupler).in_plane_omegas(REFERENCE_MODES)
     top_period = 2 * math.pi / omegas[-1]
     step = min(first_period_s(coupler) / 400.0, top_period / REFERENCE_STEPS_PER_TOP_PERIOD)
     mesh = max(min(coupler["thickness_m"], coupler["length_m"] / 32.0), REFERENCE_MESH_FLOOR_M)

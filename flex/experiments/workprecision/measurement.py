@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import FlexError, SceneError
+from flex.base.physics import Plate
 from flex.config.settings import has_auto_link_keys, resolve_link_keys, resolved_simulation
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
@@ -314,9 +315,7 @@ class ReductionPool:
         from flex.dynamics.solver import reduction_for_scene
 
         c = scene["coupler"]
-        key = tuple(c[k] for k in ("length_m", "thickness_m", "width_m", "youngs_modulus_Pa",
-                                   "density_kg_per_m3", "poisson_ratio", "mesh_size_m",
-                                   "modes")) + (order,)
+        key = (Plate.of(c), c["mesh_size_m"], c["modes"], order)
         if key not in self._by_key:
             self._by_key[key] = reduction_for_scene(scene, cache_dir=self.cache_dir,
                                                     mesh_order=order)
