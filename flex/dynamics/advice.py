@@ -187,13 +187,11 @@ def channel_cutoff_Hz(scene: Scene,
     """Cut-off [Hz] of the zero-phase low-pass channel the deployment's headline peaks are
     read on (:mod:`flex.fidelity.headlines`): :data:`CHANNEL_FACTOR` times the lowest
     pinned-pinned first bending frequency of the scene's flexible plate links (Euler-
-    Bernoulli, :func:`flex.base.physics.euler_bernoulli_omega`); None when no link is
+    Bernoulli, :attr:`flex.base.physics.Plate.pinned_pinned_omega`); None when no link is
     flexible (a rigid mechanism has no elastic ringing to filter)."""
-    from flex.base.physics import euler_bernoulli_omega
+    from flex.base.physics import Plate
 
-    omegas = [euler_bernoulli_omega(np.pi, values["length_m"], values["thickness_m"],
-                                    values["youngs_modulus_Pa"], values["density_kg_per_m3"])
-              for values in (scene[link] for link in LINKS)
+    omegas = [Plate.of(values).pinned_pinned_omega for values in (scene[link] for link in LINKS)
               if not link_models[values["model"]].rigid and values["geometry"] == "plate"]
     return CHANNEL_FACTOR * min(omegas) / (2.0 * np.pi) if omegas else None
 
