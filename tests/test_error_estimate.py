@@ -107,8 +107,9 @@ def test_inspect_prints_the_estimated_error(tmp_path):
     case = simulate(load_scene(overrides={"simulation.end_time_s": 0.005}), cache_dir=None)
     path = write_results(tmp_path / "one.h5", "simulate", [case], to_toml(load_scene()))
     text = format_description(describe(path))
-    assert "estimated error (total = the root-sum-square of the terms):" in text
-    assert "crank angle at the end time: " in text and "(root-sum-square of step " in text
+    assert "estimated error (total = the root-sum-square of the terms: the estimate" in text
+    assert "certificate " in text
+    assert "crank angle at the end time: " in text and "; root-sum-square of step " in text
     assert "method: step: step halving" in text and "validity: asymptotic" in text
     assert "leaves out: " in text and "the elasticity of the rigid crank and coupler" in text
 

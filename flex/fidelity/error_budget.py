@@ -45,7 +45,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -68,6 +68,13 @@ MESH_FACTOR = 2.0
 BEAM_ORDER = 2
 #: case attribute prefix of a headline quantity's value
 HEADLINE_PREFIX = "headline_"
+#: a budget's certificate over its estimate: the grid convergence index's safety factor for
+#: a study whose order is known (Roache 1998: 1.25 with three or more grids in the asymptotic
+#: range); a step term outside that range is already a bound (3x its larger difference) and
+#: the mesh term takes its coarser companion's difference whole
+CERTIFICATE_FACTOR = 1.25
+#: case attribute holding :data:`CERTIFICATE_FACTOR` as the budget applied it
+CERTIFICATE_ATTR = f"{PREFIX}certificate_factor"
 
 
 def richer_modes(modes: int) -> int:
@@ -117,6 +124,7 @@ class ErrorBudget:
             out[f"{PREFIX}{quantity}"] = self.total(quantity)
             out[f"{PREFIX}{quantity}_relative"] = self.relative(quantity)
             out.update({f"{PREFIX}{quantity}_{term}": value for term, value in terms.items()})
+        out[CERTIFICATE_ATTR] = CERTIFICATE_FACTOR
         out.update({f"{PREFIX}method": "; ".join(f"{term}: {text.rstrip('.')}" for term, text
                                                  in self.methods.items()) + ".",
                     f"{PREFIX}leaves_out": "; ".join(self.leaves_out) or "nothing flex knows of",
@@ -399,18 +407,34 @@ class BudgetRow:
     relative: float
     terms: dict[str, float]
     problem: str = ""
+    #: the certificate's factor over the estimate (NaN: a file written before certificates)
+    certificate_factor: float = math.nan
+
+    @property
+    def certificate(self) -> float:
+        """The certified bound [its units]: the estimate times its stored factor."""
+        return self.certificate_factor * self.total
+
+    @property
+    def certified_relative(self) -> float:
+        """The certificate over the quantity's magnitude (what refinement decides on; the
+        estimate's relative error for a file written before certificates)."""
+        factor = self.certificate_factor if math.isfinite(self.certificate_factor) else 1.0
+        return factor * self.relative
 
     def text(self) -> str:
-        """``what: value units +- total (relative %) = rss of step a, modes b, ...``, or
-        ``what: value units +- unknown (why)`` for a budget with a problem."""
+        """``what: value units +- total (relative %) [certificate c] = rss of step a, ...``,
+        or ``what: value units +- unknown (why)`` for a budget with a problem."""
         terms = ", ".join(f"{term} {term_text(value)}" for term, value in self.terms.items())
         if self.problem:
             return (f"{self.what}: {self.value:.6g} {self.units} +- {self.problem}"
                     + (f" (terms: {terms})" if terms else ""))
         relative = (f" ({100 * self.relative:.2g} %)" if math.isfinite(self.relative)
                     else "")
+        certificate = (f", certificate {self.certificate:.2g} {self.units}"
+                       if math.isfinite(self.certificate) else "")
         return (f"{self.what}: {self.value:.6g} {self.units} +- {self.total:.2g} "
-                f"{self.units}{relative} (root-sum-square of {terms})")
+                f"{self.units}{relative} (estimate{certificate}; root-sum-square of {terms})")
 
 
 def _described(attrs: Mapping[str, Any]) -> dict[str, tuple[str, str]]:
@@ -468,6 +492,9 @@ def budget_rows(attrs: Mapping[str, Any]) -> list[BudgetRow]:
         if not any(key in attrs for key in keys):
             continue
         rows.append(_budget_row(attrs, quantity, units, what))
+    factor, _ = _number(dict(attrs), CERTIFICATE_ATTR)
+    if factor is not None and math.isfinite(factor) and factor >= 1.0:
+        rows = [replace(row, certificate_factor=factor) for row in rows]
     return rows
 
 
@@ -507,5 +534,6 @@ def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> 
     return BudgetRow(quantity, what, units, value, total, relative, terms)
 
 
-__all__ = ["DESCRIBED", "BudgetRow", "ErrorBudget", "HEADLINE_PREFIX", "MESH_FACTOR", "TERMS",
-           "UNKNOWN_ATTR", "budget_rows", "term_text", "combined", "error_budget", "richer_modes"]
+__all__ = ["CERTIFICATE_ATTR", "CERTIFICATE_FACTOR", "DESCRIBED", "BudgetRow", "ErrorBudget",
+           "HEADLINE_PREFIX", "MESH_FACTOR", "TERMS", "UNKNOWN_ATTR", "budget_rows", "combined",
+           "error_budget", "richer_modes", "term_text"]

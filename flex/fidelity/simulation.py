@@ -239,11 +239,13 @@ def _next_attempt(scene: Scene, rows: list[Any], tolerance: float, attempt: int,
     turned, unless it cannot move, is refused, or would pass the cost limit."""
     if not rows:
         return _Step(None, NOTHING_TO_REFINE, NOTHING_TO_REFINE)
-    worst = max(rows, key=lambda row: row.relative if row.relative >= 0 else math.inf)
-    found = (f"{worst.what} {100 * worst.relative:.3g} % of itself (tolerance "
-             f"{100 * tolerance:g} %)" if not worst.problem else
+    worst = max(rows, key=lambda row: row.certified_relative if row.certified_relative >= 0
+                else math.inf)
+    found = (f"{worst.what} certified to {100 * worst.certified_relative:.3g} % of itself "
+             f"(estimate {100 * worst.relative:.3g} %; tolerance {100 * tolerance:g} %)"
+             if not worst.problem else
              f"{worst.what} {worst.problem} (tolerance {100 * tolerance:g} %)")
-    if all(row.relative <= tolerance for row in rows):
+    if all(row.certified_relative <= tolerance for row in rows):
         return _Step(None, "met", f"met; worst {found}")
     term = max(worst.terms, key=lambda key: worst.terms[key] if worst.terms[key] >= 0
                else math.inf)  # an unknown term (its companion failed) first

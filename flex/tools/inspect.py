@@ -300,7 +300,9 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
     rows = budget_rows(attrs)
     if not rows and f"{PREFIX}validity" not in attrs:
         return []
-    lines = ["  estimated error (total = the root-sum-square of the terms):"]
+    lines = ["  estimated error (total = the root-sum-square of the terms: the estimate, what "
+             "the error is; the certificate: a bound, the estimate times its stated factor, "
+             "what refinement decides on):"]
     lines += [f"    {row.text()}" for row in rows] or ["    none"]
     for key in ("method", "leaves_out", "validity", "unknown"):
         if attrs.get(PREFIX + key):

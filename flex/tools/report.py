@@ -329,6 +329,8 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
             rows.append([_code(case["name"]), row.what, f"{row.value:.6g} {row.units}",
                          row.problem or f"{row.total:.2g} {row.units}",
                          f"{100 * row.relative:.2g} %" if math.isfinite(row.relative) else "-",
+                         f"{row.certificate:.2g} {row.units}"
+                         if math.isfinite(row.certificate) else "-",
                          *(term_text(row.terms[t]) if t in row.terms else "-" for t in TERMS)])
         for key in ("method", "leaves_out", "validity", "unknown"):
             if case["attrs"].get(PREFIX + key):
@@ -337,8 +339,10 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
     if not rows:
         return []
     lines = ["Estimated error of each headline quantity (total = the root-sum-square of the "
-             "terms, in the quantity's unit):", ""]
-    lines += _table(["case", "quantity", "value", "estimated error", "relative", *TERMS], rows)
+             "terms, in the quantity's unit: what the error is; certificate = the bound "
+             "refinement decides on, the estimate times its stated safety factor):", ""]
+    lines += _table(["case", "quantity", "value", "estimated error", "relative",
+                     "certificate", *TERMS], rows)
     for key, texts in notes.items():
         for text, names in texts.items():
             who = "every case" if len(names) == len(cases) else ", ".join(map(_code, names))
