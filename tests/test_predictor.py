@@ -114,3 +114,26 @@ def test_auto_stores_the_rigid_model_s_predicted_error(reduction_cache):
     # a crank left rigid by the scene gets no decision, so no prediction; an auto crank's:
     # tests/test_crank_predictor.py
     assert "fidelity_crank_predicted_rigid_error" not in result.attrs
+
+
+def test_a_rigid_plate_coupler_states_the_bending_its_loads_predict(reduction_cache):
+    """A rigid 2 mm plate coupler: the run states its predicted peak deflection over the
+    deployment, named a prediction, +- its spread; the FFRF body on the same scene (an
+    independent model) lies within that spread."""
+    from flex.api import load_scene, simulate
+    from flex.fidelity.headlines import BUILTIN_HEADLINES
+    from flex.fidelity.predictor import PREDICTION_SPREAD
+
+    plate = {"coupler.geometry": "plate", "coupler.thickness_m": 0.002,
+             "simulation.end_time_s": 0.02, "simulation.error_estimate": False}
+    rigid = simulate(load_scene(overrides={**plate, "coupler.model": "rigid"}), cache_dir=None)
+    predicted = rigid.attrs["predicted_coupler_peak_deflection_m"]
+    assert rigid.attrs["predicted_coupler_peak_deflection_m_error"] == pytest.approx(
+        PREDICTION_SPREAD * predicted)
+    assert "a prediction, not a run" in rigid.attrs["predicted_method"]
+    assert rigid.attrs["predicted_coupler_peak_bending_stress_Pa"] > 0
+    ffrf = simulate(load_scene(overrides={**plate, "coupler.model": "ffrf"}),
+                    cache_dir=reduction_cache)
+    run = BUILTIN_HEADLINES["coupler_deployment_peak_deflection_m"].read(ffrf.datasets)
+    assert abs(predicted - run) <= PREDICTION_SPREAD * predicted
+    assert not any(key.startswith("predicted_") for key in ffrf.attrs)

@@ -145,8 +145,9 @@ _AGAINST_EXACT_BEAM_TEXT = (
     "by make ladder, and the FFRF body's mesh and step errors: it leans safe)")
 
 #: a rigid link: its elasticity is what the ``auto`` decision predicts from its loads
-RIGID_RUNG = Rung(0, "rigid", leaves_out='the elasticity of the rigid {links} (predicted by '
-                  'model = "auto", fidelity_* attributes)')
+RIGID_RUNG = Rung(0, "rigid", leaves_out='the elasticity of the rigid {links} (its bending '
+                  'predicted from the run\'s loads where the link is a plate: predicted_* '
+                  'attributes, a prediction; model = "auto": fidelity_* attributes)')
 #: the FFRF body without geometric stiffness: softens wrongly under compression
 LINEAR_FFRF_RUNG = Rung(
     1, "linear FFRF (geometric_stiffness = false)", _linear_ffrf_bound, GEOMETRIC_FFRF_ERROR,

@@ -22,6 +22,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from flex.base.errors import FlexError, SceneError
 from flex.config.calibration import Calibration
 from flex.config.ladder import next_rung
@@ -98,6 +100,7 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
                                                       link_models=link_models)
     result = integrate(scene, name, reduction, crank_reduction, cache_dir=cache_dir,
                        link_models=link_models)
+    result.attrs.update(_rigid_predictions(scene, result, link_models))
     result.attrs.update(resolution.attrs())
     if result.attrs.get("solver_defaults_entry") == "flexible_fallback":
         print(f"flex: note: case {name}: outside the calibrated family: "
@@ -279,6 +282,26 @@ def _say_status(name: str, status: str, tolerance: float) -> None:
         print(f"flex: case {name}: fidelity.tolerance = {tolerance:g} not met by refinement "
               f"({status}); the last run is stored with its budget", file=sys.stderr,
               flush=True)
+
+
+def _rigid_predictions(scene: Scene, result: CaseResult,
+                       link_models: Mapping[str, LinkModel]) -> dict[str, Any]:
+    """What the run's loads predict of its rigid plate links' bending over the deployment
+    (:func:`flex.fidelity.predictor.rigid_link_predictions`); none for a drive other than the
+    spring (the predictor's measured family) or a run that failed to sample its loads."""
+    from flex.fidelity.headlines import deployment_end
+    from flex.fidelity.predictor import rigid_link_predictions
+
+    rigid = [link for link in LINKS if link_models[scene[link]["model"]].rigid
+             and scene[link]["geometry"] == "plate"]
+    needed = ("joints/B/force_on_coupler", "joints/C/force_on_coupler", "coupler/angle")
+    if not rigid or scene["drive"]["kind"] != "spring" or not all(
+            path in result.datasets for path in needed):
+        return {}
+    series = {path: np.asarray(dataset.data) for path, dataset in result.datasets.items()}
+    end = deployment_end(result.datasets)
+    window_end_s = np.inf if end is None else float(series["time"][end])
+    return rigid_link_predictions(scene, series, rigid, window_end_s)
 
 
 #: runs of an attempt's error budget, in run-equivalents (a companion at h / 2, more modes, a

@@ -307,6 +307,7 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
     for key in ("method", "leaves_out", "validity", "unknown"):
         if attrs.get(PREFIX + key):
             lines.append(f"    {key.replace('_', ' ')}: {attrs[PREFIX + key]}")
+    lines += _prediction_lines(attrs)
     lines += [f"    crest gap of the {key.removeprefix('crest_gap_').split('_')[0]}'s peak "
               f"deflection: {_quantity(value, 'm')} (the second-largest crest lies this far "
               f"below it)" for key, value in attrs.items() if key.startswith("crest_gap_")]
@@ -314,6 +315,26 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
         lines.append(f"  refinement (fidelity.refine): {attrs['refine_status']}, "
                      f"{_quantity(attrs.get('refine_wall_time_s', 0.0), 's')}")
         lines += [f"    {line}" for line in str(attrs.get("refine_attempts", "")).splitlines()]
+    return lines
+
+
+def _prediction_lines(attrs: dict[str, Any]) -> list[str]:
+    """A rigid link's predicted bending (``predicted_*``, a prediction from its loads, not
+    a run), each with its stated error."""
+    from flex.fidelity.predictor import PREDICTED_PREFIX
+
+    lines = []
+    for key, value in attrs.items():
+        name = key.removeprefix(PREDICTED_PREFIX)
+        if not key.startswith(PREDICTED_PREFIX) or name.endswith("_error") or name == "method":
+            continue
+        unit = "Pa" if name.endswith("_Pa") else "m"
+        error = attrs.get(f"{key}_error")
+        what = name.removesuffix(f"_{unit}").replace("_", " ")
+        lines.append(f"    predicted {what} (rigid link, a prediction): {_quantity(value, unit)}"
+                     + (f" +- {_quantity(error, unit)}" if error is not None else ""))
+    if lines and attrs.get(f"{PREDICTED_PREFIX}method"):
+        lines.append(f"    prediction: {attrs[f'{PREDICTED_PREFIX}method']}")
     return lines
 
 
