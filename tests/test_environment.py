@@ -132,7 +132,7 @@ def test_the_api_reads_the_cache_folder_and_a_study_run_passes_it_on(tmp_path, m
     monkeypatch.setenv("FLEX_CACHE_DIR", str(tmp_path))
     assert flex.simulate(flex.load_scene(overrides=COARSE_FFRF)).status == "ok"
     # the API's default: the user's (the run's reduction, its geometric stiffness beside it,
-    # and those of the error budget's companions: more modes, a coarser mesh)
+    # and those of the error budget's companions: more modes, a finer mesh)
     entries = sorted(path.name for path in (tmp_path / "reductions").glob("*.hdf5"))
     assert len(entries) == 6
     monkeypatch.delenv("FLEX_CACHE_DIR")

@@ -194,7 +194,7 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
         assert rows[name].terms["model"] == pytest.approx(difference, rel=1e-6)
     assert deflection.terms["modes"] > 0 and deflection.terms["mesh"] > 0
     method = result.attrs["estimated_error_method"]
-    assert "coupler 2 -> 4" in method and "coupler 0.005 -> 0.01 m" in method
+    assert "coupler 2 -> 4" in method and "coupler 0.005 -> 0.0025 m" in method
     # the first crest: a headline of its own, with the whole budget; the peak's crest gap
     crest = rows["coupler_first_crest_deflection_m"]
     assert set(crest.terms) == set(TERMS) and 0 < crest.value <= deflection.value

@@ -27,7 +27,9 @@ The contract of an entry:
    ``own_fraction``, :mod:`flex.config.ladder`), or None for a quantity of the motion (the
    rungs' ``motion_fraction``);
 7. ``certified``: :func:`flex.fidelity.simulation.refine` refines until it meets the
-   tolerance; ``crest_gap``: its budget stores the peak's crest gap (:func:`crest_gap`).
+   tolerance; ``crest_gap``: its budget stores the peak's crest gap (:func:`crest_gap`);
+   ``mesh_order``: its order of convergence under mesh refinement (the budget's mesh term
+   extrapolates a finer mesh's difference with it).
 """
 
 from __future__ import annotations
@@ -57,6 +59,9 @@ class Headline:
     link: str | None = None
     certified: bool = False
     crest_gap: bool = False
+    #: its order of convergence under mesh refinement, what the budget's mesh term
+    #: extrapolates with (a displacement or the motion 2, a stress at the outer fibre 1)
+    mesh_order: int = 2
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
@@ -181,11 +186,13 @@ def _link_headlines(link: str) -> list[list[Headline]]:
     deployment = [Headline(f"{link}_deployment_peak_{suffix}", suffix.rsplit("_", 1)[1], what
                            + " over the deployment" + _CHANNEL_TEXT,
                            deployment_peak_value(path), "value", path, window=DEPLOYMENT,
-                           link=link, certified=path == deflection)
+                           link=link, certified=path == deflection,
+                           mesh_order=2 if path == deflection else 1)
                   for path, suffix, what in series]
     whole = [Headline(f"{link}_peak_{suffix}", suffix.rsplit("_", 1)[1],
                       what + " over the whole run (raw)", peak_value(path), "peak", path,
-                      link=link, crest_gap=path == deflection)
+                      link=link, crest_gap=path == deflection,
+                      mesh_order=2 if path == deflection else 1)
              for path, suffix, what in series]
     return [deployment, whole]
 
