@@ -73,7 +73,7 @@ HEADLINE_PREFIX = "headline_"
 #: a budget's certificate over its estimate: the grid convergence index's safety factor for
 #: a study whose order is known (Roache 1998: 1.25 with three or more grids in the asymptotic
 #: range); a step term outside that range is already a bound (3x its larger difference) and
-#: the mesh term takes its coarser companion's difference whole
+#: the mesh term's order 2 lies below the orders observed (4.1 on the 2 mm plate)
 CERTIFICATE_FACTOR = 1.25
 #: case attribute holding :data:`CERTIFICATE_FACTOR` as the budget applied it
 CERTIFICATE_ATTR = f"{PREFIX}certificate_factor"
