@@ -39,7 +39,12 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
-    return Summary(*modal.survey(scene, run.progress))
+    from contextlib import closing
+
+    from flex.sweep import make_executor
+
+    with closing(make_executor()) as executor:  # its steps in parallel on local processes
+        return Summary(*modal.survey(scene, run.progress, executor))
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:

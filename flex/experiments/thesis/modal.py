@@ -30,6 +30,7 @@ from flex.bodies.thesis_tables import (
     thesis_table5_reproduction,
 )
 from flex.data.results import Dataset
+from flex.fidelity.caseloop import run_each
 
 CONVERGENCE_TOLERANCE = 0.001
 """Relative tolerance of the production mesh, on the first pinned-pinned in-plane frequency."""
@@ -67,45 +68,68 @@ def _store(datasets: dict[str, Dataset], prefix: str, table: dict) -> None:
         datasets[f"{prefix}/{key}"] = Dataset(array, _unit(key), key.replace("_", " "))
 
 
-def survey(scene: Any, progress: Progress | None = None) -> tuple[dict[str, Dataset], str]:
+def survey(scene: Any, progress: Progress | None = None, executor: Any = None
+           ) -> tuple[dict[str, Dataset], str]:
     """The whole modal survey of ``scene``'s links: ``(datasets, report)``. ``progress`` gets
-    one call per long step (about 30 s in all on one core) and a final ``done``."""
+    one call per long step (about 60 s in all on one core) and a final ``done``.
+    ``executor`` (:mod:`flex.sweep`'s, passed in; None: this process): the steps run on it in
+    parallel, the mesh convergences first; the result is the same."""
     material = scene_material(scene)
     thicknesses_m = THESIS_TABLE5["coupler_thickness_m"]
     links = link_plates(scene, thicknesses_m)
-    steps = (["Table 5: 3D FE of the four coupler plates", "Tables 7 and 9: BEAM188 emulation"]
-             + [f"modes of {name}, {condition}" for name in links for condition in CONDITIONS]
-             + [f"mesh convergence, coupler t = {t * 1e3:g} mm" for t in thicknesses_m])
-    counter = iter(range(len(steps)))
-
-    def step() -> None:
-        index = next(counter)
-        if progress:
-            progress(steps[index], index, len(steps))
-
+    steps: dict[str, tuple[Callable[..., Any], tuple]] = {
+        "Table 5: 3D FE of the four coupler plates, Tables 7 and 9: BEAM188 emulation":
+            (_tables, (material,))}
+    steps.update({f"modes of {name}, {condition}": (_link_modes, (name, plate, condition,
+                                                                  material))
+                  for name, plate in links.items() for condition in CONDITIONS})
+    steps.update({f"mesh convergence, coupler t = {t * 1e3:g} mm":
+                  (_convergence, (scene, float(t), material)) for t in thicknesses_m})
+    done = run_each(steps, run_step, progress, executor=executor,
+                    cost=lambda name, step: 10.0 if step[0] is _convergence else 1.0)
     datasets: dict[str, Dataset] = {}
-    step()
+    lines: list[str] = []
+    for index, (step_datasets, step_lines) in enumerate(done.values()):
+        if index == 1:
+            lines.append("  first five modes [Hz] (FE | Timoshenko beam), kinds from the mode "
+                         "shapes:")
+        if index == 1 + len(links) * len(CONDITIONS):
+            lines.append(f"  mesh convergence (pinned-pinned in-plane bending, tolerance "
+                         f"{CONVERGENCE_TOLERANCE:.1%}):")
+        datasets.update(step_datasets)
+        lines += step_lines
+    return datasets, "\n".join(lines)
+
+
+def run_step(name: str, step: tuple[Callable[..., Any], tuple]) -> Any:
+    """One step of :func:`survey` (on a worker): ``function(*args)``."""
+    function, args = step
+    return function(*args)
+
+
+def _tables(material: Material) -> tuple[dict[str, Dataset], list[str]]:
+    """Table 5 and the links' Tables 7 and 9, stored and reported."""
+    datasets: dict[str, Dataset] = {}
     table5 = thesis_table5_reproduction(material=material)
     _store(datasets, "table5", table5)
     lines = table5_report(table5)
-    step()
     for link in THESIS_LINKS:
         table = thesis_link_modal_reproduction(link, material=material)
         _store(datasets, f"table_{link}", table)
         lines.append(link_table_line(link, table))
-    lines.append("  first five modes [Hz] (FE | Timoshenko beam), kinds from the mode shapes:")
-    for name, plate in links.items():
-        for condition in CONDITIONS:
-            step()
-            lines.append(link_modes(datasets, name, plate, condition, material))
-    lines.append(f"  mesh convergence (pinned-pinned in-plane bending, tolerance "
-                 f"{CONVERGENCE_TOLERANCE:.1%}):")
-    for thickness_m in thicknesses_m:
-        step()
-        lines.append(convergence(datasets, scene, thickness_m, material))
-    if progress:
-        progress("done", len(steps), len(steps))
-    return datasets, "\n".join(lines)
+    return datasets, lines
+
+
+def _link_modes(name: str, plate: tuple[float, float, float, float], condition: str,
+                material: Material) -> tuple[dict[str, Dataset], list[str]]:
+    datasets: dict[str, Dataset] = {}
+    return datasets, [link_modes(datasets, name, plate, condition, material)]
+
+
+def _convergence(scene: Any, thickness_m: float, material: Material
+                 ) -> tuple[dict[str, Dataset], list[str]]:
+    datasets: dict[str, Dataset] = {}
+    return datasets, [convergence(datasets, scene, thickness_m, material)]
 
 
 def table5_report(table5: dict[str, np.ndarray]) -> list[str]:
