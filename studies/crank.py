@@ -72,9 +72,13 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """Phase 1: fit cases; fit the law, write :data:`CRITERION_PATH`; phase 2: validation
-    cases, ``auto`` reading the law just fitted (passed as an argument)."""
+    cases, ``auto`` reading the law just fitted (passed as an argument). The cases run on
+    local processes, those of one crank plate together."""
+    from flex.sweep import make_executor
+
     runner = lawfit.SerialRunner("crank", NAME, len(scenes), run.progress,
-                                 cache_dir=run.cache_dir)
+                                 cache_dir=run.cache_dir, executor=make_executor(),
+                                 group=crank.same_crank)
     results, run.notes["analysis"] = crank.fit_then_validate(scenes, runner, CRITERION_PATH,
                                                                 run.cache_dir)
     return results

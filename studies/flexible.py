@@ -64,8 +64,15 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
-    """Simulate every case; each model's reduction is built (or loaded) once."""
-    return simulate_twins(scenes, run.progress, run.notes, cache_dir=run.cache_dir)
+    """Simulate every case, in parallel on local processes; each model's reduction is built
+    (or loaded) once."""
+    from contextlib import closing
+
+    from flex.sweep import make_executor
+
+    with closing(make_executor()) as executor:
+        return simulate_twins(scenes, run.progress, run.notes, cache_dir=run.cache_dir,
+                              executor=executor)
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],

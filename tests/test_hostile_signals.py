@@ -179,10 +179,29 @@ def test_silence_watch_speaks_when_nothing_else_does():
     stream = _Lines("still working")
     with silence_watch(stream, interval_s=0.01) as watched:
         print("flex: reducing the coupler", file=watched)
-        assert stream.seen.wait(timeout=60)  # the timeout only guards against a hang
-    line = stream.getvalue().splitlines()[1]
+        while "(last line" not in stream.getvalue():  # a loaded machine may speak first
+            assert stream.seen.wait(timeout=60)  # the timeout only guards against a hang
+            threading.Event().wait(0.005)
+    text = stream.getvalue()
+    line = text[text.index("flex: reducing the coupler"):].splitlines()[1]
     assert line.startswith("flex: still working after ")
     assert line.endswith("ago: flex: reducing the coupler)")
+
+
+def test_silence_watch_names_the_work_s_line_not_its_own():
+    """A long silence (the cases on worker processes) gives one plain line per interval, each
+    naming the work's last line: never the watch's previous line nested inside."""
+    from flex.base.progress import silence_watch
+
+    stream = _Lines("still working")
+    with silence_watch(stream, interval_s=0.01) as watched:
+        print("flex: reducing the coupler", file=watched)
+        while stream.getvalue().count("(last line") < 3:
+            threading.Event().wait(0.005)
+    text = stream.getvalue()
+    lines = text[text.index("flex: reducing the coupler"):].splitlines()[1:]
+    assert len(lines) >= 2 and all(line.count("still working") == 1 and
+               line.endswith("ago: flex: reducing the coupler)") for line in lines)
 
 
 def test_the_command_line_is_never_silent_for_its_interval(monkeypatch):

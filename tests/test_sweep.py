@@ -275,3 +275,29 @@ def test_case_hash_follows_the_criterion_of_auto_links(tmp_path):
     # a law passed as an argument is part of the case function's identity
     with_law = functools.partial(simulate_case, criterion=criterion_of())
     assert case_hash(auto, with_law) != case_hash(auto, simulate_case)
+
+
+def test_run_each_on_an_executor_gives_the_serial_results_in_order():
+    """A study's case loop on local processes (jobs grouped by a key, longest first) returns
+    what it returns in this process, in the order of the scenes, and reports every case."""
+    from flex.fidelity.caseloop import run_each
+
+    scenes = {"a50": _rigid(50.0), "a30": _rigid(30.0), "a40": _rigid(40.0)}
+    serial = run_each(scenes, simulate_scene_case)
+    seen = []
+    executor = make_executor(workers=2)
+    try:
+        parallel = run_each(scenes, simulate_scene_case, lambda *args: seen.append(args),
+                            executor=executor,
+                            group=lambda name, scene: None if name == "a50" else "narrow",
+                            cost=lambda name, scene: scene["crank"]["initial_angle_deg"])
+    finally:
+        executor.close()
+    assert list(parallel) == list(scenes)
+    for name, case in serial.items():
+        assert case.status == parallel[name].status == "ok"
+        assert set(case.datasets) == set(parallel[name].datasets)
+        for key, dataset in case.datasets.items():
+            assert (dataset.data == parallel[name].datasets[key].data).all(), key
+    assert sorted(args[0] for args in seen) == sorted([*scenes, "done"])
+    assert seen[-1] == ("done", 3, 3)

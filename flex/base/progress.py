@@ -83,6 +83,14 @@ class _Watched:
                 self.last_line = lines[-1].strip()
             return self.stream.write(text)
 
+    def write_aside(self, text: str) -> None:
+        """Write ``text`` and flush, noting the time but keeping the last line (the watch's
+        own lines: each names the work's last line, never the watch's previous one)."""
+        with self.lock:
+            self.last_s = time.perf_counter()
+            self.stream.write(text)
+            self.stream.flush()
+
     def __getattr__(self, name: str):
         return getattr(self.stream, name)
 
@@ -109,9 +117,9 @@ def silence_watch(stream: TextIO, interval_s: float = PROGRESS_INTERVAL_S
             now = time.perf_counter()
             last = (f" (last line {duration_text(now - watched.last_s)} ago: "
                     f"{watched.last_line})" if watched.last_line else "")
-            try:
-                print(f"flex: still working after {duration_text(now - start)}{last}",
-                      file=watched, flush=True)
+            try:  # not a last line of its own: the next one names the work's again
+                watched.write_aside(f"flex: still working after {duration_text(now - start)}"
+                                    f"{last}\n")
             except (OSError, ValueError):  # a closed stream: nothing more to say
                 return
 

@@ -118,11 +118,15 @@ def von_mises_history(reduction: Any, modal_coordinates: np.ndarray, nodes: np.n
     if nodes.size == 0:
         return np.full(len(coordinates), np.nan), np.full(len(coordinates), -1)
     modes = stress_modes(reduction)[nodes]
+    # (modes, nodes x 6): each chunk's stresses in one matrix product (BLAS; an einsum of
+    # the same sum ran without it, ~10x slower)
+    columns = np.ascontiguousarray(modes.transpose(1, 0, 2).reshape(modes.shape[1], -1))
     peaks = np.empty(len(coordinates))
     where = np.empty(len(coordinates), dtype=np.int64)
     chunk = max(1, _CHUNK_VALUES // (6 * len(nodes)))
     for start in range(0, len(coordinates), chunk):
-        values = von_mises(np.einsum("sm,nmc->snc", coordinates[start:start + chunk], modes))
+        part = coordinates[start:start + chunk]
+        values = von_mises((part @ columns).reshape(len(part), len(nodes), len(COMPONENTS)))
         best = np.argmax(values, axis=1)
         peaks[start:start + chunk] = values[np.arange(len(best)), best]
         where[start:start + chunk] = nodes[best]

@@ -71,6 +71,13 @@ def cases(scene: Scene, fit: tuple[tuple[float, float], ...],
     return out
 
 
+def same_crank(name: str, scene: Scene) -> float:
+    """The job key of a case on an executor (:class:`flex.experiments.fitting.lawfit.
+    SerialRunner`): its crank's thickness [m]: the cases of one crank plate share its
+    reductions and frequency analyses, built once when they run one after the other."""
+    return float(scene["crank"]["thickness_m"])
+
+
 def analyse(scenes: dict[str, Scene], results: dict[str, CaseResult],
             cache_dir: Path | None = None) -> dict[str, Any]:
     """Fit table (per fit scene with both runs ok: n = delta_t of the rigid run x the

@@ -25,6 +25,7 @@ on an executor). The sweep engine is passed in by the study: this module sits be
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -36,6 +37,7 @@ import numpy as np
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.dynamics.link_models import FFRF
+from flex.fidelity.caseloop import run_each
 from flex.fidelity.criteria import GOVERNING, PRIMARY_DELTA_T
 from flex.fidelity.laws import Criterion, ErrorLaw, fit_error_law
 
@@ -93,11 +95,21 @@ class CaseRunner(Protocol):
         """Release what the runner holds (workers)."""
 
 
+def law_case(name: str, scene: Scene, *, link: str, criterion_text: str | None, source: str,
+             cache_dir: Path | None = None) -> CaseResult:
+    """:func:`simulate_with_law` as a case function ``(name, scene)`` (for
+    :func:`flex.fidelity.caseloop.run_each`; picklable as a ``functools.partial``)."""
+    return simulate_with_law(scene, name, link, criterion_text, source, cache_dir=cache_dir)
+
+
 @dataclass
 class SerialRunner:
-    """Every case in this process, one after the other (:func:`simulate_with_law`);
-    ``progress(case, done, total)`` counts over both phases; ``cache_dir``: the reduction
-    cache folder (None: built in memory, no disk cache)."""
+    """Every case in this process, one after the other (:func:`simulate_with_law`), or,
+    given an ``executor`` (:mod:`flex.sweep`'s, passed in and closed by :meth:`close`), in
+    parallel jobs of :func:`flex.fidelity.caseloop.run_each`: the cases of one ``group`` key
+    (``group(name, scene)``, e.g. those sharing a reduction) one after the other in one job;
+    the results are the same. ``progress(case, done, total)`` counts over both phases;
+    ``cache_dir``: the reduction cache folder (None: built in memory, no disk cache)."""
 
     link: str
     label: str
@@ -105,25 +117,30 @@ class SerialRunner:
     progress: Callable[[str, int, int], None] | None = None
     done: int = 0
     cache_dir: Path | None = None
+    executor: Any = None
+    group: Callable[[str, Scene], Any] | None = None
 
     def run(self, phase: str, scenes: dict[str, Scene],
             criterion_text: str | None) -> dict[str, CaseResult]:
-        results = {}
-        for name, scene in scenes.items():
-            if self.progress:
-                self.progress(name, self.done, self.total)
-            results[name] = simulate_with_law(scene, name, self.link, criterion_text,
-                                              f"{self.label} (this run's fit)",
-                                              cache_dir=self.cache_dir)
-            self.done += 1
+        case = functools.partial(law_case, link=self.link, criterion_text=criterion_text,
+                                 source=f"{self.label} (this run's fit)",
+                                 cache_dir=self.cache_dir)
+        results = run_each(scenes, case, self._counted, executor=self.executor,
+                           group=self.group)
+        self.done += len(results)
         return results
+
+    def _counted(self, name: str, done: int, total: int) -> None:
+        if self.progress and name != "done":  # counted over both phases
+            self.progress(name, self.done + done, self.total)
 
     def say(self, text: str) -> None:
         if self.progress:
             self.progress(f"{self.label}: {text}", self.done, self.total)
 
     def close(self) -> None:
-        pass
+        if self.executor is not None:
+            self.executor.close()
 
 
 @dataclass(frozen=True)

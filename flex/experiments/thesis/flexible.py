@@ -20,6 +20,8 @@ draws them.
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Hashable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -80,10 +82,11 @@ def twin_cases(scene: Scene, plates: Plates, reference_spans_s: dict[str, float 
     return out
 
 
-def _simulate_one(name: str, scene: Scene, notes: dict[str, Any],
-                  cache_dir: Path | None) -> CaseResult:
-    """One case with its reduction (FFRF, cached in ``cache_dir``) or mesh (nonlinear FE);
-    their facts in attrs, the reduction's in ``notes["reductions"][name]``."""
+def simulate_twin(name: str, scene: Scene, *, cache_dir: Path | None = None
+                  ) -> tuple[CaseResult, dict[str, Any] | None]:
+    """One case with its reduction (FFRF, cached in ``cache_dir``) or mesh (nonlinear FE),
+    their facts in attrs; returns it with the reduction's facts the summary reports (None
+    for a case without a reduction)."""
     entry = BUILTIN_LINK_MODELS[scene["coupler"]["model"]]
     reduction = None
     if entry.modal:
@@ -91,27 +94,48 @@ def _simulate_one(name: str, scene: Scene, notes: dict[str, Any],
     elif entry.meshed:
         reduction = nonlinear_plate_for_scene(scene)  # the mesh and its node sets
     case = simulate_case(scene, name, reduction, cache_dir=cache_dir)
+    facts = None
     if entry.modal:
         case.attrs.update(reduction_key=reduction.key,
                           reduction_from_cache=reduction.from_cache,
                           reduction_build_time_s=reduction.build_time_s)
-        notes.setdefault("reductions", {})[name] = {
-            key: getattr(reduction, key) for key in REDUCTION_FACTS}
+        facts = {key: getattr(reduction, key) for key in REDUCTION_FACTS}
     elif entry.meshed:
         case.attrs.update(fe_nodes=reduction.n_nodes, fe_dof=reduction.n_dof,
                           fe_elements=reduction.n_elements,
                           fe_mesh_time_s=reduction.build_time_s)
-    return case
+    return case, facts
+
+
+def _plate_of(name: str, scene: Scene) -> Hashable | None:
+    """The job of a case on an executor: a plate's reduced models together (they share its
+    reduction, built once), the nonlinear FE reference alone."""
+    return None if scene["coupler"]["model"] == NONLINEAR_FE else name.rsplit("_", 1)[0]
+
+
+def _cost(name: str, scene: Scene) -> float:
+    """A case's rough cost [s] for ordering the jobs: a nonlinear FE reference's steps
+    (~0.1 s x 1 mm / thickness each), a reduced run with its error budget ~10 s."""
+    if scene["coupler"]["model"] != NONLINEAR_FE:
+        return 10.0
+    return (scene["simulation"]["end_time_s"] / scene["simulation"]["step_s"]
+            * 1e-4 / scene["coupler"]["thickness_m"])
 
 
 def simulate_twins(scenes: dict[str, Scene], progress: Progress | None,
-                   notes: dict[str, Any], *, cache_dir: Path | None = None
-                   ) -> dict[str, CaseResult]:
+                   notes: dict[str, Any], *, cache_dir: Path | None = None,
+                   executor: Any = None) -> dict[str, CaseResult]:
     """Simulate every case; each plate's reduction is built (or loaded from ``cache_dir``,
     the reduction cache folder; None: built in memory, no disk cache), and what the summary
-    reports of it goes to ``notes`` (the run's, handed on to the summary)."""
-    return run_each(scenes, lambda name, scene: _simulate_one(name, scene, notes, cache_dir),
-                    progress)
+    reports of it goes to ``notes`` (the run's, handed on to the summary). ``executor``
+    (:mod:`flex.sweep`'s, passed in; None: this process): each plate's reduced models in one
+    job, each nonlinear FE reference in its own, the longest first."""
+    done = run_each(scenes, functools.partial(simulate_twin, cache_dir=cache_dir), progress,
+                    executor=executor, group=_plate_of, cost=_cost)
+    for name, (_, facts) in done.items():
+        if facts is not None:
+            notes.setdefault("reductions", {})[name] = facts
+    return {name: case for name, (case, _) in done.items()}
 
 
 HEADER = (f"  {'model':14s} {'t [mm]':>6s} {'f_pp [Hz]':>10s} {'n thesis':>9s} "
