@@ -378,6 +378,7 @@ def test_near_twins_one_setting_cannot_serve_fast_are_found():
     assert row["shared_pair"].startswith("1 modes")
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_the_calibration_summary_stores_and_reports_the_designs_compared():
     from flex.experiments.fitting.calibration_report import calibration_summary
     from flex.experiments.fitting.rule_designs import NEIGHBOUR_MARGINS, NEIGHBOURS

@@ -96,6 +96,7 @@ CHEAP = {
 }
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 @pytest.mark.parametrize("name", list(CHEAP))
 def test_cheap_study_figures(name, tmp_path, reviewed, reduction_cache):
     overrides, expected = CHEAP[name]
@@ -274,6 +275,7 @@ def test_tradeoff_figures_synthetic(tmp_path, reviewed):
     check_pngs(paths, tmp_path, {"tradeoff-rigid.png"})
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_stability_figures_synthetic(tmp_path, reviewed):
     from studies import stability
 
@@ -291,6 +293,7 @@ def test_stability_figures_synthetic(tmp_path, reviewed):
     check_pngs(paths, tmp_path, {"stability-step.png", "stability-energy.png"})
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_bench_figures_synthetic(tmp_path, reviewed):
     from studies import bench
 

@@ -209,6 +209,7 @@ def test_nonlinear_fe_scene_needs_a_plate_and_no_damping():
                               "coupler.damping_ratio=0.01"])
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_nonlinear_fe_coupler_follows_its_ffrf_twin():
     # coarse 5 mm plate (1.4k coordinates), first 0.5 ms: geometric nonlinearity is
     # negligible here (compression / Euler load ~ 0.01), so the two flexible models must agree

@@ -83,6 +83,7 @@ def test_a_refine_limit_without_refine_would_be_ignored_and_is_refused():
                   ["fidelity.refine_limit_s", "fidelity.refine = true"])
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_a_refinement_whose_next_run_would_exceed_the_limit_stops_before_it(reduction_cache):
     """3 mm at 0.2 %: the first run's certificate (0.35 %) misses it, and its budget alone
     takes longer than the 1 s limit on any machine: the refinement stops at its cost limit,

@@ -224,6 +224,7 @@ def test_other_invalid_inputs_raise_scene_error():
 
 # --- finite-element check ---------------------------------------------------------------------
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_fe_helix_segment_matches_wahl_coarse():
     result = spring_fe.fe_helix_segment_stress(spring.CONSISTENT_THESIS_SPRING, 33.0)
     assert result.peak_angle_deg == pytest.approx(0.0, abs=20.0)  # inner fibre

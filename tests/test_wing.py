@@ -57,6 +57,7 @@ def test_cantilever_formulas():
     assert result["out_of_plane_frequency_Hz"] == pytest.approx(eb, rel=2e-3)
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_spring_fit_reaches_the_thesis_outcome():
     scene = load_scene(overrides=OVERRIDES)
     fitted, values = wing.fit_spring(scene)
