@@ -154,6 +154,7 @@ def _ffrf_deflection_error(scene, reduction_cache) -> dict[str, float]:
                                scene["crank"]["length_m"])
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_auto_stores_the_crank_s_prediction_and_it_meets_the_ffrf_crank(reduction_cache):
     """A 1 mm steel crank, thesis spring, no wing: auto stores the rigid model's deflection
     error predicted from its probe's loads (fidelity_crank_predicted_rigid_error), and it is

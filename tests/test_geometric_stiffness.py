@@ -197,6 +197,7 @@ def test_geometric_stiffness_is_cached_beside_its_reduction(reduction, stiffness
     assert not geometric_stiffness(moved).from_cache
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_an_edited_geometric_stiffness_entry_is_rebuilt(reduction, stiffness, tmp_path, capfd):
     # matrices scaled by 1.5 with every attribute kept: the content digest catches it
     import h5py
