@@ -119,7 +119,6 @@ from flex.dynamics.exact_beam_link import (
     prepare_beam,
 )
 from flex.dynamics.link_outputs import (  # noqa: F401 - the names callers import from here
-    MODAL_MOTION,
     NO_MOTION,
     NODAL_MOTION,
     RIGID_MOTION,
@@ -127,6 +126,7 @@ from flex.dynamics.link_outputs import (  # noqa: F401 - the names callers impor
     elastic_datasets,
     flexible_datasets,
     flexible_sensors,
+    modal_motion,
     sensor_data,
     stress_window_m,
 )
@@ -155,9 +155,6 @@ def _no_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, Dataset]
     return {}
 
 
-#: the readers of stored motion a built-in model names (the contract's point 10), by kind
-STORED_MOTIONS: Mapping[str, MotionReader] = MappingProxyType(
-    {reader.kind: reader for reader in (RIGID_MOTION, MODAL_MOTION, NODAL_MOTION, NO_MOTION)})
 
 
 @dataclass(frozen=True)
@@ -313,6 +310,13 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
     with heartbeat(f"{link} reduction ({c['modes']} modes)"):
         return build_reduction(Plate.of(c), c["mesh_size_m"], c["modes"], cache_dir,
                                mode_selection=c["mode_selection"], mesh_order=mesh_order)
+
+
+#: an FFRF link's stored motion: its modal coordinates on its reduction's basis
+MODAL_MOTION = modal_motion(reduction_for_scene)
+#: the readers of stored motion a built-in model names (the contract's point 10), by kind
+STORED_MOTIONS: Mapping[str, MotionReader] = MappingProxyType(
+    {reader.kind: reader for reader in (RIGID_MOTION, MODAL_MOTION, NODAL_MOTION, NO_MOTION)})
 
 
 def _prepare_reduction(scene: Scene, link: str, given: Any, cache_dir: Path | None) -> Any:

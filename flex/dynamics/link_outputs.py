@@ -6,12 +6,13 @@ feed them. Shared by the link models' entries (:mod:`flex.dynamics.link_models`,
 
 And how a link's stored motion is read back from a result file (the link models' contract,
 point 10): each entry names its :class:`MotionReader` (:data:`RIGID_MOTION`,
-:data:`MODAL_MOTION`, :data:`NODAL_MOTION`, :data:`NO_MOTION`), which rebuilds the link's
+:func:`modal_motion`, :data:`NODAL_MOTION`, :data:`NO_MOTION`), which rebuilds the link's
 mesh (:class:`Body`) and its state at a sample (:class:`BodyState`);
 :func:`flex.tools.motion.case_motion` calls through it."""
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -222,10 +223,10 @@ def _rigid_state(body: Body, source: Any, data: CaseData, sample: int, index: in
 
 
 def _modal_body(link: str, scene: Any, data: CaseData, attrs: dict[str, Any], where: str,
-                cache_dir: Path | None) -> tuple[Body, Any]:
+                cache_dir: Path | None, *, reduction_for_scene: Callable[..., Any]
+                ) -> tuple[Body, Any]:
     from flex.bodies.plate import tet10_cells
     from flex.bodies.stress import check_basis_identity
-    from flex.dynamics.solver import reduction_for_scene
 
     missing = [name for name in ("modal_coordinates", "frame_position", "frame_angle")
                if f"{link}/{name}" not in data]
@@ -299,9 +300,16 @@ def _nodal_state(body: Body, plate: Any, data: CaseData, sample: int, index: int
 
 #: the rigid model's: the link's angle and joint positions, a box of its plate moved with them
 RIGID_MOTION = MotionReader("rigid", _rigid_body, _rigid_state)
-#: ``<link>/modal_coordinates`` and the floating frame's pose ``<link>/frame_position``,
-#: ``frame_angle``, on the basis of the link's reduction (rebuilt from the case's scene)
-MODAL_MOTION = MotionReader("modal", _modal_body, _modal_state)
+def modal_motion(reduction_for_scene: Callable[..., Any]) -> MotionReader:
+    """The reader of ``<link>/modal_coordinates`` and the floating frame's pose
+    ``<link>/frame_position``, ``frame_angle``, on the basis of the link's reduction,
+    rebuilt from the case's scene by ``reduction_for_scene(scene, link, cache_dir=...)``
+    (:func:`flex.dynamics.link_models.reduction_for_scene`; passed in: the reduction is the
+    registry's, a layer this module's callers stand on)."""
+    return MotionReader("modal", functools.partial(
+        _modal_body, reduction_for_scene=reduction_for_scene), _modal_state)
+
+
 #: every node's position, ``<link>/nodal/position`` at ``<link>/nodal/time``, on the link's
 #: plate mesh
 NODAL_MOTION = MotionReader("nodal", _nodal_body, _nodal_state)
