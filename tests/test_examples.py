@@ -48,6 +48,7 @@ def test_simulate_runs_the_given_scene():
     assert re.search(r"crank angle 0\.8727", output.summary.report)
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_spring_fe_agrees_with_wahl():
     _, output = run("spring")
     ratio = output.summary.datasets["fe/over_wahl"].data

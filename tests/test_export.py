@@ -318,6 +318,7 @@ def test_gif_animation_decodes_to_its_frames(ffrf_file, tmp_path, capsys):
         assert image.size == (960, 540) and image.n_frames == 8
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_run_simulate_animate_writes_beside_the_figures(tmp_path, capsys):
     status, out, _ = run_cli(capsys, "run", "simulate", *[x for o in PLATE for x in ("--set", o)],
                              "--set", 'coupler.model="ffrf"', "--set",

@@ -185,6 +185,7 @@ def test_exudyn_body_with_geometric_force_vibrates_at_the_closed_form(reduction,
         pytest.approx(1.0, rel=5e-3)
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 def test_geometric_stiffness_is_cached_beside_its_reduction(reduction, stiffness, tmp_path):
     moved = dataclasses.replace(reduction, cache_file=tmp_path / f"{reduction.key}.hdf5")
     built = geometric_stiffness(moved)

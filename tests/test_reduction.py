@@ -388,6 +388,7 @@ def test_joint_markers_use_the_frame_node_and_four_corners_of_the_rigid_face(red
     assert _rigid_face_motions(positions[end_b], bent) is None
 
 
+@pytest.mark.slow  # make test-slow: the default suite stays within 3 min
 @pytest.mark.parametrize("link", ["coupler", "crank"])
 def test_fewest_joint_markers_give_the_motion_of_all_face_nodes(reduction, cache_dir, link):
     """The thesis deployment's first 2 ms with the plate as coupler (or crank): every output
