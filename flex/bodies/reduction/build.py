@@ -21,6 +21,7 @@ from flex.base.errors import SceneError
 from flex.base.physics import Plate
 from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction.basis import (
+    EIGENSOLVER_ITERATIONS,
     craig_bampton_basis,
     fix_eigenmode_signs,
 )
@@ -301,7 +302,8 @@ def _reduction_parameters(sizes: dict[str, float], poisson_ratio: float, modes: 
     parameters.update(poisson_ratio=float(poisson_ratio), modes=int(modes),
                       mesh_order=int(mesh_order), stress_modes=True)
     if mode_selection != "all":  # "all" keeps the keys (and cache entries) it always had
-        parameters["mode_selection"] = mode_selection
+        parameters.update(mode_selection=mode_selection,
+                          eigensolver_iterations=EIGENSOLVER_ITERATIONS)
     return parameters
 
 
