@@ -39,9 +39,11 @@ from flex.study import RESULTS_DIR, StudyRun, Summary
 
 NAME = "crank"
 DESCRIPTION = "flexible FFRF crank against auto's choice, with and without the wing"
-OVERRIDES = pinned_overrides() + ["simulation.error_estimate=false",  # own references
-                                  'crank.geometry="plate"', "simulation.step_s=2e-5",
-                                  "simulation.end_time_s=0.05"]
+# the solver entry of flexible links: the rigid entry's 1e-5 s grid with modified Newton (on
+# the 1 mm plate every headline equal to full Newton's within 3e-7, in half the time)
+OVERRIDES = pinned_overrides("flexible_fallback") + [
+    "simulation.error_estimate=false",  # own references
+    'crank.geometry="plate"', "simulation.step_s=2e-5", "simulation.end_time_s=0.05"]
 # keys the study reads itself (its fit grid), beside what its cases simulate
 READS = ("crank.length_m", "crank.thickness_m", "drive.spring_stiffness_N_per_m")
 
