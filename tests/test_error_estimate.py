@@ -200,6 +200,11 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
     assert set(crest.terms) == set(TERMS) and 0 < crest.value <= deflection.value
     gap = result.attrs["crest_gap_coupler_peak_deflection_m"]
     assert 0 <= gap < deflection.value
+    # the quantities whose step term is a bound, stored as data: those the validity names
+    bounded = [name for name in result.attrs["estimated_error_step_bounds"].split(", ") if name]
+    validity = result.attrs["estimated_error_validity"]
+    assert all(f"{name} (observed order" in validity for name in bounded)
+    assert bool(bounded) == ("are bounds" in validity)
 
 
 def test_first_crest_and_crest_gap_of_a_beat_against_closed_forms():

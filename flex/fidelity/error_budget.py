@@ -104,6 +104,8 @@ class ErrorBudget:
     #: why a term is unknown (NaN in ``terms``, making its quantities' totals unknown), one
     #: phrase per term that could not be measured
     unknown: list[str] = field(default_factory=list)
+    #: the quantities whose step term is a bound (observed order outside the window)
+    step_bounds: tuple[str, ...] = ()
 
     def total(self, quantity: str) -> float:
         """The root-sum-square of the quantity's terms [its units] (module doc)."""
@@ -139,6 +141,7 @@ class ErrorBudget:
                                        in self.described.items())
         if self.unknown:
             out[UNKNOWN_ATTR] = "; ".join(self.unknown)
+        out[STEP_BOUNDS_ATTR] = ", ".join(self.step_bounds)
         return out
 
     def unknown_quantities(self) -> list[str]:
@@ -155,6 +158,8 @@ def combined(terms: Any) -> float:
 DESCRIBED = "headlines_described"
 #: case attribute saying why a budget's unknown terms (NaN) could not be measured
 UNKNOWN_ATTR = f"{PREFIX}unknown"
+#: the quantities whose step term is a bound, comma-separated ("" when every one is an estimate)
+STEP_BOUNDS_ATTR = f"{PREFIX}step_bounds"
 #: case attribute prefix of a peak's crest gap (:func:`flex.fidelity.error_estimate.crest_gap`)
 CREST_GAP_PREFIX = "crest_gap_"
 
@@ -388,7 +393,7 @@ def error_budget(scene: Scene, result: CaseResult,
                        _crest_gaps(result, values, headlines),
                        {name: (headlines[name].unit, headlines[name].what) for name in values},
                        _unknown(terms, failed, [f"step: {step.validity}", *companions.failures],
-                                headlines))
+                                headlines), tuple(step.bounds))
 
 
 def _unknown(terms: dict[str, dict[str, float]], failed: set[str], failures: list[str],
@@ -562,5 +567,6 @@ def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> 
 
 
 __all__ = ["CERTIFICATE_ATTR", "CERTIFICATE_FACTOR", "DESCRIBED", "BudgetRow", "ErrorBudget",
-           "HEADLINE_PREFIX", "MESH_FACTOR", "TERMS", "UNKNOWN_ATTR", "budget_rows", "combined",
+           "HEADLINE_PREFIX", "MESH_FACTOR", "STEP_BOUNDS_ATTR", "TERMS", "UNKNOWN_ATTR",
+           "budget_rows", "combined",
            "error_budget", "richer_modes", "term_text"]

@@ -1,0 +1,36 @@
+"""The estimates study's verdicts (flex.experiments.workprecision.estimate_check): a pair whose
+step term is a bound is flagged, not judged; a known true error above its certificate is
+reported by name."""
+
+from __future__ import annotations
+
+from flex.data.results import CaseResult
+from flex.experiments.workprecision.estimate_check import _rows, estimate_summary
+from flex.fidelity.error_budget import CERTIFICATE_ATTR, STEP_BOUNDS_ATTR
+
+PEAK, END = "coupler_deployment_peak_deflection_m", "crank_angle_end_rad"
+
+
+def _case(true_peak: float, bounded: str) -> CaseResult:
+    attrs = {CERTIFICATE_ATTR: 1.25, STEP_BOUNDS_ATTR: bounded}
+    for quantity, estimated, true in ((PEAK, 2e-7, true_peak), (END, 1e-4, 0.8e-4)):
+        attrs.update({f"estimated_error_{quantity}": estimated,
+                      f"true_error_{quantity}": true,
+                      f"reference_accuracy_{quantity}": true / 100,
+                      f"headline_{quantity}": 1.0 if quantity == END else 1e-4})
+    return CaseResult("case", "", attrs=attrs)
+
+
+def test_a_bounded_step_term_is_flagged_not_judged():
+    rows = {row["quantity"]: row for row in _rows({"a": _case(1.5e-7, PEAK)})}
+    assert rows[PEAK]["flagged"] and not rows[PEAK]["judged"]
+    assert "flagged" in rows[PEAK]["why"]
+    assert rows[END]["judged"] and not rows[END]["flagged"]
+
+
+def test_a_true_error_above_its_certificate_is_named():
+    _, report = estimate_summary({"a": _case(3e-7, "")})  # certificate 2.5e-7
+    line = next(text for text in report.splitlines() if "certificates exceeded" in text)
+    assert "exceeded by a known true error: 1" in line and PEAK in line
+    _, report = estimate_summary({"a": _case(2e-7, "")})
+    assert "exceeded by a known true error: 0" in report
