@@ -126,6 +126,14 @@ def test_peak_where_and_when_with_estimate(ffrf_file, reduction, capsys):
     assert reduction.thickness_m <= x <= reduction.length_m - reduction.thickness_m
     x_joint = attrs["coupler_peak_von_mises_at_joints_position_m"][0]
     assert min(x_joint, reduction.length_m - x_joint) <= reduction.thickness_m
+    # the attributes come from the stored series (its largest sample evaluated again):
+    # the same as a search of the whole run
+    from flex.bodies.stress import peak_attrs
+
+    whole_run = peak_attrs("coupler", reduction, data["coupler/modal_coordinates"],
+                           data["time"])
+    for key, value in whole_run.items():
+        np.testing.assert_allclose(attrs[key], value, rtol=1e-12)
     # the step-error estimate of the new headline: finite, and smaller than the peak
     error = attrs["estimated_error_coupler_peak_von_mises_Pa"]
     assert 0 <= error < attrs["coupler_peak_von_mises_Pa"]

@@ -31,6 +31,7 @@ far more.
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -157,6 +158,20 @@ def stress_peak(reduction: Any, modal_coordinates: np.ndarray, time_s: np.ndarra
                       np.asarray(position, dtype=float), node)
 
 
+def _stored_peak(reduction: Any, modal_coordinates: np.ndarray, time_s: np.ndarray,
+                 region: str, peaks: np.ndarray) -> StressPeak:
+    """:func:`stress_peak` from the region's stored peak series ``peaks`` [Pa]: the largest
+    sample's node found by evaluating that sample alone."""
+    peaks = np.asarray(peaks, dtype=float)
+    sample = int(np.nanargmax(peaks)) if np.any(np.isfinite(peaks)) else 0
+    coordinates = _as_coordinates(reduction, modal_coordinates)[sample:sample + 1]
+    _, where = von_mises_history(reduction, coordinates, region_nodes(reduction)[region])
+    node = int(where[0])
+    position = reduction.fem.GetNodePositionsAsArray()[node] if node >= 0 else np.full(3, np.nan)
+    return StressPeak(region, float(peaks[sample]), float(np.asarray(time_s)[sample]),
+                      np.asarray(position, dtype=float), node)
+
+
 def peak_datasets(link: str, reduction: Any, modal_coordinates: np.ndarray
                   ) -> dict[str, Dataset]:
     """The stored peak series of a flexible ``link``: ``<link>/peak_von_mises_stress`` (away
@@ -173,16 +188,21 @@ def peak_datasets(link: str, reduction: Any, modal_coordinates: np.ndarray
 
 
 def peak_attrs(link: str, reduction: Any, modal_coordinates: np.ndarray,
-               time_s: np.ndarray) -> dict[str, Any]:
+               time_s: np.ndarray, stored: Mapping[str, Any] | None = None
+               ) -> dict[str, Any]:
     """Case attributes of the run's peaks, units in the names: ``<link>_peak_von_mises_Pa``,
     ``_time_s``, ``_position_m`` (x, y, z on the plate, body coordinates) and the same with
-    ``_at_joints`` (:data:`REGIONS`)."""
+    ``_at_joints`` (:data:`REGIONS`). ``stored``: the run's datasets; where they hold a
+    region's peak series (:func:`peak_datasets`), only its largest sample is evaluated again
+    (for the node), not the whole run."""
     out: dict[str, Any] = {}
     nodes = region_nodes(reduction)
     for region, suffix in (("away", ""), ("at_joints", "_at_joints")):
         if nodes[region].size == 0:
             continue
-        peak = stress_peak(reduction, modal_coordinates, time_s, region)
+        series = (stored or {}).get(f"{link}/peak_von_mises_stress{suffix}")
+        peak = (stress_peak(reduction, modal_coordinates, time_s, region) if series is None
+                else _stored_peak(reduction, modal_coordinates, time_s, region, series.data))
         name = f"{link}_peak_von_mises{suffix}"
         out.update({f"{name}_Pa": peak.von_mises_Pa, f"{name}_time_s": peak.time_s,
                     f"{name}_position_m": peak.position_m})

@@ -271,7 +271,7 @@ def flexible_link_attrs(scene: Scene, datasets: dict[str, Dataset],
         out.update(basis_identity(link, reduction))
         if reduction.has_stress_modes:
             out.update(peak_attrs(link, reduction, datasets[f"{link}/modal_coordinates"].data,
-                                  datasets["time"].data))
+                                  datasets["time"].data, datasets))
     return out
 
 
