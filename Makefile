@@ -31,13 +31,7 @@ MAKEFLAGS += --no-builtin-rules
 	$(STUDIES) $(LONG) \
 	force-rerun
 
-# `all`: the single-process studies two at a time (each keeps to about one core; a study's
-# lines are printed together when it ends), then those that spread their cases over every core
-LIGHT := modal kinematics dynamics spring wing
-HEAVY := flexible crank kfit
-all:
-	@$(MAKE) --no-print-directory -j2 --output-sync=target $(LIGHT:%=results/%.h5)
-	@$(MAKE) --no-print-directory $(HEAVY:%=results/%.h5)
+all: $(RESULTS)
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
