@@ -48,6 +48,7 @@ def test_refinement_meets_the_tolerance_against_a_finer_reference(reduction_cach
     assert _peak(refined) == pytest.approx(_peak(reference), rel=0.01)
 
 
+@pytest.mark.slow  # make test-slow: 23 s, the default suite stays within 3 min
 def test_a_refinement_that_cannot_meet_the_tolerance_says_so_and_keeps_its_best(
         reduction_cache, capsys):
     """0.1 %: the FFRF body's own model term (0.5 % of the deflection) dominates; the model

@@ -122,6 +122,7 @@ def test_start_near_a_dead_centre_matches_the_reference(angle_deg, bound_rad):
         assert swing > 10 * abs(math.radians(angle_deg))
 
 
+@pytest.mark.slow  # make test-slow: 13 s, the default suite stays within 3 min
 def test_a_coupler_beyond_its_euler_load_runs_and_says_the_result_is_not_valid(
         reduction_cache):
     # a 0.3 mm plate (Euler load 6.9 N) pushed by the ~33 N spring: the chord-frame FFRF body
