@@ -17,6 +17,7 @@ the governing one is fitted and held against the tolerance.
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +29,7 @@ from flex.data.scene_edit import derive_scene
 from flex.experiments.fitting import lawfit
 from flex.experiments.fitting.lawfit import REPORT_TOLERANCES, Validation, case_data
 from flex.fidelity.auto import crank_elastic_omega
+from flex.fidelity.caseloop import run_each
 from flex.fidelity.criteria import (
     DELTA_T_DEFINITIONS,
     GOVERNING,
@@ -78,24 +80,37 @@ def same_crank(name: str, scene: Scene) -> float:
     return float(scene["crank"]["thickness_m"])
 
 
+def _omega_case(name: str, scene: Scene, *, cache_dir: Path | None = None) -> float:
+    """:func:`crank_elastic_omega` as a case function of
+    :func:`flex.fidelity.caseloop.run_each` [rad/s]."""
+    return crank_elastic_omega(scene, cache_dir=cache_dir)
+
+
 def analyse(scenes: dict[str, Scene], results: dict[str, CaseResult],
-            cache_dir: Path | None = None) -> dict[str, Any]:
+            cache_dir: Path | None = None, executor: Any = None) -> dict[str, Any]:
     """Fit table (per fit scene with both runs ok: n = delta_t of the rigid run x the
     crank's in-mechanism frequency / 2 pi, the errors of the rigid crank against the full
     one) and the governing law over it (``fits``, keyed as
     :func:`flex.experiments.fitting.lawfit.fit_laws`). ``cache_dir``: the reduction cache folder of
-    the frequency analyses (None: built in memory, no disk cache)."""
-    rows = {}
+    the frequency analyses (None: built in memory, no disk cache); ``executor``
+    (:mod:`flex.sweep`'s, passed in; None: this process): where the frequency analyses run,
+    those of one crank plate in one job (they share its reduction)."""
+    fitted = {}
     for name, scene in scenes.items():
         name = name.removesuffix("__rigid")
         rigid, full = results.get(f"{name}__rigid"), results.get(f"{name}__full")
-        if f"{name}__rigid" not in scenes or not (rigid and full and rigid.status == "ok"
-                                                   and full.status == "ok"):
-            continue
+        if f"{name}__rigid" in scenes and rigid and full and rigid.status == "ok" \
+                and full.status == "ok":
+            fitted[name] = scene
+    omegas = run_each(fitted, functools.partial(_omega_case, cache_dir=cache_dir),
+                      executor=executor, group=same_crank)
+    rows = {}
+    for name, scene in fitted.items():
+        rigid, full = results[f"{name}__rigid"], results[f"{name}__full"]
         rigid_data = case_data(rigid)
         times = deployment_times(rigid_data["time"], rigid_data["crank/angle"],
                                  rigid_data["crank/angular_velocity"])
-        omega = crank_elastic_omega(scene, cache_dir=cache_dir)
+        omega = omegas[name]
         row = errors_against_full(rigid_data, case_data(full), "crank",
                                   scene["crank"]["length_m"])
         row.update(n=n_values(times["stop"], omega)["physical"], omega=omega,
@@ -125,7 +140,8 @@ def fit_then_validate(scenes: dict[str, Scene], runner: lawfit.CaseRunner, path:
     criterion at ``path``, the validation cases."""
     fit = {n: s for n, s in scenes.items() if n.startswith("fit_")}
     return lawfit.fit_then_validate(scenes, lambda name: name.startswith("fit_"), runner,
-                                    lambda results: analyse(fit, results, cache_dir),
+                                    lambda results: analyse(fit, results, cache_dir,
+                                                            getattr(runner, "executor", None)),
                                     criterion_toml, path)
 
 
