@@ -4,6 +4,12 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.installed
 export EXUDYN_NO_USER_SETTINGS := 1
+# Python caches compiled modules in __pycache__ unless PYTHONDONTWRITEBYTECODE is set (some
+# shells and CI images set it): then every process -- each test worker, each spawned sweep
+# worker, each `flex` subprocess -- compiles flex, scipy and the rest from source again
+# (measured: the suite's collection 6.8 s instead of 2.7 s). The venv is installed without
+# compiling every module of every package; what runs is compiled once, on first import.
+unexport PYTHONDONTWRITEBYTECODE
 export MPLBACKEND := Agg
 RUN := $(PY) -m flex run
 
@@ -35,8 +41,7 @@ all: $(RESULTS)
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --upgrade pip
-	$(PY) -m pip install --quiet -e '.[test]'
+	$(PY) -m pip install --quiet --no-compile -e '.[test]'
 	touch $(STAMP)
 
 setup: $(STAMP)

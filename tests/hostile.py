@@ -6,7 +6,9 @@ Each hostile case asserts (README "When something goes wrong"):
 - the documented exit status (:mod:`flex.base.errors`);
 - for a refusal (status 2): exactly one ``flex: error: ...`` line on stderr that contains
   the words the case names (the key, file or argument at fault);
-- no watched file changed (result files, scene files, figures: compared byte for byte).
+- no watched file changed (result files, scene files, figures: compared byte for byte;
+  bystanders -- the other files of a folder, which the command was not given -- by name,
+  size, inode and modification time).
 """
 
 from __future__ import annotations
@@ -43,6 +45,19 @@ def fingerprint(paths: Iterable[Path]) -> dict[Path, str | None]:
     return seen
 
 
+def stat_signature(folders: Iterable[Path]) -> dict[Path, tuple[int, int, int]]:
+    """Size, inode and modification time [ns] of every file below ``folders``: a bystander
+    that is written, replaced or removed shows here without reading it (hashing every
+    bystander for every command was ~30 % of the hostile result-file cases)."""
+    seen: dict[Path, tuple[int, int, int]] = {}
+    for folder in folders:
+        for file in Path(folder).rglob("*"):
+            if file.is_file():
+                info = file.stat()
+                seen[file] = (info.st_size, info.st_ino, info.st_mtime_ns)
+    return seen
+
+
 def run_cli(argv: Sequence[str]) -> Outcome:
     """``flex ARGV`` in this process; SystemExit (argparse, --version) becomes the status."""
     out, err = io.StringIO(), io.StringIO()
@@ -55,10 +70,13 @@ def run_cli(argv: Sequence[str]) -> Outcome:
 
 
 def check_refused(argv: Sequence[str], names: Sequence[str] = (), watch: Iterable[Path] = (),
-                  status: int = EXIT_BAD_INPUT) -> Outcome:
-    """Run ``argv``; assert the contract for a refusal naming ``names`` (case-insensitive)."""
-    watch = list(watch)
+                  status: int = EXIT_BAD_INPUT, bystanders: Iterable[Path] = ()) -> Outcome:
+    """Run ``argv``; assert the contract for a refusal naming ``names`` (case-insensitive).
+    ``watch``: files compared byte for byte; ``bystanders``: folders whose files are
+    compared by :func:`stat_signature`."""
+    watch, bystanders = list(watch), list(bystanders)
     before = fingerprint(watch)
+    around = stat_signature(bystanders)
     outcome = run_cli(argv)
     assert_no_traceback(outcome)
     assert outcome.status == status, (argv, outcome)
@@ -68,6 +86,9 @@ def check_refused(argv: Sequence[str], names: Sequence[str] = (), watch: Iterabl
         for name in names:
             assert name.lower() in lines[0].lower(), (name, lines[0])
     assert fingerprint(watch) == before, f"{argv} changed a watched file"
+    after = stat_signature(bystanders)
+    changed = [str(file) for file, signature in around.items() if after.get(file) != signature]
+    assert not changed, f"{argv} changed files beside those given: {changed}"
     return outcome
 
 

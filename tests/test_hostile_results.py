@@ -281,8 +281,12 @@ def files(tmp_path_factory) -> dict[str, Path]:
     return out
 
 
-def watched(files: dict[str, Path]) -> list[Path]:
-    return [path for key, path in files.items() if key != "folder" and path.is_file()]
+def watched(files: dict[str, Path]) -> dict:
+    """What a command on these files must leave as it was: the valid files byte for byte,
+    every other file of the folder (the damaged ones) as a bystander."""
+    return {"watch": [path for key, path in files.items()
+                      if key in ("good", "one", "failed_only")],
+            "bystanders": [files["folder"]]}
 
 
 # --- every damage, every verb -------------------------------------------------------------
@@ -310,7 +314,9 @@ def test_a_damaged_layout_is_refused_by_every_verb(files, name):
     for verb in VERBS:
         argv = argv_for(verb, bad, files["good"], files["folder"])
         figure = files["folder"] / f"never-{bad.stem}-{verb}.png"
-        check_refused(argv, names=[bad.name, *words], watch=[*watched(files), figure])
+        seen = watched(files)
+        check_refused(argv, names=[bad.name, *words], watch=[*seen["watch"], bad, figure],
+                      bystanders=seen["bystanders"])
 
 
 BROKEN = {"zero": ["empty", "0 bytes"], "random": ["not an HDF5 file"],
@@ -331,8 +337,9 @@ def test_a_broken_file_gives_one_message(files, name, verb):
     else:
         bad, words = files[name], BROKEN[name]
     argv = argv_for(verb, bad, files["good"], files["folder"])
-    check_refused(argv, names=[bad.name, *words],
-                  watch=[*watched(files), files["folder"] / f"never-{bad.stem}-{verb}.png"])
+    seen = watched(files)
+    check_refused(argv, names=[bad.name, *words], bystanders=seen["bystanders"],
+                  watch=[*seen["watch"], bad, files["folder"] / f"never-{bad.stem}-{verb}.png"])
 
 
 def test_every_damage_is_refused_by_the_checker_itself(files):
@@ -452,7 +459,9 @@ UNUSUAL_OK = [
 @pytest.mark.parametrize("name", [name for name, _ in UNUSUAL_OK])
 def test_unusual_but_valid_content_works(files, unusual, name):
     argv = dict(UNUSUAL_OK)[name](unusual, files)
-    check_refused(argv, watch=[*watched(files), *unusual.values()], status=0)
+    seen = watched(files)
+    check_refused(argv, watch=[*seen["watch"], *unusual.values()], status=0,
+                  bystanders=seen["bystanders"])
 
 
 # --- refusals of what cannot be done with a valid file ------------------------------------
@@ -534,8 +543,9 @@ REFUSAL_NAMES = [name for name, _, _ in _refusals({k: Path(k) for k in (
 @pytest.mark.parametrize("name", REFUSAL_NAMES)
 def test_what_cannot_be_done_is_refused(files, unusual, refusals, name):
     argv, words = refusals[name]
-    check_refused(argv, names=words, watch=[*watched(files), *unusual.values(),
-                                            files["folder"] / "never.png"])
+    seen = watched(files)
+    check_refused(argv, names=words, bystanders=seen["bystanders"],
+                  watch=[*seen["watch"], *unusual.values(), files["folder"] / "never.png"])
 
 
 # --- plot outputs: never clobber an input, never a traceback, always atomic ---------------
@@ -633,7 +643,7 @@ def test_compare_names_a_case_that_failed(files):
                        (["compare", good, good, "--json"], "A")):
         # failed in both files (a file compared with itself): the same outcome, status 0
         both = argv[1] == argv[2]
-        outcome = check_refused(argv, watch=watched(files), status=0 if both else 1)
+        outcome = check_refused(argv, **watched(files), status=0 if both else 1)
         case = "gamma" if "failed_only" not in " ".join(argv) else "alpha"
         assert f"case {case} failed in {side}: {FAILURE}" in outcome.stdout, (argv, outcome)
         assert "no dataset in common" not in outcome.stdout + outcome.stderr
@@ -645,7 +655,7 @@ def test_compare_text_and_missing_time_are_differences_not_crashes(files, unusua
     good = str(files["good"])
     for other in ("text_curve", "no_time"):
         outcome = check_refused(["compare", str(unusual[other]), good, "alpha/crank/angle"],
-                                watch=watched(files), status=1)
+                                **watched(files), status=1)
         assert "FAIL" in outcome.stdout
 
 
