@@ -147,7 +147,8 @@ def reference_deviations(data: dict, scene) -> dict[str, float]:
     return out
 
 
-@pytest.mark.parametrize("name", ["thesis", "soft_spring", "wing"])
+@pytest.mark.parametrize("name", ["thesis", pytest.param("soft_spring", marks=pytest.mark.slow),
+                                  pytest.param("wing", marks=pytest.mark.slow)])
 def test_both_builds_agree_with_the_reference_at_a_small_step(name):
     scene = scene_of(SCENES[name] + [f"simulation.step_s={SMALL_STEP_S!r}",
                                      f"simulation.output_step_s={10 * SMALL_STEP_S!r}"])

@@ -201,6 +201,7 @@ def test_two_writers_at_once_last_complete_writer_wins(tmp_path):
     assert reads > 0
 
 
+@pytest.mark.slow  # two real `flex run` processes; the writers' contract is in the test above
 def test_two_flex_runs_on_one_path(tmp_path):
     out = tmp_path / "kinematics.h5"
     speeds = {"slow": 3.0, "fast": 6.0}
