@@ -161,12 +161,15 @@ def study_scene(module: ModuleType, source: str | Path | None = None,
     return load_scene(source, list(getattr(module, "OVERRIDES", [])) + list(overrides or []))
 
 
-def progress_printer(stream=None) -> Callable[[str, int, int], None]:
-    """A progress callback printing ``[done/total] case`` lines (to stderr by default)."""
+def progress_printer(study: str = "", stream=None) -> Callable[[str, int, int], None]:
+    """A progress callback printing ``[done/total] study: case`` lines (to stderr by
+    default): the study named, so that the log of two studies run side by side (``make
+    all`` runs two at a time) says whose case each line is."""
     stream = stream or sys.stderr
+    label = f"{study}: " if study else ""
 
     def report(case: str, done: int, total: int) -> None:
-        print(f"  [{done}/{total}] {case}", file=stream, flush=True)
+        print(f"  [{done}/{total}] {label}{case}", file=stream, flush=True)
 
     return report
 
@@ -307,7 +310,7 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
     check_cases(module, scenes, given)
     staging: Staging | None = None
     try:
-        output = execute(module, scene, None if quiet else progress_printer(), scenes,
+        output = execute(module, scene, None if quiet else progress_printer(name), scenes,
                          sweep, cache_dir=cache_dir, environment=environment)
         output.expected_failures = frozenset(getattr(module, "EXPECTED_FAILURES", ()))
         target = path if output.as_expected or not path.exists() else failed_path(path)

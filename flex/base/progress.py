@@ -33,9 +33,12 @@ REPORT_INTERVAL_S = 9.0
 
 
 def duration_text(seconds: float) -> str:
-    """``seconds`` for a person: ``0.5 s``, ``42 s``, ``3.5 min``, ``2.1 h``, ``3 days``."""
-    if seconds < 120:
+    """``seconds`` for a person: ``0.5 s``, ``9.4 s``, ``42 s``, ``105 s``, ``3.5 min``,
+    ``2.1 h``, ``3 days``."""
+    if seconds < 10:
         return f"{seconds:.2g} s"
+    if seconds < 120:  # "1e+02 s" is no way to say a hundred seconds
+        return f"{seconds:.0f} s"
     if seconds < 7200:
         return f"{seconds / 60:.2g} min"
     if seconds < 2 * 86400:
