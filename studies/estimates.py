@@ -61,7 +61,12 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
-    return check_estimates(scenes, run.cache_dir, run.progress)
+    from contextlib import closing
+
+    from flex.sweep import make_executor
+
+    with closing(make_executor()) as executor:
+        return check_estimates(scenes, run.cache_dir, run.progress, executor)
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],

@@ -205,6 +205,12 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
     validity = result.attrs["estimated_error_validity"]
     assert all(f"{name} (observed order" in validity for name in bounded)
     assert bool(bounded) == ("are bounds" in validity)
+    # the raw whole-run peaks: their totals are bounds, stored and printed as such; the
+    # deployment's peaks and the first crest are estimates
+    assert {name for name, row in rows.items() if row.bound} == {
+        name for name in rows if BUILTIN_HEADLINES[name].kind == "peak"} != set()
+    assert "a bound, not an estimate" in deflection.text()
+    assert "(estimate" in rows["coupler_deployment_peak_deflection_m"].text()
 
 
 def test_first_crest_and_crest_gap_of_a_beat_against_closed_forms():

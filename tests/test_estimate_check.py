@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from flex.data.results import CaseResult
 from flex.experiments.workprecision.estimate_check import _rows, estimate_summary
-from flex.fidelity.error_budget import CERTIFICATE_ATTR, STEP_BOUNDS_ATTR
+from flex.fidelity.error_budget import BOUNDS_ATTR, CERTIFICATE_ATTR, STEP_BOUNDS_ATTR
 
 PEAK, END = "coupler_deployment_peak_deflection_m", "crank_angle_end_rad"
 
@@ -34,3 +34,16 @@ def test_a_true_error_above_its_certificate_is_named():
     assert "exceeded by a known true error: 1" in line and PEAK in line
     _, report = estimate_summary({"a": _case(2e-7, "")})
     assert "exceeded by a known true error: 0" in report
+
+
+def test_a_raw_peak_is_a_bound_checked_against_its_certificate_not_judged():
+    case = _case(1e-9, "")  # 200x below its "estimate": pessimistic, as a bound may be
+    case.attrs[BOUNDS_ATTR] = PEAK
+    rows = {row["quantity"]: row for row in _rows({"a": case})}
+    assert rows[PEAK]["bound"] and not rows[PEAK]["judged"] and "bound" in rows[PEAK]["why"]
+    assert rows[END]["judged"] and not rows[END]["bound"]
+    _, report = estimate_summary({"a": case})
+    assert "bounds (raw whole-run peaks" in report and "1 pairs, 1 with a known" in report
+    case.attrs[f"true_error_{PEAK}"] = 3e-7  # above its certificate: still named
+    _, report = estimate_summary({"a": case})
+    assert "exceeded by a known true error: 1" in report

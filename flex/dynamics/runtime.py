@@ -57,7 +57,7 @@ def announce_integration(scene: Scene, name: str, reductions: dict[str, Any],
     estimate = estimated_run_time_s(scene, modes, link_models)
     if estimate > ANNOUNCE_RUN_S:
         sim = scene["simulation"]
-        print(f"flex: integrating {name}: {sim['end_time_s'] / sim['step_s']:.3g} steps of "
+        print(f"flex: integrating {name}: {round(sim['end_time_s'] / sim['step_s'])} steps of "
               f"{sim['step_s']:g} s to t = {sim['end_time_s']:g} s, ~{duration_text(estimate)} "
               f"(estimate; progress follows)", file=sys.stderr, flush=True)
 

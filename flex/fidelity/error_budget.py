@@ -106,6 +106,9 @@ class ErrorBudget:
     unknown: list[str] = field(default_factory=list)
     #: the quantities whose step term is a bound (observed order outside the window)
     step_bounds: tuple[str, ...] = ()
+    #: the quantities whose total is a bound, not an estimate: the raw whole-run peaks
+    #: (:attr:`flex.fidelity.headlines.Headline.bound`)
+    bounds: tuple[str, ...] = ()
 
     def total(self, quantity: str) -> float:
         """The root-sum-square of the quantity's terms [its units] (module doc)."""
@@ -142,6 +145,7 @@ class ErrorBudget:
         if self.unknown:
             out[UNKNOWN_ATTR] = "; ".join(self.unknown)
         out[STEP_BOUNDS_ATTR] = ", ".join(self.step_bounds)
+        out[BOUNDS_ATTR] = ", ".join(self.bounds)
         return out
 
     def unknown_quantities(self) -> list[str]:
@@ -160,6 +164,9 @@ DESCRIBED = "headlines_described"
 UNKNOWN_ATTR = f"{PREFIX}unknown"
 #: the quantities whose step term is a bound, comma-separated ("" when every one is an estimate)
 STEP_BOUNDS_ATTR = f"{PREFIX}step_bounds"
+#: the quantities whose total is a bound, not an estimate (the raw whole-run peaks),
+#: comma-separated
+BOUNDS_ATTR = f"{PREFIX}bounds"
 #: case attribute prefix of a peak's crest gap (:func:`flex.fidelity.error_estimate.crest_gap`)
 CREST_GAP_PREFIX = "crest_gap_"
 
@@ -393,7 +400,8 @@ def error_budget(scene: Scene, result: CaseResult,
                        _crest_gaps(result, values, headlines),
                        {name: (headlines[name].unit, headlines[name].what) for name in values},
                        _unknown(terms, failed, [f"step: {step.validity}", *companions.failures],
-                                headlines), tuple(step.bounds))
+                                headlines), tuple(step.bounds),
+                       tuple(name for name in values if headlines[name].bound))
 
 
 def _unknown(terms: dict[str, dict[str, float]], failed: set[str], failures: list[str],
@@ -441,6 +449,8 @@ class BudgetRow:
     problem: str = ""
     #: the certificate's factor over the estimate (NaN: a file written before certificates)
     certificate_factor: float = math.nan
+    #: the total is a bound, not an estimate (a raw whole-run peak, :data:`BOUNDS_ATTR`)
+    bound: bool = False
 
     @property
     def certificate(self) -> float:
@@ -465,8 +475,9 @@ class BudgetRow:
                     else "")
         certificate = (f", certificate {self.certificate:.2g} {self.units}"
                        if math.isfinite(self.certificate) else "")
+        kind = (f"a bound, not an estimate: {BOUND_TEXT}" if self.bound else "estimate")
         return (f"{self.what}: {self.value:.6g} {self.units} +- {self.total:.2g} "
-                f"{self.units}{relative} (estimate{certificate}; root-sum-square of {terms})")
+                f"{self.units}{relative} ({kind}{certificate}; root-sum-square of {terms})")
 
 
 def _described(attrs: Mapping[str, Any]) -> dict[str, tuple[str, str]]:
@@ -483,6 +494,10 @@ def term_text(value: float) -> str:
     return f"{value:.2g}" if math.isfinite(value) else "unknown"
 
 
+#: why a raw peak's total is a bound (printed beside it)
+BOUND_TEXT = ("a raw maximum over the whole run races between the crests of the ringing and "
+              "has no order of convergence; its terms are the largest mismatches of the "
+              "companions' crests")
 #: how far a stored total may lie from the root-sum-square of its stored terms (relative)
 CONSISTENCY = 1e-6
 
@@ -527,7 +542,18 @@ def budget_rows(attrs: Mapping[str, Any]) -> list[BudgetRow]:
     factor, _ = _number(dict(attrs), CERTIFICATE_ATTR)
     if factor is not None and math.isfinite(factor) and factor >= 1.0:
         rows = [replace(row, certificate_factor=factor) for row in rows]
-    return rows
+    bounds = bound_quantities(attrs)
+    return [replace(row, bound=True) if row.quantity in bounds else row for row in rows]
+
+
+def bound_quantities(attrs: Mapping[str, Any]) -> frozenset[str]:
+    """The quantities a stored budget names as bounds (:data:`BOUNDS_ATTR`; none in a file
+    written before, or where the attribute is not text)."""
+    value = attrs.get(BOUNDS_ATTR, "")
+    if isinstance(value, bytes):
+        value = value.decode("utf-8", "replace")
+    return frozenset(name.strip() for name in value.split(",") if name.strip()) \
+        if isinstance(value, str) else frozenset()
 
 
 def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> BudgetRow:
@@ -567,6 +593,7 @@ def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> 
 
 
 __all__ = ["CERTIFICATE_ATTR", "CERTIFICATE_FACTOR", "DESCRIBED", "BudgetRow", "ErrorBudget",
-           "HEADLINE_PREFIX", "MESH_FACTOR", "STEP_BOUNDS_ATTR", "TERMS", "UNKNOWN_ATTR",
-           "budget_rows", "combined",
+           "BOUNDS_ATTR", "HEADLINE_PREFIX", "MESH_FACTOR", "STEP_BOUNDS_ATTR", "TERMS",
+           "UNKNOWN_ATTR",
+           "bound_quantities", "budget_rows", "combined",
            "error_budget", "richer_modes", "term_text"]

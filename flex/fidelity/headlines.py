@@ -21,7 +21,9 @@ The contract of an entry:
    ``|series|`` over ``window``: :func:`flex.fidelity.error_estimate.peak_difference`, which
    also counts a crest that moves), ``"first_crest"`` (the largest ``|series|`` of its first
    lobe; a rigid twin's missing series counts as zero); ``series``: the dataset it is read
-   from (peaks and crests);
+   from (peaks and crests). A ``"peak"`` is a raw maximum over the whole run: it races
+   between the sub-crests of undamped ringing and has no order of convergence, so its
+   budget is a *bound*, not an estimate (:attr:`Headline.bound`), and says so;
 5. ``window``: the part of the run it is read over, in words;
 6. ``link``: the link whose own elastic response it is (its model term is the link's rung's
    ``own_fraction``, :mod:`flex.config.ladder`), or None for a quantity of the motion (the
@@ -62,6 +64,12 @@ class Headline:
     #: its order of convergence under mesh refinement, what the budget's mesh term
     #: extrapolates with (a displacement or the motion 2, a stress at the outer fibre 1)
     mesh_order: int = 2
+
+    @property
+    def bound(self) -> bool:
+        """Its budget's total is a bound, not an estimate: a raw maximum (``kind`` ``"peak"``,
+        point 4 of the module's contract), whose terms are crest mismatches."""
+        return self.kind == "peak"
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:

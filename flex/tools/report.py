@@ -327,7 +327,8 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
     for case in cases:
         for row in budget_rows(case["attrs"]):
             rows.append([_code(case["name"]), row.what, f"{row.value:.6g} {row.units}",
-                         row.problem or f"{row.total:.2g} {row.units}",
+                         row.problem or f"{'bound ' if row.bound else ''}{row.total:.2g} "
+                                        f"{row.units}",
                          f"{100 * row.relative:.2g} %" if math.isfinite(row.relative) else "-",
                          f"{row.certificate:.2g} {row.units}"
                          if math.isfinite(row.certificate) else "-",
@@ -340,7 +341,8 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
         return []
     lines = ["Estimated error of each headline quantity (total = the root-sum-square of the "
              "terms, in the quantity's unit: what the error is; certificate = the bound "
-             "refinement decides on, the estimate times its stated safety factor):", ""]
+             "refinement decides on, the estimate times its stated safety factor; a raw "
+             "whole-run peak's error is a bound, not an estimate, marked so):", ""]
     lines += _table(["case", "quantity", "value", "estimated error", "relative",
                      "certificate", *TERMS], rows)
     for key, texts in notes.items():
