@@ -67,3 +67,29 @@ def test_the_deployment_time_ignores_ripple_on_the_crank_angle():
     assert "channel/crank/angle" in run
     deployment = BUILTIN_HEADLINES["deployment_time_s"].read(run)
     assert deployment == pytest.approx(0.015, abs=2e-6)
+
+
+def test_a_ripple_pinned_at_the_runs_end_is_not_read_as_the_peak():
+    """A smooth crest of 1e-4 m mid-run and a 10 kHz ripple that grows to 3e-4 m at the
+    run's end: the channel's last 2 cut-off periods are undetermined (the filter reads its
+    padding there) and no headline reads them, so the deployment's peak is the crest's;
+    without the mark the end's ripple would win."""
+    from flex.dynamics.advice import CHANNEL_DETERMINED, CHANNEL_EDGE_PERIODS
+
+    time_s = np.arange(0.0, 0.01, 2e-6)
+    crest = 1e-4 * np.sin(2 * np.pi * 100 * time_s)
+    ripple = 3e-4 * np.cos(2 * np.pi * 10_000 * time_s) * (time_s > 0.0095)
+    run = _run(time_s, crest + ripple)
+    run.update(channel_datasets(run, 1000.0))
+    determined = run[CHANNEL_DETERMINED].data
+    tail = int(np.ceil(CHANNEL_EDGE_PERIODS / (1000.0 * 2e-6)))
+    assert determined[:-tail].all() and not determined[-tail:].any()
+    peak = BUILTIN_HEADLINES["coupler_deployment_peak_deflection_m"].read(run)
+    assert peak == pytest.approx(1e-4, rel=2e-3)
+    unmarked = {key: value for key, value in run.items() if key != CHANNEL_DETERMINED}
+    assert BUILTIN_HEADLINES["coupler_deployment_peak_deflection_m"].read(unmarked) > 1.2e-4
+
+
+def test_a_run_shorter_than_twice_the_channels_tail_has_no_channel():
+    time_s = np.arange(0.0, 0.003, 2e-6)  # 3 cut-off periods of 1 kHz: a 2-period tail
+    assert channel_datasets(_run(time_s, np.sin(2 * np.pi * 100 * time_s)), 1000.0) == {}

@@ -126,10 +126,17 @@ def crest_gap(values: np.ndarray) -> float | None:
 def channel(datasets: Mapping[str, Any], path: str) -> np.ndarray:
     """Series ``path`` on the run's headline channel, ``channel/<path>`` (zero-phase
     low-pass at the cut-off the run stores as ``channel_cutoff_Hz``,
-    :func:`flex.dynamics.advice.channel_datasets`), or the series itself where the run has
-    none (nothing flexible, or a sampling that holds nothing above the cut-off) [the series'
-    unit]."""
-    return np.asarray(datasets.get(f"channel/{path}", datasets[path]).data, dtype=float)
+    :func:`flex.dynamics.advice.channel_datasets`) up to its undetermined tail at the run's
+    end (``channel/determined``: where the filter reads its padding, not the run), or the
+    whole series itself where the run has none (nothing flexible, or a sampling that holds
+    nothing above the cut-off) [the series' unit]. Its samples are the run's first ones:
+    index k is the time ``time[k]``."""
+    if f"channel/{path}" not in datasets:
+        return np.asarray(datasets[path].data, dtype=float)
+    values = np.asarray(datasets[f"channel/{path}"].data, dtype=float)
+    if "channel/determined" not in datasets:  # a file written before the tail was marked
+        return values
+    return values[:int(np.count_nonzero(np.asarray(datasets["channel/determined"].data)))]
 
 
 def deployment_end(datasets: Mapping[str, Any]) -> int | None:
@@ -175,7 +182,8 @@ def deployment_time_s(datasets: Mapping[str, Any]) -> float | None:
     return float(time_s[top] + np.clip(offset, -0.5, 0.5) * (time_s[top + 1] - time_s[top]))
 
 
-DEPLOYMENT = "release to the first crank maximum, on the headline channel"
+DEPLOYMENT = ("release to the first crank maximum (without one: to the run's end, less the "
+              "channel's undetermined tail), on the headline channel")
 _CHANNEL_TEXT = " (headline channel)"
 
 
