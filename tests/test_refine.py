@@ -99,3 +99,32 @@ def test_a_refinement_whose_next_run_would_exceed_the_limit_stops_before_it(redu
     attempts = result.attrs["refine_attempts"].splitlines()
     assert 1 <= len(attempts) <= 6 and "stopped: cost limit" in attempts[-1]
     assert "estimated_error_coupler_peak_deflection_m" in result.attrs
+
+
+def test_a_quantity_outside_the_asymptotic_range_is_not_chased():
+    """Refinement does not chase a quantity whose step term is a bound (flagged outside the
+    asymptotic range): with only such quantities above the tolerance it stops and names
+    them; with another one above it too, it refines for that one."""
+    from flex.config.settings import resolve_solver_settings
+    from flex.dynamics.link_models import BUILTIN_LINK_MODELS
+    from flex.fidelity.error_budget import BudgetRow
+    from flex.fidelity.simulation import KNOBS, _next_attempt
+
+    scene, _ = resolve_solver_settings(load_scene(overrides={
+        "coupler.geometry": "plate", "coupler.model": "ffrf", "coupler.modes": 2}))
+
+    def row(quantity: str, relative: float, dominant: str) -> BudgetRow:
+        terms = {"step": 0.0, "modes": 0.0, "mesh": 0.0, "model": 0.0, dominant: relative}
+        return BudgetRow(quantity, quantity.replace("_", " "), "m", 1.0, relative, relative,
+                         terms, certificate_factor=1.25)
+
+    rows = [row("first_crest", 0.05, "step"), row("deployment_peak", 0.001, "modes")]
+    step = _next_attempt(scene, rows, 0.01, 1, 0.0, BUILTIN_LINK_MODELS, frozenset(KNOBS),
+                         frozenset({"first_crest"}))
+    assert step.refined is None and step.status.startswith("not chased: first crest")
+    assert "outside the asymptotic range" in step.status
+    rows[1] = row("deployment_peak", 0.02, "modes")
+    step = _next_attempt(scene, rows, 0.01, 1, 0.0, BUILTIN_LINK_MODELS, frozenset(KNOBS),
+                         frozenset({"first_crest"}))
+    assert step.refined is not None and "deployment peak" in step.line
+    assert "modes term dominant" in step.line

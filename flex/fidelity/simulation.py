@@ -195,7 +195,9 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     ``refine_attempts`` (one line per run: its settings, the worst quantity, what changed
     and why) and ``refine_wall_time_s``; a run that did not meet the tolerance says so in
     one stderr line. The companion runs of one attempt are not reused by the next (a known
-    cost: the refined run equals one of them). ``free``: the knobs it may turn
+    cost: the refined run equals one of them). A quantity flagged outside the asymptotic
+    range (its step term a bound) is not chased: when only such quantities miss the
+    tolerance it stops and names them. ``free``: the knobs it may turn
     (:func:`free_knobs`); one the user set that blocks the tolerance stops it, and the status
     says which value and what refinement would make of it."""
     from flex.fidelity.error_budget import budget_rows
@@ -213,7 +215,8 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
         rows = [row for row in budget_rows(result.attrs)
                 if row.quantity in headlines and headlines[row.quantity].certified]
         step = _next_attempt(current.scene, rows, tolerance, attempt,
-                             time.perf_counter() - start, link_models, free)
+                             time.perf_counter() - start, link_models, free,
+                             step_bounded(result.attrs))
         lines.append(f"{attempt}: {_settings_text(current.scene, link_models)}: {step.line}")
         if step.refined is None:
             break
@@ -234,16 +237,37 @@ class _Step:
     line: str
 
 
+def step_bounded(attrs: Mapping[str, Any]) -> frozenset[str]:
+    """The quantities a stored budget flags outside the asymptotic range (their step term a
+    bound: :data:`flex.fidelity.error_budget.STEP_BOUNDS_ATTR`)."""
+    from flex.fidelity.error_budget import STEP_BOUNDS_ATTR
+
+    value = attrs.get(STEP_BOUNDS_ATTR, "")
+    return frozenset(name.strip() for name in value.split(",") if name.strip()) \
+        if isinstance(value, str) else frozenset()
+
+
 def _next_attempt(scene: Scene, rows: list[Any], tolerance: float, attempt: int,
                   spent_s: float, link_models: Mapping[str, LinkModel],
-                  free: frozenset[str]) -> _Step:
+                  free: frozenset[str], flagged: frozenset[str] = frozenset()) -> _Step:
     """After attempt ``attempt`` (its certified budget ``rows``, ``spent_s`` [s] so far): the
     tolerance met, nothing to certify, or the knob of the worst quantity's dominant term
-    turned, unless it cannot move, is refused, or would pass the cost limit."""
+    turned, unless it cannot move, is refused, or would pass the cost limit. A quantity in
+    ``flagged`` (outside the asymptotic range: its step term a bound that need not shrink
+    with the step) is not chased: when only such quantities miss the tolerance, refinement
+    stops and names them."""
     if not rows:
         return _Step(None, NOTHING_TO_REFINE, NOTHING_TO_REFINE)
-    worst = max(rows, key=lambda row: row.certified_relative if row.certified_relative >= 0
-                else math.inf)
+    missing = [row for row in rows if not row.certified_relative <= tolerance]
+    if missing and all(row.quantity in flagged for row in missing):
+        status = ("not chased: " + "; ".join(
+            f"{row.what} certified to {100 * row.certified_relative:.3g} % is outside the "
+            f"asymptotic range (its step term a bound: the observed order left the window)"
+            for row in missing) + f" (tolerance {100 * tolerance:g} %)")
+        return _Step(None, status, f"stopped: {status}")
+    chased = [row for row in rows if row.quantity not in flagged] or rows
+    worst = max(chased, key=lambda row: row.certified_relative
+                if row.certified_relative >= 0 else math.inf)
     found = (f"{worst.what} certified to {100 * worst.certified_relative:.3g} % of itself "
              f"(estimate {100 * worst.relative:.3g} %; tolerance {100 * tolerance:g} %)"
              if not worst.problem else
