@@ -128,3 +128,26 @@ def test_a_quantity_outside_the_asymptotic_range_is_not_chased():
                          frozenset({"first_crest"}))
     assert step.refined is not None and "deployment peak" in step.line
     assert "modes term dominant" in step.line
+
+
+def test_the_next_attempt_is_the_last_ones_finer_companion():
+    """A refinement's next attempt (the step halved, the modes raised, the mesh halved) has
+    the key of the companion the last attempt's budget ran at those settings: it is reused,
+    not run again (flex.fidelity.simulation.companion_key)."""
+    from flex.config.settings import resolve_solver_settings
+    from flex.data.scene import apply_overrides, to_toml
+    from flex.data.scene_edit import derive_scene
+    from flex.dynamics.link_models import BUILTIN_LINK_MODELS
+    from flex.fidelity.simulation import _refined, companion_key
+
+    scene, _ = resolve_solver_settings(load_scene(overrides={
+        "coupler.geometry": "plate", "coupler.model": "ffrf", "coupler.modes": 2}))
+    step, mesh = scene["simulation"]["step_s"], scene["coupler"]["mesh_size_m"]
+    for term, companion in (("step", [f"simulation.step_s={step / 2.0!r}"]),
+                            ("modes", ["coupler.modes=4"]),
+                            ("mesh", [f"coupler.mesh_size_m={mesh / 2.0!r}"])):
+        change, _ = _refined(scene, term, BUILTIN_LINK_MODELS)
+        made = to_toml(apply_overrides(scene, [*companion, "simulation.output_step_s=0.0",
+                                               "simulation.error_estimate=false"]))
+        assert companion_key(derive_scene(scene, change)) == made, term
+    assert companion_key(apply_overrides(scene, ["simulation.output_step_s=1e-4"])) is None

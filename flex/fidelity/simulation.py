@@ -87,10 +87,15 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
                       crank_reduction: Any = None, *, cache_dir: Path | None = None,
                       beyond: str = "",
                       link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
-                      headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> CaseResult:
+                      headlines: Mapping[str, Headline] = BUILTIN_HEADLINES,
+                      companions: dict[str, CaseResult] | None = None) -> CaseResult:
     """:func:`simulate` of a scene already resolved (:func:`flex.fidelity.auto.resolve`):
     integrate, attributes, error budget. ``beyond``: why the scene's tolerance is beyond
-    what flex can certify ("" if it is not), stored as a validity warning."""
+    what flex can certify ("" if it is not), stored as a validity warning. ``companions``:
+    runs already made, by their scene's TOML (:func:`companion_key`; :func:`refine` keeps
+    them across its attempts): a companion found there is not run again, and neither is the
+    run itself when one of them is its scene (the next attempt of a refinement is the last
+    one's finer companion); the companions this run makes are added."""
     scene = resolution.scene
     if any(decision.link != "spring" for decision in resolution.decisions):
         reduction = crank_reduction = None
@@ -98,8 +103,11 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
         reduction, crank_reduction = scene_reductions(scene, reduction, crank_reduction,
                                                       cache_dir=cache_dir,
                                                       link_models=link_models)
-    result = integrate(scene, name, reduction, crank_reduction, cache_dir=cache_dir,
-                       link_models=link_models)
+    made = (companions or {}).get(companion_key(scene))
+    result = (replace(made, name=name, scene_toml=to_toml(scene), attrs=dict(made.attrs))
+              if made is not None else
+              integrate(scene, name, reduction, crank_reduction, cache_dir=cache_dir,
+                        link_models=link_models))
     result.attrs.update(_rigid_predictions(scene, result, link_models))
     result.attrs.update(resolution.attrs())
     if result.attrs.get("solver_defaults_entry") == "flexible_fallback":
@@ -114,13 +122,19 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
                       if built is not None and link_models[scene[link]["model"]].modal}
 
         def run_companion(companion: Scene) -> CaseResult:
+            toml = to_toml(companion)
+            if companions is not None and toml in companions:
+                return companions[toml]
             # the run's reductions serve a companion whose links are meshed and reduced alike
             same = all(companion[link][key] == scene[link][key] for link in ("coupler",
                                                                             "crank")
                        for key in ("model", "modes", "mesh_size_m"))
-            return integrate(companion, f"{name}_companion", reduction if same else None,
-                             crank_reduction if same else None, cache_dir=cache_dir,
-                             link_models=link_models)
+            out = integrate(companion, f"{name}_companion", reduction if same else None,
+                            crank_reduction if same else None, cache_dir=cache_dir,
+                            link_models=link_models)
+            if companions is not None:
+                companions[toml] = out
+            return out
 
         scales = time_scales(scene, reductions, link_models)
         budget = error_budget(scene, result, run_companion, scales, link_models, headlines)
@@ -131,6 +145,18 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
                   f"{', '.join(budget.unknown_quantities())}: {'; '.join(budget.unknown)}",
                   file=sys.stderr, flush=True)
     return result
+
+
+def companion_key(scene: Scene) -> str | None:
+    """The key under which a run of ``scene`` would be found among companion runs: the TOML
+    of the scene as a companion runs it (every step stored, no budget of its own); None for
+    a scene that stores fewer samples than every step (no companion is such a run)."""
+    from flex.data.scene import apply_overrides
+
+    if float(scene["simulation"]["output_step_s"]) != 0.0:
+        return None
+    return to_toml(apply_overrides(scene, ["simulation.output_step_s=0.0",
+                                           "simulation.error_estimate=false"]))
 
 
 def _warn_unresolved_drive(result: CaseResult, scales: list[tuple[float, float, str]],
@@ -194,8 +220,10 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     Returns the last run, with ``refine_status`` (``met``, or why not),
     ``refine_attempts`` (one line per run: its settings, the worst quantity, what changed
     and why) and ``refine_wall_time_s``; a run that did not meet the tolerance says so in
-    one stderr line. The companion runs of one attempt are not reused by the next (a known
-    cost: the refined run equals one of them). A quantity flagged outside the asymptotic
+    one stderr line. The companion runs are kept across attempts: the next attempt's run is
+    the last one's finer companion where its settings are that companion's (the step halved,
+    the modes raised, the mesh halved; its attempt line says so), and a companion made once
+    is not made again. A quantity flagged outside the asymptotic
     range (its step term a bound) is not chased: when only such quantities miss the
     tolerance it stops and names them. ``free``: the knobs it may turn
     (:func:`free_knobs`); one the user set that blocks the tolerance stops it, and the status
@@ -209,15 +237,19 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     start, lines = time.perf_counter(), []
     tolerance = float(resolution.scene["fidelity"]["tolerance"])
     current = resolution
+    made: dict[str, CaseResult] = {}  # every companion run so far, by its scene
     for attempt in range(1, MAX_ATTEMPTS + 1):
+        reused = companion_key(current.scene) in made
         result = simulate_resolved(current, name, cache_dir=cache_dir, link_models=link_models,
-                                   headlines=headlines)
+                                   headlines=headlines, companions=made)
         rows = [row for row in budget_rows(result.attrs)
                 if row.quantity in headlines and headlines[row.quantity].certified]
         step = _next_attempt(current.scene, rows, tolerance, attempt,
                              time.perf_counter() - start, link_models, free,
                              step_bounded(result.attrs))
-        lines.append(f"{attempt}: {_settings_text(current.scene, link_models)}: {step.line}")
+        lines.append(f"{attempt}: {_settings_text(current.scene, link_models)}"
+                     f"{' (the last companion at these settings, reused)' if reused else ''}: "
+                     f"{step.line}")
         if step.refined is None:
             break
         current = replace(current, scene=step.refined)
