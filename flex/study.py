@@ -25,6 +25,7 @@ The command lines and :mod:`flex.api` read them once (:func:`from_environment`).
 
 from __future__ import annotations
 
+import functools
 import importlib
 import sys
 import time
@@ -249,11 +250,21 @@ def check_cases(module: ModuleType, scenes: dict[str, Scene],
             raise SceneError(f"{name} = {value!r} would be ignored: {why}")
 
 
-def simulate_each(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
+def simulate_each(scenes: dict[str, Scene], run: StudyRun, executor: Any = None,
+                  group: Callable[[str, Scene], Any] | None = None,
+                  cost: Callable[[str, Scene], float] | None = None) -> dict[str, CaseResult]:
     """The default ``simulate_cases``: each case on its own
-    (:func:`flex.fidelity.simulation.simulate_case`, reductions cached in ``run.cache_dir``)."""
-    return run_each(scenes, lambda name, case_scene: simulate_case(
-        case_scene, name, cache_dir=run.cache_dir), run.progress)
+    (:func:`flex.fidelity.simulation.simulate_case`, reductions cached in ``run.cache_dir``);
+    on ``executor`` (:mod:`flex.sweep`'s) in parallel jobs, ``group`` and ``cost`` as
+    :func:`flex.fidelity.caseloop.run_each` takes them."""
+    return run_each(scenes, functools.partial(simulate_named, cache_dir=run.cache_dir),
+                    run.progress, executor=executor, group=group, cost=cost)
+
+
+def simulate_named(name: str, scene: Scene, cache_dir: Path | None = None) -> CaseResult:
+    """:func:`flex.fidelity.simulation.simulate_case` of ``scene`` as case ``name`` (the
+    argument order of :func:`flex.fidelity.caseloop.run_each`; picklable, for an executor)."""
+    return simulate_case(scene, name, cache_dir=cache_dir)
 
 
 def execute(module: ModuleType, scene: Scene,

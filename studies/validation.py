@@ -50,11 +50,30 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
-    """flex's runs (reductions cached in ``run.cache_dir``), then the independent two-mode
-    runs into ``run.notes``."""
-    results = simulate_each(scenes, run)
-    run.notes["two_mode"] = validation.two_mode_runs(progress=run.progress)
+    """flex's runs (reductions cached in ``run.cache_dir``), two at a time (the nonlinear FE
+    references first; the runs of one reduction together), then the independent two-mode
+    runs into ``run.notes``, two at a time."""
+    from contextlib import closing
+
+    from flex.sweep import make_executor
+
+    with closing(make_executor()) as executor:
+        results = simulate_each(scenes, run, executor, _reduction_of, _cost)
+        run.notes["two_mode"] = validation.two_mode_runs(progress=run.progress,
+                                                         executor=executor)
     return results
+
+
+def _reduction_of(name: str, scene: Scene) -> tuple | None:
+    """The runs of one reduction go together (built once); a nonlinear FE run alone."""
+    rod = scene["coupler"]
+    return None if rod["model"] != "ffrf" else (rod["mesh_size_m"], rod["modes"])
+
+
+def _cost(name: str, scene: Scene) -> float:
+    """A run's rough cost for ordering: its steps, a nonlinear FE step ~20x an FFRF one."""
+    steps = scene["simulation"]["end_time_s"] / scene["simulation"]["step_s"]
+    return steps * (20.0 if scene["coupler"]["model"] == "nonlinear_fe" else 1.0)
 
 
 def summarize(scene: Scene, results: dict[str, CaseResult],

@@ -35,6 +35,7 @@ Units: m, s, rad, Hz; deflections and positions in m (reports in um).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -55,6 +56,7 @@ from flex.dynamics.ivp_crank import (
     CrankBenchmark,
     CrankSolution,
 )
+from flex.fidelity.caseloop import run_each
 
 BENCH = CrankBenchmark()
 #: the published components compared, index into PUBLISHED_AT_0P1S, and unit
@@ -142,23 +144,26 @@ WINDOW_S = 0.01
 
 def two_mode_runs(runs: dict[str, tuple[int, int, float, str, str, float]] | None = None,
                   rtol: float = 1e-10,
-                  progress: Callable[[str, int, int], None] | None = None
-                  ) -> dict[str, CrankSolution]:
+                  progress: Callable[[str, int, int], None] | None = None,
+                  executor: Any = None) -> dict[str, CrankSolution]:
     """The independent model's runs (:data:`TWO_MODE_RUNS` by default), 5-140 s each (axial
     bubbles make the explicit integration stiff: ~0.9 M evaluations); ``progress(name, done,
-    total)`` is told before each (a log shows which one is running)."""
-    chosen = runs or TWO_MODE_RUNS
-    out = {}
-    for index, (name, (modes, bubbles, factor, stiffening, initial, pi_value)) in enumerate(
-            chosen.items()):
+    total)`` as :func:`flex.fidelity.caseloop.run_each` reports; on ``executor`` (one of
+    :mod:`flex.sweep`'s) in parallel."""
+    def told(name: str, done: int, total: int) -> None:
         if progress:
-            progress(f"two-mode model: {name}", index, len(chosen))
-        out[name] = ivp_crank.solve(BENCH, modes, factor, stiffening, initial,
-                                    output_step_s=OUTPUT_STEP_S, rtol=rtol, atol=rtol * 1e-3,
-                                    pi_value=pi_value, axial_bubbles=bubbles)
-    if progress:
-        progress("two-mode model: done", len(chosen), len(chosen))
-    return out
+            progress(f"two-mode model: {name}", done, total)
+
+    return run_each(dict(runs or TWO_MODE_RUNS), functools.partial(_two_mode_run, rtol=rtol),
+                    told, executor=executor)
+
+
+def _two_mode_run(name: str, run: tuple[int, int, float, str, str, float], rtol: float
+                  ) -> CrankSolution:
+    modes, bubbles, factor, stiffening, initial, pi_value = run
+    return ivp_crank.solve(BENCH, modes, factor, stiffening, initial,
+                           output_step_s=OUTPUT_STEP_S, rtol=rtol, atol=rtol * 1e-3,
+                           pi_value=pi_value, axial_bubbles=bubbles)
 
 
 def dominant_frequency_hz(time_s: np.ndarray, signal: np.ndarray,
