@@ -29,8 +29,11 @@ def test_refinement_meets_the_tolerance_against_a_finer_reference(reduction_cach
                        cache_dir=reduction_cache)
     attempts = refined.attrs["refine_attempts"].splitlines()
     assert refined.attrs["refine_status"] == "met", refined.attrs["refine_attempts"]
-    assert len(attempts) >= 2 and "dominant ->" in attempts[0]  # the rule's guess was refined
-    assert refined.attrs["estimated_error_coupler_peak_deflection_m_relative"] <= 0.01
+    # the rule's first guess either meets it (measured since 2026-12: certified to 0.39 %) or
+    # is refined until it does
+    assert all("dominant ->" in line for line in attempts[:-1]) and ": met" in attempts[-1]
+    assert refined.attrs[
+        "estimated_error_coupler_deployment_peak_deflection_m_relative"] <= 0.01 / 1.25
     from flex.tools.inspect import _estimate_lines  # what flex inspect prints of the case
 
     shown = "\n".join(_estimate_lines(refined.attrs))
