@@ -542,14 +542,14 @@ def budget_rows(attrs: Mapping[str, Any]) -> list[BudgetRow]:
     factor, _ = _number(dict(attrs), CERTIFICATE_ATTR)
     if factor is not None and math.isfinite(factor) and factor >= 1.0:
         rows = [replace(row, certificate_factor=factor) for row in rows]
-    bounds = bound_quantities(attrs)
+    bounds = named_quantities(attrs)
     return [replace(row, bound=True) if row.quantity in bounds else row for row in rows]
 
 
-def bound_quantities(attrs: Mapping[str, Any]) -> frozenset[str]:
-    """The quantities a stored budget names as bounds (:data:`BOUNDS_ATTR`; none in a file
-    written before, or where the attribute is not text)."""
-    value = attrs.get(BOUNDS_ATTR, "")
+def named_quantities(attrs: Mapping[str, Any], key: str = BOUNDS_ATTR) -> frozenset[str]:
+    """The quantities a stored budget lists under ``key``, :data:`BOUNDS_ATTR` (bounds) or
+    :data:`STEP_BOUNDS_ATTR` (flagged); none in an older file or one whose value is no text."""
+    value = attrs.get(key, "")
     if isinstance(value, bytes):
         value = value.decode("utf-8", "replace")
     return frozenset(name.strip() for name in value.split(",") if name.strip()) \
@@ -595,5 +595,5 @@ def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> 
 __all__ = ["CERTIFICATE_ATTR", "CERTIFICATE_FACTOR", "DESCRIBED", "BudgetRow", "ErrorBudget",
            "BOUNDS_ATTR", "HEADLINE_PREFIX", "MESH_FACTOR", "STEP_BOUNDS_ATTR", "TERMS",
            "UNKNOWN_ATTR",
-           "bound_quantities", "budget_rows", "combined",
+           "budget_rows", "combined", "named_quantities",
            "error_budget", "richer_modes", "term_text"]

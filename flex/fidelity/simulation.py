@@ -34,7 +34,7 @@ from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.dynamics.solver import VALIDITY_WARNING, integrate, scene_reductions, time_scales
 from flex.fidelity.auto import Resolution, resolve
-from flex.fidelity.error_budget import error_budget
+from flex.fidelity.error_budget import STEP_BOUNDS_ATTR, error_budget, named_quantities
 from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 from flex.fidelity.laws import Criterion
 
@@ -246,7 +246,7 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
                 if row.quantity in headlines and headlines[row.quantity].certified]
         step = _next_attempt(current.scene, rows, tolerance, attempt,
                              time.perf_counter() - start, link_models, free,
-                             step_bounded(result.attrs))
+                             named_quantities(result.attrs, STEP_BOUNDS_ATTR))
         lines.append(f"{attempt}: {_settings_text(current.scene, link_models)}"
                      f"{' (the last companion at these settings, reused)' if reused else ''}: "
                      f"{step.line}")
@@ -267,16 +267,6 @@ class _Step:
     refined: Scene | None
     status: str
     line: str
-
-
-def step_bounded(attrs: Mapping[str, Any]) -> frozenset[str]:
-    """The quantities a stored budget flags outside the asymptotic range (their step term a
-    bound: :data:`flex.fidelity.error_budget.STEP_BOUNDS_ATTR`)."""
-    from flex.fidelity.error_budget import STEP_BOUNDS_ATTR
-
-    value = attrs.get(STEP_BOUNDS_ATTR, "")
-    return frozenset(name.strip() for name in value.split(",") if name.strip()) \
-        if isinstance(value, str) else frozenset()
 
 
 def _next_attempt(scene: Scene, rows: list[Any], tolerance: float, attempt: int,

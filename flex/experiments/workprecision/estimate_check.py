@@ -46,7 +46,7 @@ from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, NONLINEAR_FE
 from flex.fidelity.caseloop import run_each
-from flex.fidelity.error_budget import CERTIFICATE_ATTR, STEP_BOUNDS_ATTR, bound_quantities
+from flex.fidelity.error_budget import CERTIFICATE_ATTR, STEP_BOUNDS_ATTR, named_quantities
 from flex.fidelity.error_estimate import PREFIX, integrator_order, richardson_error
 from flex.fidelity.headlines import BUILTIN_HEADLINES
 from flex.fidelity.simulation import simulate_case
@@ -195,8 +195,8 @@ def _rows(results: Mapping[str, CaseResult]) -> list[dict[str, Any]]:
             above_noise = max(true, estimated) > NOISE_FLOOR * scale
             terms = {term: float(case.attrs.get(f"{PREFIX}{quantity}_{term}", 0.0))
                      for term in ("step", "modes", "mesh", "model")}
-            flagged = quantity in str(case.attrs.get(STEP_BOUNDS_ATTR, "")).split(", ")
-            bound = quantity in bound_quantities(case.attrs)
+            flagged = quantity in named_quantities(case.attrs, STEP_BOUNDS_ATTR)
+            bound = quantity in named_quantities(case.attrs)
             factor = float(case.attrs.get(CERTIFICATE_ATTR, 1.0))
             rows.append({"case": name, "quantity": quantity, "estimated": estimated,
                          "certificate": factor * estimated, "flagged": flagged,
