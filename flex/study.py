@@ -35,6 +35,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+from flex.base.caseloop import run_each
 from flex.base.errors import FlexError, OutputError, ResultFileError, SceneError
 from flex.config.usage import explicit_keys, unused_keys
 from flex.data.outputs import (
@@ -48,7 +49,6 @@ from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import Scene, load_scene, to_toml
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.fidelity.auto import check
-from flex.fidelity.caseloop import run_each
 from flex.fidelity.simulation import simulate_case
 from flex.tools.report import default_report_path, figures_of, render_report
 
@@ -256,14 +256,14 @@ def simulate_each(scenes: dict[str, Scene], run: StudyRun, executor: Any = None,
     """The default ``simulate_cases``: each case on its own
     (:func:`flex.fidelity.simulation.simulate_case`, reductions cached in ``run.cache_dir``);
     on ``executor`` (:mod:`flex.sweep`'s) in parallel jobs, ``group`` and ``cost`` as
-    :func:`flex.fidelity.caseloop.run_each` takes them."""
+    :func:`flex.base.caseloop.run_each` takes them."""
     return run_each(scenes, functools.partial(simulate_named, cache_dir=run.cache_dir),
                     run.progress, executor=executor, group=group, cost=cost)
 
 
 def simulate_named(name: str, scene: Scene, cache_dir: Path | None = None) -> CaseResult:
     """:func:`flex.fidelity.simulation.simulate_case` of ``scene`` as case ``name`` (the
-    argument order of :func:`flex.fidelity.caseloop.run_each`; picklable, for an executor)."""
+    argument order of :func:`flex.base.caseloop.run_each`; picklable, for an executor)."""
     return simulate_case(scene, name, cache_dir=cache_dir)
 
 

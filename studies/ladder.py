@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 
+from flex.base.caseloop import run_each
 from flex.config.settings import pinned_overrides
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
@@ -31,7 +32,6 @@ from flex.experiments.models.ladder import (
     rung_scenes,
     simulate_model,
 )
-from flex.fidelity.caseloop import run_each
 from flex.study import StudyRun, Summary
 
 NAME = "ladder"

@@ -439,22 +439,22 @@ REFINED = [  # (term, the user's setting, knob, what refinement would set)
 
 @pytest.mark.parametrize("term, given, knob, would", REFINED, ids=[r[0] for r in REFINED])
 def test_refinement_never_changes_a_value_the_user_set(term, given, knob, would):
-    from flex.fidelity.simulation import KNOBS, _refined, free_knobs
+    from flex.fidelity.refinement import KNOBS, free_knobs, refined_change
 
     base = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.modes=2",
             "coupler.mesh_size_m=0.002", "simulation.step_s=0.0001"]
     scene = load_scene(overrides=[*base, given])
     free = free_knobs(load_scene(overrides=['coupler.geometry="plate"', given]))
     assert knob not in free and free < frozenset(KNOBS)
-    change, why = _refined(scene, term, BUILTIN_LINK_MODELS, free)
+    change, why = refined_change(scene, term, BUILTIN_LINK_MODELS, free)
     assert change is None, change
     assert knob in why and "set in the scene" in why and would.split("=")[0] in why
-    change, _ = _refined(scene, term, BUILTIN_LINK_MODELS)
+    change, _ = refined_change(scene, term, BUILTIN_LINK_MODELS)
     assert change is not None and any(item.startswith(knob) for item in change)
 
 
 def test_knobs_left_on_auto_or_default_are_free():
-    from flex.fidelity.simulation import KNOBS, free_knobs
+    from flex.fidelity.refinement import KNOBS, free_knobs
 
     assert free_knobs(load_scene()) == frozenset(KNOBS)
 

@@ -280,7 +280,7 @@ def test_case_hash_follows_the_criterion_of_auto_links(tmp_path):
 def test_run_each_on_an_executor_gives_the_serial_results_in_order():
     """A study's case loop on local processes (jobs grouped by a key, longest first) returns
     what it returns in this process, in the order of the scenes, and reports every case."""
-    from flex.fidelity.caseloop import run_each
+    from flex.base.caseloop import run_each
 
     scenes = {"a50": _rigid(50.0), "a30": _rigid(30.0), "a40": _rigid(40.0)}
     serial = run_each(scenes, simulate_scene_case)

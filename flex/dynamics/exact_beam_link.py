@@ -25,6 +25,14 @@ from flex.dynamics.link_outputs import flexible_datasets, flexible_sensors, sens
 #: 3e-7 (3.5e-7 at 8.6 ms); 1e-6 converged, and moved the 3 mm plate's deployment peak by
 #: 6e-6 of itself against 1e-7 at 64 elements (measured 2026-11-28)
 EXACT_BEAM_NEWTON_TOLERANCES = (1e-6, 1e-6)
+#: the element count up to which those tolerances hold; beyond it they grow with the square of
+#: the count (the round-off floor of the residual grows with the elements' axial stiffness):
+#: the 1 mm plate at h = 5e-6 s stalled at 256 elements with 1e-6 (1.18e-6 at 23.5 ms) and
+#: converged with 2e-6 and 4e-6 (the 3 mm plate: stalled with 1e-6 at 8.7 ms, converged with
+#: 4e-6), and at 512 elements with 4e-6 and 1.6e-5;
+#: 1.6e-5 against 4e-6 moved the 512-element deployment peak by 6e-6 of itself and its first
+#: crest by 2e-5 (measured 2026-12-06)
+EXACT_BEAM_NEWTON_ELEMENTS = 128
 
 
 #: wall time per step [s] of an exact beam link: (per link, per element). CPU time of a
@@ -111,15 +119,26 @@ def exact_beam_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
     return STEP_COST_EXACT_BEAM_S[0] + STEP_COST_EXACT_BEAM_S[1] * float(elements)
 
 
-def exact_beam_solver(settings: dict[str, Any]) -> None:
+def exact_beam_newton_tolerances(elements: int) -> tuple[float, float]:
+    """The Newton tolerances (relative, absolute) an exact beam link of ``elements`` needs:
+    :data:`EXACT_BEAM_NEWTON_TOLERANCES`, grown with the square of the count beyond
+    :data:`EXACT_BEAM_NEWTON_ELEMENTS`."""
+    growth = max(1.0, elements / EXACT_BEAM_NEWTON_ELEMENTS) ** 2
+    return (EXACT_BEAM_NEWTON_TOLERANCES[0] * growth, EXACT_BEAM_NEWTON_TOLERANCES[1] * growth)
+
+
+def exact_beam_solver(settings: dict[str, Any], values: dict[str, Any]) -> None:
+    """A sparse solver, and Newton tolerances no tighter than the link's elements allow
+    (:func:`exact_beam_newton_tolerances`)."""
     settings["linear_solver"] = "EigenSparse"
-    relative, absolute = EXACT_BEAM_NEWTON_TOLERANCES
+    elements = values["elements"] if values["elements"] != AUTO else EXACT_BEAM_ELEMENTS
+    relative, absolute = exact_beam_newton_tolerances(int(elements))
     settings["newton_relative_tolerance"] = max(settings["newton_relative_tolerance"],
                                                 relative)
     settings["newton_absolute_tolerance"] = max(settings["newton_absolute_tolerance"],
                                                 absolute)
 
 
-__all__ = ["EXACT_BEAM_NEWTON_TOLERANCES", "STEP_COST_EXACT_BEAM_S", "add_exact_beam",
-           "beam_elements", "exact_beam_datasets", "exact_beam_sensors", "exact_beam_solver",
-           "exact_beam_step_cost_s", "prepare_beam"]
+__all__ = ["EXACT_BEAM_NEWTON_ELEMENTS", "EXACT_BEAM_NEWTON_TOLERANCES", "STEP_COST_EXACT_BEAM_S",
+           "add_exact_beam", "beam_elements", "exact_beam_datasets", "exact_beam_newton_tolerances",
+           "exact_beam_sensors", "exact_beam_solver", "exact_beam_step_cost_s", "prepare_beam"]

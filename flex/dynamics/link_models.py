@@ -50,8 +50,9 @@ The contract of an entry -- what a link model declares, point by point:
    first bending mode of a nonlinear FE plate), which the step advice must resolve
    (:func:`flex.dynamics.advice.time_scales`); ``step_cost_s(values, modes)``: its share of
    the wall time per integration step [s] (:func:`flex.dynamics.runtime.estimated_run_time_s`).
-8. **solver adjustments**: ``adjust_solver(settings)`` changes the integrator settings in
-   place (a sparse solver, a looser absolute tolerance); ``own_progress``: the model prints
+8. **solver adjustments**: ``adjust_solver(settings, values)`` changes the integrator
+   settings in place for a link of scene ``values`` (a sparse solver, a looser absolute
+   tolerance, a Newton tolerance that follows the element count); ``own_progress``: the model prints
    its own progress during a solve.
 9. **its rung on the ladder**: ``rung(values)`` -> a :class:`flex.config.ladder.Rung` (or
    None: on no rung): what bounds its model error against the rung above, what that leaves
@@ -184,8 +185,8 @@ class LinkModel(LinkSchema):
     #: ``step_cost_s(values, modes)`` [s per step]
     time_scale: Callable[[str, dict[str, Any], Any], tuple[float, str] | None] = _nothing
     step_cost_s: Callable[[dict[str, Any], int | None], float] = _free
-    #: (8) ``adjust_solver(settings)`` in place; prints its own progress
-    adjust_solver: Callable[[dict[str, Any]], None] = _nothing
+    #: (8) ``adjust_solver(settings, values)`` in place; prints its own progress
+    adjust_solver: Callable[[dict[str, Any], dict[str, Any]], None] = _nothing
     own_progress: bool = False
     #: (9) its rung on the model ladder for a link's scene values (:mod:`flex.dynamics.
     #: ladder`), or None: a model on no rung (its budget then says its model error is left out)
@@ -436,7 +437,7 @@ def _nonlinear_fe_step_cost_s(values: dict[str, Any], modes: int | None) -> floa
     return STEP_COST_NONLINEAR_FE_PER_DOF_S * dof
 
 
-def _nonlinear_fe_solver(settings: dict[str, Any]) -> None:
+def _nonlinear_fe_solver(settings: dict[str, Any], values: dict[str, Any]) -> None:
     settings.update(NONLINEAR_FE_SOLVER)
     settings["newton_absolute_tolerance"] = max(settings["newton_absolute_tolerance"],
                                                 NONLINEAR_FE_NEWTON_ABSOLUTE_TOLERANCE)

@@ -104,8 +104,8 @@ def solver_settings(scene: Scene, link_models: Mapping[str, LinkModel] = BUILTIN
     if sim["newton"] == "jacobian_per_step":  # only then: other runs' stored settings stay
         settings["jacobian_per_step"] = True
     settings.update(_integrator_settings(sim))
-    for model in entries(scene, link_models).values():
-        model.adjust_solver(settings)
+    for link, model in entries(scene, link_models).items():
+        model.adjust_solver(settings, scene[link])
     return settings
 
 

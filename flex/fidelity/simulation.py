@@ -14,32 +14,36 @@ command line and :mod:`flex.api` pass the user's folder
 
 from __future__ import annotations
 
-import math
 import sys
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from flex.base.errors import FlexError, SceneError
+from flex.base.errors import FlexError, SceneError, SimulationError
 from flex.config.calibration import Calibration
-from flex.config.ladder import next_rung
 from flex.config.settings import tolerance_beyond_reach
 from flex.data.results import CaseResult
-from flex.data.scene import LINKS, SCHEMA, Scene, to_toml
-from flex.data.scene_edit import derive_scene
+from flex.data.scene import LINKS, Scene, to_toml
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.dynamics.solver import VALIDITY_WARNING, integrate, scene_reductions, time_scales
 from flex.fidelity.auto import Resolution, resolve
 from flex.fidelity.error_budget import STEP_BOUNDS_ATTR, error_budget, named_quantities
 from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 from flex.fidelity.laws import Criterion
-
-#: the most elements a beam link's refinement gives it (the scene key's maximum)
-MAX_ELEMENTS = SCHEMA["coupler"]["elements"].maximum
+from flex.fidelity.refinement import (
+    KNOBS,
+    MAX_ATTEMPTS,
+    NOTHING_TO_REFINE,
+    Step,
+    free_knobs,
+    next_attempt,
+    observed_fall,
+    settings_text,
+)
 
 
 def simulate(scene: Scene, name: str = "case", reduction: Any = None,
@@ -176,58 +180,31 @@ def _warn_unresolved_drive(result: CaseResult, scales: list[tuple[float, float, 
             filter(None, [str(result.attrs.get(VALIDITY_WARNING, "")), text]))
 
 
-#: most attempts of :func:`refine` (each one a run with its whole error budget)
-MAX_ATTEMPTS = 6
-#: :func:`refine`'s status of a run with no quantity it certifies
-NOTHING_TO_REFINE = ("nothing to refine: no flexible link's deflection to certify (the "
-                     "tolerance bounds a flexible link's own deflection; every link is rigid)")
-
-
-#: the knobs refinement turns: scene keys (``<link>.`` ones for each link)
-KNOBS = ("simulation.step_s", "coupler.model", "crank.modes", "coupler.modes",
-         "crank.mesh_size_m", "coupler.mesh_size_m", "crank.elements", "coupler.elements")
-
-
-def free_knobs(scene: Scene) -> frozenset[str]:
-    """The knobs (:data:`KNOBS`) of ``scene`` as the user gave it (before ``"auto"`` is
-    resolved) that refinement may turn: those left on ``"auto"`` or on the bundled
-    scene's value. A value the user set is never changed."""
-    from flex.data.scene import default_scene
-
-    bundled = default_scene()
-    out = set()
-    for knob in KNOBS:
-        section, key = knob.split(".")
-        value = scene[section][key]
-        if value == "auto" or value == bundled[section][key]:
-            out.add(knob)
-    return frozenset(out)
-
-
 def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None = None,
            link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
            headlines: Mapping[str, Headline] = BUILTIN_HEADLINES,
            free: frozenset[str] = frozenset(KNOBS)) -> CaseResult:
     """``fidelity.refine``: run the resolved scene with its error budget; while a certified
     quantity (a headline whose entry says ``certified``: each flexible link's peak
-    deflection and first crest, docs/criterion.md) has a total estimated error above
-    ``fidelity.tolerance`` relative to itself, refine the knob whose term dominates it (the
-    step halved, the modes of the modal links raised as the modes companion's, the mesh of
-    the meshed links halved, a link climbed to the next rung of the ladder,
-    :func:`flex.config.ladder.next_rung`) and run again, until every one meets
-    it, the next run's estimated cost (:func:`_attempt_cost_s`) would pass
-    ``fidelity.refine_limit_s`` [s], :data:`MAX_ATTEMPTS` runs are made or no knob can move.
-    Returns the last run, with ``refine_status`` (``met``, or why not),
-    ``refine_attempts`` (one line per run: its settings, the worst quantity, what changed
-    and why) and ``refine_wall_time_s``; a run that did not meet the tolerance says so in
-    one stderr line. The companion runs are kept across attempts: the next attempt's run is
-    the last one's finer companion where its settings are that companion's (the step halved,
-    the modes raised, the mesh halved; its attempt line says so), and a companion made once
-    is not made again. A quantity flagged outside the asymptotic
-    range (its step term a bound) is not chased: when only such quantities miss the
-    tolerance it stops and names them. ``free``: the knobs it may turn
-    (:func:`free_knobs`); one the user set that blocks the tolerance stops it, and the status
-    says which value and what refinement would make of it."""
+    deflection and first crest, docs/criterion.md) has a certified error above
+    ``fidelity.tolerance`` relative to itself, turn the knob predicted to remove the most of
+    its certificate per second of cost (:func:`flex.fidelity.refinement.next_attempt`: the
+    step halved, the modes of the modal links raised as the modes companion's, the mesh of the
+    meshed links halved, a link climbed to the next rung of the ladder; each term's fall as
+    observed when its knob was last turned) and run again, until every one meets it, the next
+    run's estimated cost would pass ``fidelity.refine_limit_s`` [s], :data:`MAX_ATTEMPTS`
+    runs are made or no knob can lower it. Returns the last run, with ``refine_status``
+    (``met``, or why not), ``refine_attempts`` (one line per run: its settings, the worst
+    quantity, what changed and why) and ``refine_wall_time_s``; a run that did not meet the
+    tolerance says so in one stderr line. The companion runs are kept across attempts: the
+    next attempt's run is the last one's finer companion where its settings are that
+    companion's (the step halved, the modes raised, the mesh halved; its attempt line says
+    so), and a companion made once is not made again. A quantity flagged outside the
+    asymptotic range (its step term a bound) is not chased: when only such quantities miss
+    the tolerance it stops and names them. ``free``: the knobs it may turn
+    (:func:`flex.fidelity.refinement.free_knobs`); when the terms of the values the user set
+    keep the certificate above the tolerance it stops, and the status says which value and
+    what refinement would make of it."""
     from flex.fidelity.error_budget import budget_rows
 
     if not resolution.scene["simulation"]["error_estimate"]:
@@ -238,84 +215,42 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     tolerance = float(resolution.scene["fidelity"]["tolerance"])
     current = resolution
     made: dict[str, CaseResult] = {}  # every companion run so far, by its scene
+    falls: dict[str, float] = {}  # each term's fall, observed when its knob was last turned
+    last: tuple[Step, dict[str, Any], CaseResult] | None = None  # the last attempt
     for attempt in range(1, MAX_ATTEMPTS + 1):
         reused = companion_key(current.scene) in made
-        result = simulate_resolved(current, name, cache_dir=cache_dir, link_models=link_models,
-                                   headlines=headlines, companions=made)
-        rows = [row for row in budget_rows(result.attrs)
-                if row.quantity in headlines and headlines[row.quantity].certified]
-        step = _next_attempt(current.scene, rows, tolerance, attempt,
-                             time.perf_counter() - start, link_models, free,
-                             named_quantities(result.attrs, STEP_BOUNDS_ATTR))
-        lines.append(f"{attempt}: {_settings_text(current.scene, link_models)}"
+        try:
+            result = simulate_resolved(current, name, cache_dir=cache_dir,
+                                       link_models=link_models, headlines=headlines,
+                                       companions=made)
+        except SimulationError as failed:  # a diverging attempt: the last one stays
+            if last is None:  # the first guess itself: nothing to keep
+                raise
+            step = Step(None, f"the next attempt failed ({failed}); the last run is kept",
+                        f"failed: {failed}")
+            lines.append(f"{attempt}: {settings_text(current.scene, link_models)}: "
+                         f"{step.line}")
+            result = last[2]
+            break
+        rows = {row.quantity: row for row in budget_rows(result.attrs)
+                if row.quantity in headlines and headlines[row.quantity].certified}
+        if last is not None:  # the term whose knob the last attempt turned, on its worst
+            fall = observed_fall(last[1].get(last[0].worst), rows.get(last[0].worst),
+                                 last[0].term)
+            falls.update({last[0].term: fall} if fall is not None else {})
+        step = next_attempt(current.scene, list(rows.values()), tolerance, attempt,
+                            time.perf_counter() - start, link_models, free,
+                            named_quantities(result.attrs, STEP_BOUNDS_ATTR), falls)
+        lines.append(f"{attempt}: {settings_text(current.scene, link_models)}"
                      f"{' (the last companion at these settings, reused)' if reused else ''}: "
                      f"{step.line}")
         if step.refined is None:
             break
-        current = replace(current, scene=step.refined)
+        current, last = replace(current, scene=step.refined), (step, rows, result)
     result.attrs.update({"refine_status": step.status, "refine_attempts": "\n".join(lines),
                          "refine_wall_time_s": time.perf_counter() - start})
     _say_status(name, step.status, tolerance)
     return result
-
-
-@dataclass(frozen=True)
-class _Step:
-    """What :func:`refine` does after an attempt: the next scene (None: stop, with
-    ``status``), and the attempt's line after its settings."""
-
-    refined: Scene | None
-    status: str
-    line: str
-
-
-def _next_attempt(scene: Scene, rows: list[Any], tolerance: float, attempt: int,
-                  spent_s: float, link_models: Mapping[str, LinkModel],
-                  free: frozenset[str], flagged: frozenset[str] = frozenset()) -> _Step:
-    """After attempt ``attempt`` (its certified budget ``rows``, ``spent_s`` [s] so far): the
-    tolerance met, nothing to certify, or the knob of the worst quantity's dominant term
-    turned, unless it cannot move, is refused, or would pass the cost limit. A quantity in
-    ``flagged`` (outside the asymptotic range: its step term a bound that need not shrink
-    with the step) is not chased: when only such quantities miss the tolerance, refinement
-    stops and names them."""
-    if not rows:
-        return _Step(None, NOTHING_TO_REFINE, NOTHING_TO_REFINE)
-    missing = [row for row in rows if not row.certified_relative <= tolerance]
-    if missing and all(row.quantity in flagged for row in missing):
-        status = ("not chased: " + "; ".join(
-            f"{row.what} certified to {100 * row.certified_relative:.3g} % is outside the "
-            f"asymptotic range (its step term a bound: the observed order left the window)"
-            for row in missing) + f" (tolerance {100 * tolerance:g} %)")
-        return _Step(None, status, f"stopped: {status}")
-    chased = [row for row in rows if row.quantity not in flagged] or rows
-    worst = max(chased, key=lambda row: row.certified_relative
-                if row.certified_relative >= 0 else math.inf)
-    found = (f"{worst.what} certified to {100 * worst.certified_relative:.3g} % of itself "
-             f"(estimate {100 * worst.relative:.3g} %; tolerance {100 * tolerance:g} %)"
-             if not worst.problem else
-             f"{worst.what} {worst.problem} (tolerance {100 * tolerance:g} %)")
-    if all(row.certified_relative <= tolerance for row in rows):
-        return _Step(None, "met", f"met; worst {found}")
-    term = max(worst.terms, key=lambda key: worst.terms[key] if worst.terms[key] >= 0
-               else math.inf)  # an unknown term (its companion failed) first
-    change, why = _refined(scene, term, link_models, free)
-    limit = scene["fidelity"]["refine_limit_s"]
-    if change is None or spent_s > limit or attempt == MAX_ATTEMPTS:
-        status = (why if change is None else
-                  f"cost limit ({spent_s:.0f} s of fidelity.refine_limit_s = {limit:g} s)"
-                  if attempt < MAX_ATTEMPTS else f"{MAX_ATTEMPTS} runs made")
-        return _Step(None, status, f"{found}, {term} term dominant; stopped: {status}")
-    try:  # validated as --set is: a mesh too fine for this machine stops here
-        refined = derive_scene(scene, change, link_models=link_models)
-    except SceneError as refused:
-        status = f"{why}: refused: {refused}"
-        return _Step(None, status, f"{found}; stopped: {status}")
-    cost_s = _attempt_cost_s(refined, link_models)
-    if spent_s + cost_s > limit:
-        status = (f"cost limit: {why} would take ~{cost_s:.3g} s with its budget (estimate), "
-                  f"beyond fidelity.refine_limit_s = {limit:g} s after {spent_s:.3g} s")
-        return _Step(None, status, f"{found}; stopped: {status}")
-    return _Step(refined, "", f"{found}, {term} term dominant -> {why}")
 
 
 def _say_status(name: str, status: str, tolerance: float) -> None:
@@ -348,101 +283,6 @@ def _rigid_predictions(scene: Scene, result: CaseResult,
     end = deployment_end(result.datasets)
     window_end_s = np.inf if end is None else float(series["time"][end])
     return rigid_link_predictions(scene, series, rigid, window_end_s)
-
-
-#: runs of an attempt's error budget, in run-equivalents (a companion at h / 2, more modes, a
-#: coarser mesh, the rung above; rough: the coarser ones cost less, one at h / 4 more)
-BUDGET_RUNS = 5.0
-
-
-def _attempt_cost_s(scene: Scene, link_models: Mapping[str, LinkModel]) -> float:
-    """Rough wall time [s] of one attempt on ``scene``: the run and its budget's companions
-    (:data:`BUDGET_RUNS`), plus meshing and reducing each meshed link at its mesh, twice
-    (the run's reduction and the modes companion's), as flex estimates them before meshing."""
-    from flex.data.plates import estimate_mesh
-    from flex.dynamics.runtime import estimated_run_time_s
-    from flex.fidelity.error_budget import richer_modes
-
-    cost = (1.0 + BUDGET_RUNS) * estimated_run_time_s(scene, link_models=link_models)
-    for link in LINKS:
-        values, entry = scene[link], link_models[scene[link]["model"]]
-        if entry.meshed:
-            modes = values["modes"] if entry.modal else None
-            plate = (values["length_m"], values["thickness_m"], values["width_m"],
-                     values["mesh_size_m"])
-            cost += estimate_mesh(*plate, modes).build_time_s
-            if entry.modal:
-                cost += estimate_mesh(*plate, richer_modes(modes)).build_time_s
-    return cost
-
-
-def _settings_text(scene: Scene, link_models: Mapping[str, LinkModel]) -> str:
-    parts = [f"step {scene['simulation']['step_s']:g} s"]
-    for link in LINKS:
-        values = scene[link]
-        entry = link_models[values["model"]]
-        if entry.meshed:
-            modes = f", {values['modes']} modes" if entry.modal else ""
-            parts.append(f"{link} {values['model']}{modes}, mesh {values['mesh_size_m']:g} m")
-        elif entry.beam:
-            parts.append(f"{link} {values['model']}, {values['elements']} elements")
-    return "; ".join(parts)
-
-
-def _refined(scene: Scene, term: str, link_models: Mapping[str, LinkModel],
-             free: frozenset[str] = frozenset(KNOBS)) -> tuple[list[str] | None, str]:
-    """The overrides that refine the knob of ``term`` (step, modes, mesh, model) and what
-    they do; (None, why not) when it cannot move, or when it would change a value the user
-    set (not in ``free``): then why says which value and what it would take."""
-    change, why = _refined_any(scene, term, link_models)
-    set_by_user = [item for item in change or [] if item.split("=")[0] not in free]
-    if not set_by_user:
-        return change, why
-    keys = ", ".join(f"{item.split('=')[0]} = {_value(scene, item.split('=')[0])}"
-                     for item in set_by_user)
-    return None, (f"the {term} term dominates and {keys} was set in the scene (refinement "
-                  f"changes only \"auto\" or default values): it would take "
-                  f"{', '.join(set_by_user)} ({why})")
-
-
-def _value(scene: Scene, knob: str) -> Any:
-    section, key = knob.split(".")
-    return scene[section][key]
-
-
-def _refined_any(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
-                 ) -> tuple[list[str] | None, str]:
-    """:func:`_refined` with every knob free."""
-    from flex.fidelity.error_budget import richer_modes
-
-    links = {link: link_models[scene[link]["model"]] for link in LINKS}
-    if term == "step":
-        step = scene["simulation"]["step_s"] / 2
-        return [f"simulation.step_s={step!r}"], f"step halved to {step:g} s"
-    if term == "modes":
-        modal = [link for link, entry in links.items() if entry.modal
-                 and richer_modes(scene[link]["modes"]) <= 100]
-        return ([f"{link}.modes={richer_modes(scene[link]['modes'])}" for link in modal] or None,
-                "modes raised (" + ", ".join(f"{link} {scene[link]['modes']} -> "
-                                             f"{richer_modes(scene[link]['modes'])}"
-                                             for link in modal) + ")"
-                if modal else "the modes term dominates and no link can take more modes")
-    if term == "mesh":
-        meshed = [link for link, entry in links.items() if entry.meshed]
-        beams = [link for link, entry in links.items()  # a beam's elements: doubled
-                 if entry.beam and 2 * int(scene[link]["elements"]) <= MAX_ELEMENTS]
-        return ([f"{link}.mesh_size_m={scene[link]['mesh_size_m'] / 2!r}" for link in meshed]
-                + [f"{link}.elements={2 * int(scene[link]['elements'])}" for link in beams]
-                or None, "mesh halved (" + ", ".join(meshed) + ")" if meshed and not beams
-                else "mesh refined (" + ", ".join(meshed + [f"{link} elements doubled"
-                                                            for link in beams]) + ")"
-                if beams else "the mesh term dominates and no link is meshed")
-    for link in ("coupler", "crank"):
-        higher = next_rung(link, scene[link], link_models)
-        if higher is not None:
-            return ([f'{link}.model="{higher}"'],
-                    f"{link} climbed to the {link_models[higher].label} rung")
-    return None, "the model term dominates and no link has a higher rung"
 
 
 def simulate_case(scene: Scene, name: str = "case", reduction: Any = None,

@@ -23,13 +23,13 @@ from typing import Any
 
 import numpy as np
 
+from flex.base.caseloop import run_each
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
 from flex.experiments.fitting import lawfit
 from flex.experiments.fitting.lawfit import REPORT_TOLERANCES, Validation, case_data
 from flex.fidelity.auto import crank_elastic_omega
-from flex.fidelity.caseloop import run_each
 from flex.fidelity.criteria import (
     DELTA_T_DEFINITIONS,
     GOVERNING,
@@ -82,7 +82,7 @@ def same_crank(name: str, scene: Scene) -> float:
 
 def _omega_case(name: str, scene: Scene, *, cache_dir: Path | None = None) -> float:
     """:func:`crank_elastic_omega` as a case function of
-    :func:`flex.fidelity.caseloop.run_each` [rad/s]."""
+    :func:`flex.base.caseloop.run_each` [rad/s]."""
     return crank_elastic_omega(scene, cache_dir=cache_dir)
 
 

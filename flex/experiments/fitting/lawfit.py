@@ -34,10 +34,10 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from flex.base.caseloop import run_each
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.dynamics.link_models import FFRF
-from flex.fidelity.caseloop import run_each
 from flex.fidelity.criteria import GOVERNING, PRIMARY_DELTA_T
 from flex.fidelity.laws import Criterion, ErrorLaw, fit_error_law
 
@@ -98,7 +98,7 @@ class CaseRunner(Protocol):
 def law_case(name: str, scene: Scene, *, link: str, criterion_text: str | None, source: str,
              cache_dir: Path | None = None) -> CaseResult:
     """:func:`simulate_with_law` as a case function ``(name, scene)`` (for
-    :func:`flex.fidelity.caseloop.run_each`; picklable as a ``functools.partial``)."""
+    :func:`flex.base.caseloop.run_each`; picklable as a ``functools.partial``)."""
     return simulate_with_law(scene, name, link, criterion_text, source, cache_dir=cache_dir)
 
 
@@ -106,7 +106,7 @@ def law_case(name: str, scene: Scene, *, link: str, criterion_text: str | None, 
 class SerialRunner:
     """Every case in this process, one after the other (:func:`simulate_with_law`), or,
     given an ``executor`` (:mod:`flex.sweep`'s, passed in and closed by :meth:`close`), in
-    parallel jobs of :func:`flex.fidelity.caseloop.run_each`: the cases of one ``group`` key
+    parallel jobs of :func:`flex.base.caseloop.run_each`: the cases of one ``group`` key
     (``group(name, scene)``, e.g. those sharing a reduction) one after the other in one job;
     the results are the same. ``progress(case, done, total)`` counts over both phases;
     ``cache_dir``: the reduction cache folder (None: built in memory, no disk cache)."""

@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from flex.base.caseloop import Progress, run_each
 from flex.base.errors import FlexError
 from flex.base.kinematics import constant_speed_motion
 from flex.base.physics import Plate, pinned_pinned_omega
@@ -52,7 +53,6 @@ from flex.experiments.workprecision.measurement import (
     Setting,
     nonlinear_available,
 )
-from flex.fidelity.caseloop import Progress, run_each
 from flex.fidelity.simulation import simulate_case
 from flex.fidelity.softening import coupler_compression_N
 

@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+from flex.base.caseloop import run_each
 from flex.base.kinematics import constant_speed_motion
 from flex.base.physics import euler_buckling_load_N, pinned_pinned_omega
 from flex.data.results import CaseResult, Dataset
@@ -56,7 +57,6 @@ from flex.dynamics.ivp_crank import (
     CrankBenchmark,
     CrankSolution,
 )
-from flex.fidelity.caseloop import run_each
 
 BENCH = CrankBenchmark()
 #: the published components compared, index into PUBLISHED_AT_0P1S, and unit
@@ -148,7 +148,7 @@ def two_mode_runs(runs: dict[str, tuple[int, int, float, str, str, float]] | Non
                   executor: Any = None) -> dict[str, CrankSolution]:
     """The independent model's runs (:data:`TWO_MODE_RUNS` by default), 5-140 s each (axial
     bubbles make the explicit integration stiff: ~0.9 M evaluations); ``progress(name, done,
-    total)`` as :func:`flex.fidelity.caseloop.run_each` reports; on ``executor`` (one of
+    total)`` as :func:`flex.base.caseloop.run_each` reports; on ``executor`` (one of
     :mod:`flex.sweep`'s) in parallel."""
     def told(name: str, done: int, total: int) -> None:
         if progress:

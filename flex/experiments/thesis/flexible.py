@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 
+from flex.base.caseloop import Progress, run_each
 from flex.base.physics import Plate, n_values
 from flex.base.plotting import MICRO, figure, legend_below, panels
 from flex.bodies.nonlinear import nonlinear_plate_for_scene
@@ -37,7 +38,6 @@ from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, NONLINEAR_FE, RIGID
 from flex.dynamics.solver import reduction_for_scene
-from flex.fidelity.caseloop import Progress, run_each
 from flex.fidelity.error_budget import budget_rows
 from flex.fidelity.simulation import simulate_case
 from flex.fidelity.softening import compare_with_reference

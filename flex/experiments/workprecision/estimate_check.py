@@ -37,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from flex.base.caseloop import run_each
 from flex.base.plotting import figure
 from flex.config.settings import resolve_solver_settings
 from flex.data.plates import is_damped
@@ -45,7 +46,6 @@ from flex.data.scene import LINKS, Scene
 from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, NONLINEAR_FE
-from flex.fidelity.caseloop import run_each
 from flex.fidelity.error_budget import CERTIFICATE_ATTR, STEP_BOUNDS_ATTR, named_quantities
 from flex.fidelity.error_estimate import PREFIX, integrator_order, richardson_error
 from flex.fidelity.headlines import BUILTIN_HEADLINES

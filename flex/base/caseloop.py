@@ -17,7 +17,8 @@ from __future__ import annotations
 from collections.abc import Callable, Hashable
 from typing import Any
 
-from flex.data.scene import Scene
+#: a scene (flex.data.scene.Scene; this module sits below it): sections of keys and values
+Scene = dict[str, dict[str, Any]]
 
 Progress = Callable[[str, int, int], None]
 

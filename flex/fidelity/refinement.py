@@ -1,0 +1,306 @@
+"""What refinement does after each attempt: the tolerance met, or the next knob to turn.
+
+:func:`flex.fidelity.simulation.refine` runs a resolved scene with its error budget, then asks
+:func:`next_attempt` what to do. Contract of :func:`next_attempt`: given the attempt's scene, its
+certified budget rows (:class:`flex.fidelity.error_budget.BudgetRow`), the tolerance and what
+refinement has observed so far, it returns a :class:`Step`: stop (met, nothing to certify, a
+quantity outside the asymptotic range only, a value the user set that blocks, the cost limit)
+or the next scene. The knob it turns is the one whose term is predicted to lower the worst
+certified quantity's certificate the most per second of added cost:
+
+- each term's knob (:func:`refined_change`: the step halved, the modes raised as the modes
+  companion's, the mesh halved or a beam's elements doubled, a link climbed to the next rung)
+  is predicted to divide its term by its *fall*: the one refinement observed when it last
+  turned that knob (the term before over the term after, on the same quantity), or until then
+  :data:`PRIOR_FALL`; a rung climb is predicted to remove its term;
+- its cost is :func:`attempt_cost_s` of the next scene minus this one's [s] (flex's own
+  estimates of run and meshing time, before anything runs);
+- a term whose knob did not make it fall (observed fall at most 1) is not chased again;
+- the terms whose knobs cannot move (a value the user set, a limit) stay: when they alone
+  keep the certificate above the tolerance, refinement stops and says which value and what it
+  would take.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from flex.base.errors import SceneError
+from flex.config.ladder import next_rung
+from flex.config.settings import resolve_solver_settings
+from flex.data.plates import estimate_mesh
+from flex.data.scene import LINKS, SCHEMA, Scene, default_scene
+from flex.data.scene_edit import derive_scene
+from flex.dynamics.link_models import LinkModel
+from flex.dynamics.runtime import estimated_run_time_s
+from flex.fidelity.error_budget import BudgetRow, combined, richer_modes
+
+#: the most elements a beam link's refinement gives it (the scene key's maximum)
+MAX_ELEMENTS = SCHEMA["coupler"]["elements"].maximum
+
+#: most attempts of a refinement (each one a run with its whole error budget)
+MAX_ATTEMPTS = 6
+#: refinement's status of a run with no quantity it certifies
+NOTHING_TO_REFINE = ("nothing to refine: no flexible link's deflection to certify (the "
+                     "tolerance bounds a flexible link's own deflection; every link is rigid)")
+
+
+#: the knobs refinement turns: scene keys (``<link>.`` ones for each link)
+KNOBS = ("simulation.step_s", "coupler.model", "crank.modes", "coupler.modes",
+         "crank.mesh_size_m", "coupler.mesh_size_m", "crank.elements", "coupler.elements")
+
+
+def free_knobs(scene: Scene) -> frozenset[str]:
+    """The knobs (:data:`KNOBS`) of ``scene`` as the user gave it (before ``"auto"`` is
+    resolved) that refinement may turn: those left on ``"auto"`` or on the bundled
+    scene's value. A value the user set is never changed."""
+    bundled = default_scene()
+    out = set()
+    for knob in KNOBS:
+        section, key = knob.split(".")
+        value = scene[section][key]
+        if value == "auto" or value == bundled[section][key]:
+            out.add(knob)
+    return frozenset(out)
+
+
+
+#: how many times a term is predicted to shrink when its knob is turned once, until refinement
+#: has observed it on the run: the step halved at the integrator's order 2 (generalized-alpha);
+#: the mesh halved at the certified deflections' mesh order 2, or a beam's elements doubled
+#: at its order 2 (:data:`flex.fidelity.error_budget.BEAM_ORDER`); the modes raised as the
+#: modes companion's: taken alike (modal convergence is faster on the plates measured); a rung
+#: climbed: its term is predicted gone (the rung above's own term is not known before it runs)
+PRIOR_FALL = {"step": 4.0, "modes": 4.0, "mesh": 4.0, "model": math.inf}
+
+
+@dataclass(frozen=True)
+class Step:
+    """What refinement does after an attempt: the next scene (None: stop, with ``status``),
+    the attempt's line after its settings, the term whose knob it turned and the quantity it
+    turned it for ("" if none)."""
+
+    refined: Scene | None
+    status: str
+    line: str
+    term: str = ""
+    worst: str = ""
+
+
+@dataclass(frozen=True)
+class _Move:
+    """A knob refinement may turn: its term, the next scene, what it does, the worst
+    quantity's certificate predicted after it [fraction of the quantity] and the next
+    attempt's estimated cost [s]."""
+
+    term: str
+    scene: Scene
+    why: str
+    predicted: float
+    cost_s: float
+
+
+def observed_fall(before: BudgetRow | None, after: BudgetRow | None, term: str) -> float | None:
+    """How many times ``term`` shrank on one quantity from the attempt ``before`` to the one
+    ``after`` it, where its knob was turned (None: not measurable, a term zero or unknown)."""
+    if before is None or after is None:
+        return None
+    old, new = before.terms.get(term, math.nan), after.terms.get(term, math.nan)
+    if not (math.isfinite(old) and math.isfinite(new)) or old <= 0.0:
+        return None
+    return math.inf if new <= 0.0 else old / new
+
+
+def next_attempt(scene: Scene, rows: list[BudgetRow], tolerance: float, attempt: int,
+                 spent_s: float, link_models: Mapping[str, LinkModel],
+                 free: frozenset[str], flagged: frozenset[str] = frozenset(),
+                 falls: Mapping[str, float] | None = None, limit_s: float | None = None,
+                 max_attempts: int = MAX_ATTEMPTS) -> Step:
+    """After attempt ``attempt`` (its certified budget ``rows``, ``spent_s`` [s] so far): the
+    tolerance met, nothing to certify, or the next scene (module doc). A quantity in
+    ``flagged`` (outside the asymptotic range: its step term a bound that need not shrink with
+    the step) is not chased: when only such quantities miss the tolerance, refinement stops
+    and names them. ``falls``: each term's fall observed so far (:func:`observed_fall`);
+    ``limit_s``: the cost limit [s] (None: the scene's ``fidelity.refine_limit_s``)."""
+    if not rows:
+        return Step(None, NOTHING_TO_REFINE, NOTHING_TO_REFINE)
+    missing = [row for row in rows if not row.certified_relative <= tolerance]
+    if missing and all(row.quantity in flagged for row in missing):
+        status = ("not chased: " + "; ".join(
+            f"{row.what} certified to {100 * row.certified_relative:.3g} % is outside the "
+            f"asymptotic range (its step term a bound: the observed order left the window)"
+            for row in missing) + f" (tolerance {100 * tolerance:g} %)")
+        return Step(None, status, f"stopped: {status}")
+    chased = [row for row in rows if row.quantity not in flagged] or rows
+    worst = max(chased, key=lambda row: row.certified_relative
+                if row.certified_relative >= 0 else math.inf)
+    found = (f"{worst.what} certified to {100 * worst.certified_relative:.3g} % of itself "
+             f"(estimate {100 * worst.relative:.3g} %; tolerance {100 * tolerance:g} %)"
+             if not worst.problem else
+             f"{worst.what} {worst.problem} (tolerance {100 * tolerance:g} %)")
+    if all(row.certified_relative <= tolerance for row in rows):
+        return Step(None, "met", f"met; worst {found}")
+    limit = float(scene["fidelity"]["refine_limit_s"] if limit_s is None else limit_s)
+    move, why_not = _best_move(scene, worst, tolerance, link_models, free, dict(falls or {}))
+    if move is None:
+        return Step(None, why_not, f"{found}; stopped: {why_not}")
+    if spent_s > limit or attempt >= max_attempts:
+        status = (f"cost limit ({spent_s:.0f} s of fidelity.refine_limit_s = {limit:g} s)"
+                  if attempt < max_attempts else f"{max_attempts} runs made")
+        return Step(None, status, f"{found}; stopped: {status}")
+    if spent_s + move.cost_s > limit:
+        status = (f"cost limit: {move.why} would take ~{move.cost_s:.3g} s with its budget "
+                  f"(estimate), beyond fidelity.refine_limit_s = {limit:g} s after "
+                  f"{spent_s:.3g} s")
+        return Step(None, status, f"{found}; stopped: {status}")
+    return Step(move.scene, "", f"{found} -> {move.why}: the {move.term} term's knob, "
+                f"predicted to leave {100 * move.predicted:.3g} % for ~{move.cost_s:.3g} s "
+                f"(the most certified error removed per second)", move.term, worst.quantity)
+
+
+def _best_move(scene: Scene, worst: BudgetRow, tolerance: float,
+               link_models: Mapping[str, LinkModel], free: frozenset[str],
+               falls: dict[str, float]) -> tuple[_Move | None, str]:
+    """The knob to turn for ``worst`` (module doc), or None and why none: an unknown term
+    (its companion failed) stops it; else the most predicted certificate removed per second
+    of added cost, unless the terms no knob can lower keep it above the tolerance."""
+    unknown = [term for term, value in worst.terms.items() if not value >= 0.0]
+    if unknown:  # turning its knob would run the very companion that failed
+        return None, (f"the {', '.join(unknown)} term of {worst.what} is unknown (its "
+                      f"companion run failed; estimated_error_unknown says why), and the "
+                      f"next attempt would be that companion")
+    moves, stuck = _moves(scene, worst, link_models, free, falls)
+    scale = (worst.certified_relative / worst.total if worst.total > 0 else 0.0)
+    floor = scale * combined(value for term, value in worst.terms.items()
+                             if term in dict(stuck))
+    if floor > tolerance or not moves:
+        term, why = max(stuck, key=lambda item: worst.terms[item[0]],
+                        default=("", "no knob can lower it"))
+        return None, why
+    base_s = attempt_cost_s(scene, link_models)
+    gains = [(worst.certified_relative - move.predicted)
+             / max(move.cost_s - base_s, 1e-3 * base_s, 1e-9) for move in moves]
+    best = max(range(len(moves)), key=gains.__getitem__)
+    if gains[best] <= 0.0:
+        return None, "no knob is predicted to lower it (the terms did not fall when turned)"
+    return moves[best], ""
+
+
+def _moves(scene: Scene, worst: BudgetRow, link_models: Mapping[str, LinkModel],
+           free: frozenset[str], falls: dict[str, float]
+           ) -> tuple[list[_Move], list[tuple[str, str]]]:
+    """The knobs that can turn for ``worst``'s nonzero terms, with their predictions; and
+    the terms that cannot move, with why."""
+    moves, stuck = [], []
+    scale = worst.certified_relative / worst.total if worst.total > 0 else 0.0
+    for term in [term for term, value in worst.terms.items() if value > 0.0]:
+        change, why = refined_change(scene, term, link_models, free)
+        if change is None:
+            stuck.append((term, why))
+            continue
+        try:  # validated as --set is: a mesh too fine for this machine stops here
+            refined = derive_scene(scene, change, link_models=link_models)
+            refined, _ = resolve_solver_settings(refined, link_models=link_models)
+        except SceneError as refused:
+            stuck.append((term, f"{why}: refused: {refused}"))
+            continue
+        left = {**worst.terms, term: worst.terms[term] / falls.get(term, PRIOR_FALL[term])}
+        predicted = scale * combined(left.values()) if math.isfinite(scale) else math.nan
+        moves.append(_Move(term, refined, why, predicted, attempt_cost_s(refined, link_models)))
+    return moves, stuck
+
+
+#: runs of an attempt's error budget, in run-equivalents (a companion at h / 2, more modes, a
+#: coarser mesh, the rung above; rough: the coarser ones cost less, one at h / 4 more)
+BUDGET_RUNS = 5.0
+
+
+def attempt_cost_s(scene: Scene, link_models: Mapping[str, LinkModel]) -> float:
+    """Rough wall time [s] of one attempt on ``scene``: the run and its budget's companions
+    (:data:`BUDGET_RUNS`), plus meshing and reducing each meshed link at its mesh, twice
+    (the run's reduction and the modes companion's), as flex estimates them before meshing."""
+    cost = (1.0 + BUDGET_RUNS) * estimated_run_time_s(scene, link_models=link_models)
+    for link in LINKS:
+        values, entry = scene[link], link_models[scene[link]["model"]]
+        if entry.meshed:
+            modes = values["modes"] if entry.modal else None
+            plate = (values["length_m"], values["thickness_m"], values["width_m"],
+                     values["mesh_size_m"])
+            cost += estimate_mesh(*plate, modes).build_time_s
+            if entry.modal:
+                cost += estimate_mesh(*plate, richer_modes(modes)).build_time_s
+    return cost
+
+
+def settings_text(scene: Scene, link_models: Mapping[str, LinkModel]) -> str:
+    """An attempt's settings in a few words: its step, and each meshed or beam link's model,
+    modes, mesh or elements."""
+    parts = [f"step {scene['simulation']['step_s']:g} s"]
+    for link in LINKS:
+        values = scene[link]
+        entry = link_models[values["model"]]
+        if entry.meshed:
+            modes = f", {values['modes']} modes" if entry.modal else ""
+            parts.append(f"{link} {values['model']}{modes}, mesh {values['mesh_size_m']:g} m")
+        elif entry.beam:
+            parts.append(f"{link} {values['model']}, {values['elements']} elements")
+    return "; ".join(parts)
+
+
+def refined_change(scene: Scene, term: str, link_models: Mapping[str, LinkModel],
+                   free: frozenset[str] = frozenset(KNOBS)) -> tuple[list[str] | None, str]:
+    """The overrides that refine the knob of ``term`` (step, modes, mesh, model) and what
+    they do; (None, why not) when it cannot move, or when it would change a value the user
+    set (not in ``free``): then why says which value and what it would take."""
+    change, why = _refined_any(scene, term, link_models)
+    set_by_user = [item for item in change or [] if item.split("=")[0] not in free]
+    if not set_by_user:
+        return change, why
+    keys = ", ".join(f"{item.split('=')[0]} = {_value(scene, item.split('=')[0])}"
+                     for item in set_by_user)
+    return None, (f"the {term} term's knob {keys} was set in the scene (refinement changes "
+                  f"only \"auto\" or default values): lowering it would take "
+                  f"{', '.join(set_by_user)} ({why})")
+
+
+def _value(scene: Scene, knob: str) -> Any:
+    section, key = knob.split(".")
+    return scene[section][key]
+
+
+def _refined_any(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
+                 ) -> tuple[list[str] | None, str]:
+    """:func:`_refined` with every knob free."""
+    links = {link: link_models[scene[link]["model"]] for link in LINKS}
+    if term == "step":
+        step = scene["simulation"]["step_s"] / 2
+        return [f"simulation.step_s={step!r}"], f"step halved to {step:g} s"
+    if term == "modes":
+        modal = [link for link, entry in links.items() if entry.modal
+                 and richer_modes(scene[link]["modes"]) <= 100]
+        return ([f"{link}.modes={richer_modes(scene[link]['modes'])}" for link in modal] or None,
+                "modes raised (" + ", ".join(f"{link} {scene[link]['modes']} -> "
+                                             f"{richer_modes(scene[link]['modes'])}"
+                                             for link in modal) + ")"
+                if modal else "the modes term dominates and no link can take more modes")
+    if term == "mesh":
+        meshed = [link for link, entry in links.items() if entry.meshed]
+        beams = [link for link, entry in links.items()  # a beam's elements: doubled
+                 if entry.beam and 2 * int(scene[link]["elements"]) <= MAX_ELEMENTS]
+        return ([f"{link}.mesh_size_m={scene[link]['mesh_size_m'] / 2!r}" for link in meshed]
+                + [f"{link}.elements={2 * int(scene[link]['elements'])}" for link in beams]
+                or None, "mesh halved (" + ", ".join(meshed) + ")" if meshed and not beams
+                else "mesh refined (" + ", ".join(meshed + [f"{link} elements doubled"
+                                                            for link in beams]) + ")"
+                if beams else "the mesh term dominates and no link is meshed")
+    for link in ("coupler", "crank"):
+        higher = next_rung(link, scene[link], link_models)
+        if higher is not None:
+            return ([f'{link}.model="{higher}"'],
+                    f"{link} climbed to the {link_models[higher].label} rung")
+    return None, "the model term dominates and no link has a higher rung"
+
+
