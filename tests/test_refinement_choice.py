@@ -45,9 +45,10 @@ def _row(terms: dict[str, float]) -> BudgetRow:
                      total, total / PEAK_M, dict(terms), certificate_factor=CERTIFICATE_FACTOR)
 
 
-def _next(scene, terms, free=frozenset(KNOBS), falls=None):
+def _next(scene, terms, free=frozenset(KNOBS), falls=None, noise_m=0.0):
     return next_attempt(scene, [_row(terms)], 0.001, 1, 0.0, BUILTIN_LINK_MODELS, free,
-                        falls=falls, limit_s=1e6)
+                        falls=falls, limit_s=1e6,
+                        noise_floors={"coupler_deployment_peak_deflection_m": noise_m})
 
 
 def test_the_cheap_knob_wins_over_the_costly_climb(beam_scene):
@@ -104,3 +105,15 @@ def test_the_observed_fall_is_the_term_before_over_after():
     assert observed_fall(before, after, "mesh") == pytest.approx(4.2)
     assert observed_fall(before, after, "modes") is None  # zero before: nothing observed
     assert observed_fall(before, None, "mesh") is None
+
+
+def test_a_term_at_the_noise_floor_is_not_chased(beam_scene):
+    """The Newton tolerance moves the peak by as much as the mesh term: doubling the elements
+    cannot lower it, so another knob is turned."""
+    step = _next(beam_scene, TERMS_M, noise_m=TERMS_M["mesh"])
+    assert step.refined is not None and step.term != "mesh", step.line
+
+
+def test_a_tolerance_below_the_noise_floor_stops_refinement(beam_scene):
+    step = _next(beam_scene, TERMS_M, noise_m=0.001 * PEAK_M)
+    assert step.refined is None and "below the solver's noise floor" in step.status

@@ -117,14 +117,18 @@ def observed_fall(before: BudgetRow | None, after: BudgetRow | None, term: str) 
 def next_attempt(scene: Scene, rows: list[BudgetRow], tolerance: float, attempt: int,
                  spent_s: float, link_models: Mapping[str, LinkModel],
                  free: frozenset[str], flagged: frozenset[str] = frozenset(),
-                 falls: Mapping[str, float] | None = None, limit_s: float | None = None,
+                 falls: Mapping[str, float] | None = None,
+                 noise_floors: Mapping[str, float] | None = None, limit_s: float | None = None,
                  max_attempts: int = MAX_ATTEMPTS) -> Step:
     """After attempt ``attempt`` (its certified budget ``rows``, ``spent_s`` [s] so far): the
     tolerance met, nothing to certify, or the next scene (module doc). A quantity in
     ``flagged`` (outside the asymptotic range: its step term a bound that need not shrink with
     the step) is not chased: when only such quantities miss the tolerance, refinement stops
     and names them. ``falls``: each term's fall observed so far (:func:`observed_fall`);
-    ``limit_s``: the cost limit [s] (None: the scene's ``fidelity.refine_limit_s``)."""
+    ``noise_floors``: each quantity's noise floor [its unit] (the Newton tolerance's effect on
+    it): a term at or below it is not chased, and a tolerance its certificate cannot clear
+    stops refinement; ``limit_s``: the cost limit [s] (None: the scene's
+    ``fidelity.refine_limit_s``)."""
     if not rows:
         return Step(None, NOTHING_TO_REFINE, NOTHING_TO_REFINE)
     missing = [row for row in rows if not row.certified_relative <= tolerance]
@@ -143,8 +147,13 @@ def next_attempt(scene: Scene, rows: list[BudgetRow], tolerance: float, attempt:
              f"{worst.what} {worst.problem} (tolerance {100 * tolerance:g} %)")
     if all(row.certified_relative <= tolerance for row in rows):
         return Step(None, "met", f"met; worst {found}")
+    noise = (noise_floors or {}).get(worst.quantity)
+    if noise is not None and worst.total > 0:
+        found += (f"; noise floor {100 * noise * worst.certified_relative / worst.total:.2g} % "
+                  f"(the Newton tolerance's effect)")
     limit = float(scene["fidelity"]["refine_limit_s"] if limit_s is None else limit_s)
-    move, why_not = _best_move(scene, worst, tolerance, link_models, free, dict(falls or {}))
+    move, why_not = _best_move(scene, worst, tolerance, link_models, free, dict(falls or {}),
+                               (noise_floors or {}).get(worst.quantity, 0.0))
     if move is None:
         return Step(None, why_not, f"{found}; stopped: {why_not}")
     if spent_s > limit or attempt >= max_attempts:
@@ -163,7 +172,8 @@ def next_attempt(scene: Scene, rows: list[BudgetRow], tolerance: float, attempt:
 
 def _best_move(scene: Scene, worst: BudgetRow, tolerance: float,
                link_models: Mapping[str, LinkModel], free: frozenset[str],
-               falls: dict[str, float]) -> tuple[_Move | None, str]:
+               falls: dict[str, float], noise_floor: float = 0.0
+               ) -> tuple[_Move | None, str]:
     """The knob to turn for ``worst`` (module doc), or None and why none: an unknown term
     (its companion failed) stops it; else the most predicted certificate removed per second
     of added cost, unless the terms no knob can lower keep it above the tolerance."""
@@ -172,8 +182,12 @@ def _best_move(scene: Scene, worst: BudgetRow, tolerance: float,
         return None, (f"the {', '.join(unknown)} term of {worst.what} is unknown (its "
                       f"companion run failed; estimated_error_unknown says why), and the "
                       f"next attempt would be that companion")
-    moves, stuck = _moves(scene, worst, link_models, free, falls)
     scale = (worst.certified_relative / worst.total if worst.total > 0 else 0.0)
+    if scale * noise_floor > tolerance:
+        return None, (f"the tolerance is below the solver's noise floor: the Newton "
+                      f"tolerance moves {worst.what} by ~{noise_floor:.3g} {worst.units} "
+                      f"({100 * scale * noise_floor:.3g} % certified)")
+    moves, stuck = _moves(scene, worst, link_models, free, falls, noise_floor)
     floor = scale * combined(value for term, value in worst.terms.items()
                              if term in dict(stuck))
     if floor > tolerance or not moves:
@@ -190,13 +204,17 @@ def _best_move(scene: Scene, worst: BudgetRow, tolerance: float,
 
 
 def _moves(scene: Scene, worst: BudgetRow, link_models: Mapping[str, LinkModel],
-           free: frozenset[str], falls: dict[str, float]
+           free: frozenset[str], falls: dict[str, float], noise_floor: float = 0.0
            ) -> tuple[list[_Move], list[tuple[str, str]]]:
     """The knobs that can turn for ``worst``'s nonzero terms, with their predictions; and
-    the terms that cannot move, with why."""
+    the terms that cannot move (or sit at the noise floor), with why."""
     moves, stuck = [], []
     scale = worst.certified_relative / worst.total if worst.total > 0 else 0.0
     for term in [term for term, value in worst.terms.items() if value > 0.0]:
+        if worst.terms[term] <= noise_floor:
+            stuck.append((term, f"the {term} term ({worst.terms[term]:.3g} {worst.units}) is "
+                                f"at the solver's noise floor ({noise_floor:.3g})"))
+            continue
         change, why = refined_change(scene, term, link_models, free)
         if change is None:
             stuck.append((term, why))
@@ -207,7 +225,8 @@ def _moves(scene: Scene, worst: BudgetRow, link_models: Mapping[str, LinkModel],
         except SceneError as refused:
             stuck.append((term, f"{why}: refused: {refused}"))
             continue
-        left = {**worst.terms, term: worst.terms[term] / falls.get(term, PRIOR_FALL[term])}
+        fallen = worst.terms[term] / falls.get(term, PRIOR_FALL[term])
+        left = {**worst.terms, term: max(fallen, noise_floor)}  # not below the solver's noise
         predicted = scale * combined(left.values()) if math.isfinite(scale) else math.nan
         moves.append(_Move(term, refined, why, predicted, attempt_cost_s(refined, link_models)))
     return moves, stuck

@@ -14,6 +14,7 @@ command line and :mod:`flex.api` pass the user's folder
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from collections.abc import Mapping
@@ -238,9 +239,13 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
             fall = observed_fall(last[1].get(last[0].worst), rows.get(last[0].worst),
                                  last[0].term)
             falls.update({last[0].term: fall} if fall is not None else {})
+        floors = (_noise_floors(current.scene, result, rows, name, cache_dir, link_models,
+                                headlines)
+                  if any(not row.certified_relative <= tolerance for row in rows.values())
+                  else {})
         step = next_attempt(current.scene, list(rows.values()), tolerance, attempt,
                             time.perf_counter() - start, link_models, free,
-                            named_quantities(result.attrs, STEP_BOUNDS_ATTR), falls)
+                            named_quantities(result.attrs, STEP_BOUNDS_ATTR), falls, floors)
         lines.append(f"{attempt}: {settings_text(current.scene, link_models)}"
                      f"{' (the last companion at these settings, reused)' if reused else ''}: "
                      f"{step.line}")
@@ -251,6 +256,44 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
                          "refine_wall_time_s": time.perf_counter() - start})
     _say_status(name, step.status, tolerance)
     return result
+
+
+#: the noise floor's companion runs at this many times the run's Newton tolerance (looser, so
+#: it converges wherever the run did); the floor is their difference over (factor - 1): the
+#: tolerance's effect taken as linear in it
+NOISE_FACTOR = 4.0
+
+
+def _noise_floors(scene: Scene, result: CaseResult, rows: Mapping[str, Any], name: str,
+                  cache_dir: Path | None, link_models: Mapping[str, LinkModel],
+                  headlines: Mapping[str, Headline]) -> dict[str, float]:
+    """Each certified quantity's noise floor [its unit]: the Newton tolerance's effect on it,
+    measured by a companion run at :data:`NOISE_FACTOR` times the tolerance the run's solver
+    used (its links may loosen the scene's, :func:`flex.dynamics.solver.solver_settings`).
+    None for an explicit integrator (no Newton iteration) or a companion that fails."""
+    from flex.data.scene import SCHEMA, apply_overrides
+    from flex.dynamics.solver import solver_settings
+    from flex.fidelity.error_estimate import headline_difference
+
+    if scene["simulation"]["integrator"] == "explicit_penalty":
+        return {}
+    used = float(solver_settings(scene, link_models)["newton_relative_tolerance"])
+    loose = min(NOISE_FACTOR * used,
+                SCHEMA["simulation"]["newton_relative_tolerance"].maximum)
+    try:
+        other = integrate(apply_overrides(scene, [
+            f"simulation.newton_relative_tolerance={loose!r}", "simulation.output_step_s=0.0",
+            "simulation.error_estimate=false"]), f"{name}_noise_floor", cache_dir=cache_dir,
+            link_models=link_models)
+    except SimulationError:
+        return {}
+    factor = loose / used - 1.0 if loose > used else math.inf
+    out = {}
+    for quantity in rows:
+        difference = headline_difference(headlines[quantity], result.datasets, other.datasets)
+        if difference is not None:
+            out[quantity] = difference / factor
+    return out
 
 
 def _say_status(name: str, status: str, tolerance: float) -> None:
