@@ -303,7 +303,13 @@ def test_ffrf_default_reaches_the_scene_tolerance_much_faster_than_the_scene_set
     scene_settings = measure(base, Setting("rigid-model settings"), reference, repeats=1,
                              pool=pool)
     assert scene_settings.ok and scene_settings.error < tolerance
-    assert default.wall_time_s < scene_settings.wall_time_s / 10
+    # "much faster" as work, not as a timed assertion (speed is measured by make bench, never
+    # by a timed test: a 10x wall-time ratio here read 9.2x with the suite's other worker
+    # busy, 17.7x alone): at least 5x fewer steps, at least 10x fewer Jacobian updates (a
+    # factorization each, the cost of the rigid-model settings' full Newton)
+    assert default.steps * 5 <= scene_settings.steps
+    assert default.jacobian_updates * 10 <= scene_settings.jacobian_updates, (
+        default.jacobian_updates, scene_settings.jacobian_updates)
 
 
 def test_the_study_summary_checks_the_bundled_defaults(rigid_reference):
