@@ -121,8 +121,7 @@ def test_second_build_is_a_fast_identical_cache_hit(reduction, cache_dir):
     assert reduction.cache_file.parent == cache_dir and reduction.cache_file.is_file()
     assert not list(cache_dir.glob("*.tmp.hdf5"))  # temporary file renamed away
     again = build_reduction(*ARGS, cache_dir=cache_dir)
-    assert again.from_cache
-    assert again.build_time_s < 1.0
+    assert again.from_cache  # read, not rebuilt (no timed assertion: make bench times it)
     assert again.cold_build_time_s == reduction.cold_build_time_s
     _assert_same_reduction(reduction, again, exact=True)
 

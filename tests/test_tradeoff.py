@@ -257,7 +257,6 @@ def test_bundled_defaults_are_the_fastest_setting_within_the_default_tolerance()
     # its pick (full and modified Newton at 1e-8 both take one iteration per step and swap
     # places from run to run), and take one Newton iteration per step
     from flex.experiments.workprecision.defaults_check import (
-        DEFAULT_TIE,
         DEFAULT_TOLERANCE,
         default_recommendation,
         default_setting,
@@ -278,7 +277,9 @@ def test_bundled_defaults_are_the_fastest_setting_within_the_default_tolerance()
     assert best is not None and within_default_tolerance(defaults, pinned)
     assert resolved_simulation(base)["step_s"] == step
     assert defaults.newton_iterations <= defaults.steps * 1.01
-    assert defaults.wall_time_s <= (1 + DEFAULT_TIE) * best.wall_time_s
+    # as fast as the pick, as work (no timed assertion: make tradeoff's summary compares the
+    # wall times): the fewest Newton iterations of the settings tried
+    assert defaults.newton_iterations <= min(run.newton_iterations for run in runs if run.ok)
 
 
 @pytest.mark.slow
