@@ -114,9 +114,13 @@ def exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, D
     return out
 
 
+def _elements(values: dict[str, Any]) -> int:
+    """A beam link's element count (its ``"auto"``: :data:`EXACT_BEAM_ELEMENTS`)."""
+    return int(values["elements"] if values["elements"] != AUTO else EXACT_BEAM_ELEMENTS)
+
+
 def exact_beam_step_cost_s(values: dict[str, Any], modes: int | None) -> float:
-    elements = values["elements"] if values["elements"] != AUTO else EXACT_BEAM_ELEMENTS
-    return STEP_COST_EXACT_BEAM_S[0] + STEP_COST_EXACT_BEAM_S[1] * float(elements)
+    return STEP_COST_EXACT_BEAM_S[0] + STEP_COST_EXACT_BEAM_S[1] * float(_elements(values))
 
 
 def exact_beam_newton_tolerances(elements: int) -> tuple[float, float]:
@@ -131,8 +135,7 @@ def exact_beam_solver(settings: dict[str, Any], values: dict[str, Any]) -> None:
     """A sparse solver, and Newton tolerances no tighter than the link's elements allow
     (:func:`exact_beam_newton_tolerances`)."""
     settings["linear_solver"] = "EigenSparse"
-    elements = values["elements"] if values["elements"] != AUTO else EXACT_BEAM_ELEMENTS
-    relative, absolute = exact_beam_newton_tolerances(int(elements))
+    relative, absolute = exact_beam_newton_tolerances(_elements(values))
     settings["newton_relative_tolerance"] = max(settings["newton_relative_tolerance"],
                                                 relative)
     settings["newton_absolute_tolerance"] = max(settings["newton_absolute_tolerance"],

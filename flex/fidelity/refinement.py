@@ -148,12 +148,12 @@ def next_attempt(scene: Scene, rows: list[BudgetRow], tolerance: float, attempt:
     if all(row.certified_relative <= tolerance for row in rows):
         return Step(None, "met", f"met; worst {found}")
     noise = (noise_floors or {}).get(worst.quantity)
-    if noise is not None and worst.total > 0:
-        found += (f"; noise floor {100 * noise * worst.certified_relative / worst.total:.2g} % "
-                  f"(the Newton tolerance's effect)")
+    if noise is not None:
+        found += (f"; noise floor {100 * _certified_per_unit(worst) * noise:.2g} % (the Newton "
+                  f"tolerance's effect)")
     limit = float(scene["fidelity"]["refine_limit_s"] if limit_s is None else limit_s)
     move, why_not = _best_move(scene, worst, tolerance, link_models, free, dict(falls or {}),
-                               (noise_floors or {}).get(worst.quantity, 0.0))
+                               noise or 0.0)
     if move is None:
         return Step(None, why_not, f"{found}; stopped: {why_not}")
     if spent_s > limit or attempt >= max_attempts:
@@ -170,6 +170,12 @@ def next_attempt(scene: Scene, rows: list[BudgetRow], tolerance: float, attempt:
                 f"(the most certified error removed per second)", move.term, worst.quantity)
 
 
+def _certified_per_unit(row: BudgetRow) -> float:
+    """The certified relative error per unit of error in the row's quantity [1/its unit]:
+    the certificate's factor over the quantity's magnitude (0 for an error-free row)."""
+    return row.certified_relative / row.total if row.total > 0 else 0.0
+
+
 def _best_move(scene: Scene, worst: BudgetRow, tolerance: float,
                link_models: Mapping[str, LinkModel], free: frozenset[str],
                falls: dict[str, float], noise_floor: float = 0.0
@@ -182,7 +188,7 @@ def _best_move(scene: Scene, worst: BudgetRow, tolerance: float,
         return None, (f"the {', '.join(unknown)} term of {worst.what} is unknown (its "
                       f"companion run failed; estimated_error_unknown says why), and the "
                       f"next attempt would be that companion")
-    scale = (worst.certified_relative / worst.total if worst.total > 0 else 0.0)
+    scale = _certified_per_unit(worst)
     if scale * noise_floor > tolerance:
         return None, (f"the tolerance is below the solver's noise floor: the Newton "
                       f"tolerance moves {worst.what} by ~{noise_floor:.3g} {worst.units} "
@@ -191,9 +197,8 @@ def _best_move(scene: Scene, worst: BudgetRow, tolerance: float,
     floor = scale * combined(value for term, value in worst.terms.items()
                              if term in dict(stuck))
     if floor > tolerance or not moves:
-        term, why = max(stuck, key=lambda item: worst.terms[item[0]],
-                        default=("", "no knob can lower it"))
-        return None, why
+        return None, max(stuck, key=lambda item: worst.terms[item[0]],
+                         default=("", "no knob can lower it"))[1]
     base_s = attempt_cost_s(scene, link_models)
     gains = [(worst.certified_relative - move.predicted)
              / max(move.cost_s - base_s, 1e-3 * base_s, 1e-9) for move in moves]
@@ -209,7 +214,7 @@ def _moves(scene: Scene, worst: BudgetRow, link_models: Mapping[str, LinkModel],
     """The knobs that can turn for ``worst``'s nonzero terms, with their predictions; and
     the terms that cannot move (or sit at the noise floor), with why."""
     moves, stuck = [], []
-    scale = worst.certified_relative / worst.total if worst.total > 0 else 0.0
+    scale = _certified_per_unit(worst)
     for term in [term for term, value in worst.terms.items() if value > 0.0]:
         if worst.terms[term] <= noise_floor:
             stuck.append((term, f"the {term} term ({worst.terms[term]:.3g} {worst.units}) is "
