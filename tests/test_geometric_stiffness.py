@@ -111,6 +111,25 @@ def test_reduced_link_buckles_at_the_closed_form_loads(reduction, stiffness):
                                    rel=0.01)
 
 
+
+def test_a_linear_tetrahedra_reduction_gets_its_geometric_stiffness(reduction_cache):
+    # K_G is assembled on a mesh remade from the reduction's arguments, tetrahedra order
+    # included: the work-precision study's "linear tets" setting stopped with a traceback
+    # when the remade mesh was quadratic ("the remade mesh differs from the reduction's")
+    sizes = {key: PLATE[key] for key in ("length_m", "thickness_m", "width_m",
+                                         "youngs_modulus_Pa", "density_kg_per_m3",
+                                         "poisson_ratio")}
+    linear = build_reduction(Plate(**sizes), PLATE["mesh_size_m"], PLATE["modes"],
+                             cache_dir=reduction_cache, mesh_order=1)
+    assert linear.mesh_order == 1
+    stiffness = geometric_stiffness(linear)
+    length, area = PLATE["length_m"], PLATE["thickness_m"] * PLATE["width_m"]
+    assert stiffness.axial_force_row_N_per_m[stiffness.axial_mode] == pytest.approx(
+        PLATE["youngs_modulus_Pa"] * area / length, rel=0.01)
+    _, load_N = pinned_pinned_eigen(linear, stiffness, 0.0)
+    # linear tetrahedra lock in bending: stiffer than the beam, never softer
+    assert load_N > 0.99 * euler_load_N()
+
 @pytest.mark.parametrize("load_ratio", [-0.5, 0.25, 0.5, 0.75])
 def test_bending_frequency_follows_the_axial_load(reduction, stiffness, load_ratio):
     # f(P) = f0 sqrt(1 - P / P_E); tension (negative) stiffens; f0 is the reduction's own

@@ -138,12 +138,12 @@ def unit_axial_stress_matrices(reduction: Any, rising: bool = False) -> Any:
     from flex.bodies.nonlinear import build_nonlinear_plate
 
     r = reduction
-    plate = build_nonlinear_plate(r.plate, r.mesh_size_m)
+    plate = build_nonlinear_plate(r.plate, r.mesh_size_m, mesh_order=r.mesh_order)
     positions = r.fem.GetNodePositionsAsArray()
     if plate.node_positions_m.shape != positions.shape or not np.allclose(
             plate.node_positions_m, positions, rtol=0, atol=1e-9 * r.length_m):
         raise RuntimeError("the remade mesh differs from the reduction's: cannot project")
-    space = ngs.NodalFESpace(plate.mesh, order=2) ** 3
+    space = ngs.NodalFESpace(plate.mesh, order=r.mesh_order) ** 3
     u, v = space.TnT()
     n_nodes = len(positions)
     coordinate = np.arange(3 * n_nodes)

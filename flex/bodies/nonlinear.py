@@ -103,13 +103,15 @@ class NonlinearPlate(PlateLink):
 
 
 def build_nonlinear_plate(plate: Plate, mesh_size_m: float, *,
-                          ngsolve_threads: int | None = 1) -> NonlinearPlate:
+                          ngsolve_threads: int | None = 1,
+                          mesh_order: int = _MESH_ORDER) -> NonlinearPlate:
     """Mesh the plate and find its joint and midpoint node sets.
 
     Contract: ``plate`` its sizes in metres, E in Pa, density in kg/m^3, Poisson's ratio
     (:class:`flex.base.physics.Plate`), ``mesh_size_m`` is netgen's maxh [m];
     the same arguments as :func:`flex.bodies.reduction.build_reduction` (without ``modes``) give the
-    same mesh, node numbering and node sets. Bad values raise
+    same mesh, node numbering and node sets (``mesh_order``: the tetrahedra's order, 2 as the
+    reduction's default, 1 for a linear-tetrahedra reduction's). Bad values raise
     :class:`flex.base.errors.SceneError`. ``ngsolve_threads`` as in ``build_reduction`` (1: the
     import's assembly took 0.85 s with NGsolve's default threads on the shared 2-core
     machine, 0.05 s with one). Nothing is cached: meshing takes one to a few seconds; the
@@ -132,7 +134,7 @@ def build_nonlinear_plate(plate: Plate, mesh_size_m: float, *,
         # second call adds unconnected nodes) and numbers the nodes as the reduction does
         fem.ImportMeshFromNGsolve(mesh, density=density_kg_per_m3,
                                   youngsModulus=youngs_modulus_Pa,
-                                  poissonsRatio=poisson_ratio, meshOrder=_MESH_ORDER,
+                                  poissonsRatio=poisson_ratio, meshOrder=mesh_order,
                                   boundaryNamesList=[END_A, END_B])
     positions = fem.GetNodePositionsAsArray()
     face_sets = _face_sets(fem)

@@ -75,6 +75,8 @@ class Reduction(PlateLink):
     from_cache: bool
     cache_file: Path | None
     key: str  #: hash of everything the reduction depends on
+    #: the tetrahedra's order: 2 (quadratic, the default) or 1 (linear)
+    mesh_order: int = MESH_ORDER
     _ffrf_interface: Any = field(default=None, repr=False, compare=False)
 
     @property
@@ -283,7 +285,7 @@ def build_reduction(plate: Plate, mesh_size_m: float, modes: int,
         n_elements=int(meta["n_elements"]), n_dof=3 * int(fem.NumberOfNodes()),
         cold_build_time_s=float(meta["cold_build_time_s"]),
         build_time_s=time.perf_counter() - start, from_cache=from_cache,
-        cache_file=cache_file, key=key,
+        cache_file=cache_file, key=key, mesh_order=int(mesh_order),
         _ffrf_interface=ffrf_interface,
     )
 
