@@ -206,6 +206,9 @@ class TwoModeCrank:
         self.baumgarte = baumgarte_rad_per_s
         self.nq = rod.mass.shape[0]
         self.n = 3 + self.nq
+        # the strictly lower triangle, filled from the upper one (made once: the right-hand
+        # side runs ~10^5-10^6 times per run)
+        self._lower = np.tril_indices(self.n, -1)
 
     def mass_matrix(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The mass matrix M(p) [kg, kg m, kg m^2] and its derivatives dM/dp_k, (n, n, n)."""
@@ -231,10 +234,9 @@ class TwoModeCrank:
         dm[3:, 0, 1] = rho * l1 * (s12 * rod.c2 + c12_ * rod.c1)
         dm[3:, 1, 1] = 2 * rod.mass @ q + 2 * rho * rod.c12
         dm[3:, 1, 3:] = rho * rod.gyroscopic
-        upper = np.triu(np.ones((self.n, self.n)), 1).astype(bool)
-        m.T[upper] = m[upper]
-        for k in range(self.n):
-            dm[k].T[upper] = dm[k][upper]
+        rows, columns = self._lower
+        m[rows, columns] = m[columns, rows]
+        dm[:, rows, columns] = dm[:, columns, rows]
         return m, dm
 
     def constraints(self, t: float, p: np.ndarray, rates: np.ndarray
@@ -277,7 +279,9 @@ class TwoModeCrank:
                 self.bench, self.rod, q, self.stiffening == "tangent_frame_geometric")
         g, jac, velocity, gamma = self.constraints(t, p, rates)
         a = self.baumgarte
-        system = np.block([[m, jac.T], [jac, np.zeros((3, 3))]])
+        system = np.zeros((self.n + 3, self.n + 3))
+        system[:self.n, :self.n], system[:self.n, self.n:], system[self.n:, :self.n] = (
+            m, jac.T, jac)
         rhs = np.concatenate([force, -gamma - 2 * a * velocity - a**2 * g])
         solution = np.linalg.solve(system, rhs)
         return solution[:self.n], solution[self.n:]
