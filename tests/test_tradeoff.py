@@ -80,22 +80,27 @@ def test_recommend_counts_the_reference_accuracy_in_the_error(rigid_reference):
     assert picks[0].measurement.setting.label == "certified"
 
 
-def test_the_1mm_reference_sequences_run_through_the_reference():
-    from flex.experiments.workprecision.reference_plans import (
-        FFRF_REFERENCE,
-        reference_plan,
-        through_reference,
-    )
+def test_the_1mm_reference_is_the_exact_beam_with_its_idealization_bound():
+    from flex.config.ladder import EXACT_BEAM_ERROR_PER_SLENDERNESS
+    from flex.experiments.workprecision.measurement import certifies
+    from flex.experiments.workprecision.reference_plans import exact_beam_bound, reference_plan
 
-    finest, _, _, _, refinements, anchor = reference_plan("ffrf_1mm")
-    assert through_reference(FFRF_REFERENCE["ffrf_1mm"]) and anchor is None
-    for refinement in refinements[:3]:  # step, mesh, modes: the fine level is the reference
-        assert refinement.levels[0].knobs() == finest.knobs()
+    plan = reference_plan("ffrf_1mm")
+    assert dict(plan.finest.overrides)["coupler.model"] == "exact_beam" and plan.anchor is None
+    for refinement in plan.refinements:  # elements, step: the fine level is the reference
+        assert refinement.levels[0].knobs() == plan.finest.knobs()
         others = [dict(level.overrides) for level in refinement.levels]
         varied = {key for key in others[0] if len({repr(o[key]) for o in others}) > 1}
         assert len(varied) == 1  # only the sequence's own knob changes
+    # the model term: the ladder's bound, 0.05 t / L; at 1 mm (L = 80 mm) small enough for
+    # the reference to certify 1 %, at 10 mm not (that plate keeps an FFRF reference)
+    scene = load_scene(overrides=['coupler.geometry="plate"', "coupler.thickness_m=0.001"])
+    bound, _ = exact_beam_bound(scene)
+    length = scene["coupler"]["length_m"]
+    assert bound == pytest.approx(EXACT_BEAM_ERROR_PER_SLENDERNESS * 0.001 / length)
+    assert certifies(2 * bound, 1e-2) and not certifies(10 * bound, 1e-2)
     # 10 mm keeps cheaper bases, so it keeps the additivity check
-    assert reference_plan("ffrf_10mm")[5] is not None
+    assert reference_plan("ffrf_10mm").anchor is not None
 
 
 def test_richardson_estimates_the_fine_error_of_a_second_order_sequence():

@@ -26,7 +26,6 @@ from flex.experiments.workprecision.measurement import (
     ReductionPool,
     Reference,
     Setting,
-    peak_value,
     run_once,
     scene_for,
 )
@@ -94,10 +93,8 @@ def richardson(change_fine: float, change_coarse: float, ratio: float, max_order
     return out
 
 
-def _signed_peak(observables: Observables) -> float:
-    if observables.deflection_m is None:
-        return math.nan
-    return peak_value(observables.time_s, observables.deflection_m)
+def _peak(observables: Observables) -> float:
+    return observables.peak_m
 
 
 def converged_reference(base: Scene, label: str, finest: Setting,
@@ -187,7 +184,7 @@ def _refinement_evidence(reference: Reference, refinement: Refinement,
         medium_ref = Reference("medium", levels[1][0], refinement.levels[1], {},
                                tolerance, 0.0)
         changes_coarse = medium_ref.errors(levels[2][0])
-    peaks = [_signed_peak(obs) for obs, _ in levels]
+    peaks = [_peak(obs) for obs, _ in levels]
     record: dict[str, Any] = {"error": 0.0}
     for measure_name in MEASURES:
         d1 = changes_fine[measure_name]
@@ -220,7 +217,7 @@ def _knob_key(knob: str) -> str:
 
 
 def _value(observables: Observables, flexible: bool) -> float:
-    return (_signed_peak(observables) if flexible
+    return (_peak(observables) if flexible
             else float(observables.crank_angle_rad[-1]))
 
 

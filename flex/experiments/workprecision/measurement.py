@@ -12,7 +12,11 @@ iterations, and the errors against a converged :class:`Reference`:
 - ``crank_angle_rad``: max over the run's samples of |theta - theta_ref| [rad];
 - ``slider_position_m``: max |x - x_ref| [m];
 - ``peak_deflection_m``: |peak - peak_ref| of the elastic midpoint deflection [m] (flexible
-  couplers; peaks refined by a parabola through the three samples around the largest |w|);
+  couplers): the peak is the certified headline a user's tolerance applies to, the coupler's
+  deployment peak on the headline channel (:data:`PEAK_HEADLINE`; a raw maximum of undamped
+  ringing races between sub-crests and has no order of convergence); observables made
+  without it (arrays only) use the raw peak, refined by a parabola through the three samples
+  around the largest |w|;
 - relative errors: the first two divided by the reference's range (swing of the crank,
   travel of the slider; 1 rad and 1 mm for a reference that does not move), the third by
   the reference peak; ``error`` is the largest of the
@@ -145,24 +149,45 @@ def peak_value(time_s: np.ndarray, signal: np.ndarray) -> float:
     return float(y1 - 0.25 * (y0 - y2) * offset)
 
 
+#: the headline the peak deflection error is measured on (:mod:`flex.fidelity.headlines`)
+PEAK_HEADLINE = "coupler_deployment_peak_deflection_m"
+
+
 @dataclass
 class Observables:
     """What the errors are computed from: time [s], crank angle [rad], slider position [m],
-    elastic midpoint deflection [m] (None for a rigid coupler)."""
+    elastic midpoint deflection [m] (None for a rigid coupler) and the run's
+    :data:`PEAK_HEADLINE` [m] (None: not read, the raw peak stands in)."""
 
     time_s: np.ndarray
     crank_angle_rad: np.ndarray
     slider_position_m: np.ndarray
     deflection_m: np.ndarray | None = None
+    headline_peak_m: float | None = None
 
     @staticmethod
     def of_datasets(datasets: dict[str, Dataset], flexible: bool) -> Observables:
-        """From a :class:`~flex.data.results.CaseResult`'s datasets."""
+        """From a :class:`~flex.data.results.CaseResult`'s datasets (a flexible coupler's
+        :data:`PEAK_HEADLINE` read as the run's headlines read it)."""
+        from flex.fidelity.headlines import BUILTIN_HEADLINES
+
         return Observables(np.asarray(datasets["time"].data),
                            np.asarray(datasets["crank/angle"].data),
                            np.asarray(datasets["slider/position"].data),
                            np.asarray(datasets["coupler/midpoint_deflection"].data)
-                           if flexible else None)
+                           if flexible else None,
+                           BUILTIN_HEADLINES[PEAK_HEADLINE].read(datasets) if flexible
+                           else None)
+
+    @property
+    def peak_m(self) -> float:
+        """The peak the errors compare [m]: the headline, or (not read) the raw peak
+        (:func:`peak_value`); nan for a rigid coupler."""
+        if self.headline_peak_m is not None:
+            return float(self.headline_peak_m)
+        if self.deflection_m is None:
+            return float("nan")
+        return peak_value(self.time_s, self.deflection_m)
 
 
 @dataclass
@@ -204,9 +229,7 @@ class Reference:
 
     @property
     def peak_deflection_m(self) -> float:
-        if self.observables.deflection_m is None:
-            return float("nan")
-        return peak_value(self.observables.time_s, self.observables.deflection_m)
+        return self.observables.peak_m
 
     def at(self, name: str, time_s: np.ndarray) -> np.ndarray:
         """The reference's ``crank_angle_rad`` or ``slider_position_m`` at ``time_s`` (cubic
@@ -243,8 +266,10 @@ class Reference:
         if self.flexible:
             if run.deflection_m is None:
                 raise FlexError("a flexible reference needs a run with a midpoint deflection")
-            peak = peak_value(run.time_s, run.deflection_m)
-            out["peak_deflection_m"] = abs(peak - self.peak_deflection_m)
+            if (run.headline_peak_m is None) != (self.observables.headline_peak_m is None):
+                raise FlexError("the run and the reference read their peak deflection "
+                                "differently (headline and raw peak): not comparable")
+            out["peak_deflection_m"] = abs(run.peak_m - self.peak_deflection_m)
             out["peak_deflection_relative"] = out["peak_deflection_m"] / self.peak_deflection_m
         relative = [value for key, value in out.items()
                     if key.endswith("_relative") and math.isfinite(value)]

@@ -24,8 +24,10 @@ S = Setting.of
 
 class ReferencePlan(NamedTuple):
     """Finest setting, its one-level coarsenings (name -> setting), claimed relative accuracy
-    (dimensionless), a description, the three-level knob sequences and the anchor of the
-    additivity check (None when every sequence runs through the reference)."""
+    (dimensionless), a description, the three-level knob sequences, the anchor of the
+    additivity check (None when every sequence runs through the reference) and the model
+    term: a function of the scene giving the reference model's own error bound (relative)
+    and what it is (None: the reference is the model whose settings it measures)."""
 
     finest: Setting
     coarsenings: dict[str, Setting]
@@ -33,42 +35,40 @@ class ReferencePlan(NamedTuple):
     description: str
     refinements: Sequence[Refinement] = ()
     anchor: Setting | None = None
+    model_bound: Callable[[Scene], tuple[float, str]] | None = None
 
 
 #: FFRF references: the finest step, mesh and modes, and where each knob's three-level sequence is
 #: run (``*_base``: the values of the other knobs; its finest level has the reference's value of
-#: its own knob). 1 mm: every sequence runs through the reference itself (the bases are the
-#: reference's values), so each knob's estimate is its error *at the reference* and no additivity
-#: assumption is needed. An earlier plan ran the sequences at cheaper values of the other knobs and
-#: paid for the additivity check: at h = 6.25e-7 s, 0.75 mm, 24 modes the measured interaction
-#: alone was 1.1e-3, the step sequence (1.5 mm, 12 modes) was not yet asymptotic (order 0.62) and
-#: modes 12 -> 24 still moved the peak by 5.4e-4 -- accurate to 2.1e-3, which certifies 1 % only.
-#: Measured while choosing this plan (1.5 mm, 12 modes): the step sequence 1.25e-6 -> 6.25e-7 ->
-#: 3.125e-7 s changes the peak by 1.5e-4 then 3.5e-5 (order 2.1, asymptotic); modes 6 -> 12 -> 24
-#: by 2.3e-3 and 5.4e-4 (order 2.1), so 48 modes are needed for 0.1 % (the estimate at 24, ~2.3e-4,
-#: plus the mesh's, ~1.5e-4, exceeds the 3.3e-4 that 0.1 % allows); 48 modes on the 0.75 mm mesh
-#: cost ~880 s per run at 3.125e-7 s and 176 s to reduce. Measured by this plan (make tradeoff):
-#: modes 12 -> 24 -> 48 change the peak by 4.7e-4 then 2.4e-4, first order (the 6 -> 12 -> 24
-#: sequence was not yet asymptotic), so the reference certifies 1 % (accuracy 1.6e-3) and 0.1 %
-#: would need ~96 modes (README "Why the FFRF levels stop there"). 10 mm: the sequences run at
-#: cheaper values of the other knobs, with the additivity check (``anchor``); the peak is the
-#: largest of several crests within ~1 % of each other (24.3, 24.6, 24.8 ms) and which one wins
-#: follows the phase of 20-27 kHz modes: h = 1.25e-6 -> 6.25e-7 -> 3.125e-7 -> 1.5625e-7 s change
-#: it by -0.15 %, -0.18 %, then +0.30 % (1.5 mm, 12 modes); below 2e-7 s the step converges at
-#: second order (2e-7, 1.5625e-7, 1e-7 s: 0.737916, 0.737834, 0.737750 um), but 24 modes instead of
-#: 12 at 2e-7 s move the peak by -0.52 % to another crest: a reference needs modes and mesh
-#: converged at ~1e-7 s steps (17 min per run: out of this machine's run budget)
+#: its own knob; :func:`through_reference`: every base at the reference's values, then each
+#: estimate is the knob's error *at the reference* and no additivity check is needed). 10 mm: the
+#: sequences run at cheaper values of the other knobs, with the additivity check (``anchor``).
+#: Measured on its raw peak (the largest of several crests within ~1 % of each other, 24.3, 24.6,
+#: 24.8 ms, which one wins following the phase of 20-27 kHz modes): h = 1.25e-6 -> 6.25e-7 ->
+#: 3.125e-7 -> 1.5625e-7 s changed it by -0.15 %, -0.18 %, then +0.30 % (1.5 mm, 12 modes); below
+#: 2e-7 s the step converged at second order, but 24 modes instead of 12 at 2e-7 s moved it by
+#: -0.52 % to another crest. The errors are now read on the deployment peak of the headline
+#: channel (:data:`~flex.experiments.workprecision.measurement.PEAK_HEADLINE`). The 1 mm plate's
+#: reference is the exact beam (:data:`BEAM_REFERENCE`)
 FFRF_REFERENCE: dict[str, dict[str, Any]] = {
-    "ffrf_1mm": {"step": 3.125e-7, "mesh": 0.00075, "modes": 48,
-                 "step_base": {"mesh": 0.00075, "modes": 48},
-                 "mesh_base": {"step": 3.125e-7, "modes": 48}, "mesh_ratio": 2**0.5,
-                 "modes_base": {"step": 3.125e-7, "mesh": 0.00075},
-                 "newton_base": {"step": 1.25e-6, "mesh": 0.0015, "modes": 12}},
     "ffrf_10mm": {"step": 3.125e-7, "mesh": 0.005, "modes": 24,
                   "step_base": {"mesh": 0.005, "modes": 12},
                   "mesh_base": {"step": 1.25e-6, "modes": 12}, "mesh_ratio": 2**0.5,
                   "modes_base": {"step": 1.25e-6, "mesh": 0.005},
                   "newton_base": {"step": 1.25e-6, "mesh": 0.005, "modes": 12}},
+}
+#: exact-beam references: the geometrically exact beam (the ladder's cheap rung) where the
+#: ladder says it is exact enough to certify 1 %: its idealization bound
+#: (:data:`flex.config.ladder.EXACT_BEAM_ERROR_PER_SLENDERNESS` x t / L: 6.25e-4 for the 1 mm
+#: plate) within a third of it with its numerics (not for 10 mm: 6.25e-3). Finest elements and
+#: step; sequences of elements and step (x2, three levels each) through it. The 1 mm plate's
+#: FFRF reference (48 modes on a 0.75 mm mesh at 3.125e-7 s, with its sequences) took over an
+#: hour on 2 cores (its reduction alone > 50 min cold) and certified 1 % only (accuracy
+#: 1.6e-3); measured for this plan (coupler deployment peak on the headline channel): 64 ->
+#: 128 -> 256 elements at 2.5e-6 s change it by 3.8e-4 then 5.8e-5 (order 2.7), h = 1e-5 ->
+#: 5e-6 -> 2.5e-6 s at 128 elements by 2.5e-5 then 3e-6, 15 s for the finest run
+BEAM_REFERENCE: dict[str, dict[str, Any]] = {
+    "ffrf_1mm": {"elements": 256, "step": 2.5e-6},
 }
 #: formal orders that cap an observed order: generalized-alpha is second order in the step;
 #: quadratic tetrahedra converge at up to fourth order in the element size (eigenvalues,
@@ -127,13 +127,55 @@ def ffrf_refinements(plan: dict[str, Any]) -> list[Refinement]:
     ]
 
 
+def _beam_setting(elements: int, step: float) -> Setting:
+    """An exact-beam reference-level setting: coupler elements, step [s], modified Newton
+    (the beam's own tolerances, :mod:`flex.dynamics.exact_beam_link`), spectral radius 0.9."""
+    return S(f"reference exact beam elements={elements} h={step:g}",
+             coupler__model="exact_beam", coupler__elements=elements, step_s=step,
+             newton="modified", spectral_radius=0.9)
+
+
+def exact_beam_bound(scene: Scene) -> tuple[float, str]:
+    """The exact beam's idealization bound for the scene's coupler (relative to its own
+    deflection, :data:`flex.config.ladder.EXACT_BEAM_RUNG`) and what it is."""
+    from flex.config.ladder import EXACT_BEAM_ERROR_PER_SLENDERNESS, EXACT_BEAM_RUNG
+
+    return (EXACT_BEAM_RUNG.own(scene["coupler"]),
+            f"the exact beam's idealization: the ladder's bound "
+            f"{EXACT_BEAM_ERROR_PER_SLENDERNESS:g} x thickness / length of the coupler's "
+            f"deflection (taken for every measure)")
+
+
+def beam_plan(scene_name: str) -> ReferencePlan:
+    """The exact-beam reference of :data:`BEAM_REFERENCE` ``[scene_name]``: claims 1e-3;
+    its accuracy holds the element and step sequences' estimates and the ladder's
+    idealization bound (:func:`exact_beam_bound`)."""
+    plan = BEAM_REFERENCE[scene_name]
+    elements, step = plan["elements"], plan["step"]
+    refinements = [
+        Refinement("coupler.elements", tuple(_beam_setting(elements // k, step)
+                                             for k in (1, 2, 4)), 2.0, MAX_ORDER["step"]),
+        Refinement("step_s", tuple(_beam_setting(elements, step * k) for k in (1, 2, 4)),
+                   2.0, MAX_ORDER["step"])]
+    description = (
+        f"the geometrically exact beam (the ladder's rung above FFRF), {elements} elements, "
+        f"generalized-alpha index 3 (rho 0.9), h = {step:g} s, modified Newton; shown "
+        f"converged by three-level sequences of elements and step (x2) with Richardson error "
+        f"estimates, each through the reference, plus the ladder's bound on the beam's "
+        f"idealization (its model term): the FFRF settings' errors hold their model error")
+    return ReferencePlan(refinements[0].levels[0], {}, 1e-3, description, refinements, None,
+                         exact_beam_bound)
+
+
 def reference_plan(scene_name: str) -> ReferencePlan:
     """The plan of the work-precision study's scene ``scene_name``: ``"rigid"``
-    (:func:`rigid_plan`) or a key of :data:`FFRF_REFERENCE` (claims 1e-3; the anchor is the
-    step sequence's finest level unless every sequence runs through the reference,
-    :func:`through_reference`)."""
+    (:func:`rigid_plan`), a key of :data:`BEAM_REFERENCE` (:func:`beam_plan`) or of
+    :data:`FFRF_REFERENCE` (claims 1e-3; the anchor is the step sequence's finest level
+    unless every sequence runs through the reference, :func:`through_reference`)."""
     if scene_name == "rigid":
         return rigid_plan()
+    if scene_name in BEAM_REFERENCE:
+        return beam_plan(scene_name)
     plan = FFRF_REFERENCE[scene_name]
     step, mesh, modes = plan["step"], plan["mesh"], plan["modes"]
     refinements = ffrf_refinements(plan)
@@ -166,8 +208,14 @@ def build_reference(base: Scene, label: str, plan: ReferencePlan,
                     pool: ReductionPool | None = None,
                     progress: Callable[[str], None] | None = None) -> Reference:
     """Run ``plan`` on ``base``
-    (:func:`flex.experiments.workprecision.convergence.converged_reference`); raises
-    :class:`~flex.base.errors.FlexError` if the finest run fails."""
-    return converged_reference(base, label, plan.finest, plan.coarsenings, plan.tolerance,
-                               pool, plan.description, progress, plan.refinements,
-                               plan.anchor)
+    (:func:`flex.experiments.workprecision.convergence.converged_reference`), its model term
+    (if any) added to the evidence as ``model``; raises :class:`~flex.base.errors.FlexError`
+    if the finest run fails."""
+    reference = converged_reference(base, label, plan.finest, plan.coarsenings,
+                                    plan.tolerance, pool, plan.description, progress,
+                                    plan.refinements, plan.anchor)
+    if plan.model_bound is not None:
+        bound, what = plan.model_bound(base)
+        reference.evidence["model"] = {"error": bound, "governing": "peak_deflection_relative",
+                                       "settings": [what]}
+    return reference
