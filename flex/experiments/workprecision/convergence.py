@@ -93,10 +93,6 @@ def richardson(change_fine: float, change_coarse: float, ratio: float, max_order
     return out
 
 
-def _peak(observables: Observables) -> float:
-    return observables.peak_m
-
-
 def converged_reference(base: Scene, label: str, finest: Setting,
                         coarsenings: dict[str, Setting], tolerance: float,
                         pool: ReductionPool | None = None, description: str = "",
@@ -184,7 +180,7 @@ def _refinement_evidence(reference: Reference, refinement: Refinement,
         medium_ref = Reference("medium", levels[1][0], refinement.levels[1], {},
                                tolerance, 0.0)
         changes_coarse = medium_ref.errors(levels[2][0])
-    peaks = [_peak(obs) for obs, _ in levels]
+    peaks = [obs.peak_m for obs, _ in levels]
     record: dict[str, Any] = {"error": 0.0}
     for measure_name in MEASURES:
         d1 = changes_fine[measure_name]
@@ -217,7 +213,7 @@ def _knob_key(knob: str) -> str:
 
 
 def _value(observables: Observables, flexible: bool) -> float:
-    return (_peak(observables) if flexible
+    return (observables.peak_m if flexible
             else float(observables.crank_angle_rad[-1]))
 
 
