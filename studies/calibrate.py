@@ -55,7 +55,7 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
     settings = run.sweep or SweepSettings()
     outcome = run_sweep(scenes, settings.folder or RESULTS_DIR / "calibrate-cases",
                         partial(measure_case, repeats=REPEATS, cache_dir=run.cache_dir,
-                                mesh_rule=rule_constants()["mesh"]),
+                                mesh_rule=dict(rule_constants()["mesh"])),
                         executor=make_executor(settings.scheduler, settings.workers or 1),
                         retry_failed=settings.retry_failed, progress=settings.progress,
                         study=NAME)

@@ -96,3 +96,15 @@ def test_a_declared_table_becomes_one_dataset_per_column_and_reads_back(tmp_path
         assert [v.decode() for v in h5["cases/c/runs/name"][()]] == ["a", "b"]
         np.testing.assert_array_equal(h5["cases/c/runs/time"][()], [0.5, 1.5])
         assert h5["cases/c/runs/time"].attrs["units"] == "s"
+
+
+def test_an_empty_text_column_is_written(tmp_path):
+    # a study summary whose cases all failed has empty object-dtype text columns: h5py cannot
+    # guess their type ("Object dtype dtype('O') has no native HDF5 equivalent", an internal
+    # error of make calibrate); they are written as (empty) string datasets
+    summary = {"names": Dataset(np.array([], dtype=object), "1", "case names"),
+               "labels": Dataset(np.array(["a", "b"], dtype=object), "1", "labels")}
+    path = write_results(tmp_path / "empty.h5", "demo", [], "", summary)
+    with h5py.File(path) as f:
+        assert f["summary/names"].shape == (0,)
+        assert [v.decode() for v in f["summary/labels"][()]] == ["a", "b"]

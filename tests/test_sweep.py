@@ -36,6 +36,11 @@ def failing_case(name: str, scene) -> CaseResult:
     return simulate_scene_case(name, scene)
 
 
+
+def failing_case_with(name: str, scene, constants) -> CaseResult:
+    """:func:`failing_case` with bound ``constants`` (unused)."""
+    return failing_case(name, scene)
+
 def crashing_case(name: str, scene) -> CaseResult:
     """Kills its worker process for the case named ``crash`` (as a segfault would)."""
     if name == "crash":
@@ -122,6 +127,34 @@ def test_bad_names_and_schedulers_are_refused(tmp_path):
     with pytest.raises(FlexError, match="workers"):
         make_executor("serial", workers=0)
 
+
+
+def test_a_case_function_no_worker_can_receive_is_refused_before_any_case(tmp_path):
+    # make calibrate bound a mappingproxy (the FFRF rule's mesh constants): every case failed
+    # in its worker ("cannot pickle 'mappingproxy' object") and was kept as a failed case
+    from functools import partial
+    from types import MappingProxyType
+
+    unsendable = partial(failing_case_with, constants=MappingProxyType({"a": 1.0}))
+    with pytest.raises(FlexError, match="cannot be sent to a worker process.*mappingproxy"):
+        run_sweep(_scenes(), tmp_path, unsendable, workers=2, progress=False)
+    assert not any(tmp_path.rglob("*.h5"))  # nothing kept
+    sendable = partial(failing_case_with, constants={"a": 1.0})
+    outcome = run_sweep({"a30": _rigid(30.0)}, tmp_path, sendable, workers=2, progress=False)
+    assert outcome.results["a30"].status == "ok"
+
+
+def test_the_calibrate_studys_case_function_can_be_sent_to_a_worker():
+    import pickle
+    from functools import partial
+
+    import studies.calibrate as calibrate
+    from flex.config.ffrf_rule import rule_constants
+    from flex.experiments.fitting.calibration import measure_case
+
+    # as studies/calibrate.py binds it
+    pickle.dumps(partial(measure_case, repeats=calibrate.REPEATS, cache_dir=None,
+                         mesh_rule=dict(rule_constants()["mesh"])))
 
 def test_local_process_pool_survives_a_crashing_worker(tmp_path):
     scenes = {**_scenes(), "crash": _rigid(35.0)}

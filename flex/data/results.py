@@ -194,7 +194,10 @@ def _fsync_folder(folder: Path) -> None:
 
 def _write_dataset(group, path: str, dataset: Dataset) -> None:
     data = np.asarray(dataset.data)
-    if data.dtype.kind in "US":
+    # text columns: numpy strings, or objects that are all str (an empty column included:
+    # h5py cannot guess the type of an empty object array)
+    if data.dtype.kind in "US" or (data.dtype.kind == "O"
+                                   and all(isinstance(v, str) for v in data.ravel())):
         data = data.astype(object)
         created = group.create_dataset(path, data=data, dtype=_string_dtype())
     elif dataset.compress:

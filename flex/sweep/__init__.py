@@ -41,6 +41,7 @@ environment's
 
 from __future__ import annotations
 
+import pickle
 import re
 import sys
 import time
@@ -252,6 +253,9 @@ def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
     problem = folder_problem(case_path(folder, "case").parent)
     if problem:  # refused before any case runs: no case could be kept
         raise SWEEP_CASES.error(folder, problem)
+    if not (isinstance(executor, SerialExecutor) if executor is not None
+            else scheduler == "serial"):  # the cases run in other processes
+        _check_sendable(case_function)
     digests = {name: case_hash(scene, case_function) for name, scene in scenes.items()}
     results = _resumable(scenes, folder, digests, retry_failed)
     own_executor = executor is None
@@ -269,6 +273,18 @@ def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
     outcome.results = {name: results[name] for name in scenes if name in results}
     outcome.wall_time_s = time.perf_counter() - start
     return outcome
+
+
+def _check_sendable(case_function: CaseFunction) -> None:
+    """Refuse, before any case runs, a case function that cannot be sent to a worker process
+    (pickled): every case would fail alike and be kept as failed (``make calibrate`` bound
+    a ``mappingproxy`` and stored 56 failed cases in a second)."""
+    try:
+        pickle.dumps(case_function)
+    except Exception as exc:  # pickling raises TypeError, AttributeError, PicklingError...
+        raise FlexError(f"the sweep's case function {case_function!r} cannot be sent to a "
+                        f"worker process ({type(exc).__name__}: {exc}); bind plain values "
+                        f"(a dict, not a mappingproxy; module-level functions)") from None
 
 
 def _resumable(scenes: Mapping[str, Scene], folder: Path, digests: dict[str, str],
