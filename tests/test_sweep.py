@@ -41,6 +41,17 @@ def failing_case_with(name: str, scene, constants) -> CaseResult:
     """:func:`failing_case` with bound ``constants`` (unused)."""
     return failing_case(name, scene)
 
+def sleeping_case(pid_file: str, name: str, scene) -> CaseResult:
+    """Writes its worker's process id to ``pid_file`` and sleeps a minute (a long eigen-solve
+    that sees no signal)."""
+    import time
+
+    with open(pid_file, "w") as handle:
+        handle.write(str(os.getpid()))
+    time.sleep(60.0)
+    return simulate_scene_case(name, scene)
+
+
 def crashing_case(name: str, scene) -> CaseResult:
     """Kills its worker process for the case named ``crash`` (as a segfault would)."""
     if name == "crash":
@@ -334,3 +345,41 @@ def test_run_each_on_an_executor_gives_the_serial_results_in_order():
             assert (dataset.data == parallel[name].datasets[key].data).all(), key
     assert sorted(args[0] for args in seen) == sorted([*scenes, "done"])
     assert seen[-1] == ("done", 3, 3)
+
+
+def test_an_aborted_process_pool_leaves_no_worker_running(tmp_path):
+    # an interrupt ends a sweep with abort(): the workers are terminated, not joined (an
+    # interrupted make calibrate waited minutes for its workers' eigen-solves)
+    import time
+    from functools import partial
+
+    executor = make_executor(workers=1)
+    pid_file = tmp_path / "pid"
+    executor.submit(partial(sleeping_case, str(pid_file)), "slow", _rigid(30.0))
+    for _ in range(600):  # the worker has started its case
+        if pid_file.exists() and pid_file.read_text():
+            break
+        time.sleep(0.1)
+    pid = int(pid_file.read_text())
+    executor.abort()
+    with pytest.raises(ProcessLookupError):
+        os.kill(pid, 0)
+    executor.close()
+
+
+def test_an_interrupt_aborts_the_executor_of_a_case_loop():
+    from flex.base.caseloop import run_each
+
+    class Interrupted(SerialExecutor):
+        aborted = False
+
+        def wait_first(self, futures, timeout=None):
+            raise KeyboardInterrupt
+
+        def abort(self):
+            self.aborted = True
+
+    executor = Interrupted()
+    with pytest.raises(KeyboardInterrupt):
+        run_each({"a30": _rigid(30.0)}, simulate_scene_case, executor=executor)
+    assert executor.aborted

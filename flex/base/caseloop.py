@@ -3,7 +3,8 @@
 :func:`run_each` is the loop of a study's ``simulate_cases`` (:mod:`flex.study`): it calls
 ``progress(case, done, total)`` for each case and ``progress("done", total, total)`` at the
 end, the protocol of :func:`flex.study.progress_printer`. Given an ``executor`` (one of
-:mod:`flex.sweep`'s: ``submit(function, *args)`` and ``wait_first(futures, timeout)``; the
+:mod:`flex.sweep`'s: ``submit(function, *args)``, ``wait_first(futures, timeout)`` and
+``abort()``, called when an interrupt ends the loop; the
 study passes it in, this module sits below the sweep engine) the cases run in parallel, in
 jobs: the cases of one ``group`` key run one after the other in one job, in their order
 (cases that share a reduction: it is built once, as when they run in this process), and the
@@ -64,11 +65,15 @@ def _run_jobs(scenes: dict[str, Scene], run_one: Callable[[str, Scene], Any],
         ordered.sort(key=lambda cases: -sum(cost(name, scene) for name, scene in cases))
     pending = {executor.submit(run_job, run_one, cases): cases for cases in ordered}
     results: dict[str, Any] = {}
-    while pending:
-        for future in executor.wait_first(list(pending), timeout=None):
-            pending.pop(future)
-            for name, value in future.result():
-                if progress:
-                    progress(name, len(results), len(scenes))
-                results[name] = value
+    try:
+        while pending:
+            for future in executor.wait_first(list(pending), timeout=None):
+                pending.pop(future)
+                for name, value in future.result():
+                    if progress:
+                        progress(name, len(results), len(scenes))
+                    results[name] = value
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM: the running jobs are abandoned
+        executor.abort()
+        raise
     return results

@@ -265,6 +265,9 @@ def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
     try:
         run.submit_all(prepare, prepare_key)
         run.drain()
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM: the running cases are abandoned
+        executor.abort()
+        raise
     finally:
         run.bar.close()
         if own_executor:

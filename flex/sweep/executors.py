@@ -101,6 +101,10 @@ class Executor:
     def close(self) -> None:
         """Release workers (and the cluster, if this executor started one)."""
 
+    def abort(self) -> None:
+        """Stop at once (an interrupt): running work is abandoned, not waited for."""
+        self.close()
+
 
 class SerialExecutor(Executor):
     """Runs every submission at once, in this process."""
@@ -141,6 +145,19 @@ class ProcessExecutor(Executor):
 
     def close(self) -> None:
         self._pool.shutdown(wait=True, cancel_futures=True)
+
+    def abort(self) -> None:
+        """Cancel what waits and terminate the workers: a worker in a minutes-long eigen-solve
+        does not see a signal (an interrupted ``make calibrate`` said "terminated" and went on
+        for minutes, joining its workers). A new pool serves any later submission."""
+        import multiprocessing
+
+        self._pool.shutdown(wait=False, cancel_futures=True)
+        for child in multiprocessing.active_children():  # this process's workers
+            child.terminate()
+        for child in multiprocessing.active_children():
+            child.join(timeout=5.0)
+        self._pool = ProcessPoolExecutor(self.workers, mp_context=self._context)
 
 
 class DaskExecutor(Executor):
