@@ -375,3 +375,24 @@ def test_profile_times_flex_phases_and_reads_exudyn_shares():
     shares = {k: v for k, v in prof.items() if k.startswith("exudyn_")}
     assert len(shares) >= 3 and all(k.endswith("_percent") and 0 <= v <= 100
                                     for k, v in shares.items())
+
+
+def test_the_peak_error_is_read_on_the_headline_a_tolerance_applies_to():
+    from flex.base.errors import FlexError
+    from flex.experiments.workprecision.measurement import PEAK_HEADLINE
+    from flex.fidelity.headlines import BUILTIN_HEADLINES
+
+    assert BUILTIN_HEADLINES[PEAK_HEADLINE].certified  # what fidelity.tolerance certifies
+    time_s = np.linspace(0.0, 1.0, 101)
+    ringing = 1e-4 * np.sin(np.pi * time_s) + 2e-6 * np.sin(80 * np.pi * time_s)
+    angle = slider = np.zeros_like(time_s)
+    headline = Observables(time_s, angle, slider, ringing, headline_peak_m=1.0e-4)
+    raw = Observables(time_s, angle, slider, ringing)
+    assert headline.peak_m == 1.0e-4  # the headline, not the ripple's raw maximum
+    assert raw.peak_m == pytest.approx(peak_value(time_s, ringing))
+    reference = Reference("r", headline, Setting("r"), {}, 1e-3, 0.0)
+    assert reference.errors(Observables(time_s, angle, slider, ringing,
+                                        headline_peak_m=1.01e-4))[
+        "peak_deflection_relative"] == pytest.approx(0.01)
+    with pytest.raises(FlexError, match="not comparable"):
+        reference.errors(raw)  # a raw peak is never compared with a headline
