@@ -189,6 +189,22 @@ def test_a_diverged_setting_is_measured_as_failed(rigid_reference):
     assert not measurement.errors and math.isnan(measurement.error)
 
 
+
+def test_an_internal_error_in_one_setting_is_a_failed_measurement(rigid_reference,
+                                                                    monkeypatch):
+    # a bug in one setting's run (make tradeoff's "linear tets" once raised a RuntimeError)
+    # fails that setting, named, instead of ending the study with a traceback
+    import flex.experiments.workprecision.measurement as measurement_module
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("the remade mesh differs")
+
+    monkeypatch.setattr(measurement_module, "run_once", broken)
+    measurement = measure(load_scene(overrides=SHORT), Setting.of("h=1e-4", step_s=1e-4),
+                          rigid_reference)
+    assert measurement.status == "failed"
+    assert measurement.message == "internal error: RuntimeError: the remade mesh differs"
+
 def test_scipy_reference_is_a_setting_too(rigid_reference):
     base = load_scene(overrides=SHORT)
     loose = measure(base, Setting("scipy 1e-6", engine="scipy", rtol=1e-6, atol=1e-8),

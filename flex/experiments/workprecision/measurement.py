@@ -385,7 +385,10 @@ def measure(base: Scene, setting: Setting, reference: Reference, repeats: int = 
     """Run ``setting`` on ``base`` ``repeats`` times (once if the first run takes longer
     than :data:`REPEAT_LIMIT_S`) and measure it against ``reference``.
 
-    Never raises for a diverged or refused run: it comes back ``failed`` with the message.
+    Never raises for a diverged or refused run: it comes back ``failed`` with the message;
+    nor for an internal error of one setting, which comes back ``failed`` naming it (a long
+    study goes on with its other settings and exits as having failed cases: make tradeoff
+    once stopped with a traceback after minutes at one setting).
     """
     measurement = Measurement(setting)
     try:
@@ -400,6 +403,10 @@ def measure(base: Scene, setting: Setting, reference: Reference, repeats: int = 
         measurement.errors = reference.errors(observables)
     except FlexError as exc:
         measurement.status, measurement.message = "failed", str(exc)
+        return measurement
+    except Exception as exc:  # a bug in one setting's run: said, not lost with the others
+        measurement.status = "failed"
+        measurement.message = f"internal error: {type(exc).__name__}: {exc}"
         return measurement
     measurement.wall_times_s = walls
     measurement.wall_time_s = statistics.median(walls)
