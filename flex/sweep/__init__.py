@@ -253,13 +253,17 @@ def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
     problem = folder_problem(case_path(folder, "case").parent)
     if problem:  # refused before any case runs: no case could be kept
         raise SWEEP_CASES.error(folder, problem)
-    if not (isinstance(executor, SerialExecutor) if executor is not None
-            else scheduler == "serial"):  # the cases run in other processes
-        _check_sendable(case_function)
-    digests = {name: case_hash(scene, case_function) for name, scene in scenes.items()}
-    results = _resumable(scenes, folder, digests, retry_failed)
     own_executor = executor is None
     executor = executor or make_executor(scheduler, workers)
+    if executor.pickles:  # the cases run in other processes
+        try:
+            _check_sendable(case_function)
+        except FlexError:
+            if own_executor:
+                executor.close()
+            raise
+    digests = {name: case_hash(scene, case_function) for name, scene in scenes.items()}
+    results = _resumable(scenes, folder, digests, retry_failed)
     run = _SweepRun(scenes, folder, case_function, digests, results, executor, study,
                     progress)
     try:

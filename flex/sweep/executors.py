@@ -83,6 +83,8 @@ class Executor:
 
     description = "executor"
     workers = 1
+    #: submissions reach the workers pickled (a local process pool; Dask uses cloudpickle)
+    pickles = False
 
     def submit(self, function: Callable[..., Any], *args: Any) -> Any:
         raise NotImplementedError
@@ -121,6 +123,8 @@ class SerialExecutor(Executor):
 class ProcessExecutor(Executor):
     """``concurrent.futures.ProcessPoolExecutor`` with ``workers`` spawned processes."""
 
+    pickles = True
+
     def __init__(self, workers: int | None = None) -> None:
         import multiprocessing
 
@@ -153,7 +157,8 @@ class ProcessExecutor(Executor):
         import multiprocessing
 
         self._pool.shutdown(wait=False, cancel_futures=True)
-        for child in multiprocessing.active_children():  # this process's workers
+        # every child process of this (interrupted) process, the pool's workers among them
+        for child in multiprocessing.active_children():
             child.terminate()
         for child in multiprocessing.active_children():
             child.join(timeout=5.0)
