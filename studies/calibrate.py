@@ -50,15 +50,17 @@ def cases(scene: Scene) -> dict[str, Scene]:
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
     """One case per scene on the sweep engine (resumable; ``results/calibrate-cases``), one
     worker unless told otherwise: the grid's timings are what it measures."""
+    from contextlib import closing
+
     from flex.sweep import SweepSettings, make_executor, run_sweep
 
     settings = run.sweep or SweepSettings()
-    outcome = run_sweep(scenes, settings.folder or RESULTS_DIR / "calibrate-cases",
-                        partial(measure_case, repeats=REPEATS, cache_dir=run.cache_dir,
-                                mesh_rule=dict(rule_constants()["mesh"])),
-                        executor=make_executor(settings.scheduler, settings.workers or 1),
-                        retry_failed=settings.retry_failed, progress=settings.progress,
-                        study=NAME)
+    with closing(make_executor(settings.scheduler, settings.workers or 1)) as executor:
+        outcome = run_sweep(scenes, settings.folder or RESULTS_DIR / "calibrate-cases",
+                            partial(measure_case, repeats=REPEATS, cache_dir=run.cache_dir,
+                                    mesh_rule=dict(rule_constants()["mesh"])),
+                            executor=executor, retry_failed=settings.retry_failed,
+                            progress=settings.progress, study=NAME)
     run.notes.setdefault("sweep", {})["wall_time_s"] = outcome.wall_time_s
     return outcome.results
 

@@ -28,6 +28,7 @@ largest (governing) is fitted and held against the tolerance.
 
 from __future__ import annotations
 
+from contextlib import closing
 from pathlib import Path
 
 from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M
@@ -78,11 +79,12 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
     local processes, those of one crank plate together."""
     from flex.sweep import make_executor
 
-    runner = lawfit.SerialRunner("crank", NAME, len(scenes), run.progress,
-                                 cache_dir=run.cache_dir, executor=make_executor(),
-                                 group=crank.same_crank)
-    results, run.notes["analysis"] = crank.fit_then_validate(scenes, runner, CRITERION_PATH,
-                                                                run.cache_dir)
+    with closing(make_executor()) as executor:
+        runner = lawfit.SerialRunner("crank", NAME, len(scenes), run.progress,
+                                     cache_dir=run.cache_dir, executor=executor,
+                                     group=crank.same_crank)
+        results, run.notes["analysis"] = crank.fit_then_validate(
+            scenes, runner, CRITERION_PATH, run.cache_dir)
     return results
 
 

@@ -111,15 +111,18 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
     """The :mod:`flex.experiments.fitting.lawfit` pipeline on the sweep engine (``run.sweep``:
     where and how; None: a process pool on all cores, ``results/kfit-cases``); the criterion
     goes beside the case folder (``kfit-criterion.toml``)."""
+    from contextlib import closing
+
     from flex.sweep import SweepSettings, make_executor, run_sweep
 
     settings = run.sweep or SweepSettings()
     folder = settings.folder or RESULTS_DIR / "kfit-cases"
-    runner = lawfit.SweepRunner(run_sweep, make_executor(settings.scheduler, settings.workers),
-                                folder, kfit.sweep_phases(run.cache_dir), NAME,
-                                run.notes.setdefault("sweep", {}), settings.retry_failed,
-                                settings.progress)
-    results, run.notes["analysis"] = kfit_law.fit_then_validate(scenes, runner, folder)
+    with closing(make_executor(settings.scheduler, settings.workers)) as executor:
+        runner = lawfit.SweepRunner(run_sweep, executor, folder,
+                                    kfit.sweep_phases(run.cache_dir), NAME,
+                                    run.notes.setdefault("sweep", {}), settings.retry_failed,
+                                    settings.progress)
+        results, run.notes["analysis"] = kfit_law.fit_then_validate(scenes, runner, folder)
     return results
 
 
