@@ -40,3 +40,16 @@ def test_newton_variants_report_their_iterations_per_step(reduction_cache):
     assert full["newton_per_step"] < modified["newton_per_step"]
     assert all(math.isfinite(row["ms_per_step"]) and row["ms_per_step"] > 0
                for row in (modified, full))
+
+
+def test_make_all_is_timed_in_the_clone_that_holds_flex():
+    # make bench once ran "make all" inside flex/ (a fixed parents[2] gone stale when the
+    # module moved a folder deeper): "No rule to make target 'all'", nothing timed
+    from pathlib import Path
+
+    import flex
+    from flex.experiments.workprecision.benchmark import repository_root
+
+    root = repository_root()
+    assert root == Path(flex.__file__).resolve().parents[1]
+    assert "\nall: " in (root / "Makefile").read_text()

@@ -439,6 +439,17 @@ def bench_reduction(scene: Scene, say: Say, notes: dict[str, Any]) -> None:
         f"{statistics.median(cached):.3f} s")
 
 
+def repository_root() -> Path | None:
+    """The clone holding flex's package: the nearest folder above it with a ``Makefile`` and a
+    ``pyproject.toml`` (None for an installed flex). A fixed ``parents[k]`` went stale when
+    this module moved a folder deeper: make bench ran ``make all`` inside ``flex/`` ("No rule
+    to make target 'all'") and timed nothing."""
+    for folder in Path(__file__).resolve().parents:
+        if (folder / "Makefile").is_file() and (folder / "pyproject.toml").is_file():
+            return folder
+    return None
+
+
 def bench_make_all(say: Say, notes: dict[str, Any], run: bool = True) -> None:
     """``make all FORCE=1`` [s] in the repository holding flex, with an empty reduction cache
     (cold) and again with it filled (warm); skipped when not ``run`` (``FLEX_BENCH_MAKE=0``).
@@ -447,7 +458,11 @@ def bench_make_all(say: Say, notes: dict[str, Any], run: bool = True) -> None:
     if not run:
         notes["make_all"] = {"skipped": "FLEX_BENCH_MAKE=0"}
         return
-    root = Path(__file__).resolve().parents[2]
+    root = repository_root()
+    if root is None:
+        notes["make_all"] = {"skipped": "no Makefile above flex's package (an installed flex, "
+                                        "not a clone): make all cannot be timed"}
+        return
     subprocess.run(["make", "-s", "setup"], cwd=root, capture_output=True, check=False)
     out: dict[str, Any] = {}
     with tempfile.TemporaryDirectory() as folder:
@@ -462,6 +477,10 @@ def bench_make_all(say: Say, notes: dict[str, Any], run: bool = True) -> None:
             if done.returncode:
                 out[f"{label}_error"] = (done.stderr or done.stdout)[-400:]
     notes["make_all"] = out
+    failed = [label for label in ("cold", "warm") if out[f"{label}_returncode"]]
+    if failed:  # a failed case of the study (its exit status says so), not a table line only
+        raise FlexError(f"make all failed ({', '.join(failed)} reduction cache) in {root}: "
+                        f"{out[f'{failed[0]}_error'][-200:]}")
 
 
 def run_bench(scenes: Mapping[str, Scene], plan: BenchPlan, repeats: int,
