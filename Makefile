@@ -15,8 +15,9 @@ RUN := $(PY) -m flex run
 
 STUDIES := kinematics dynamics modal flexible spring wing crank kfit
 # long runs, not part of `all` (README "Speed and accuracy", "Numerical stability"). On 2
-# shared cores: tradeoff ~11 min with an empty reduction cache, stability ~10 min, bench ~23 min (it times `make all FORCE=1`
-# twice); `make all` itself takes about 5 min when every study reruns with an empty cache.
+# shared cores: tradeoff ~11 min with an empty reduction cache, stability ~6-10 min, bench
+# ~14 min (it times `make all FORCE=1` twice); `make all` itself takes about 5-6 min when
+# every study reruns with an empty cache.
 # `flex run stability` exits 0 when exactly its runs built to diverge fail.
 LONG := tradeoff stability bench estimates calibrate design validation ladder spring_mass
 
