@@ -93,7 +93,8 @@ def evidence_datasets(prefix: str, evidence: Mapping[str, Mapping[str, Any]]
     return {
         f"{prefix}/coarsening": Dataset(
             np.array(names, dtype=object), "1",
-            "knob sequence (three levels) or one-level coarsening of the reference"),
+            "knob sequence (three levels), one-level coarsening of the reference, or its model "
+            "term (a reference on another model: that model's own error bound)"),
         f"{prefix}/error": Dataset(
             np.array([evidence[n]["error"] for n in names]), "1",
             "estimated contribution to the reference's relative error (Richardson with "
@@ -137,7 +138,8 @@ def reference_datasets(group: str, reference: Reference, reference_time_s: float
         f"{prefix}/wall_time": Dataset(reference.wall_time_s, "s",
                                        "reference integration time"),
         f"{prefix}/accuracy": Dataset(reference.accuracy, "1",
-                                      "largest relative change under one-level coarsening"),
+                                      "estimated relative error: the sum of its evidence "
+                                      "(knob estimates and, if any, its model term)"),
         f"{prefix}/tolerance": Dataset(reference.tolerance, "1", "claimed relative accuracy"),
         f"{prefix}/converged": Dataset(reference.converged, "1", "accuracy <= tolerance")}
     if reference.flexible:
