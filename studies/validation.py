@@ -6,7 +6,8 @@ Crank 0.15 m at 150 rad/s, steel rod 0.3 m x 8 x 8 mm, slider 0.075552 kg, no gr
 damping. Runs: flex's rigid rod (against the closed form), flex's default FFRF rod (chord
 frame, geometric stiffness) under step, mode and mesh refinement, the linear FFRF rod, the
 nonlinear FE rod at two steps (the reference), and the independent two-mode model
-(:mod:`flex.dynamics.ivp_crank`) with the published settings and one change at a time. What
+(:mod:`flex.experiments.models.ivp_crank`) with the published settings and one change at a time.
+What
 each comparison means: :mod:`flex.experiments.models.validation`, docs/validation.md.
 """
 

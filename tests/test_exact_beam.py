@@ -25,12 +25,13 @@ import pytest
 import flex
 from flex.base import physics
 from flex.base.errors import SceneError
-from flex.bodies.beams import SHEAR_CORRECTION_RECTANGLE, Material, timoshenko_bending_rad_per_s
+from flex.base.physics import SHEAR_CORRECTION_RECTANGLE
 from flex.bodies.exact_beam import (
     add_exact_beam_link,
     exact_beam_section,
     section_stress_peaks,
 )
+from flex.experiments.thesis.beams import Material, timoshenko_bending_rad_per_s
 from flex.fidelity.headlines import BUILTIN_HEADLINES
 from flex.fidelity.softening import first_peak_index
 

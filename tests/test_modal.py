@@ -1,7 +1,9 @@
-"""Tests of the modal modules: beam theory (flex.bodies.beams), mode classification and 3D FE modes
-(flex.bodies.fe_modes), BEAM188 emulation (flex.bodies.beam_elements), mesh selection
-(flex.bodies.mesh_convergence)
-and the thesis's tables (flex.bodies.thesis_tables).
+"""Tests of the modal modules: beam theory (flex.experiments.thesis.beams), mode classification
+and 3D FE modes
+(flex.experiments.thesis.fe_modes), BEAM188 emulation (flex.experiments.thesis.beam_elements),
+mesh selection
+(flex.experiments.thesis.mesh_convergence)
+and the thesis's tables (flex.experiments.thesis.thesis_tables).
 
 The FE tests use meshes of at most ~10k DOF (about 1 s each on one core); the full Table 5
 and a mesh-convergence run are marked slow.
@@ -17,9 +19,9 @@ import pytest
 
 os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
 
-from flex.base import thesis  # noqa: E402
+from flex.base import physics, thesis  # noqa: E402
 from flex.base.errors import SceneError  # noqa: E402
-from flex.bodies import (  # noqa: E402
+from flex.experiments.thesis import (  # noqa: E402
     beam_elements,
     beams,
     fe_modes,
@@ -66,15 +68,15 @@ def test_euler_bernoulli_wave_numbers_match_tables(end_condition, expected):
 
 def test_rectangle_torsion_constant():
     side_m = 0.01
-    assert beams.rectangle_torsion_constant_m4(side_m, side_m) == pytest.approx(
+    assert physics.checked_rectangle_torsion_constant_m4(side_m, side_m) == pytest.approx(
         0.1406 * side_m**4, rel=1e-3)
     # Thin strip: J -> a b^3 / 3 (1 - 0.630 b / a).
     long_m, short_m = 0.1, 0.001
-    assert beams.rectangle_torsion_constant_m4(short_m, long_m) == pytest.approx(
+    assert physics.checked_rectangle_torsion_constant_m4(short_m, long_m) == pytest.approx(
         long_m * short_m**3 / 3 * (1 - 0.630 * short_m / long_m), rel=1e-3)
 
 
-@pytest.mark.parametrize("end_condition", beams.BEAM_END_CONDITIONS)
+@pytest.mark.parametrize("end_condition", physics.BEAM_END_CONDITIONS)
 def test_timoshenko_without_shear_and_rotary_inertia_is_euler_bernoulli(end_condition):
     args = (COUPLER_LENGTH_M, 0.01, WIDTH_M, end_condition, 5)
     reduced = beams.timoshenko_bending_rad_per_s(*args, rotary_inertia=False,

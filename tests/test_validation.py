@@ -3,7 +3,7 @@ published matrices and reference values, flex's rigid rod against the closed for
 
 Published values: Mazzia & Magherini, *Test Set for IVP Solvers* (Bari), problem "crank",
 crank.f (B. Simeon): the matrix formulas of its RESMBS and the reference solution SOLN at
-t = 0.1 s (:data:`flex.dynamics.ivp_crank.PUBLISHED_AT_0P1S`).
+t = 0.1 s (:data:`flex.experiments.models.ivp_crank.PUBLISHED_AT_0P1S`).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import pytest
 
 from flex.base.kinematics import constant_speed_motion
 from flex.data.scene import load_scene
-from flex.dynamics import ivp_crank
+from flex.experiments.models import ivp_crank
 from flex.experiments.models import validation
 from flex.fidelity.simulation import simulate
 

@@ -1,13 +1,14 @@
 """A plate link as a planar geometrically exact beam (Simo and Reissner, with shear).
 
-The link is the rectangular plate of :mod:`flex.bodies.beams` (length L along x, thickness t
+The link is the rectangular plate of :mod:`flex.experiments.thesis.beams` (length L along x,
+thickness t
 in the mechanism plane, the height of its in-plane bending, width w out of it), modelled as
 ``elements`` two-node ``ObjectBeamGeometricallyExact2D`` elements of Exudyn (Simo and Vu-Quoc:
 axial, shear and bending strain of large displacements and rotations, one integration point;
 ``NodeRigidBody2D`` nodes: x, y and the cross-section's rotation, in the plane z = 0). Its
 section (:func:`exact_beam_section`) is that of the plate: axial stiffness E A, bending
 stiffness E I (I = w t^3 / 12), shear stiffness kappa G A (kappa: the rectangle's Timoshenko
-shear correction :data:`flex.bodies.beams.SHEAR_CORRECTION_RECTANGLE`), mass rho A and rotary
+shear correction :data:`flex.base.physics.SHEAR_CORRECTION_RECTANGLE`), mass rho A and rotary
 inertia rho I per length.
 
 :func:`add_exact_beam_link` adds the beam to an Exudyn system between two joint points with
@@ -30,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from flex.base import physics
-from flex.bodies.beams import SHEAR_CORRECTION_RECTANGLE, check_positive, rectangle_section
+from flex.base.physics import SHEAR_CORRECTION_RECTANGLE, check_positive, rectangle_section
 from flex.data.results import Dataset
 
 #: fibres across the section's height at which the von Mises stress is evaluated (odd: the

@@ -1,14 +1,14 @@
 """Validation against the IVP test set's flexible slider-crank ("crank"): the ``validation``
 study's scenes, independent two-mode runs, comparisons, report and figures.
 
-The benchmark (:mod:`flex.dynamics.ivp_crank`: source, parameters, published values) is a
+The benchmark (:mod:`flex.experiments.models.ivp_crank`: source, parameters, published values) is a
 steel rod 0.3 m x 8 x 8 mm on a 0.15 m crank turned at 150 rad/s, slider 0.075552 kg, no
 gravity, undamped. Three kinds of runs meet here:
 
 - the published reference values at t = 0.1 s (crank.f SOLN), from the published initial
   state, which starts the rod "close to smooth motion" (deflected, with the velocities of
   the quasi-static response);
-- :func:`flex.dynamics.ivp_crank.solve`, an independent implementation of the published
+- :func:`flex.experiments.models.ivp_crank.solve`, an independent implementation of the published
   two-mode model (same matrices, derived here from the shape functions): it must reproduce
   the published values, and it runs the variants that isolate each modelling choice;
 - flex's Exudyn runs: a rigid rod (against the closed form,
@@ -49,8 +49,8 @@ from flex.base.physics import euler_buckling_load_N, pinned_pinned_omega
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, derived_scenes
 from flex.data.tables import table_datasets
-from flex.dynamics import ivp_crank
-from flex.dynamics.ivp_crank import (
+from flex.experiments.models import ivp_crank
+from flex.experiments.models.ivp_crank import (
     PUBLISHED_AT_0P1S,
     PUBLISHED_PI,
     PUBLISHED_TIME_S,
@@ -110,7 +110,7 @@ def flex_cases(scene: Scene, runs: dict[str, tuple[str, float, int, float, bool]
 #: the bending coordinates only, no foreshortening pull on the axial ones; ``tangent_frame``:
 #: the strain of a rod linear elastic in a frame tangent at B, as flex's FFRF rod;
 #: ``tangent_frame_geometric``: that plus the geometric stiffness in that frame, as flex's FFRF
-#: rod with ``coupler.geometric_stiffness``, :mod:`flex.dynamics.ivp_crank`)
+#: rod with ``coupler.geometric_stiffness``, :mod:`flex.experiments.models.ivp_crank`)
 TWO_MODE_RUNS: dict[str, tuple[int, int, float, str, str, float]] = {
     "published": (2, 0, 15.0, "none", "published", PUBLISHED_PI),
     "published_mass_fixed": (2, 0, 1.0, "none", "published", math.pi),
@@ -274,7 +274,7 @@ def _published(solutions: dict[str, CrankSolution]) -> tuple[list[str], dict[str
         "published/value": Dataset(PUBLISHED_AT_0P1S[index], "SI (see component)",
                                    "crank.f SOLN at t = 0.1 s"),
         "published/independent": Dataset(published[index], "SI (see component)",
-                                         "flex.dynamics.ivp_crank, published settings"),
+                                         "flex.experiments.models.ivp_crank, published settings"),
         "published/relative_difference": Dataset(relative, "1", "|independent - published| "
                                                  "/ |published|")})
     consistent, published_mass = (first_axial_frequency_hz(f) for f in (1.0, 15.0))
@@ -435,7 +435,8 @@ def first_mode_geometric_stiffness_per_N(bench: CrankBenchmark = BENCH,
     """Generalized stiffness [1/m] that 1 N of uniform axial tension adds to the first
     pinned-pinned bending mode ``v = a sin(pi x / L)``: with the true strain of the axis
     ``u' + v'^2 / 2`` (``pi^2 / (2 L)``) and with the strain of a rod linear elastic in a
-    frame tangent to it at B, flex's FFRF rod (``-pi^2 / L``, :func:`flex.dynamics.ivp_crank.
+    frame tangent to it at B, flex's FFRF rod (``-pi^2 / L``,
+    :func:`flex.experiments.models.ivp_crank.
     tangent_frame_membrane_force`). By finite difference at ``amplitude_m`` [m]."""
     rod = ivp_crank.rod_matrices(bench, 2)
     strain = 1e-6

@@ -2,11 +2,14 @@
 and draws.
 
 :func:`survey` computes, for the scene's coupler material: Table 5 in both period conventions
-and Tables 7 and 9 with flex's reading of them (:mod:`flex.bodies.thesis_tables`); the first five
+and Tables 7 and 9 with flex's reading of them (:mod:`flex.experiments.thesis.thesis_tables`); the
+first five
 modes of each Table 5 coupler plate and of the crank, free-free and pinned-pinned, by 3D FE
-(:mod:`flex.bodies.fe_modes`) beside the Timoshenko beam (:mod:`flex.bodies.beams`), each
+(:mod:`flex.experiments.thesis.fe_modes`) beside the Timoshenko beam
+(:mod:`flex.experiments.thesis.beams`), each
 classified; and
-the mesh convergence of each Table 5 plate (:mod:`flex.bodies.mesh_convergence`). It returns the
+the mesh convergence of each Table 5 plate (:mod:`flex.experiments.thesis.mesh_convergence`). It
+returns the
 datasets stored under ``/summary`` (units from the keys: ``_m``, ``_s``, ``_Hz``,
 ``_rad_per_s``) and the report. :func:`draw_figures` draws them back from those datasets.
 """
@@ -22,16 +25,16 @@ import numpy as np
 
 from flex.base.physics import Plate
 from flex.base.thesis import THESIS_TABLE5
-from flex.bodies.beams import Material, beam_link_modes
-from flex.bodies.fe_modes import plate_modes
-from flex.bodies.mesh_convergence import mesh_convergence
-from flex.bodies.thesis_tables import (
+from flex.data.results import Dataset
+from flex.experiments.thesis.beams import Material, beam_link_modes
+from flex.experiments.thesis.fe_modes import plate_modes
+from flex.experiments.thesis.mesh_convergence import mesh_convergence
+from flex.experiments.thesis.thesis_tables import (
     TABLE5_FE_MESH_SIZES_M,
     THESIS_LINKS,
     thesis_link_modal_reproduction,
     thesis_table5_reproduction,
 )
-from flex.data.results import Dataset
 
 CONVERGENCE_TOLERANCE = 0.001
 """Relative tolerance of the production mesh, on the first pinned-pinned in-plane frequency."""

@@ -2,7 +2,8 @@
 
 :func:`select_production_mesh` (pure: no FE) estimates the converged frequency by Richardson
 extrapolation and picks the coarsest mesh within a relative tolerance;
-:func:`mesh_convergence` refines a plate's mesh (:func:`flex.bodies.fe_modes.plate_modes`) and
+:func:`mesh_convergence` refines a plate's mesh
+(:func:`flex.experiments.thesis.fe_modes.plate_modes`) and
 applies it. Sizes in m, frequencies in Hz (or any one unit), times in s.
 """
 
@@ -15,16 +16,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.bodies.beams import (
+from flex.base.physics import check_positive
+from flex.experiments.thesis.beams import (
     LINK_BOUNDARY_CONDITIONS,
     MODE_KINDS,
     THESIS_STEEL,
     Material,
     brent_root,
     check_choice,
-    check_positive,
 )
-from flex.bodies.fe_modes import plate_modes
+from flex.experiments.thesis.fe_modes import plate_modes
 
 
 @dataclass(frozen=True)
@@ -101,7 +102,8 @@ class MeshConvergence:
 
     Arrays (n_levels,): ``mesh_sizes_m`` (m), ``element_counts``, ``dof_counts``,
     ``frequencies_Hz`` (Hz, first mode of ``mode_kind``), ``wall_times_s`` (s, whole
-    :func:`flex.bodies.fe_modes.plate_modes` call), ``cpu_times_s`` (s, process CPU time of the
+    :func:`flex.experiments.thesis.fe_modes.plate_modes` call), ``cpu_times_s`` (s, process CPU
+    time of the
     call).
     ``selection``: :class:`MeshSelection`. ``production_mesh_size_m``: the selected size (m),
     or None. ``mode_kind`` and ``boundary_condition`` as requested.

@@ -4,7 +4,8 @@
 ANSYS documents BEAM188 with its default KEYOPT(3) = 0 (ANSYS Theory Reference, BEAM188):
 linear interpolation of the three displacements and three rotations, stiffness integrated with
 one point along the length (reduced integration: no shear locking), consistent mass with
-rotary (rho I) and torsional (rho I_p) inertia. Axes as :mod:`flex.bodies.beams` (x along the link,
+rotary (rho I) and torsional (rho I_p) inertia. Axes as :mod:`flex.experiments.thesis.beams` (x
+along the link,
 thickness along y, width along z); SI units throughout, frequencies in rad/s and Hz.
 """
 
@@ -15,16 +16,14 @@ import math
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.bodies.beams import (
+from flex.base.physics import SHEAR_CORRECTION_RECTANGLE, check_positive, rectangle_section
+from flex.experiments.thesis.beams import (
     LINK_BOUNDARY_CONDITIONS,
-    SHEAR_CORRECTION_RECTANGLE,
     THESIS_STEEL,
     BeamLinkModes,
     Material,
     check_choice,
     check_count,
-    check_positive,
-    rectangle_section,
     weak_plane_bending_rad_per_s,
 )
 
@@ -143,8 +142,10 @@ def beam_element_modes(length_m: float, thickness_m: float, width_m: float,
     length (m) along x. ``boundary_condition`` from :data:`LINK_BOUNDARY_CONDITIONS`: the end
     nodes have x, y, z translations and rotations about x and y fixed, rotation about z free;
     pinned-roller frees x at the last node. ``torsion_constant_m4`` overrides the series value
-    of :func:`flex.bodies.beams.rectangle_torsion_constant_m4`. Free-free: the six rigid modes are
-    skipped. Returns :class:`flex.bodies.beams.BeamLinkModes`; kinds from the kinetic-energy shares
+    of :func:`flex.experiments.thesis.beams.rectangle_torsion_constant_m4`. Free-free: the six
+    rigid modes are
+    skipped. Returns :class:`flex.experiments.thesis.beams.BeamLinkModes`; kinds from the
+    kinetic-energy shares
     of ux (axial), uy (in-plane bending), uz (out-of-plane bending) and rot_x (torsion);
     ``mode_orders`` counts within each kind.
     """

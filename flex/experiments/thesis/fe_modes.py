@@ -5,8 +5,8 @@ y across the thickness t, in the mechanism plane; z across the width) with tetra
 order 2, assembles stiffness K and consistent mass M of linear elasticity, and returns the
 lowest elastic modes as :class:`PlateModes`. All quantities are SI (m, kg, Pa, s); circular
 frequencies in rad/s, cyclic ones in Hz. Kinds and link boundary conditions are those of
-:mod:`flex.bodies.beams` (:data:`~flex.bodies.beams.MODE_KINDS`,
-:data:`~flex.bodies.beams.LINK_BOUNDARY_CONDITIONS`).
+:mod:`flex.experiments.thesis.beams` (:data:`~flex.experiments.thesis.beams.MODE_KINDS`,
+:data:`~flex.experiments.thesis.beams.LINK_BOUNDARY_CONDITIONS`).
 
 Method: the generalized eigenproblem K phi = omega^2 M phi is solved by Lanczos (ARPACK,
 ``scipy.sparse.linalg.eigsh``) in shift-invert mode about a negative shift
@@ -54,14 +54,14 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.bodies.beams import (
+from flex.base.physics import check_positive
+from flex.experiments.thesis.beams import (
     LINK_BOUNDARY_CONDITIONS,
     MODE_KINDS,
     THESIS_STEEL,
     Material,
     check_choice,
     check_count,
-    check_positive,
     weak_plane_bending_rad_per_s,
 )
 

@@ -17,15 +17,17 @@ Link boundary conditions (:data:`LINK_BOUNDARY_CONDITIONS`):
 
 - ``"free-free"``: unsupported; the six rigid-body modes are skipped.
 - ``"pinned-pinned"``: the coupler between its two revolute joints; each end rotates freely
-  about the z axis through its centre (:func:`flex.bodies.fe_modes.plate_modes` says how the 3D
+  about the z axis through its centre (:func:`flex.experiments.thesis.fe_modes.plate_modes` says
+  how the 3D
   model imposes it and why it is the simply supported end of in-plane bending).
 - ``"pinned-roller"``: as pinned-pinned, but ``end_b`` may slide along x (the textbook simply
   supported beam: pin and roller). Bending and torsion are those of pinned-pinned; the axial
   modes become fixed-free. This is the support that reproduces the thesis's ANSYS Tables 7
-  and 9 (:func:`flex.bodies.thesis_tables.thesis_link_modal_reproduction`).
+  and 9 (:func:`flex.experiments.thesis.thesis_tables.thesis_link_modal_reproduction`).
 
-The 3D finite-element modes are in :mod:`flex.bodies.fe_modes`, the BEAM188 emulation in
-:mod:`flex.bodies.beam_elements`, the thesis's Tables 5, 7, 9 in :mod:`flex.bodies.thesis_tables`.
+The 3D finite-element modes are in :mod:`flex.experiments.thesis.fe_modes`, the BEAM188 emulation in
+:mod:`flex.experiments.thesis.beam_elements`, the thesis's Tables 5, 7, 9 in
+:mod:`flex.experiments.thesis.thesis_tables`.
 """
 
 from __future__ import annotations
@@ -38,7 +40,12 @@ import numpy as np
 
 from flex.base import physics
 from flex.base.errors import SceneError
-from flex.base.physics import BEAM_END_CONDITIONS  # noqa: F401 - part of this module's face
+from flex.base.physics import (
+    BEAM_END_CONDITIONS,
+    SHEAR_CORRECTION_RECTANGLE,
+    check_positive,
+    rectangle_section,
+)
 from flex.base.thesis import THESIS_DENSITY_KG_PER_M3, THESIS_YOUNGS_MODULUS_PA
 
 # ---------------------------------------------------------------------------------------------
@@ -47,18 +54,13 @@ from flex.base.thesis import THESIS_DENSITY_KG_PER_M3, THESIS_YOUNGS_MODULUS_PA
 
 MODE_KINDS: tuple[str, ...] = ("axial", "in-plane bending", "out-of-plane bending", "torsion")
 """Kinds of link modes; also the column order of
-:attr:`flex.bodies.fe_modes.PlateModes.kind_shares`."""
+:attr:`flex.experiments.thesis.fe_modes.PlateModes.kind_shares`."""
 
 LINK_BOUNDARY_CONDITIONS: tuple[str, ...] = ("free-free", "pinned-pinned", "pinned-roller")
 """Boundary conditions of a whole link (3D FE model and :func:`beam_link_modes`)."""
 
 ROD_END_CONDITIONS: tuple[str, ...] = ("free-free", "fixed-fixed", "fixed-free")
 """End conditions of axial and torsional (rod) vibration."""
-
-SHEAR_CORRECTION_RECTANGLE = 5.0 / 6.0
-"""Timoshenko shear correction factor of a rectangular cross-section (Poisson-independent
-textbook value; Cowper's 10(1+nu)/(12+11 nu) = 0.850 at nu = 0.3 would raise the Timoshenko
-frequencies slightly)."""
 
 
 @dataclass(frozen=True)
@@ -102,14 +104,6 @@ does not state Poisson's ratio; nu = 0.3 is our assumption (it enters only throu
 deformation, torsion and 3D effects)."""
 
 
-def check_positive(**sizes: float) -> None:
-    """Raise :class:`SceneError` unless every value is a positive finite number."""
-    for name, value in sizes.items():
-        if not (isinstance(value, int | float | np.floating | np.integer) and value > 0
-                and math.isfinite(value)):
-            raise SceneError(f"{name} = {value!r}: must be a positive finite number")
-
-
 def check_choice(name: str, value: str, accepted: Sequence[str]) -> None:
     """Raise :class:`SceneError` unless ``value`` is one of ``accepted``."""
     if value not in accepted:
@@ -126,50 +120,6 @@ def check_count(name: str, value: int, maximum: int = 200) -> None:
 # ---------------------------------------------------------------------------------------------
 # Beam theory
 # ---------------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class RectangleSection:
-    """Section properties of a solid rectangle.
-
-    ``height_m`` is the side along the bending displacement considered (for in-plane bending of
-    the plate links: the thickness t, along y), ``width_m`` the other side. Attributes in SI:
-    area (m^2), second moment about the axis parallel to the width (m^4), second moment about
-    the other axis (m^4), polar moment of area (m^4) and St-Venant torsion constant (m^4).
-    """
-
-    height_m: float
-    width_m: float
-    area_m2: float
-    second_moment_m4: float
-    second_moment_other_m4: float
-    polar_moment_m4: float
-    torsion_constant_m4: float
-
-
-def rectangle_torsion_constant_m4(height_m: float, width_m: float, series_terms: int = 50
-                                  ) -> float:
-    """St-Venant torsion constant J of a solid rectangle, m^4: the series of
-    :func:`flex.base.physics.rectangle_torsion_constant_m4` (Timoshenko & Goodier), sizes checked.
-    """
-    check_positive(height_m=height_m, width_m=width_m)
-    return physics.rectangle_torsion_constant_m4(height_m, width_m, series_terms)
-
-
-def rectangle_section(height_m: float, width_m: float) -> RectangleSection:
-    """Area, second moments, polar moment and torsion constant of a height x width rectangle.
-
-    Inputs in m; see :class:`RectangleSection` for the outputs and their units.
-    """
-    check_positive(height_m=height_m, width_m=width_m)
-    area_m2 = height_m * width_m
-    second_moment_m4 = width_m * height_m**3 / 12.0
-    second_moment_other_m4 = height_m * width_m**3 / 12.0
-    return RectangleSection(
-        height_m=height_m, width_m=width_m, area_m2=area_m2,
-        second_moment_m4=second_moment_m4, second_moment_other_m4=second_moment_other_m4,
-        polar_moment_m4=physics.rectangle_polar_moment_m4(height_m, width_m),
-        torsion_constant_m4=rectangle_torsion_constant_m4(height_m, width_m))
 
 
 def brent_root(function, lower: float, upper: float) -> float:
@@ -422,7 +372,8 @@ def beam_link_modes(length_m: float, thickness_m: float, width_m: float,
                     shear_correction: float = SHEAR_CORRECTION_RECTANGLE) -> BeamLinkModes:
     """The first ``mode_count`` modes of a rectangular link from beam and rod theory.
 
-    The link's counterpart of :func:`flex.bodies.fe_modes.plate_modes`: thickness (m) along y
+    The link's counterpart of :func:`flex.experiments.thesis.fe_modes.plate_modes`: thickness (m)
+    along y
     (in-plane bending height), width (m) along z. ``boundary_condition`` from
     :data:`LINK_BOUNDARY_CONDITIONS`: free-free uses free ends for every kind; pinned-pinned
     (revolute joints about z) uses pinned in-plane bending, clamped out-of-plane bending,

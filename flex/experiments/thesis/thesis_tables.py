@@ -1,7 +1,8 @@
 """The thesis's modal tables recomputed: Table 5 (four plate couplers, the rigid-or-flexible
 number n = delta_t / T in both period conventions) and Tables 7 and 9 (ANSYS BEAM188 crank and
-coupler frequencies) beside beam theory (:mod:`flex.bodies.beams`), the BEAM188 emulation
-(:mod:`flex.bodies.beam_elements`) and 3D FE (:mod:`flex.bodies.fe_modes`).
+coupler frequencies) beside beam theory (:mod:`flex.experiments.thesis.beams`), the BEAM188
+emulation
+(:mod:`flex.experiments.thesis.beam_elements`) and 3D FE (:mod:`flex.experiments.thesis.fe_modes`).
 
 Cavezza (2012), *Flexibility and Transient Dynamic Analysis of a Slider-Crank Deployment
 Mechanism* (West Virginia University, MS thesis), sections 6.2-6.3; its published values are in
@@ -17,6 +18,7 @@ import numpy as np
 
 from flex.base import physics
 from flex.base.errors import SceneError
+from flex.base.physics import check_positive
 from flex.base.thesis import (
     THESIS_COUPLER_LENGTH_M,
     THESIS_CRANK_LENGTH_M,
@@ -29,17 +31,16 @@ from flex.base.thesis import (
     THESIS_TABLE7_CRANK,
     THESIS_TABLE9_COUPLER,
 )
-from flex.bodies.beam_elements import beam_element_modes
-from flex.bodies.beams import (
+from flex.experiments.thesis.beam_elements import beam_element_modes
+from flex.experiments.thesis.beams import (
     THESIS_STEEL,
     Material,
     beam_link_modes,
     check_choice,
-    check_positive,
     euler_bernoulli_bending_rad_per_s,
     timoshenko_bending_rad_per_s,
 )
-from flex.bodies.fe_modes import plate_modes
+from flex.experiments.thesis.fe_modes import plate_modes
 
 DEPLOYMENT_TIME_S = THESIS_DELTA_T_S
 """Deployment time delta_t of the thesis's criterion, s
@@ -51,7 +52,8 @@ THESIS_K_CRITERION = int(THESIS_K)
 
 TABLE5_FE_MESH_SIZES_M: tuple[float, ...] = (0.002, 0.003, 0.0025, 0.0035)
 """Production netgen maxh (m) of the four Table 5 plates, t = 1, 3, 5, 10 mm, from
-:func:`flex.bodies.mesh_convergence.mesh_convergence` (pinned-pinned, first in-plane bending): each
+:func:`flex.experiments.thesis.mesh_convergence.mesh_convergence` (pinned-pinned, first in-plane
+bending): each
 lies within 0.05 % of the Richardson-extrapolated (or finest) frequency and costs at most
 ~10k DOF."""
 
