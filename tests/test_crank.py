@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from flex.base.errors import SceneError
+from flex.base.physics import pinned_pinned_omega
 from flex.data.scene import load_scene
 from flex.fidelity.auto import crank_elastic_omega, decide_links
-from flex.fidelity.criteria import pinned_pinned_omega
 from flex.fidelity.simulation import simulate
 
 PLATE = ['crank.geometry="plate"', "simulation.step_s=2e-5", "simulation.end_time_s=0.01"]

@@ -241,7 +241,7 @@ def test_a_linear_ffrf_run_counts_its_distance_to_the_default_body(reduction_cac
     """geometric_stiffness = false: the model term adds the difference to the default body,
     so it exceeds the default body's own bound on the deflection."""
     from flex.api import load_scene
-    from flex.fidelity.criteria import GEOMETRIC_FFRF_ERROR
+    from flex.config.ladder import GEOMETRIC_FFRF_ERROR
     from flex.fidelity.error_budget import budget_rows
     from flex.fidelity.simulation import simulate
 

@@ -43,7 +43,7 @@ from flex.cli import main
 from flex.config.settings import pinned_overrides
 from flex.data.results import read_case, write_results
 from flex.data.scene import load_scene, to_toml
-from flex.dynamics.solver import reduction_for_scene
+from flex.dynamics.link_models import reduction_for_scene
 
 # a coarse 5 mm plate (maxh 5 mm, 4 modes), 2 ms at the rigid 1e-5 s step, a sample per
 # 1e-4 s: 21 samples

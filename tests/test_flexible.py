@@ -174,7 +174,7 @@ def test_deflection_converges_under_mode_refinement(tmp_path):
 
 def test_nonlinear_plate_has_the_reductions_mesh_and_node_sets(reduction_cache):
     from flex.bodies.nonlinear import build_nonlinear_plate
-    from flex.dynamics.solver import reduction_for_scene
+    from flex.dynamics.link_models import reduction_for_scene
 
     plate = build_nonlinear_plate(Plate(**COARSE_PLATE), COARSE_MESH_M)
     # the stiff-limit test's steel plate: the reduction comes from the cache

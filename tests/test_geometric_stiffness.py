@@ -263,12 +263,12 @@ def test_deployment_peak_matches_the_nonlinear_fe_coupler(reduction_cache):
 
 
 def test_the_ladder_takes_ffrf_when_its_model_error_meets_the_tolerance():
-    from flex.fidelity.criteria import (
+    from flex.config.ladder import (
         GEOMETRIC_FFRF_ERROR,
         LINEAR_FFRF_ERROR_FLOOR,
         LINEAR_FFRF_ERROR_PER_LOAD,
-        flexible_rung,
     )
+    from flex.fidelity.criteria import flexible_rung
 
     load_ratio = 0.1  # the rigid probe's compression / Euler load
     linear = LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio

@@ -22,8 +22,9 @@ from hostile import check_refused, run_cli
 
 from flex.base.progress import Progress, duration_text, heartbeat
 from flex.config.settings import tolerance_beyond_reach
+from flex.data.plates import estimate_mesh, modes_cost_factor
 from flex.data.results import CaseResult, Dataset, write_results
-from flex.data.scene import estimate_mesh, load_scene, modes_cost_factor
+from flex.data.scene import load_scene
 
 PLATE = ['coupler.geometry="plate"', 'coupler.model="ffrf"']
 
@@ -103,7 +104,7 @@ def test_a_deployment_not_completed_is_not_an_answer(target, value):
 
 # --- cost estimates and progress ------------------------------------------------------------
 def test_a_reduction_to_many_modes_is_estimated_and_announced(capsys):
-    from flex.dynamics.solver import announce_mesh
+    from flex.dynamics.link_models import announce_mesh
 
     few = estimate_mesh(0.08, 0.001, 0.01, 0.002, 6).build_time_s
     many = estimate_mesh(0.08, 0.001, 0.01, 0.002, 100).build_time_s

@@ -24,14 +24,10 @@ from hostile import check_refused, run_cli
 
 from flex.base.errors import SceneError, SimulationError
 from flex.config.usage import explicit_keys, unused_keys
+from flex.data.plates import estimate_mesh
 from flex.data.results import CaseResult, Dataset, write_results
-from flex.data.scene import SCHEMA, estimate_mesh, load_scene
-from flex.dynamics.solver import (
-    VALIDITY_WARNING,
-    check_finite,
-    divergence_advice,
-    validity_warning,
-)
+from flex.data.scene import SCHEMA, load_scene
+from flex.dynamics.advice import VALIDITY_WARNING, check_finite, divergence_advice, validity_warning
 from flex.fidelity.auto import check as check_runnable
 from flex.fidelity.simulation import simulate_case
 

@@ -31,10 +31,11 @@ import pytest
 from flex.base.errors import SceneError
 from flex.config.settings import resolve_solver_settings
 from flex.data.scene import load_scene
+from flex.dynamics.collect import collect
 from flex.dynamics.mechanism import build_mechanism
 from flex.dynamics.planar import is_planar
 from flex.dynamics.reference import solve_reference
-from flex.dynamics.solver import collect, run
+from flex.dynamics.solver import run
 
 #: position-level agreement of the two builds [m, rad] (module docstring)
 DQ = 1e-12

@@ -394,8 +394,10 @@ def test_fewest_joint_markers_give_the_motion_of_all_face_nodes(reduction, cache
     of the cheap markers equals the all-node markers' to the Newton tolerance (1e-5 of each
     curve's range; measured up to ~4e-8 for positions and forces, ~2e-6 for accelerations)."""
     from flex.data.scene import apply_overrides, default_scene
+    from flex.dynamics.collect import collect
+    from flex.dynamics.link_models import reduction_for_scene
     from flex.dynamics.mechanism import build_mechanism
-    from flex.dynamics.solver import collect, reduction_for_scene, run
+    from flex.dynamics.solver import run
 
     scene = apply_overrides(default_scene(), [
         f'{link}.geometry="plate"', f'{link}.model="ffrf"', f"{link}.thickness_m={THICKNESS}",

@@ -6,7 +6,8 @@ import sys
 import pytest
 
 from flex.base.errors import SceneError
-from flex.data.scene import SCHEMA, load_scene, plate_mass_properties, to_toml
+from flex.data.plates import plate_mass_properties
+from flex.data.scene import SCHEMA, load_scene, to_toml
 
 
 def test_default_scene_is_the_thesis_parameter_set():

@@ -112,8 +112,8 @@ def test_chain_conserves_energy_in_both_builds(planar):
 
 def test_three_dimensional_build_matches_planar():
     """The 3D build (rigid bodies, exact joints) gives the planar build's chain run."""
+    from flex.dynamics.collect import collect
     from flex.dynamics.mechanism import build_mechanism
-    from flex.dynamics.solver import collect
     from flex.dynamics.solver import run as solve
 
     scene = resolve(load_scene(None, chain(3, "simulation.end_time_s=0.01",

@@ -15,8 +15,7 @@ import pytest
 
 from flex.base.kinematics import constant_speed_motion
 from flex.data.scene import load_scene
-from flex.experiments.models import ivp_crank
-from flex.experiments.models import validation
+from flex.experiments.models import ivp_crank, validation
 from flex.fidelity.simulation import simulate
 
 BENCH = ivp_crank.CrankBenchmark()
@@ -217,7 +216,7 @@ def test_ffrf_rod_chord_is_its_frame_axis(reduction_cache):
     # flex's FFRF rod (chord frame, 2 modes, 10 ms): C stays on the frame's x axis, so the
     # chord B-C changes by the frame-x stretch u_C alone (the frame-y displacement of C is 0)
     from flex.bodies.geometric_stiffness import face_mean_displacement
-    from flex.dynamics.solver import reduction_for_scene
+    from flex.dynamics.link_models import reduction_for_scene
 
     scene = load_scene(overrides=validation.benchmark_overrides() + [
         'coupler.model="ffrf"', "coupler.mesh_size_m=0.008", "coupler.modes=2",

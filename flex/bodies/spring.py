@@ -20,10 +20,9 @@ from typing import Literal
 
 from flex.base.errors import SceneError
 from flex.base.physics import TWO_PI, n_values, spring_end_mass_wave_numbers
-from flex.base.thesis import (  # noqa: F401 - part of this module's face
+from flex.base.thesis import (
     THESIS_ACTIVE_COILS,
     THESIS_ANGLE_MAX_TIME_S,
-    THESIS_COMPRESSION_M,
     THESIS_DELTA_T_S,
     THESIS_FREE_LENGTH_M,
     THESIS_K,

@@ -43,7 +43,8 @@ from typing import Any
 
 from flex.base.physics import Plate
 from flex.config.calibration import Calibration, calibration_of
-from flex.data.scene import LINKS, MESH_ASPECT_LIMIT, plate_mass_properties
+from flex.data.plates import MESH_ASPECT_LIMIT, plate_mass_properties
+from flex.data.scene import AUTO, LINKS
 
 #: steps per first bending period the rule chooses from (make calibrate's grid)
 STEP_GRID = (4, 8, 16, 32, 64, 128)
@@ -51,7 +52,7 @@ STEP_GRID = (4, 8, 16, 32, 64, 128)
 MODE_GRID = (1, 2, 4, 8)
 #: scene keys of a link the rule may fill when they are ``"auto"``
 LINK_KEYS = ("modes", "mesh_size_m")
-AUTO = "auto"
+
 
 
 def rule_constants(calibration: Calibration | None = None) -> Mapping[str, Any]:
@@ -82,7 +83,7 @@ def first_period_s(link: Mapping[str, Any]) -> float:
 def rule_mesh_size_m(link: Mapping[str, Any], mesh: Mapping[str, float] | None = None,
                      calibration: Calibration | None = None) -> float:
     """Element size [m] the rule gives a plate link: ``min(MESH_PER_THICKNESS t, L /
-    MESH_PER_LENGTH)``, and at most :data:`flex.data.scene.MESH_ASPECT_LIMIT` x the plate's
+    MESH_PER_LENGTH)``, and at most :data:`flex.data.plates.MESH_ASPECT_LIMIT` x the plate's
     smaller side (the elements' aspect limit the scene checks). ``mesh``: the constants
     ``per_thickness`` and ``per_length`` (default: ``calibration``'s)."""
     mesh = rule_constants(calibration)["mesh"] if mesh is None else mesh

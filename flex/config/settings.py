@@ -41,22 +41,22 @@ from typing import Any
 from flex.base.errors import SceneError
 from flex.config.calibration import Calibration, calibration_of
 from flex.config.ffrf_rule import LINK_KEYS, RulePick, fill_link_keys, pick, rule_constants
+from flex.data.plates import EXACT_BEAM_ELEMENTS
 from flex.data.scene import (
+    AUTO,
     BUILTIN_LINK_SCHEMAS,
-    EXACT_BEAM_ELEMENTS,
     LINKS,
     Scene,
-    check_drive_steps,
     check_meshed_plate,
-    check_steps,
     link_model,
     meshes,
     model_names,
 )
+from flex.data.steps import check_drive_steps, check_steps
 
 #: the ``[simulation]`` keys that may be ``"auto"``
 AUTO_KEYS = ("step_s", "spectral_radius", "newton", "newton_relative_tolerance")
-AUTO = "auto"
+
 #: the ``--set`` pairs that leave every solver key to flex (what the bundled scene does)
 AUTO_OVERRIDES = tuple((f"simulation.{key}", AUTO) for key in AUTO_KEYS)
 #: what an uncertified flexible scene runs with, and what is known of it

@@ -21,6 +21,7 @@ from typing import Any
 
 from flex.config.settings import reads_tolerance
 from flex.data.scene import (
+    AUTO,
     BUILTIN_LINK_SCHEMAS,
     LINKS,
     Scene,
@@ -32,7 +33,6 @@ from flex.data.scene import (
     read_source,
 )
 
-AUTO = "auto"
 #: plate keys of a link beyond the mass-giving ones
 _PLATE_MASS = ("thickness_m", "width_m", "density_kg_per_m3")
 _PLATE_ELASTIC = ("youngs_modulus_Pa", "poisson_ratio", "modes", "mode_selection",

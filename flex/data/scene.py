@@ -30,26 +30,14 @@ from typing import Any
 import tomli_w
 
 from flex.base.errors import SceneError
-from flex.data.plates import (  # noqa: F401 - the names callers import from here
-    ESTIMATE_MODES,
+from flex.data.plates import (
     EXACT_BEAM_ELEMENTS,
-    MESH_ASPECT_LIMIT,
-    MESH_MEMORY_LIMIT_BYTES,
-    PLATE_SLENDERNESS_LIMIT,
-    PLATE_STUBBINESS_LIMIT,
-    MeshEstimate,
     check_beam_plate,
     check_damping_model,
-    estimate_mesh,
-    modes_cost_factor,
-    plate_mass_properties,
 )
 from flex.data.plates import check_meshed_plate as _check_meshed_plate
 from flex.data.plates import meshed_plate as _meshed_plate
-from flex.data.steps import (  # noqa: F401 - the names callers import from here
-    MAX_CRANK_TURN_PER_SAMPLE_RAD,
-    MAX_CRANK_TURN_PER_STEP_RAD,
-    MAX_STEPS,
+from flex.data.steps import (
     check_drive_steps,
     check_steps,
 )
@@ -482,7 +470,7 @@ def validate(scene: Scene, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
 
 
 def _check_value(name: str, field: Field, value: Any) -> None:
-    if field.auto and value == "auto":
+    if field.auto and value == AUTO:
         return
     if isinstance(field.kind, tuple):
         if not isinstance(value, str) or value not in field.kind:
@@ -553,7 +541,7 @@ def _check_geometry(scene: Scene, link_models: Mapping[str, Any]) -> None:
         raise SceneError('crank.model = "auto" needs drive.kind = "spring": auto analyses the '
                          "crank as a flexible plate in the mechanism, and a flexible crank needs "
                          f"the spring drive; accepted with a constant-speed drive: {rigid_cranks}")
-    if scene["drive"]["spring_model"] == "auto" and scene["drive"]["kind"] != "spring":
+    if scene["drive"]["spring_model"] == AUTO and scene["drive"]["kind"] != "spring":
         raise SceneError('drive.spring_model = "auto" needs drive.kind = "spring" (a '
                          "constant-speed drive has no spring to choose a model for); "
                          'accepted: "massless" or "chain"')
@@ -585,7 +573,7 @@ def _check_link(link: str, values: dict[str, Any], link_models: Mapping[str, Any
     if meshes(link, values, link_models) and values["geometry"] != "plate":
         raise SceneError(f'{link}.model = "{model}" needs {link}.geometry = "plate" (the '
                          "flexible body is meshed from the plate's dimensions)")
-    if model == "auto" and values["geometry"] != "plate" and link == "coupler":
+    if model == AUTO and values["geometry"] != "plate" and link == "coupler":
         raise SceneError('coupler.model = "auto" needs coupler.geometry = "plate" (the '
                          "criterion needs the plate's bending frequency; a lumped coupler has "
                          'no stiffness): use coupler.model = "rigid" for a lumped coupler')

@@ -12,8 +12,9 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SimulationError
+from flex.data.plates import plate_mass_properties
 from flex.data.results import Dataset
-from flex.data.scene import LINKS, Scene, model_names, plate_mass_properties, quoted
+from flex.data.scene import LINKS, Scene, model_names, quoted
 from flex.dynamics.builder import Mechanism
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 
@@ -111,7 +112,7 @@ def mechanism_mass_at_slider(scene: Scene) -> float:
     angle (away from the dead centres, where the slider stops and m_eff is infinite).
     """
     from flex.base.kinematics import slider_crank
-    from flex.dynamics.mechanism import wing_mass_properties
+    from flex.dynamics.builder import wing_mass_properties
 
     l1, l2 = scene["crank"]["length_m"], scene["coupler"]["length_m"]
     theta = np.linspace(-np.pi, np.pi, 721)

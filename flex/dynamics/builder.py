@@ -18,7 +18,8 @@ import numpy as np
 from flex.base.errors import SceneError
 from flex.base.kinematics import crank_pin, slider_crank
 from flex.base.physics import cuboid_inertia_kgm2, cuboid_mass_kg
-from flex.data.scene import Scene, plate_mass_properties
+from flex.data.plates import plate_mass_properties
+from flex.data.scene import AUTO, Scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel, entries
 
 os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")
@@ -113,7 +114,7 @@ class SpringChain:
 def spring_chain(scene: Scene) -> SpringChain | None:
     """The scene's :class:`SpringChain`, or None for a massless spring or no spring."""
     drive = scene["drive"]
-    if drive["kind"] == "spring" and drive["spring_model"] == "auto":
+    if drive["kind"] == "spring" and drive["spring_model"] == AUTO:
         raise SceneError('drive.spring_model = "auto" must be resolved before building '
                          "(flex.fidelity.simulation.simulate does it with "
                          "flex.fidelity.auto.resolve)")
@@ -477,7 +478,7 @@ class Builder:
                                                            output), **item)
 
     def add_sensors(self) -> None:
-        """What :func:`flex.dynamics.solver.collect` reads: bodies, joints, markers, energies."""
+        """What :func:`flex.dynamics.collect.collect` reads: bodies, joints, markers, energies."""
         if self.wing_joint is not None:
             for output in ("Velocity", "Rotation", "AngularVelocity", "AngularAcceleration"):
                 self.add(f"wing.{output}",

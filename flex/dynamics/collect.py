@@ -14,10 +14,9 @@ import numpy as np
 from flex.data.results import Dataset
 from flex.dynamics import planar
 from flex.dynamics.builder import Mechanism
-from flex.dynamics.link_outputs import (  # noqa: F401 - stress_window_m: re-exported
+from flex.dynamics.link_outputs import (
     elastic_datasets,
     sensor_data,
-    stress_window_m,
 )
 
 

@@ -99,6 +99,7 @@ from flex.config.ladder import (
     Rung,
     ffrf_rung,
 )
+from flex.data.plates import estimate_mesh, plate_mass_properties
 from flex.data.results import Dataset
 from flex.data.scene import (
     AUTO,
@@ -107,9 +108,7 @@ from flex.data.scene import (
     LinkSchema,
     Scene,
     check_meshed_plate,
-    estimate_mesh,
     link_model,
-    plate_mass_properties,
 )
 from flex.dynamics.exact_beam_link import (
     add_exact_beam,
@@ -119,17 +118,15 @@ from flex.dynamics.exact_beam_link import (
     exact_beam_step_cost_s,
     prepare_beam,
 )
-from flex.dynamics.link_outputs import (  # noqa: F401 - the names callers import from here
+from flex.dynamics.link_outputs import (
     NO_MOTION,
     NODAL_MOTION,
     RIGID_MOTION,
     MotionReader,
-    elastic_datasets,
     flexible_datasets,
     flexible_sensors,
     modal_motion,
     sensor_data,
-    stress_window_m,
 )
 
 #: the built-in models' names (for code that sets a model in a scene)
@@ -302,7 +299,7 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
     from flex.bodies.reduction import build_reduction
 
     c = scene[link]
-    if "auto" in (c["modes"], c["mesh_size_m"]):
+    if AUTO in (c["modes"], c["mesh_size_m"]):
         raise ValueError(f'{link}: resolve its "auto" modes and mesh first '
                          f"(flex.fidelity.auto.resolve, flex.config.settings.resolve_link_keys)")
     check_meshed_plate(link, dict(c, model=FFRF))  # refused before any meshing

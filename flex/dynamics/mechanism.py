@@ -30,13 +30,9 @@ from typing import Any
 
 from flex.base.errors import SceneError
 from flex.data.scene import Scene
-from flex.dynamics.builder import (  # noqa: F401 - the names callers import from here
+from flex.dynamics.builder import (
     Builder,
-    InitialConfiguration,
     Mechanism,
-    initial_configuration,
-    rotation_z,
-    wing_mass_properties,
 )
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel, entries
 from flex.dynamics.planar import PlanarBuilder, is_planar

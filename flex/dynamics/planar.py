@@ -18,7 +18,7 @@ Used automatically (:func:`flex.dynamics.mechanism.build_mechanism`) where the s
 nothing 3D (:func:`is_planar`). The drive (spring or constant speed), the welded wing and
 the sensor names are those of the 3D builder, which this one extends; the joint loads are
 read by their own rules (:func:`joint_forces`, :func:`weld_loads`), so that
-:func:`flex.dynamics.solver.collect` gives the same datasets (names, units, signs, frames).
+:func:`flex.dynamics.collect.collect` gives the same datasets (names, units, signs, frames).
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from flex.data.scene import LINKS, Scene, link_model
+from flex.data.scene import AUTO, LINKS, Scene, link_model
 from flex.dynamics.builder import Builder, Mechanism, slider_mass_kg
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 
@@ -40,7 +40,7 @@ def is_planar(scene: Scene, link_models: Mapping[str, Any] = BUILTIN_LINK_MODELS
     implicit integrator (``explicit_penalty`` keeps its 3D penalty joints, whose out-of-plane
     coordinate constraints the explicit solvers eliminate).
     """
-    return (all(scene[link]["model"] != "auto"
+    return (all(scene[link]["model"] != AUTO
                 and link_model(link, scene[link], link_models).rigid for link in LINKS)
             and scene["simulation"]["integrator"] != "explicit_penalty")
 

@@ -30,7 +30,8 @@ from flex.base.errors import SimulationError
 from flex.base.kinematics import crank_pin, slider_crank
 from flex.base.physics import cuboid_inertia_kgm2, cuboid_mass_kg
 from flex.config.settings import resolved_simulation
-from flex.data.scene import Scene, plate_mass_properties
+from flex.data.plates import plate_mass_properties
+from flex.data.scene import Scene
 
 
 @dataclass

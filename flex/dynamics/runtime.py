@@ -18,10 +18,8 @@ from typing import Any
 
 from flex.base.progress import Progress, duration_text
 from flex.data.scene import Scene
-from flex.dynamics.link_models import (  # noqa: F401 - the names callers import from here
+from flex.dynamics.link_models import (
     BUILTIN_LINK_MODELS,
-    STEP_COST_FFRF_S,
-    STEP_COST_NONLINEAR_FE_PER_DOF_S,
     LinkModel,
     entries,
 )

@@ -51,36 +51,25 @@ from flex.base.interrupts import interrupts_not_swallowed
 from flex.base.progress import heartbeat
 from flex.config.settings import check_concrete
 from flex.data.results import CaseResult, Dataset
-from flex.data.scene import LINKS, Scene, to_toml
-from flex.dynamics.advice import (  # noqa: F401 - the names callers import from here
+from flex.data.scene import Scene, to_toml
+from flex.dynamics.advice import (
     CHANNEL_ATTR,
-    CONSTRAINT_NORM_LIMIT_M,
-    EXTREME_FACTOR,
-    FFRF_DEFLECTION_LIMIT,
-    STEPS_PER_PERIOD,
     VALIDITY_WARNING,
     channel_cutoff_Hz,
     channel_datasets,
     check_finite,
     divergence_advice,
-    extreme_inputs,
-    mechanism_mass_at_slider,
     mechanism_reductions,
-    time_scales,
     validity_warning,
 )
-from flex.dynamics.collect import collect, stress_window_m  # noqa: F401 - re-exported
-from flex.dynamics.link_models import (  # noqa: F401 - the names callers import from here
+from flex.dynamics.builder import Mechanism
+from flex.dynamics.collect import collect
+from flex.dynamics.link_models import (
     BUILTIN_LINK_MODELS,
-    NONLINEAR_FE_NEWTON_ABSOLUTE_TOLERANCE,
-    NONLINEAR_FE_SOLVER,
     LinkModel,
-    announce_mesh,
     entries,
-    highest_retained_omega,
-    reduction_for_scene,
 )
-from flex.dynamics.mechanism import Mechanism, build_mechanism, rotation_z
+from flex.dynamics.mechanism import build_mechanism
 from flex.dynamics.runtime import SolverOutput, announce_integration
 
 
@@ -317,6 +306,5 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     return result
 
 
-__all__ = ["integrate", "solver_settings", "run", "collect", "rotation_z",
-           "divergence_advice", "time_scales", "validity_warning", "VALIDITY_WARNING",
-           "reduction_for_scene", "scene_reductions", "LINKS"]
+__all__ = ["integrate", "solver_settings", "run", "run_profiled", "scene_reductions",
+           "flexible_link_attrs"]

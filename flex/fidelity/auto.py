@@ -53,14 +53,8 @@ from flex.config.settings import (
     resolve_link_keys,
     resolve_solver_settings,
 )
-from flex.data.scene import (
-    EXACT_BEAM_ELEMENTS,
-    LINKS,
-    Scene,
-    check_meshed_plate,
-    model_names,
-    to_toml,
-)
+from flex.data.plates import EXACT_BEAM_ELEMENTS
+from flex.data.scene import LINKS, Scene, check_meshed_plate, model_names, to_toml
 from flex.dynamics.link_models import (
     BUILTIN_LINK_MODELS,
     FFRF,
@@ -310,8 +304,8 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]], *,
     """
     import copy
 
+    from flex.dynamics.link_models import reduction_for_scene
     from flex.dynamics.mechanism import build_mechanism
-    from flex.dynamics.solver import reduction_for_scene
 
     analysis = copy.deepcopy({k: dict(v) for k, v in scene.items()})
     analysis["coupler"]["model"] = RIGID
@@ -381,8 +375,8 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
 
     resolved = copy.deepcopy({k: dict(v) for k, v in scene.items()})
     coupler, crank = resolved["coupler"], resolved.get("crank", {})
-    wants_coupler = coupler.get("model") == "auto"
-    wants_crank = crank.get("model") == "auto"
+    wants_coupler = coupler.get("model") == AUTO
+    wants_crank = crank.get("model") == AUTO
     decisions: list[FidelityDecision] = []
     if not (wants_coupler or wants_crank):
         return resolved, decisions
@@ -417,7 +411,7 @@ def _mode_cut(decision: FidelityDecision, resolved: dict[str, dict[str, Any]], l
     """An ``ffrf`` decision keeps every estimated mode below omega_cut = k / delta_t; a link
     whose ``modes`` is ``"auto"`` gets the tolerance rule's instead (:mod:`flex.config.
     ffrf_rule`, with the mesh and the step)."""
-    if resolved[link]["modes"] == "auto":
+    if resolved[link]["modes"] == AUTO:
         from flex.config.ffrf_rule import fill_link_keys
 
         decision.modes = fill_link_keys(resolved, link, decision.tolerance,

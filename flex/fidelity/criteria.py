@@ -26,27 +26,15 @@ from typing import Any
 import numpy as np
 
 from flex.base.kinematics import chord_components
-from flex.base.physics import (  # noqa: F401 - part of this module's face
-    IN_PLANE_KINDS,
+from flex.base.physics import (
     TWO_PI,
     Plate,
-    clamped_plate_frequencies,
-    euler_buckling_load_N,
-    n_values,
-    pinned_pinned_omega,
-    plate_thickness_for_mass_m,
 )
-from flex.base.thesis import (  # noqa: F401 - part of this module's face
+from flex.base.thesis import (
     THESIS_DELTA_T_S,  # thesis sec. 6.2, Table 5 note (source not stated)
-    THESIS_K,  # thesis sec. 6.2, in the thesis convention (n = delta_t * omega)
-    THESIS_YOUNGS_MODULUS_PA,
-)
-from flex.config.ladder import (  # noqa: F401 - the measured bounds, part of this face
-    FFRF_MOTION_ERROR_FRACTION,
+    )
+from flex.config.ladder import (
     FFRF_RUNG,
-    GEOMETRIC_FFRF_ERROR,
-    LINEAR_FFRF_ERROR_FLOOR,
-    LINEAR_FFRF_ERROR_PER_LOAD,
     LINEAR_FFRF_RUNG,
 )
 from flex.dynamics.link_models import FFRF, NONLINEAR_FE

@@ -372,7 +372,7 @@ def error_budget(scene: Scene, result: CaseResult,
                  headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> ErrorBudget:
     """The error budget of ``result``, the run of ``scene`` (concrete models, solver keys
     resolved), from companion runs made by ``run_companion`` (see the module doc);
-    ``time_scales``: the scene's (:func:`flex.dynamics.solver.time_scales`);
+    ``time_scales``: the scene's (:func:`flex.dynamics.advice.time_scales`);
     ``link_models``: the registry of its link models (their flags and rungs choose the
     terms); ``headlines``: the quantities budgeted (:mod:`flex.fidelity.headlines`)."""
     values = {name: headline.read(result.datasets) for name, headline in headlines.items()}

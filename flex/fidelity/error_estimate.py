@@ -21,7 +21,7 @@ then be observed) -- and returns an :class:`ErrorEstimate`:
 - ``bounds``: the quantities whose value is such a bound, each with its observed order;
 - ``method``: that sentence, with the companions' steps;
 - ``validity``: ``"asymptotic"`` when every time scale of the scene
-  (:func:`flex.dynamics.solver.time_scales`: the spring or crank period, the highest
+  (:func:`flex.dynamics.advice.time_scales`: the spring or crank period, the highest
   retained mode of each flexible link) has at least :data:`MIN_STEPS_PER_PERIOD` steps per
   period at the run's step; otherwise the sentence names the time scales below it, and the
   quantities whose observed order left the window;
@@ -140,7 +140,7 @@ def estimate_step_error(scene: Scene, result: CaseResult,
                         headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> ErrorEstimate:
     """The estimated step error of ``result``, the run of ``scene`` (concrete models, solver
     keys resolved), from finer companion runs made by ``run_companion`` (see the module
-    doc). ``time_scales``: the scene's (:func:`flex.dynamics.solver.time_scales`);
+    doc). ``time_scales``: the scene's (:func:`flex.dynamics.advice.time_scales`);
     ``headlines``: the quantities estimated (:mod:`flex.fidelity.headlines`)."""
     sim = scene["simulation"]
     step = float(sim["step_s"])

@@ -22,7 +22,8 @@ import numpy as np
 from flex.base.errors import SceneError
 from flex.config.calibration import Calibration
 from flex.config.settings import solver_defaults
-from flex.data.scene import MAX_STEPS
+from flex.data.scene import AUTO
+from flex.data.steps import MAX_STEPS
 from flex.dynamics.link_models import RIGID
 from flex.fidelity.criteria import PRIMARY_DELTA_T, deployment_times
 
@@ -88,7 +89,7 @@ def probe_scene(scene: Mapping[str, Mapping[str, Any]], end_time_s: float | None
         end = min(end, math.pi / speed)
     rigid_entry = solver_defaults(calibration)["rigid"]
     step = scene["simulation"]["step_s"]
-    step = min(float(rigid_entry["step_s"] if step == "auto" else step), PROBE_MAX_STEP_S,
+    step = min(float(rigid_entry["step_s"] if step == AUTO else step), PROBE_MAX_STEP_S,
                end / PROBE_SAMPLES)
     if end / step > MAX_STEPS:  # the message of a scene's end time (check: end_time_s None)
         raise SceneError(f"simulation.end_time_s = {scene['simulation']['end_time_s']:g}: "
@@ -98,7 +99,7 @@ def probe_scene(scene: Mapping[str, Mapping[str, Any]], end_time_s: float | None
                          f"{MAX_STEPS * step:.3g})")
     rigid["simulation"].update(end_time_s=end, step_s=step, output_step_s=0.0)
     for key in ("spectral_radius", "newton", "newton_relative_tolerance"):
-        if rigid["simulation"][key] == "auto":  # the probe's links are rigid
+        if rigid["simulation"][key] == AUTO:  # the probe's links are rigid
             rigid["simulation"][key] = rigid_entry[key]
     return rigid
 

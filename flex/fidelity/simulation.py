@@ -29,8 +29,9 @@ from flex.config.calibration import Calibration
 from flex.config.settings import tolerance_beyond_reach
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, to_toml
+from flex.dynamics.advice import VALIDITY_WARNING, time_scales
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
-from flex.dynamics.solver import VALIDITY_WARNING, integrate, scene_reductions, time_scales
+from flex.dynamics.solver import integrate, scene_reductions
 from flex.fidelity.auto import Resolution, resolve
 from flex.fidelity.error_budget import STEP_BOUNDS_ATTR, error_budget, named_quantities
 from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline

@@ -95,7 +95,7 @@ def motion_error_fractions(ffrf: dict[str, np.ndarray], rigid: dict[str, np.ndar
                            reference: dict[str, np.ndarray], samples: int) -> dict[str, float]:
     """|FFRF - reference| / |FFRF - rigid twin| of each :data:`MOTION` quantity over the
     reference's ``samples``: the FFRF body's model error as a fraction of what the
-    elasticity changes (what :data:`flex.fidelity.criteria.FFRF_MOTION_ERROR_FRACTION`
+    elasticity changes (what :data:`flex.config.ladder.FFRF_MOTION_ERROR_FRACTION`
     bounds)."""
     out = {}
     for name, (path, how) in MOTION.items():

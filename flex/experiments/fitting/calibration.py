@@ -51,7 +51,7 @@ from flex.config.ffrf_rule import (
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
 from flex.data.tables import table_datasets
-from flex.dynamics.solver import FFRF_DEFLECTION_LIMIT
+from flex.dynamics.advice import FFRF_DEFLECTION_LIMIT
 from flex.experiments.workprecision.coupler_reference import (
     LEVELS,
     Progress,
@@ -207,7 +207,7 @@ def robustly_within(table: Mapping[str, np.ndarray], bound: float) -> np.ndarray
 
 def within_linear_validity(case: CaseResult) -> bool:
     """Whether the reference's peak deflection stays within the linear FFRF body's validity
-    (:data:`flex.dynamics.solver.FFRF_DEFLECTION_LIMIT` of the length): beyond it the
+    (:data:`flex.dynamics.advice.FFRF_DEFLECTION_LIMIT` of the length): beyond it the
     discretization of a model that no longer holds is not what the rule should follow."""
     length = coupler_of(case)["length_m"]
     return case.attrs["reference_peak_deflection_m"] <= FFRF_DEFLECTION_LIMIT * length

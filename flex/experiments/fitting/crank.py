@@ -24,18 +24,14 @@ from typing import Any
 import numpy as np
 
 from flex.base.caseloop import run_each
+from flex.base.physics import n_values
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
 from flex.experiments.fitting import lawfit
 from flex.experiments.fitting.lawfit import REPORT_TOLERANCES, Validation, case_data
 from flex.fidelity.auto import crank_elastic_omega
-from flex.fidelity.criteria import (
-    DELTA_T_DEFINITIONS,
-    GOVERNING,
-    deployment_times,
-    n_values,
-)
+from flex.fidelity.criteria import DELTA_T_DEFINITIONS, GOVERNING, deployment_times
 from flex.fidelity.laws import (
     errors_against_full,
     load_criterion,

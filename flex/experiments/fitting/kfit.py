@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from flex.base.physics import Plate
+from flex.base.physics import TWO_PI, Plate, n_values
 from flex.base.thesis import THESIS_ANGLE_MAX_TIME_S
 from flex.base.thesis import THESIS_COMPRESSION_M as THESIS_PRELOAD_M  # sec. 6.1
 from flex.base.thesis import THESIS_SPRING_RATE_N_PER_M as THESIS_SPRING_N_PER_M  # Table 2
@@ -53,10 +53,8 @@ from flex.fidelity.criteria import (
     DELTA_T_DEFINITIONS,
     EULER_LOAD_LIMIT,
     MEASURES,
-    TWO_PI,
     deployment_times,
     error_measures,
-    n_values,
     quasi_static_stress,
 )
 from flex.fidelity.predictor import predict_deflection

@@ -16,7 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from flex.base.thesis import THESIS_DELTA_T_S
+from flex.base.physics import TWO_PI
+from flex.base.thesis import THESIS_DELTA_T_S, THESIS_K
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.experiments.fitting import lawfit
@@ -28,8 +29,6 @@ from flex.fidelity.criteria import (
     GOVERNING,
     MEASURES,
     PRIMARY_DELTA_T,
-    THESIS_K,
-    TWO_PI,
 )
 from flex.fidelity.laws import (
     ErrorLaw,

@@ -11,6 +11,7 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 
+from flex.base.physics import TWO_PI
 from flex.base.plotting import (
     MICRO,
     decade_ticks,
@@ -26,7 +27,7 @@ from flex.dynamics.link_models import RIGID
 from flex.experiments.fitting.kfit import THESIS_MODELS, label
 from flex.experiments.fitting.kfit_law import PREDICTOR_BAND, predictor_ratios
 from flex.experiments.fitting.lawfit import FULL_MODES, REPORT_TOLERANCES
-from flex.fidelity.criteria import GOVERNING, TWO_PI
+from flex.fidelity.criteria import GOVERNING
 
 #: the coupler fit's case families spelt out (see :func:`flex.experiments.fitting.kfit.fit_cases`)
 FAMILY_NAMES = {"thk": "thickness sweep", "stf": "spring stiffness sweep",

@@ -36,8 +36,13 @@ from flex.data.plates import is_damped
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
-from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, NONLINEAR_FE, RIGID
-from flex.dynamics.solver import reduction_for_scene
+from flex.dynamics.link_models import (
+    BUILTIN_LINK_MODELS,
+    FFRF,
+    NONLINEAR_FE,
+    RIGID,
+    reduction_for_scene,
+)
 from flex.fidelity.error_budget import budget_rows
 from flex.fidelity.simulation import simulate_case
 from flex.fidelity.softening import compare_with_reference

@@ -147,8 +147,9 @@ def profile(scene: Scene, pool: ReductionPool) -> dict[str, float]:
     """One run of ``scene`` with flex's phases timed [s] (``phase_reduction_s``,
     ``phase_build_s``, ``phase_integration_s``, ``phase_output_s``), its counters and
     Exudyn's CPU-time shares [%] (``exudyn_<phase>_percent``)."""
+    from flex.dynamics.collect import collect
     from flex.dynamics.mechanism import build_mechanism
-    from flex.dynamics.solver import collect, run_profiled
+    from flex.dynamics.solver import run_profiled
 
     out: dict[str, float] = {}
     start = time.perf_counter()

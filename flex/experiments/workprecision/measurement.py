@@ -337,7 +337,7 @@ class ReductionPool:
             return None
         if has_auto_link_keys(scene):
             scene, _ = resolve_link_keys(scene)
-        from flex.dynamics.solver import reduction_for_scene
+        from flex.dynamics.link_models import reduction_for_scene
 
         c = scene["coupler"]
         key = (Plate.of(c), c["mesh_size_m"], c["modes"], order)
