@@ -439,13 +439,14 @@ REFINED = [  # (term, the user's setting, knob, what refinement would set)
 
 @pytest.mark.parametrize("term, given, knob, would", REFINED, ids=[r[0] for r in REFINED])
 def test_refinement_never_changes_a_value_the_user_set(term, given, knob, would):
-    from flex.fidelity.refinement import KNOBS, free_knobs, refined_change
+    from flex.config.knobs import KNOB_KEYS
+    from flex.fidelity.refinement import free_knobs, refined_change
 
     base = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.modes=2",
             "coupler.mesh_size_m=0.002", "simulation.step_s=0.0001"]
     scene = load_scene(overrides=[*base, given])
     free = free_knobs(load_scene(overrides=['coupler.geometry="plate"', given]))
-    assert knob not in free and free < frozenset(KNOBS)
+    assert knob not in free and free < frozenset(KNOB_KEYS)
     change, why = refined_change(scene, term, BUILTIN_LINK_MODELS, free)
     assert change is None, change
     assert knob in why and "set in the scene" in why and would.split("=")[0] in why
@@ -454,9 +455,10 @@ def test_refinement_never_changes_a_value_the_user_set(term, given, knob, would)
 
 
 def test_knobs_left_on_auto_or_default_are_free():
-    from flex.fidelity.refinement import KNOBS, free_knobs
+    from flex.config.knobs import KNOB_KEYS
+    from flex.fidelity.refinement import free_knobs
 
-    assert free_knobs(load_scene()) == frozenset(KNOBS)
+    assert free_knobs(load_scene()) == frozenset(KNOB_KEYS)
 
 
 STRESS = {"coupler_peak_von_mises_Pa": 2.5e7, "coupler_peak_von_mises_time_s": 0.01,

@@ -109,10 +109,11 @@ def test_a_quantity_outside_the_asymptotic_range_is_not_chased():
     """Refinement does not chase a quantity whose step term is a bound (flagged outside the
     asymptotic range): with only such quantities above the tolerance it stops and names
     them; with another one above it too, it refines for that one."""
+    from flex.config.knobs import KNOB_KEYS
     from flex.config.settings import resolve_solver_settings
     from flex.dynamics.link_models import BUILTIN_LINK_MODELS
     from flex.fidelity.error_budget import BudgetRow
-    from flex.fidelity.refinement import KNOBS, next_attempt
+    from flex.fidelity.refinement import next_attempt
 
     scene, _ = resolve_solver_settings(load_scene(overrides={
         "coupler.geometry": "plate", "coupler.model": "ffrf", "coupler.modes": 2}))
@@ -123,12 +124,12 @@ def test_a_quantity_outside_the_asymptotic_range_is_not_chased():
                          terms, certificate_factor=1.25)
 
     rows = [row("first_crest", 0.05, "step"), row("deployment_peak", 0.001, "modes")]
-    step = next_attempt(scene, rows, 0.01, 1, 0.0, BUILTIN_LINK_MODELS, frozenset(KNOBS),
+    step = next_attempt(scene, rows, 0.01, 1, 0.0, BUILTIN_LINK_MODELS, frozenset(KNOB_KEYS),
                          frozenset({"first_crest"}))
     assert step.refined is None and step.status.startswith("not chased: first crest")
     assert "outside the asymptotic range" in step.status
     rows[1] = row("deployment_peak", 0.02, "modes")
-    step = next_attempt(scene, rows, 0.01, 1, 0.0, BUILTIN_LINK_MODELS, frozenset(KNOBS),
+    step = next_attempt(scene, rows, 0.01, 1, 0.0, BUILTIN_LINK_MODELS, frozenset(KNOB_KEYS),
                          frozenset({"first_crest"}))
     assert step.refined is not None and "deployment peak" in step.line
     assert "the modes term's knob" in step.line

@@ -15,11 +15,11 @@ import math
 import pytest
 
 from flex.api import load_scene
+from flex.config.knobs import KNOB_KEYS
 from flex.config.settings import resolve_solver_settings
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 from flex.fidelity.error_budget import CERTIFICATE_FACTOR, BudgetRow, combined
 from flex.fidelity.refinement import (
-    KNOBS,
     attempt_cost_s,
     next_attempt,
     observed_fall,
@@ -45,7 +45,7 @@ def _row(terms: dict[str, float]) -> BudgetRow:
                      total, total / PEAK_M, dict(terms), certificate_factor=CERTIFICATE_FACTOR)
 
 
-def _next(scene, terms, free=frozenset(KNOBS), falls=None, noise_m=0.0):
+def _next(scene, terms, free=frozenset(KNOB_KEYS), falls=None, noise_m=0.0):
     return next_attempt(scene, [_row(terms)], 0.001, 1, 0.0, BUILTIN_LINK_MODELS, free,
                         falls=falls, limit_s=1e6,
                         noise_floors={"coupler_deployment_peak_deflection_m": noise_m})
@@ -85,7 +85,7 @@ def test_a_knob_whose_term_did_not_fall_is_not_turned_again(beam_scene):
 def test_a_set_value_that_keeps_it_above_the_tolerance_stops_it(beam_scene):
     """The elements were set (not free) and the mesh term alone, certified, is above the
     tolerance: refinement stops and names the value and what it would take."""
-    free = frozenset(KNOBS) - {"coupler.elements"}
+    free = frozenset(KNOB_KEYS) - {"coupler.elements"}
     step = _next(beam_scene, {**TERMS_M, "mesh": 1.2 * 0.001 * PEAK_M}, free=free)
     assert step.refined is None
     assert "coupler.elements = 64 was set in the scene" in step.status

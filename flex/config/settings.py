@@ -40,8 +40,8 @@ from typing import Any
 
 from flex.base.errors import SceneError
 from flex.config.calibration import Calibration, calibration_of
-from flex.config.ffrf_rule import LINK_KEYS, RulePick, fill_link_keys, pick, rule_constants
-from flex.data.plates import EXACT_BEAM_ELEMENTS
+from flex.config.ffrf_rule import RulePick, pick, rule_constants
+from flex.config.knobs import Knob, auto_value, exact_beam_settings, knobs_of
 from flex.data.scene import (
     AUTO,
     BUILTIN_LINK_SCHEMAS,
@@ -49,7 +49,6 @@ from flex.data.scene import (
     Scene,
     check_meshed_plate,
     link_model,
-    meshes,
     model_names,
 )
 from flex.data.steps import check_drive_steps, check_steps
@@ -60,6 +59,9 @@ AUTO_KEYS = ("step_s", "spectral_radius", "newton", "newton_relative_tolerance")
 #: the ``--set`` pairs that leave every solver key to flex (what the bundled scene does)
 AUTO_OVERRIDES = tuple((f"simulation.{key}", AUTO) for key in AUTO_KEYS)
 #: what an uncertified flexible scene runs with, and what is known of it
+#: a model's ``settings`` (:attr:`flex.data.scene.LinkSchema.settings`): the calibrated FFRF
+#: rule, the exact beam's measured table
+FFRF_RULE, EXACT_BEAM_STEP = "ffrf_rule", "exact_beam"
 FALLBACK = ("the flexible fallback (the rigid model's 40x smaller step with modified Newton), "
             "not certified for it")
 
@@ -100,61 +102,34 @@ def has_auto(scene: Scene) -> bool:
 
 def has_auto_link_keys(scene: Scene, *,
                        link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> bool:
-    """Whether a link's ``modes`` or ``mesh_size_m`` is ``"auto"`` (flex.config.ffrf_rule),
-    or the ``elements`` of a beam link (:data:`EXACT_BEAM_ELEMENTS`)."""
-    return any(scene[link].get(key) == AUTO for link in LINKS
-               for key in LINK_KEYS) or any(_auto_elements(scene, link, link_models)
-                                            for link in LINKS)
+    """Whether a link knob of a link's concrete model is ``"auto"`` (its modes, mesh size or
+    elements: :mod:`flex.config.knobs`)."""
+    return any(_auto_knobs(scene, link, link_models) for link in LINKS)
 
 
-def _is_beam(scene: Scene, link: str, link_models: Mapping[str, Any]) -> bool:
-    """Whether ``link``'s concrete model is a beam of elements (its entry's ``beam`` flag)."""
+def _auto_knobs(scene: Scene, link: str, link_models: Mapping[str, Any]) -> list[Knob]:
+    """The knobs of ``link``'s concrete model left ``"auto"`` (none for an ``"auto"`` or
+    unknown model)."""
     model = scene[link]["model"]
-    return (model in link_models and link in link_models[model].links
-            and getattr(link_models[model], "beam", False))
-
-
-def _auto_elements(scene: Scene, link: str, link_models: Mapping[str, Any]) -> bool:
-    """Whether ``link`` is a beam whose ``elements`` is auto."""
-    return scene[link].get("elements") == AUTO and _is_beam(scene, link, link_models)
-
-
-#: the exact beam's first-guess settings by tolerance: (tolerance at or above, elements,
-#: step [s]), tightest last. Measured on the thesis deployment (0.5-1 mm plates, the run's
-#: own budget): 32 elements at 1e-5 s stated 0.14-0.31 % on the first crest and 0.05-0.23 %
-#: on the deployment time (step and element terms); 64 elements at 5e-6 s on the 0.7 mm
-#: plate stated 0.067 % on the first crest (step 0.051 %, elements 0.004 %, model 0.044 %)
-#: and 0.045 % on the deployment time, with its whole budget in 31 s on a loaded 2-core
-#: machine. A first guess like the FFRF rule's: each run's budget says what it achieved.
-EXACT_BEAM_SETTINGS = ((0.005, EXACT_BEAM_ELEMENTS, 1e-5), (0.0, 64, 5e-6))
-
-
-def exact_beam_settings(tolerance: float) -> tuple[int, float]:
-    """The exact beam's elements and step [s] at ``fidelity.tolerance`` (dimensionless):
-    the first row of :data:`EXACT_BEAM_SETTINGS` whose tolerance it reaches."""
-    return next((elements, step) for floor, elements, step in EXACT_BEAM_SETTINGS
-                if tolerance >= floor)
+    if model not in link_models or link not in link_models[model].links:
+        return []
+    return [knob for knob in knobs_of(link_models[model])
+            if knob.value(scene, link) == AUTO]
 
 
 def resolve_link_keys(scene: Scene, calibration: Calibration | None = None, *,
                       link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
                       ) -> tuple[Scene, dict[str, Any]]:
-    """``scene`` (a copy) with the links' ``"auto"`` modes and mesh size filled by the rule
-    (:func:`flex.config.ffrf_rule.fill_link_keys` at ``fidelity.tolerance``, ``calibration``'s
-    rule; None: the bundled one; a beam link's, which it does not read, are left) and a beam
-    link's ``"auto"`` elements (:func:`exact_beam_settings`), and what was filled
-    (``"coupler.modes"`` -> value)."""
+    """``scene`` (a copy) with each link's ``"auto"`` knobs filled from ``fidelity.tolerance``
+    (:func:`flex.config.knobs.auto_value`: an FFRF link's modes and mesh by ``calibration``'s
+    rule, None: the bundled one; a beam's elements by its table; a link whose model does not
+    read a knob keeps its ``"auto"``), and what was filled (``"coupler.modes"`` -> value)."""
     resolved = copy.deepcopy(scene)
     filled: dict[str, Any] = {}
-    tolerance = float(scene["fidelity"]["tolerance"])
     for link in LINKS:
-        if _is_beam(scene, link, link_models):
-            if _auto_elements(resolved, link, link_models):
-                resolved[link]["elements"] = filled[f"{link}.elements"] = \
-                    exact_beam_settings(tolerance)[0]
-            continue
-        for key, value in fill_link_keys(resolved, link, tolerance, calibration).items():
-            filled[f"{link}.{key}"] = value
+        for knob in _auto_knobs(scene, link, link_models):
+            resolved[link][knob.link_key()] = filled[knob.scene_key(link)] = auto_value(
+                knob, scene, link, calibration)
     return resolved, filled
 
 
@@ -163,15 +138,16 @@ def choose_entry(scene: Scene, calibration: Calibration | None = None, *,
                  ) -> tuple[str, str, RulePick | None]:
     """The entry (``"rigid"``, ``"ffrf_rule"`` or ``"flexible_fallback"``) for ``scene``,
     the reason, and the rule's pick (``ffrf_rule`` only). ``link_models``: the registry of
-    the scene's link models (their ``rigid`` and ``modal`` flags choose)."""
+    the scene's link models (their ``rigid`` flags and ``settings`` choose)."""
     if AUTO in (scene["crank"]["model"], scene["coupler"]["model"]):
         raise ValueError('resolve model = "auto" links before the solver settings')
     crank, coupler = (link_model(link, scene[link], link_models) for link in ("crank",
                                                                               "coupler"))
     if crank.rigid and coupler.rigid:
         return "rigid", "rigid links", None
-    if not (coupler.modal and crank.rigid):  # the rule: a modal (FFRF) coupler, rigid crank
-        what = ("an FFRF crank" if crank.modal else f'coupler.model = "{coupler.name}"')
+    if not (coupler.settings == FFRF_RULE and crank.rigid):  # the rule's: on a rigid crank
+        what = ("an FFRF crank" if crank.settings == FFRF_RULE
+                else f'coupler.model = "{coupler.name}"')
         return "flexible_fallback", f"no calibrated rule for {what}: {FALLBACK}", None
     tolerance = float(scene["fidelity"]["tolerance"])
     chosen = pick(scene, tolerance, calibration=calibration)
@@ -198,19 +174,26 @@ def finest_certified_accuracy(calibration: Calibration | None = None) -> tuple[f
     return min(found)
 
 
+def _beam_step(scene: Scene, link_models: Mapping[str, Any]) -> bool:
+    """Whether the run's step is the exact beam's (a beam coupler on a link that is none)."""
+    rules = {link: link_model(link, scene[link], link_models).settings for link in LINKS}
+    return rules["coupler"] == EXACT_BEAM_STEP and rules["crank"] != EXACT_BEAM_STEP
+
+
 def reads_tolerance(scene: Scene, *, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS) -> bool:
     """Whether ``fidelity.tolerance`` is read: by an ``auto`` link or spring model (validated:
     only with a spring drive), by ``"auto"`` solver keys choosing the FFRF coupler's entry
     (:func:`choose_entry`), or by an exact beam coupler's ``"auto"`` step or elements
-    (:func:`exact_beam_settings`)."""
+    (:func:`flex.config.knobs.exact_beam_settings`)."""
     if AUTO in (scene["crank"]["model"], scene["coupler"]["model"]) \
             or scene["drive"]["spring_model"] == AUTO:
         return True
     if not link_model("crank", scene["crank"], link_models).rigid:
         return False
-    if _is_beam(scene, "coupler", link_models):  # its step and elements (exact_beam_settings)
-        return has_auto(scene) or _auto_elements(scene, "coupler", link_models)
-    return has_auto(scene) and link_model("coupler", scene["coupler"], link_models).modal
+    coupler = link_model("coupler", scene["coupler"], link_models).settings
+    if coupler == EXACT_BEAM_STEP:  # its step and elements (exact_beam_settings)
+        return has_auto(scene) or bool(_auto_knobs(scene, "coupler", link_models))
+    return has_auto(scene) and coupler == FFRF_RULE
 
 
 def tolerance_beyond_reach(scene: Scene, calibration: Calibration | None = None, *,
@@ -256,8 +239,7 @@ def resolve_solver_settings(scene: Scene, calibration: Calibration | None = None
             chosen.step_s, float(resolved["simulation"]["end_time_s"]), 4), chosen.level
         reason += (f"; step rounded down to {values['step_s']:.6g} s, a whole number of 4 "
                    f"steps in the end time")
-    elif name == "flexible_fallback" and _is_beam(resolved, "coupler", link_models) \
-            and not _is_beam(resolved, "crank", link_models):
+    elif name == "flexible_fallback" and _beam_step(resolved, link_models):
         tolerance = float(resolved["fidelity"]["tolerance"])
         values["step_s"] = exact_beam_settings(tolerance)[1]
         reason += (f"; the exact beam's step at tolerance {tolerance:g}: {values['step_s']:g} s "
@@ -330,10 +312,8 @@ def check_concrete(scene: Scene, choice: SolverChoice | None = None, *,
     """
     for link in LINKS:
         values = scene[link]
-        if values["model"] == AUTO or (meshes(link, values, link_models)  # a lumped or
-                                       and AUTO in (values.get(key)  # rigid link keeps its
-                                                    for key in LINK_KEYS)  # unused "auto"s
-                                       ) or _auto_elements(scene, link, link_models):
+        if values["model"] == AUTO or _auto_knobs(scene, link, link_models):  # a link keeps
+            # the "auto"s of the knobs its model does not read
             raise ValueError(f"{link}: resolve its \"auto\" values first "
                              f"(flex.fidelity.auto.resolve)")
         check_meshed_plate(link, values, link_models)

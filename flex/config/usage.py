@@ -15,10 +15,11 @@ A key the user gave that no case of a study uses (and that the study does not re
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from flex.config.knobs import knobs_of, reads_key
 from flex.config.settings import reads_tolerance
 from flex.data.scene import (
     AUTO,
@@ -132,36 +133,42 @@ def _link_unused(link: str, scene: Scene, link_models: Mapping[str, Any]) -> dic
         mark(_PLATE_ELASTIC, f'{link}.model = "{model}": a rigid link has no elasticity; used '
                              f"with model = {used_with(rigid=False)}")
     elif entry is not None:
-        if not entry.modal:
-            mark(("modes", "mode_selection"),
-                 f'{link}.model = "{model}" moves every mesh node (no modes); used with '
-                 f"model = {quoted(model_names(link, link_models, modal=True))}")
         if not entry.damped:
             mark(("damping_ratio", "damping_model"),
                  f'{link}.model = "{model}" has no damping model; used with model = '
                  f"{used_with(rigid=False, damped=True)}")
     elif model == AUTO:
         mark(("modes",), f'{link}.model = "auto" chooses the modes itself; used with '
-                         f"model = {quoted(model_names(link, link_models, modal=True))}")
+                         f"model = {quoted(model_names(link, link_models, knob='modes'))}")
+        mark(("elements",), f'{link}.model = "auto" chooses the elements itself; used with '
+                            f"model = {quoted(model_names(link, link_models, knob='elements'))}")
         if geometry == "lumped":  # an auto crank: analysed as the plate of its mass
             mark(("thickness_m",), f'{link}.model = "auto" with geometry = "lumped" analyses '
                                    f"the plate of the {link}'s mass_kg (its thickness follows "
                                    f'from it); used with geometry = "plate"')
-    if entry is None or not getattr(entry, "beam", False):
-        beams = model_names(link, link_models, beam=True)
-        mark(("elements",), f'{link}.model = "{model}" is no beam of elements; '
-                            + (f"used with model = {quoted(beams)}" if beams
-                               else f"no {link} model reads it"))
-    elif not entry.meshed:
-        mark(("mesh_size_m",), f'{link}.model = "{model}" meshes no plate (its beam has '
-                               f"{link}.elements); used with model = "
-                               f"{used_with(meshed=True)}")
-    if entry is not None and not entry.modal:
-        mark(("geometric_stiffness",),
-             f'{link}.model = "{model}": only an FFRF body takes the geometric stiffness of '
-             f"its axial force (the nonlinear FE body has it exactly); used with model = "
-             f"{used_with(modal=True)}")
+    if entry is not None:
+        _mark_knob_keys(link, model, entry, link_models, mark)
     return unused
+
+
+#: a link's keys that only some models read: their knobs' keys and what they bring
+#: (flex.config.knobs), and what a model reads beyond them
+_MODEL_KEYS = ("modes", "mode_selection", "mesh_size_m", "elements", "geometric_stiffness")
+
+
+def _mark_knob_keys(link: str, model: str, entry: Any, link_models: Mapping[str, Any],
+                    mark: Callable[[Iterable[str], str], None]) -> None:
+    """Mark the keys of :data:`_MODEL_KEYS` that ``entry`` (``link``'s concrete model) does
+    not read, naming the models that do (:func:`flex.config.knobs.reads_key`)."""
+    own = ", ".join(knob.name for knob in knobs_of(entry)) or "none"
+    for key in _MODEL_KEYS:
+        if reads_key(entry, key):
+            continue
+        readers = [name for name, other in link_models.items()
+                   if link in other.links and reads_key(other, key)]
+        mark((key,), f'{link}.model = "{model}" does not read it (its discretization knobs: '
+                     f"{own}); " + (f"used with model = {quoted([*readers, AUTO])}"
+                                    if readers else f"no {link} model reads it"))
 
 
 def explicit_keys(source: str | Path | None = None,

@@ -231,7 +231,7 @@ def check_damping_model(link: str, values: dict[str, Any], entry: Any) -> None:
         raise SceneError(f'{link}.damping_model = "modal_bands" with {link}.model = "auto": '
                          "auto decides with laws fitted per damping ratio; set "
                          f'{link}.model = "ffrf" or damping_model = "stiffness_proportional"')
-    if not entry.modal:
+    if "modes" not in entry.knobs:
         raise SceneError(f'{link}.damping_model = "modal_bands" damps the modes of a reduced '
                          f'(FFRF) body; {link}.model = "{values["model"]}" has none: set '
                          f'{link}.model = "ffrf" or damping_model = "stiffness_proportional"')

@@ -62,15 +62,21 @@ class LinkSchema:
     #: (2) a rigid body: reads the link's mass keys only (``mass_kg``/``inertia_kgm2`` or the
     #: plate's mass); builds planar; runs with the explicit integrators
     rigid: bool = False
-    #: (2) meshes the link's plate: needs ``geometry = "plate"``, reads the elastic plate keys
-    #: and ``mesh_size_m`` (the plate checks of :func:`flex.data.plates.check_meshed_plate`)
-    meshed: bool = False
-    #: (2) a modal reduction: reads ``modes``, ``mode_selection``, ``geometric_stiffness``
-    modal: bool = False
     #: (2) reads ``damping_ratio`` (False: it has no damping model, the key must be 0)
     damped: bool = True
-    #: (2) a beam of elements along the plate: reads its keys and ``elements`` (a plate)
-    beam: bool = False
+    #: (2) its discretization knobs, by name (:data:`flex.config.knobs.KNOBS`): the link keys
+    #: it reads beyond the plate's (a knob's own, ``modes``, and those it brings,
+    #: ``mode_selection``), what the error budget and refinement turn, what ``"auto"``
+    #: fills; ``"mesh"`` meshes the link's plate (``geometry = "plate"``, the plate checks of
+    #: :func:`flex.data.plates.check_meshed_plate`)
+    knobs: tuple[str, ...] = ()
+    #: (2) the link keys it reads beyond the plate's and its knobs' (``geometric_stiffness``)
+    reads: tuple[str, ...] = ()
+    #: (2) what gives its ``"auto"`` knobs and, as the coupler on a rigid crank, the run's
+    #: ``"auto"`` step from ``fidelity.tolerance`` (:mod:`flex.config.settings`):
+    #: ``"ffrf_rule"`` (the calibrated rule, :mod:`flex.config.ffrf_rule`), ``"exact_beam"``
+    #: (:data:`flex.config.knobs.EXACT_BEAM_SETTINGS`, measured), ``""``: none (the fallback)
+    settings: str = ""
     #: (3) its own checks on the scene's keys beyond the flags' (raise SceneError), or None
     check: Callable[[str, Scene], None] | None = None
 
@@ -78,19 +84,22 @@ class LinkSchema:
 #: the built-in link models' scene-level part, by name, in the order messages list them
 BUILTIN_LINK_SCHEMAS: Mapping[str, LinkSchema] = MappingProxyType({
     "rigid": LinkSchema("rigid", LINKS, rigid=True),
-    "ffrf": LinkSchema("ffrf", LINKS, meshed=True, modal=True),
-    "nonlinear_fe": LinkSchema("nonlinear_fe", ("coupler",), meshed=True, damped=False),
-    "exact_beam": LinkSchema("exact_beam", LINKS, damped=False, beam=True,
-                             check=check_beam_plate),
+    "ffrf": LinkSchema("ffrf", LINKS, knobs=("modes", "mesh"),
+                       reads=("geometric_stiffness",), settings="ffrf_rule"),
+    "nonlinear_fe": LinkSchema("nonlinear_fe", ("coupler",), damped=False, knobs=("mesh",)),
+    "exact_beam": LinkSchema("exact_beam", LINKS, damped=False, knobs=("elements",),
+                             settings="exact_beam", check=check_beam_plate),
 })
 
 
 def model_names(link: str, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS,
-                **flags: bool) -> list[str]:
+                knob: str | None = None, **flags: bool) -> list[str]:
     """The names of the models of ``link`` in ``link_models`` whose flags have the given values
-    (``rigid=True``: the rigid ones), in the registry's order."""
+    (``rigid=True``: the rigid ones) and that name ``knob`` (if given), in the registry's
+    order."""
     return [name for name, entry in link_models.items() if link in entry.links
-            and all(getattr(entry, flag) == value for flag, value in flags.items())]
+            and all(getattr(entry, flag) == value for flag, value in flags.items())
+            and (knob is None or knob in entry.knobs)]
 
 
 def quoted(names: list[str]) -> str:
@@ -112,7 +121,7 @@ def link_model(link: str, values: dict[str, Any], link_models: Mapping[str, Any]
 
 def meshes(link: str, values: dict[str, Any], link_models: Mapping[str, Any]) -> bool:
     """Whether ``link``'s concrete model meshes its plate (False for ``"auto"``)."""
-    return values["model"] != AUTO and link_model(link, values, link_models).meshed
+    return values["model"] != AUTO and "mesh" in link_model(link, values, link_models).knobs
 
 
 def check_meshed_plate(link: str, values: dict[str, Any],

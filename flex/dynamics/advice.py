@@ -101,7 +101,7 @@ def mechanism_reductions(mech: Mechanism) -> dict[str, Any]:
     """The reductions of a built mechanism's FFRF links, by link name (rigid links: none)."""
     return {link: body["reduction"] for link, body in (("crank", mech.crank),
                                                        ("coupler", mech.coupler))
-            if mech.models[link].modal}
+            if body.get("reduction") is not None}
 
 
 def mechanism_mass_at_slider(scene: Scene) -> float:

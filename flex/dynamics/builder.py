@@ -349,7 +349,7 @@ class Builder:
 
         for name, link in (("coupler", self.mech.coupler), ("crank", self.mech.crank)):
             values = self.scene[name]
-            if self.models[name].modal and values["geometric_stiffness"]:
+            if link.get("reduction") is not None and values["geometric_stiffness"]:
                 link["geometric_data"] = geometric_stiffness(link["reduction"])
                 link["geometric_stiffness"] = add_geometric_stiffness(
                     self.mbs, link["node_modal"], link["geometric_data"], name)

@@ -17,13 +17,16 @@ The contract of an entry -- what a link model declares, point by point:
    model (``links``). A name not in the registry, or a model of another link, is refused
    with a :class:`~flex.base.errors.SceneError` naming the accepted models
    (:func:`flex.data.scene.validate`, :func:`entry_of`).
-2. **scene keys it reads**, as flags on ``[<link>]``: ``rigid`` (mass keys only),
-   ``meshed`` (the plate's elastic keys and ``mesh_size_m``), ``modal`` (``modes``,
-   ``mode_selection``, ``geometric_stiffness``), ``damped`` (``damping_ratio``), ``beam``
-   (the plate's keys and ``elements``, a beam of elements along the link). A key a
-   model does not read and the user set is refused (:func:`flex.config.usage.unused_keys`).
-3. **checks on those keys** (SceneError, before anything runs): the flags' (a meshed model
-   needs ``geometry = "plate"`` and a plate that can be meshed, an undamped one
+2. **scene keys it reads and its knobs**: ``rigid`` (mass keys only), ``damped``
+   (``damping_ratio``), ``knobs`` (its discretization knobs by name,
+   :mod:`flex.config.knobs`: ``"modes"`` reads ``modes`` and ``mode_selection``, ``"mesh"``
+   meshes the plate and reads ``mesh_size_m``, ``"elements"`` a beam's ``elements``; the error
+   budget, ``auto`` and refinement loop over them), ``reads`` (further keys:
+   ``geometric_stiffness``) and ``settings`` (what fills its ``"auto"`` knobs and step from
+   the tolerance). A key a model does not read and the user set is refused
+   (:func:`flex.config.usage.unused_keys`).
+3. **checks on those keys** (SceneError, before anything runs): the flags' and knobs' (a
+   meshed model needs ``geometry = "plate"`` and a plate that can be meshed, an undamped one
    ``damping_ratio = 0``, a non-rigid crank the spring drive, the explicit integrators rigid
    links), then its own ``check(link, scene)`` if it has one.
 4. **what it prepares before a run**: ``prepare(scene, link, given, cache_dir)`` returns what
@@ -67,7 +70,7 @@ The contract of an entry -- what a link model declares, point by point:
     read back: export and animate refuse it, naming the model). :mod:`flex.tools.motion`
     calls through it and names no kind.
 
-Capability flags the callers read: ``rigid``, ``meshed``, ``modal``, ``damped`` (above);
+Capability flags the callers read: ``rigid``, ``damped`` and ``knobs`` (above);
 ``linear_elastic``: its results are trusted only for small elastic deflections and loads
 below buckling (validity warnings, :func:`flex.dynamics.advice.validity_warning`);
 ``reference``: an accuracy reference the others are compared with (named in advice);

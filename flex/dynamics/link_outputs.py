@@ -62,7 +62,7 @@ def elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
                                           f"change of the distance {chord_name} (axial strain "
                                           "x length)")
     body = mech.crank if link == "crank" else mech.coupler
-    if not mech.models[link].modal:  # nonlinear FE: nodal coordinates, no modes, no stress
+    if body.get("reduction") is None:  # nonlinear FE: nodal coordinates, no modes, no stress
         return out
     modal = sensor_data(mech, f"{link}.modal_coordinates")[:, 1:]
     out[f"{link}/modal_coordinates"] = Dataset(
@@ -125,7 +125,7 @@ def flexible_sensors(builder: Any, link: str, handles: dict[str, Any]) -> None:
     for output in ("Position", "Velocity"):
         builder.add(f"marker_{link}_mid.{output}",
                     builder.sensor("Marker", output, markerNumber=handles["marker_mid"]))
-    if not builder.models[link].modal:  # nonlinear FE: nodal coordinates only
+    if "node_modal" not in handles:  # nonlinear FE, a beam: nodal coordinates only
         return
     builder.add(f"{link}.modal_coordinates",
                 builder.sensor("Node", "Coordinates", nodeNumber=handles["node_modal"]))

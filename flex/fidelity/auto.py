@@ -45,6 +45,7 @@ from flex.base.physics import (
     plate_thickness_for_mass_m,
 )
 from flex.config.calibration import Calibration
+from flex.config.knobs import ELEMENTS, MODES
 from flex.config.ladder import climb
 from flex.config.settings import (
     AUTO,
@@ -317,7 +318,7 @@ def crank_elastic_omega(scene: Mapping[str, Mapping[str, Any]], *,
     def in_plane_omegas(model: str) -> np.ndarray:
         crank["model"] = model
         reduction = (reduction_for_scene(analysis, "crank", cache_dir=cache_dir)
-                     if BUILTIN_LINK_MODELS[model].modal else None)
+                     if model == FFRF else None)
         # 3D for both models: the modes are sorted by their out-of-plane coordinates
         mech = build_mechanism(analysis, None, reduction, planar=False)
         values, vectors = mech.mbs.ComputeODE2Eigenvalues(useAbsoluteValues=True)
@@ -453,9 +454,10 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
     if not link_models[decision.model].rigid:
         _climb(decision, coupler, ratio, tolerance, link_models)
     coupler["model"] = decision.model
-    if link_models[decision.model].modal:
+    if MODES.name in link_models[decision.model].knobs:
         _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s, calibration)
-    if link_models[decision.model].beam and coupler.get("elements") == EXACT_BEAM_ELEMENTS:
+    if ELEMENTS.name in link_models[decision.model].knobs \
+            and coupler.get("elements") == EXACT_BEAM_ELEMENTS:
         coupler["elements"] = AUTO  # auto picked the beam: its elements follow the tolerance
     return decision, how
 

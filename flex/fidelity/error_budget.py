@@ -10,18 +10,13 @@ peak bending stress), four named terms and their total [the quantity's units]:
 
 - ``step``: the time step, by Richardson extrapolation from finer companions at h / 2 (and
   h / 4, observing the order) (:func:`flex.fidelity.error_estimate.estimate_step_error`);
-- ``modes``: the modal truncation of the FFRF links: the difference to a companion whose
-  FFRF links keep :func:`richer_modes` modes (the richer basis taken as converged: modal
-  convergence is fast, so the difference is the run's truncation error);
-- ``mesh``: the mesh of the FFRF links: the difference to a companion on a mesh
-  :data:`MESH_FACTOR` times finer, extrapolated with the quantity's ``mesh_order`` (2 for
-  deflections and the motion, 1 for stresses; measured on the 2 mm plate's deployment peak
-  at 8, 4 and 2 mm meshes: observed order 4.1, so 2 leans safe), or, where the finer mesh
-  cannot run, a coarser one's difference taken whole; a
-  beam link's elements: the difference to a companion with :data:`MESH_FACTOR` times more,
-  extrapolated with the beam's order :data:`BEAM_ORDER` (measured on its frequency and its
-  first crest; a companion with fewer elements would put the racing peak of a coarse beam
-  in the term);
+- ``modes`` and ``mesh``: the links' discretization knobs (:mod:`flex.config.knobs`, each
+  named by the link's model entry): for each knob the difference to a companion with the knob
+  turned once on every link that has it (the modes raised, a plate's mesh halved, a beam's
+  elements doubled), times the knob's extrapolation factor (``r^p / (r^p - 1)`` at its order:
+  a mesh at each quantity's ``mesh_order``, a beam at 2; the modes taken whole, the richer
+  basis as converged); a mesh companion that cannot run (a mesh too fine for the machine)
+  gives way to a coarser one, its difference taken whole;
 - ``model``: the link model against the next rung of flex's ladder, read from the rung each
   link's model entry names (:mod:`flex.config.ladder`; no model is named here): a rung that
   measures its term on the scene (``measured_against``: the FFRF bodies, against the exact
@@ -53,6 +48,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import FlexError
+from flex.config.knobs import NO_KNOB, Knob, linked_knobs
 from flex.config.ladder import Rung
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, apply_overrides, model_names
@@ -62,12 +58,6 @@ from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline, crest_gap
 
 #: the named terms of a budget, in the order they are printed
 TERMS = ("step", "modes", "mesh", "model")
-#: the mesh companion's element size over the run's (a beam companion: its elements over the
-#: run's)
-MESH_FACTOR = 2.0
-#: order of convergence of a beam link under element refinement (tests/test_exact_beam.py:
-#: 2.0 on the pinned-pinned frequency, 1.98 on the first crest of the deployment)
-BEAM_ORDER = 2
 #: case attribute prefix of a headline quantity's value
 HEADLINE_PREFIX = "headline_"
 #: a budget's certificate over its estimate: the grid convergence index's safety factor for
@@ -78,11 +68,6 @@ CERTIFICATE_FACTOR = 1.25
 #: case attribute holding :data:`CERTIFICATE_FACTOR` as the budget applied it
 CERTIFICATE_ATTR = f"{PREFIX}certificate_factor"
 
-
-def richer_modes(modes: int) -> int:
-    """The modes companion's count for a link with ``modes``: twice as many, at least two
-    more (1 -> 3, 2 -> 4, 6 -> 12)."""
-    return int(modes + max(modes, 2))
 
 
 @dataclass
@@ -171,13 +156,6 @@ BOUNDS_ATTR = f"{PREFIX}bounds"
 CREST_GAP_PREFIX = "crest_gap_"
 
 
-def _links(scene: Scene, link_models: Mapping[str, LinkModel], **flags: bool) -> list[str]:
-    """The links whose models have the given flags (``modal=True``: the FFRF links)."""
-    return [link for link in LINKS
-            if all(getattr(link_models[scene[link]["model"]], flag) == value
-                   for flag, value in flags.items())]
-
-
 def _companion(scene: Scene, overrides: list[str]) -> Scene:
     return apply_overrides(scene, [*overrides, "simulation.output_step_s=0.0",
                                    "simulation.error_estimate=false"])
@@ -221,76 +199,49 @@ class _Companions:
             self.wall_time_s += time.perf_counter() - start
 
 
-def _modes_term(scene: Scene, result: CaseResult, companions: _Companions,
-                link_models: Mapping[str, LinkModel]) -> tuple[dict[str, float], str]:
-    ffrf = _links(scene, link_models, modal=True)
-    if not ffrf:
-        return {}, "no FFRF link (no modes)"
-    changes = {link: richer_modes(int(scene[link]["modes"])) for link in ffrf}
-    richer = companions.run("modes", _companion(scene, [f"{link}.modes={modes}" for link, modes
-                                                        in changes.items()]))
-    how = ", ".join(f"{link} {scene[link]['modes']} -> {modes}" for link, modes in
-                    changes.items())
-    return (companions.differences(result, richer),
-            f"difference to a companion with more modes ({how})")
+def _knob_terms(scene: Scene, result: CaseResult, companions: _Companions,
+                link_models: Mapping[str, LinkModel]
+                ) -> tuple[dict[str, dict[str, float]], dict[str, str]]:
+    """The terms the link knobs measure (:mod:`flex.config.knobs`: modes, mesh, a beam's
+    elements), by term: for each knob the scene's links have, the difference to a companion
+    with that knob turned once on each of them, times the knob's extrapolation factor; a
+    term's knobs add. Returns the terms and one sentence per term."""
+    terms: dict[str, dict[str, float]] = {term: {} for term in NO_KNOB}
+    sentences: dict[str, list[str]] = {term: [] for term in NO_KNOB}
+    for knob, links in linked_knobs(scene, link_models):
+        values, sentence = _knob_term(knob, links, scene, result, companions)
+        for name, value in values.items():
+            terms[knob.term][name] = terms[knob.term].get(name, 0.0) + value
+        sentences[knob.term].append(sentence)
+    return terms, {term: "; ".join(said) or NO_KNOB[term][0] for term, said in sentences.items()}
 
 
-def _mesh_term(scene: Scene, result: CaseResult, companions: _Companions,
-               link_models: Mapping[str, LinkModel]) -> tuple[dict[str, float], str]:
-    meshed = [link for link in _links(scene, link_models, meshed=True)
-              if scene[link]["geometry"] == "plate"]
-    beams = _links(scene, link_models, beam=True)
-    if not (meshed or beams):
-        return {}, "no meshed link"
-    terms: dict[str, float] = {}
-    sentences = []
-    if meshed:
-        terms, sentence = _plate_mesh_term(scene, result, companions, meshed)
-        sentences.append(sentence)
-    if beams:
-        counts = {link: int(MESH_FACTOR * int(scene[link]["elements"])) for link in beams}
-        finer = companions.run("mesh", _companion(
-            scene, [f"{link}.elements={count}" for link, count in counts.items()]))
-        factor = MESH_FACTOR**BEAM_ORDER / (MESH_FACTOR**BEAM_ORDER - 1)  # Richardson
-        for name, value in companions.differences(result, finer).items():
-            terms[name] = terms.get(name, 0.0) + factor * value
-        how = ", ".join(f"{link} {scene[link]['elements']} -> {count}"
-                        for link, count in counts.items())
-        sentences.append(f"difference to a companion with more beam elements ({how}) x "
-                         f"{factor:.3g} (order {BEAM_ORDER})")
-    return terms, "; ".join(sentences)
-
-
-def _plate_mesh_term(scene: Scene, result: CaseResult, companions: _Companions,
-                     meshed: list[str]) -> tuple[dict[str, float], str]:
-    """The meshed plates' term: the difference to a companion on a :data:`MESH_FACTOR`
-    times finer mesh, extrapolated with each quantity's ``mesh_order`` (Richardson); where
-    that companion cannot run (a mesh too fine for the machine), a coarser one's difference
-    taken whole, and the sentence says so."""
-    sizes = {link: float(scene[link]["mesh_size_m"]) / MESH_FACTOR for link in meshed}
+def _knob_term(knob: Knob, links: list[str], scene: Scene, result: CaseResult,
+               companions: _Companions) -> tuple[dict[str, float], str]:
+    """One knob's term on ``links``: the finer companion's differences, extrapolated with the
+    knob's factor (per headline quantity's mesh order where the knob says so); where that
+    companion cannot run and the knob has a coarser fallback (a mesh too fine for the
+    machine), the coarser one's difference taken whole, and the sentence says so."""
+    new = {link: knob.finer(knob.value(scene, link)) for link in links}
+    how = ", ".join(knob.change_text.format(link=link, old=knob.value(scene, link), new=value)
+                    for link, value in new.items())
     failures = len(companions.failures)
-    finer = companions.run("mesh", _companion(
-        scene, [f"{link}.mesh_size_m={size!r}" for link, size in sizes.items()]))
-    how = ", ".join(f"{link} {scene[link]['mesh_size_m']:g} -> {size:g} m"
-                    for link, size in sizes.items())
-    if finer is not None:
-        terms = {}
-        for name, value in companions.differences(result, finer).items():
-            factor = MESH_FACTOR ** companions.headlines[name].mesh_order
-            terms[name] = value * factor / (factor - 1.0)
-        return terms, (f"difference to a companion on a {MESH_FACTOR:g}x finer mesh ({how}), "
-                       f"extrapolated with each quantity's mesh order (2: deflections and the "
-                       f"motion, 1: stresses)")
+    finer = companions.run(knob.term, _companion(
+        scene, [knob.override(link, value) for link, value in new.items()]))
+    if finer is not None or not knob.fallback:
+        return ({name: knob.factor(companions.headlines[name].mesh_order) * value
+                 for name, value in companions.differences(result, finer).items()},
+                knob.sentence.format(how=how, factor=knob.factor()))
     reason = companions.failures.pop(failures).split(": ", 1)[1]
-    sizes = {link: min(MESH_FACTOR * float(scene[link]["mesh_size_m"]),
-                       float(scene[link]["length_m"])) for link in meshed}
-    coarser = companions.run("mesh", _companion(
-        scene, [f"{link}.mesh_size_m={size!r}" for link, size in sizes.items()]))
-    how = ", ".join(f"{link} {scene[link]['mesh_size_m']:g} -> {size:g} m"
-                    for link, size in sizes.items())
+    coarse = {link: min(2.0 * float(knob.value(scene, link)),
+                        float(scene[link]["length_m"])) for link in links}
+    coarser = companions.run(knob.term, _companion(
+        scene, [knob.override(link, value) for link, value in coarse.items()]))
+    how = ", ".join(knob.change_text.format(link=link, old=knob.value(scene, link), new=value)
+                    for link, value in coarse.items())
     return (companions.differences(result, coarser),
-            f"difference to a companion on a {MESH_FACTOR:g}x coarser mesh ({how}), taken "
-            f"whole (the finer one: {reason})")
+            f"difference to a companion on a 2x coarser mesh ({how}), taken whole (the finer "
+            f"one: {reason})")
 
 
 def _rungs(scene: Scene, link_models: Mapping[str, LinkModel]) -> dict[str, Rung | None]:
@@ -381,8 +332,7 @@ def error_budget(scene: Scene, result: CaseResult,
     companions = _Companions(run_companion, headlines)
     leaves_out = ["the spring's and joints' idealizations (massless spring unless chained, "
                   "ideal pins)"]
-    modes, modes_how = _modes_term(scene, result, companions, link_models)
-    mesh, mesh_how = _mesh_term(scene, result, companions, link_models)
+    knobbed, knob_how = _knob_terms(scene, result, companions, link_models)
     model, model_how = _model_term(scene, result, companions, leaves_out, link_models)
     failed = {failure.split(":")[0] for failure in companions.failures}
     if not step.values:
@@ -390,10 +340,10 @@ def error_budget(scene: Scene, result: CaseResult,
     leaves_out += companions.failures
     if "step" in failed:
         leaves_out.append(f"step: {step.validity}")
-    measured = {"step": step.values, "modes": modes, "mesh": mesh, "model": model}
+    measured = {"step": step.values, **knobbed, "model": model}
     terms = {name: {term: measured[term].get(name, math.nan if term in failed else 0.0)
                     for term in TERMS} for name in values}
-    methods = {"step": step.method, "modes": modes_how, "mesh": mesh_how, "model": model_how}
+    methods = {"step": step.method, **knob_how, "model": model_how}
     return ErrorBudget(values, terms, {k: v for k, v in methods.items() if k not in failed},
                        leaves_out, step.validity,
                        step.companion_wall_time_s + companions.wall_time_s,
@@ -593,7 +543,7 @@ def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> 
 
 
 __all__ = ["CERTIFICATE_ATTR", "CERTIFICATE_FACTOR", "DESCRIBED", "BudgetRow", "ErrorBudget",
-           "BOUNDS_ATTR", "HEADLINE_PREFIX", "MESH_FACTOR", "STEP_BOUNDS_ATTR", "TERMS",
+           "BOUNDS_ATTR", "HEADLINE_PREFIX", "STEP_BOUNDS_ATTR", "TERMS",
            "UNKNOWN_ATTR",
            "budget_rows", "combined", "named_quantities",
-           "error_budget", "richer_modes", "term_text"]
+           "error_budget", "term_text"]

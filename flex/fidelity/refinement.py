@@ -12,7 +12,7 @@ certified quantity's certificate the most per second of added cost:
   companion's, the mesh halved or a beam's elements doubled, a link climbed to the next rung)
   is predicted to divide its term by its *fall*: the one refinement observed when it last
   turned that knob (the term before over the term after, on the same quantity), or until then
-  :data:`PRIOR_FALL`; a rung climb is predicted to remove its term;
+  :func:`prior_fall`; a rung climb is predicted to remove its term;
 - its cost is :func:`attempt_cost_s` of the next scene minus this one's [s] (flex's own
   estimates of run and meshing time, before anything runs);
 - a term whose knob did not make it fall (observed fall at most 1) is not chased again;
@@ -29,17 +29,14 @@ from dataclasses import dataclass
 from typing import Any
 
 from flex.base.errors import SceneError
+from flex.config.knobs import KNOB_KEYS, KNOBS, NO_KNOB, STEP, linked_knobs, preparation_s
 from flex.config.ladder import next_rung
 from flex.config.settings import resolve_solver_settings
-from flex.data.plates import estimate_mesh
-from flex.data.scene import LINKS, SCHEMA, Scene, default_scene
+from flex.data.scene import AUTO, Scene, default_scene
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import LinkModel
 from flex.dynamics.runtime import estimated_run_time_s
-from flex.fidelity.error_budget import BudgetRow, combined, richer_modes
-
-#: the most elements a beam link's refinement gives it (the scene key's maximum)
-MAX_ELEMENTS = SCHEMA["coupler"]["elements"].maximum
+from flex.fidelity.error_budget import BudgetRow, combined
 
 #: most attempts of a refinement (each one a run with its whole error budget)
 MAX_ATTEMPTS = 6
@@ -48,33 +45,30 @@ NOTHING_TO_REFINE = ("nothing to refine: no flexible link's deflection to certif
                      "tolerance bounds a flexible link's own deflection; every link is rigid)")
 
 
-#: the knobs refinement turns: scene keys (``<link>.`` ones for each link)
-KNOBS = ("simulation.step_s", "coupler.model", "crank.modes", "coupler.modes",
-         "crank.mesh_size_m", "coupler.mesh_size_m", "crank.elements", "coupler.elements")
-
-
 def free_knobs(scene: Scene) -> frozenset[str]:
-    """The knobs (:data:`KNOBS`) of ``scene`` as the user gave it (before ``"auto"`` is
-    resolved) that refinement may turn: those left on ``"auto"`` or on the bundled
-    scene's value. A value the user set is never changed."""
+    """The knobs (:data:`flex.config.knobs.KNOB_KEYS`) of ``scene`` as the user gave it
+    (before ``"auto"`` is resolved) that refinement may turn: those left on ``"auto"`` or on
+    the bundled scene's value. A value the user set is never changed."""
     bundled = default_scene()
     out = set()
-    for knob in KNOBS:
+    for knob in KNOB_KEYS:
         section, key = knob.split(".")
         value = scene[section][key]
-        if value == "auto" or value == bundled[section][key]:
+        if value == AUTO or value == bundled[section][key]:
             out.add(knob)
     return frozenset(out)
 
 
-
-#: how many times a term is predicted to shrink when its knob is turned once, until refinement
-#: has observed it on the run: the step halved at the integrator's order 2 (generalized-alpha);
-#: the mesh halved at the certified deflections' mesh order 2, or a beam's elements doubled
-#: at its order 2 (:data:`flex.fidelity.error_budget.BEAM_ORDER`); the modes raised as the
-#: modes companion's: taken alike (modal convergence is faster on the plates measured); a rung
-#: climbed: its term is predicted gone (the rung above's own term is not known before it runs)
-PRIOR_FALL = {"step": 4.0, "modes": 4.0, "mesh": 4.0, "model": math.inf}
+def prior_fall(term: str) -> float:
+    """How many times a term is predicted to shrink when its knob is turned once, until
+    refinement has observed it on the run: the knob's own (:attr:`flex.config.knobs.Knob.
+    prior_fall`: the step halved at the integrator's order 2, a mesh halved at the certified
+    deflections' order 2, a beam's elements doubled at its order 2, the modes raised taken
+    alike); a rung climbed: its term is predicted gone (the rung above's own term is not known
+    before it runs)."""
+    if term == "model":
+        return math.inf
+    return min(knob.prior_fall for knob in KNOBS.values() if knob.term == term)
 
 
 @dataclass(frozen=True)
@@ -230,7 +224,7 @@ def _moves(scene: Scene, worst: BudgetRow, link_models: Mapping[str, LinkModel],
         except SceneError as refused:
             stuck.append((term, f"{why}: refused: {refused}"))
             continue
-        fallen = worst.terms[term] / falls.get(term, PRIOR_FALL[term])
+        fallen = worst.terms[term] / falls.get(term, prior_fall(term))
         left = {**worst.terms, term: max(fallen, noise_floor)}  # not below the solver's noise
         predicted = scale * combined(left.values()) if math.isfinite(scale) else math.nan
         moves.append(_Move(term, refined, why, predicted, attempt_cost_s(refined, link_models)))
@@ -244,38 +238,15 @@ BUDGET_RUNS = 5.0
 
 def attempt_cost_s(scene: Scene, link_models: Mapping[str, LinkModel]) -> float:
     """Rough wall time [s] of one attempt on ``scene``: the run and its budget's companions
-    (:data:`BUDGET_RUNS`), plus meshing and reducing each meshed link at its mesh, twice
-    (the run's reduction and the modes companion's), as flex estimates them before meshing."""
-    cost = (1.0 + BUDGET_RUNS) * estimated_run_time_s(scene, link_models=link_models)
-    for link in LINKS:
-        values, entry = scene[link], link_models[scene[link]["model"]]
-        if entry.meshed:
-            modes = values["modes"] if entry.modal else None
-            plate = (values["length_m"], values["thickness_m"], values["width_m"],
-                     values["mesh_size_m"])
-            cost += estimate_mesh(*plate, modes).build_time_s
-            if entry.modal:
-                cost += estimate_mesh(*plate, richer_modes(modes)).build_time_s
-    return cost
-
-
-def settings_text(scene: Scene, link_models: Mapping[str, LinkModel]) -> str:
-    """An attempt's settings in a few words: its step, and each meshed or beam link's model,
-    modes, mesh or elements."""
-    parts = [f"step {scene['simulation']['step_s']:g} s"]
-    for link in LINKS:
-        values = scene[link]
-        entry = link_models[values["model"]]
-        if entry.meshed:
-            modes = f", {values['modes']} modes" if entry.modal else ""
-            parts.append(f"{link} {values['model']}{modes}, mesh {values['mesh_size_m']:g} m")
-        elif entry.beam:
-            parts.append(f"{link} {values['model']}, {values['elements']} elements")
-    return "; ".join(parts)
+    (:data:`BUDGET_RUNS`), plus what its links' knobs cost to prepare (meshing and reducing
+    each meshed link at its mesh, and the modes companion's reduction:
+    :func:`flex.config.knobs.preparation_s`), as flex estimates them before meshing."""
+    return ((1.0 + BUDGET_RUNS) * estimated_run_time_s(scene, link_models=link_models)
+            + preparation_s(scene, link_models))
 
 
 def refined_change(scene: Scene, term: str, link_models: Mapping[str, LinkModel],
-                   free: frozenset[str] = frozenset(KNOBS)) -> tuple[list[str] | None, str]:
+                   free: frozenset[str] = frozenset(KNOB_KEYS)) -> tuple[list[str] | None, str]:
     """The overrides that refine the knob of ``term`` (step, modes, mesh, model) and what
     they do; (None, why not) when it cannot move, or when it would change a value the user
     set (not in ``free``): then why says which value and what it would take."""
@@ -297,34 +268,39 @@ def _value(scene: Scene, knob: str) -> Any:
 
 def _refined_any(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
                  ) -> tuple[list[str] | None, str]:
-    """:func:`_refined` with every knob free."""
-    links = {link: link_models[scene[link]["model"]] for link in LINKS}
-    if term == "step":
-        step = scene["simulation"]["step_s"] / 2
-        return [f"simulation.step_s={step!r}"], f"step halved to {step:g} s"
-    if term == "modes":
-        modal = [link for link, entry in links.items() if entry.modal
-                 and richer_modes(scene[link]["modes"]) <= 100]
-        return ([f"{link}.modes={richer_modes(scene[link]['modes'])}" for link in modal] or None,
-                "modes raised (" + ", ".join(f"{link} {scene[link]['modes']} -> "
-                                             f"{richer_modes(scene[link]['modes'])}"
-                                             for link in modal) + ")"
-                if modal else "the modes term dominates and no link can take more modes")
-    if term == "mesh":
-        meshed = [link for link, entry in links.items() if entry.meshed]
-        beams = [link for link, entry in links.items()  # a beam's elements: doubled
-                 if entry.beam and 2 * int(scene[link]["elements"]) <= MAX_ELEMENTS]
-        return ([f"{link}.mesh_size_m={scene[link]['mesh_size_m'] / 2!r}" for link in meshed]
-                + [f"{link}.elements={2 * int(scene[link]['elements'])}" for link in beams]
-                or None, "mesh halved (" + ", ".join(meshed) + ")" if meshed and not beams
-                else "mesh refined (" + ", ".join(meshed + [f"{link} elements doubled"
-                                                            for link in beams]) + ")"
-                if beams else "the mesh term dominates and no link is meshed")
+    """:func:`refined_change` with every knob free: the step halved; a term's link knobs
+    turned once on every link that has them and can take it (:mod:`flex.config.knobs`); the
+    model term: the coupler, then the crank, climbed to the next rung."""
+    if term == STEP.term:
+        step = STEP.finer(STEP.value(scene))
+        return [STEP.override("", step)], f"{STEP.verb} to {step:g} s"
+    if term in NO_KNOB:
+        return _turned(scene, term, link_models)
     for link in ("coupler", "crank"):
         higher = next_rung(link, scene[link], link_models)
         if higher is not None:
             return ([f'{link}.model="{higher}"'],
                     f"{link} climbed to the {link_models[higher].label} rung")
     return None, "the model term dominates and no link has a higher rung"
+
+
+def _turned(scene: Scene, term: str, link_models: Mapping[str, LinkModel]
+            ) -> tuple[list[str] | None, str]:
+    """The overrides that turn ``term``'s link knobs once where they can turn, and what they
+    do (``"mesh halved (coupler)"``); (None, why) when none can."""
+    overrides, said, verbs = [], [], set()
+    for knob, links in linked_knobs(scene, link_models, term):
+        for link in links:
+            new = knob.turned(scene, link)
+            if new is not None:
+                overrides.append(knob.override(link, new))
+                said.append(knob.moved_text.format(link=link, old=knob.value(scene, link),
+                                                   new=new))
+                verbs.add(knob.verb)
+    if not overrides:
+        return None, NO_KNOB[term][1]
+    verb = verbs.pop() if len(verbs) == 1 else f"{term} refined"
+    return overrides, f"{verb} ({', '.join(said)})"
+
 
 

@@ -26,6 +26,7 @@ import numpy as np
 
 from flex.base.errors import FlexError, SceneError, SimulationError
 from flex.config.calibration import Calibration
+from flex.config.knobs import KNOB_KEYS, settings_text
 from flex.config.settings import tolerance_beyond_reach
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, to_toml
@@ -37,14 +38,12 @@ from flex.fidelity.error_budget import STEP_BOUNDS_ATTR, error_budget, named_qua
 from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 from flex.fidelity.laws import Criterion
 from flex.fidelity.refinement import (
-    KNOBS,
     MAX_ATTEMPTS,
     NOTHING_TO_REFINE,
     Step,
     free_knobs,
     next_attempt,
     observed_fall,
-    settings_text,
 )
 
 
@@ -125,7 +124,7 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
     if scene["simulation"]["error_estimate"]:
         reductions = {link: built for link, built in (("coupler", reduction),
                                                        ("crank", crank_reduction))
-                      if built is not None and link_models[scene[link]["model"]].modal}
+                      if built is not None}
 
         def run_companion(companion: Scene) -> CaseResult:
             toml = to_toml(companion)
@@ -185,7 +184,7 @@ def _warn_unresolved_drive(result: CaseResult, scales: list[tuple[float, float, 
 def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None = None,
            link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
            headlines: Mapping[str, Headline] = BUILTIN_HEADLINES,
-           free: frozenset[str] = frozenset(KNOBS)) -> CaseResult:
+           free: frozenset[str] = frozenset(KNOB_KEYS)) -> CaseResult:
     """``fidelity.refine``: run the resolved scene with its error budget; while a certified
     quantity (a headline whose entry says ``certified``: each flexible link's peak
     deflection and first crest, docs/criterion.md) has a certified error above

@@ -37,7 +37,6 @@ from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import (
-    BUILTIN_LINK_MODELS,
     FFRF,
     NONLINEAR_FE,
     RIGID,
@@ -92,20 +91,20 @@ def simulate_twin(name: str, scene: Scene, *, cache_dir: Path | None = None
     """One case with its reduction (FFRF, cached in ``cache_dir``) or mesh (nonlinear FE),
     their facts in attrs; returns it with the reduction's facts the summary reports (None
     for a case without a reduction)."""
-    entry = BUILTIN_LINK_MODELS[scene["coupler"]["model"]]
+    model = scene["coupler"]["model"]
     reduction = None
-    if entry.modal:
+    if model == FFRF:
         reduction = reduction_for_scene(scene, cache_dir=cache_dir)
-    elif entry.meshed:
+    elif model == NONLINEAR_FE:
         reduction = nonlinear_plate_for_scene(scene)  # the mesh and its node sets
     case = simulate_case(scene, name, reduction, cache_dir=cache_dir)
     facts = None
-    if entry.modal:
+    if model == FFRF:
         case.attrs.update(reduction_key=reduction.key,
                           reduction_from_cache=reduction.from_cache,
                           reduction_build_time_s=reduction.build_time_s)
         facts = {key: getattr(reduction, key) for key in REDUCTION_FACTS}
-    elif entry.meshed:
+    elif model == NONLINEAR_FE:
         case.attrs.update(fe_nodes=reduction.n_nodes, fe_dof=reduction.n_dof,
                           fe_elements=reduction.n_elements,
                           fe_mesh_time_s=reduction.build_time_s)

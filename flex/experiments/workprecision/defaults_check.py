@@ -21,7 +21,7 @@ from flex.base.errors import SceneError
 from flex.config.settings import AUTO_OVERRIDES, resolve_solver_settings
 from flex.data.results import Dataset
 from flex.data.scene import Scene
-from flex.dynamics.link_models import BUILTIN_LINK_MODELS
+from flex.dynamics.link_models import FFRF
 from flex.experiments.workprecision.measurement import (
     Measurement,
     Reference,
@@ -59,7 +59,7 @@ def same_discretization(plate_scene: Scene, setting: Setting) -> bool:
         scene = scene_for(plate_scene, setting)
     except SceneError:
         return False
-    return (setting.element_order == 2 and BUILTIN_LINK_MODELS[scene["coupler"]["model"]].modal
+    return (setting.element_order == 2 and scene["coupler"]["model"] == FFRF
             and all(scene["coupler"][key] == plate_scene["coupler"][key]
                     for key in ("mesh_size_m", "modes")))
 

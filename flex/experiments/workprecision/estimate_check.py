@@ -45,7 +45,7 @@ from flex.data.results import CaseResult, Dataset
 from flex.data.scene import LINKS, Scene
 from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
-from flex.dynamics.link_models import BUILTIN_LINK_MODELS, NONLINEAR_FE
+from flex.dynamics.link_models import FFRF, NONLINEAR_FE
 from flex.fidelity.error_budget import CERTIFICATE_ATTR, STEP_BOUNDS_ATTR, named_quantities
 from flex.fidelity.error_estimate import PREFIX, integrator_order, richardson_error
 from flex.fidelity.headlines import BUILTIN_HEADLINES
@@ -83,7 +83,7 @@ def reference_overrides(scene: Scene) -> tuple[list[str], str]:
     overrides, parts = [], []
     for link in LINKS:
         values = scene[link]
-        if not BUILTIN_LINK_MODELS[values["model"]].modal:
+        if values["model"] != FFRF:
             continue
         if link == "coupler" and not is_damped(values):
             overrides.append(f'coupler.model="{NONLINEAR_FE}"')
@@ -99,7 +99,7 @@ def _mesh_overrides(scene: Scene, fine: bool) -> list[str]:
     :data:`REFERENCE_MODES` modes, on the run's mesh or one :data:`MESH_REFINEMENT` finer."""
     out = []
     for link in LINKS:
-        if BUILTIN_LINK_MODELS[scene[link]["model"]].modal:
+        if scene[link]["model"] == FFRF:
             size = float(scene[link]["mesh_size_m"]) / (MESH_REFINEMENT if fine else 1.0)
             out += [f"{link}.modes={REFERENCE_MODES}", f"{link}.mesh_size_m={size!r}"]
     return out
@@ -116,7 +116,7 @@ def check_one(name: str, scene: Scene, cache_dir: Path | None) -> CaseResult:
     lift, what = reference_overrides(resolved)
     quiet = ["simulation.error_estimate=false"]
     runs = {"best": (lift, step / REFINEMENT), "other": (lift, 2 * step / REFINEMENT)}
-    if any(BUILTIN_LINK_MODELS[resolved[link]["model"]].modal for link in LINKS):
+    if any(resolved[link]["model"] == FFRF for link in LINKS):
         runs["mesh"] = (_mesh_overrides(resolved, False), step / REFINEMENT)
         runs["mesh_other"] = (_mesh_overrides(resolved, False), 2 * step / REFINEMENT)
         runs["fine_mesh"] = (_mesh_overrides(resolved, True), step / REFINEMENT)

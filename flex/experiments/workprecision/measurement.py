@@ -47,7 +47,7 @@ from flex.config.settings import has_auto_link_keys, resolve_link_keys, resolved
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
 from flex.data.scene_edit import derive_scene
-from flex.dynamics.link_models import BUILTIN_LINK_MODELS
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF
 from flex.dynamics.reference import solve_reference
 
 #: a reference certifies an accuracy level only if the level is at least this many times the
@@ -333,7 +333,7 @@ class ReductionPool:
         None. ``"auto"`` modes and mesh size are keyed by what the rule fills in at the
         scene's ``fidelity.tolerance`` (:func:`flex.config.settings.resolve_link_keys`), as
         the run resolves them."""
-        if not BUILTIN_LINK_MODELS[scene["coupler"]["model"]].modal:
+        if scene["coupler"]["model"] != FFRF:
             return None
         if has_auto_link_keys(scene):
             scene, _ = resolve_link_keys(scene)

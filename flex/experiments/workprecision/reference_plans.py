@@ -150,13 +150,13 @@ def beam_plan(scene_name: str) -> ReferencePlan:
     """The exact-beam reference of :data:`BEAM_REFERENCE` ``[scene_name]``: claims 1e-3;
     its accuracy holds the element and step sequences' estimates and the ladder's
     idealization bound (:func:`exact_beam_bound`)."""
-    from flex.fidelity.error_budget import BEAM_ORDER
+    from flex.config.knobs import ELEMENTS
 
     plan = BEAM_REFERENCE[scene_name]
     elements, step = plan["elements"], plan["step"]
     refinements = [
         Refinement("coupler.elements", tuple(_beam_setting(elements // k, step)
-                                             for k in (1, 2, 4)), 2.0, BEAM_ORDER),
+                                             for k in (1, 2, 4)), ELEMENTS.ratio, ELEMENTS.order),
         Refinement("step_s", tuple(_beam_setting(elements, step * k) for k in (1, 2, 4)),
                    2.0, MAX_ORDER["step"])]
     description = (
