@@ -9,11 +9,11 @@ import math
 import numpy as np
 import pytest
 
+from flex.config.knobs import integrator_order
 from flex.fidelity.error_estimate import (
     BOUND_FACTOR,
     MIN_STEPS_PER_PERIOD,
     finer_estimate,
-    integrator_order,
     richardson_error,
     unresolved_time_scales,
 )

@@ -152,7 +152,7 @@ STEP_BOUNDS_ATTR = f"{PREFIX}step_bounds"
 #: the quantities whose total is a bound, not an estimate (the raw whole-run peaks),
 #: comma-separated
 BOUNDS_ATTR = f"{PREFIX}bounds"
-#: case attribute prefix of a peak's crest gap (:func:`flex.fidelity.error_estimate.crest_gap`)
+#: case attribute prefix of a peak's crest gap (:func:`flex.fidelity.headlines.crest_gap`)
 CREST_GAP_PREFIX = "crest_gap_"
 
 

@@ -43,12 +43,11 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import FlexError
+from flex.config.knobs import STEP, integrator_order
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, apply_overrides
-from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline, crest_gap
+from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 
-#: order of accuracy of the explicit Runge-Kutta methods (``simulation.explicit_method``)
-EXPLICIT_ORDERS = {"RK44": 4, "RK67": 6, "ExplicitMidpoint": 2}
 #: a time scale with fewer steps per period than this is outside the asymptotic range
 MIN_STEPS_PER_PERIOD = 10.0
 #: case attribute prefix
@@ -101,17 +100,6 @@ class ErrorEstimate:
         return out
 
 
-def integrator_order(simulation: dict[str, Any]) -> int:
-    """Order of accuracy of the scene's integrator (resolved ``[simulation]`` keys):
-    generalized-alpha 2 (Chung and Hulbert, any spectral radius); Newmark with velocity-level
-    constraints 2 at spectral radius 1 (trapezoidal rule), else 1 (gamma > 1/2); explicit
-    Runge-Kutta its own (:data:`EXPLICIT_ORDERS`)."""
-    if simulation["integrator"] == "explicit_penalty":
-        return EXPLICIT_ORDERS[simulation["explicit_method"]]
-    if simulation["formulation"] == "index2" and simulation["spectral_radius"] < 1.0:
-        return 1
-    return 2
-
 
 def richardson_error(value: float, companion: float, step_s: float, companion_step: float,
                      order: int) -> float:
@@ -146,7 +134,7 @@ def estimate_step_error(scene: Scene, result: CaseResult,
     step = float(sim["step_s"])
     unresolved = unresolved_time_scales(time_scales, step)
     order = integrator_order(sim)
-    steps = [step, step / 2.0] + ([step / 4.0] if unresolved else [])
+    steps = [step, STEP.finer(step)] + ([STEP.finer(STEP.finer(step))] if unresolved else [])
     at = ", ".join(f"{h:g}" for h in steps[1:])
     method = (f"step halving: {'companion runs' if len(steps) > 2 else 'a companion run'} at "
               f"h = {at} s (the run: {step:g} s), Richardson extrapolation with the "
@@ -261,6 +249,6 @@ def _crest(magnitude: np.ndarray) -> np.ndarray:
     return np.arange(start, end)
 
 
-__all__ = ["BOUND_FACTOR", "ErrorEstimate", "MIN_STEPS_PER_PERIOD", "ORDER_WINDOW", "crest_gap",
-           "estimate_step_error", "finer_estimate", "headline_difference", "integrator_order",
+__all__ = ["BOUND_FACTOR", "ErrorEstimate", "MIN_STEPS_PER_PERIOD", "ORDER_WINDOW",
+           "estimate_step_error", "finer_estimate", "headline_difference",
            "peak_difference", "richardson_error", "unresolved_time_scales"]

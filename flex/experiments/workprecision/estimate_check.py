@@ -39,6 +39,7 @@ import numpy as np
 
 from flex.base.caseloop import run_each
 from flex.base.plotting import figure
+from flex.config.knobs import integrator_order
 from flex.config.settings import resolve_solver_settings
 from flex.data.plates import is_damped
 from flex.data.results import CaseResult, Dataset
@@ -47,7 +48,7 @@ from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
 from flex.dynamics.link_models import FFRF, NONLINEAR_FE
 from flex.fidelity.error_budget import CERTIFICATE_ATTR, STEP_BOUNDS_ATTR, named_quantities
-from flex.fidelity.error_estimate import PREFIX, integrator_order, richardson_error
+from flex.fidelity.error_estimate import PREFIX, richardson_error
 from flex.fidelity.headlines import BUILTIN_HEADLINES
 from flex.fidelity.simulation import simulate_case
 
