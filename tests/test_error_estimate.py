@@ -166,9 +166,9 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
     independently)."""
     from flex.api import derive_scene, load_scene
     from flex.config.ladder import FFRF_RUNG
-    from flex.fidelity.error_budget import TERMS, budget_rows
     from flex.fidelity.headlines import BUILTIN_HEADLINES
     from flex.fidelity.simulation import simulate
+    from flex.fidelity.stored_budget import TERMS, budget_rows
 
     scene = load_scene(overrides=['coupler.geometry="plate"', 'coupler.model="ffrf"',
                                   "coupler.thickness_m=0.005", "coupler.mesh_size_m=0.005",
@@ -242,8 +242,8 @@ def test_a_linear_ffrf_run_counts_its_distance_to_the_default_body(reduction_cac
     so it exceeds the default body's own bound on the deflection."""
     from flex.api import load_scene
     from flex.config.ladder import GEOMETRIC_FFRF_ERROR
-    from flex.fidelity.error_budget import budget_rows
     from flex.fidelity.simulation import simulate
+    from flex.fidelity.stored_budget import budget_rows
 
     scene = load_scene(overrides=['coupler.geometry="plate"', 'coupler.model="ffrf"',
                                   "coupler.thickness_m=0.001", "coupler.mesh_size_m=0.004",

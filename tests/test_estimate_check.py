@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from flex.data.results import CaseResult
 from flex.experiments.workprecision.estimate_check import _rows, estimate_summary
-from flex.fidelity.error_budget import BOUNDS_ATTR, CERTIFICATE_ATTR, STEP_BOUNDS_ATTR
+from flex.fidelity.stored_budget import BOUNDS_ATTR, CERTIFICATE_ATTR, STEP_BOUNDS_ATTR
 
 PEAK, END = "coupler_deployment_peak_deflection_m", "crank_angle_end_rad"
 

@@ -364,7 +364,7 @@ PEAK = {"coupler_peak_von_mises_Pa": 2.8e7, "coupler_peak_von_mises_time_s": 0.0
         "estimated_error_coupler_peak_von_mises_Pa": 2.1e6,
         "crest_gap_coupler_peak_deflection_m": 2.3e-5, "refine_status": "met",
         "refine_wall_time_s": 16.8, "refine_attempts": "1: met"}
-#: inspect's own lines (estimated_error_* budget rows: flex.fidelity.error_budget.budget_rows)
+#: inspect's own lines (estimated_error_* budget rows: flex.fidelity.stored_budget.budget_rows)
 BROKEN = ["coupler_peak_von_mises_Pa", "coupler_peak_von_mises_time_s",
           "crest_gap_coupler_peak_deflection_m", "refine_wall_time_s"]
 

@@ -36,13 +36,9 @@ from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import load_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 from flex.fidelity.criteria import deployment_times, first_maximum_index
-from flex.fidelity.error_budget import (
-    UNKNOWN_ATTR,
-    ErrorBudget,
-    budget_rows,
-    error_budget,
-)
+from flex.fidelity.error_budget import error_budget
 from flex.fidelity.headlines import BUILTIN_HEADLINES
+from flex.fidelity.stored_budget import UNKNOWN_ATTR, ErrorBudget, budget_rows
 
 # --- 1. a term that could not be measured makes the total unknown ---------------------------
 FFRF = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.modes=2",

@@ -41,8 +41,8 @@ from flex.config.settings import pinned_overrides
 from flex.data.results import write_results
 from flex.data.scene import load_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
-from flex.fidelity.error_budget import budget_rows
 from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
+from flex.fidelity.stored_budget import budget_rows
 
 # a coarse 5 mm plate (maxh 5 mm, 4 modes), 2 ms at the rigid 1e-5 s step
 PLATE = [*pinned_overrides(), 'coupler.geometry="plate"', "coupler.thickness_m=0.005",

@@ -112,8 +112,8 @@ def test_a_quantity_outside_the_asymptotic_range_is_not_chased():
     from flex.config.knobs import KNOB_KEYS
     from flex.config.settings import resolve_solver_settings
     from flex.dynamics.link_models import BUILTIN_LINK_MODELS
-    from flex.fidelity.error_budget import BudgetRow
     from flex.fidelity.refinement import next_attempt
+    from flex.fidelity.stored_budget import BudgetRow
 
     scene, _ = resolve_solver_settings(load_scene(overrides={
         "coupler.geometry": "plate", "coupler.model": "ffrf", "coupler.modes": 2}))

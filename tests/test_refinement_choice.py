@@ -18,13 +18,13 @@ from flex.api import load_scene
 from flex.config.knobs import KNOB_KEYS
 from flex.config.settings import resolve_solver_settings
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
-from flex.fidelity.error_budget import CERTIFICATE_FACTOR, BudgetRow, combined
 from flex.fidelity.refinement import (
     attempt_cost_s,
     next_attempt,
     observed_fall,
     refined_change,
 )
+from flex.fidelity.stored_budget import CERTIFICATE_FACTOR, BudgetRow, combined
 
 PEAK_M = 1.7124e-4
 TERMS_M = {"step": 2.99e-9, "modes": 0.0, "mesh": 9.02e-8, "model": 1.07e-7}

@@ -29,7 +29,7 @@ then be observed) -- and returns an :class:`ErrorEstimate`:
 
 It covers the step only: modal truncation and mesh errors are not estimated here. A
 companion that fails (a step the scene cannot take) gives no values and says why in
-``validity``. :func:`ErrorEstimate.attrs` are the case attributes ``estimated_error_*``.
+``validity``; the error budget (:mod:`flex.fidelity.error_budget`) stores it as its step term.
 """
 
 from __future__ import annotations
@@ -50,8 +50,6 @@ from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 
 #: a time scale with fewer steps per period than this is outside the asymptotic range
 MIN_STEPS_PER_PERIOD = 10.0
-#: case attribute prefix
-PREFIX = "estimated_error_"
 #: an observed order within this distance of the integrator's is in the asymptotic range
 ORDER_WINDOW = 0.5
 #: outside the window the step term is a bound: this many times the larger difference of
@@ -91,13 +89,6 @@ class ErrorEstimate:
     #: their three runs showed
     bounds: dict[str, float] = field(default_factory=dict)
 
-    def attrs(self) -> dict[str, Any]:
-        """Case attributes: ``estimated_error_<quantity>`` [its units, in the name] and
-        ``estimated_error_method``, ``_validity``, ``_companion_wall_time_s``."""
-        out: dict[str, Any] = {f"{PREFIX}{name}": value for name, value in self.values.items()}
-        out.update({f"{PREFIX}method": self.method, f"{PREFIX}validity": self.validity,
-                    f"{PREFIX}companion_wall_time_s": self.companion_wall_time_s})
-        return out
 
 
 

@@ -2,7 +2,7 @@
 
 :func:`flex.fidelity.simulation.refine` runs a resolved scene with its error budget, then asks
 :func:`next_attempt` what to do. Contract of :func:`next_attempt`: given the attempt's scene, its
-certified budget rows (:class:`flex.fidelity.error_budget.BudgetRow`), the tolerance and what
+certified budget rows (:class:`flex.fidelity.stored_budget.BudgetRow`), the tolerance and what
 refinement has observed so far, it returns a :class:`Step`: stop (met, nothing to certify, a
 quantity outside the asymptotic range only, a value the user set that blocks, the cost limit)
 or the next scene. The knob it turns is the one whose term is predicted to lower the worst
@@ -36,7 +36,7 @@ from flex.data.scene import AUTO, Scene, default_scene
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import LinkModel
 from flex.dynamics.runtime import estimated_run_time_s
-from flex.fidelity.error_budget import BudgetRow, combined
+from flex.fidelity.stored_budget import BudgetRow, combined
 
 #: most attempts of a refinement (each one a run with its whole error budget)
 MAX_ATTEMPTS = 6

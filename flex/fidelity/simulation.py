@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import sys
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -34,7 +34,7 @@ from flex.dynamics.advice import VALIDITY_WARNING, time_scales
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.dynamics.solver import integrate, scene_reductions
 from flex.fidelity.auto import Resolution, resolve
-from flex.fidelity.error_budget import STEP_BOUNDS_ATTR, error_budget, named_quantities
+from flex.fidelity.error_budget import error_budget
 from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 from flex.fidelity.laws import Criterion
 from flex.fidelity.refinement import (
@@ -45,6 +45,7 @@ from flex.fidelity.refinement import (
     next_attempt,
     observed_fall,
 )
+from flex.fidelity.stored_budget import ErrorBudget, headline_attrs
 
 
 def simulate(scene: Scene, name: str = "case", reduction: Any = None,
@@ -95,12 +96,24 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
                       headlines: Mapping[str, Headline] = BUILTIN_HEADLINES,
                       companions: dict[str, CaseResult] | None = None) -> CaseResult:
     """:func:`simulate` of a scene already resolved (:func:`flex.fidelity.auto.resolve`):
-    integrate, attributes, error budget. ``beyond``: why the scene's tolerance is beyond
-    what flex can certify ("" if it is not), stored as a validity warning. ``companions``:
-    runs already made, by their scene's TOML (:func:`companion_key`; :func:`refine` keeps
-    them across its attempts): a companion found there is not run again, and neither is the
-    run itself when one of them is its scene (the next attempt of a refinement is the last
-    one's finer companion); the companions this run makes are added."""
+    integrate, attributes (the headline values always, :func:`flex.fidelity.stored_budget.
+    headline_attrs`), error budget. ``beyond``: why the scene's tolerance is beyond what flex
+    can certify ("" if it is not), stored as a validity warning. ``companions``: runs already
+    made, by their scene's TOML (:func:`companion_key`; :func:`refine` keeps them across its
+    attempts): a companion found there is not run again, and neither is the run itself when
+    one of them is its scene (the next attempt of a refinement is the last one's finer
+    companion); the companions this run makes are added."""
+    return _run_budgeted(resolution, name, reduction, crank_reduction, cache_dir=cache_dir,
+                         beyond=beyond, link_models=link_models, headlines=headlines,
+                         companions=companions)[0]
+
+
+def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduction: Any, *,
+                  cache_dir: Path | None, beyond: str, link_models: Mapping[str, LinkModel],
+                  headlines: Mapping[str, Headline], companions: dict[str, CaseResult] | None
+                  ) -> tuple[CaseResult, ErrorBudget | None]:
+    """:func:`simulate_resolved`, returning the run and its budget in memory (None: not
+    estimated)."""
     scene = resolution.scene
     if any(decision.link != "spring" for decision in resolution.decisions):
         reduction = crank_reduction = None
@@ -115,41 +128,52 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
                         link_models=link_models))
     result.attrs.update(_rigid_predictions(scene, result, link_models))
     result.attrs.update(resolution.attrs())
+    result.attrs.update(headline_attrs(result.datasets, headlines))
     if result.attrs.get("solver_defaults_entry") == "flexible_fallback":
         print(f"flex: note: case {name}: outside the calibrated family: "
               f"{result.attrs.get('solver_defaults_reason', '')}", file=sys.stderr, flush=True)
     if beyond:
         result.attrs[VALIDITY_WARNING] = "; ".join(
             filter(None, [str(result.attrs.get(VALIDITY_WARNING, "")), beyond]))
-    if scene["simulation"]["error_estimate"]:
-        reductions = {link: built for link, built in (("coupler", reduction),
-                                                       ("crank", crank_reduction))
-                      if built is not None}
+    if not scene["simulation"]["error_estimate"]:
+        return result, None
+    prepared = {link: built for link, built in (("coupler", reduction),
+                                                ("crank", crank_reduction))
+                if built is not None}
+    run_companion = _companion_runner(scene, name, prepared, cache_dir, link_models,
+                                      companions)
+    scales = time_scales(scene, prepared, link_models)
+    budget = error_budget(scene, result, run_companion, scales, link_models, headlines)
+    result.attrs.update(budget.attrs())
+    _warn_unresolved_drive(result, scales, float(scene["simulation"]["step_s"]))
+    if budget.unknown:
+        print(f"flex: warning: case {name}: estimated error unknown for "
+              f"{', '.join(budget.unknown_quantities())}: {'; '.join(budget.unknown)}",
+              file=sys.stderr, flush=True)
+    return result, budget
 
-        def run_companion(companion: Scene) -> CaseResult:
-            toml = to_toml(companion)
-            if companions is not None and toml in companions:
-                return companions[toml]
-            # the run's reductions serve a companion whose links are meshed and reduced alike
-            same = all(companion[link][key] == scene[link][key] for link in ("coupler",
-                                                                            "crank")
-                       for key in ("model", "modes", "mesh_size_m"))
-            out = integrate(companion, f"{name}_companion", reduction if same else None,
-                            crank_reduction if same else None, cache_dir=cache_dir,
-                            link_models=link_models)
-            if companions is not None:
-                companions[toml] = out
-            return out
 
-        scales = time_scales(scene, reductions, link_models)
-        budget = error_budget(scene, result, run_companion, scales, link_models, headlines)
-        result.attrs.update(budget.attrs())
-        _warn_unresolved_drive(result, scales, float(scene["simulation"]["step_s"]))
-        if budget.unknown:
-            print(f"flex: warning: case {name}: estimated error unknown for "
-                  f"{', '.join(budget.unknown_quantities())}: {'; '.join(budget.unknown)}",
-                  file=sys.stderr, flush=True)
-    return result
+def _companion_runner(scene: Scene, name: str, prepared: dict[str, Any],
+                      cache_dir: Path | None, link_models: Mapping[str, LinkModel],
+                      companions: dict[str, CaseResult] | None
+                      ) -> Callable[[Scene], CaseResult]:
+    """How the budget runs a companion scene: from ``companions`` where it was made before
+    (kept there when made), with the run's reductions where its links are meshed and reduced
+    alike."""
+    def run_companion(companion: Scene) -> CaseResult:
+        toml = to_toml(companion)
+        if companions is not None and toml in companions:
+            return companions[toml]
+        same = all(companion[link][key] == scene[link][key] for link in ("coupler", "crank")
+                   for key in ("model", "modes", "mesh_size_m"))
+        out = integrate(companion, f"{name}_companion",
+                        prepared.get("coupler") if same else None,
+                        prepared.get("crank") if same else None, cache_dir=cache_dir,
+                        link_models=link_models)
+        if companions is not None:
+            companions[toml] = out
+        return out
+    return run_companion
 
 
 def companion_key(scene: Scene) -> str | None:
@@ -206,8 +230,6 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     (:func:`flex.fidelity.refinement.free_knobs`); when the terms of the values the user set
     keep the certificate above the tolerance it stops, and the status says which value and
     what refinement would make of it."""
-    from flex.fidelity.error_budget import budget_rows
-
     if not resolution.scene["simulation"]["error_estimate"]:
         raise SceneError("fidelity.refine = true with simulation.error_estimate = false: "
                          "refinement follows the error budget; set error_estimate = true or "
@@ -221,9 +243,9 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     for attempt in range(1, MAX_ATTEMPTS + 1):
         reused = companion_key(current.scene) in made
         try:
-            result = simulate_resolved(current, name, cache_dir=cache_dir,
-                                       link_models=link_models, headlines=headlines,
-                                       companions=made)
+            result, budget = _run_budgeted(current, name, None, None, cache_dir=cache_dir,
+                                           beyond="", link_models=link_models,
+                                           headlines=headlines, companions=made)
         except SimulationError as failed:  # a diverging attempt: the last one stays
             if last is None:  # the first guess itself: nothing to keep
                 raise
@@ -233,7 +255,7 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
                          f"{step.line}")
             result = last[2]
             break
-        rows = {row.quantity: row for row in budget_rows(result.attrs)
+        rows = {row.quantity: row for row in budget.rows()
                 if row.quantity in headlines and headlines[row.quantity].certified}
         if last is not None:  # the term whose knob the last attempt turned, on its worst
             fall = observed_fall(last[1].get(last[0].worst), rows.get(last[0].worst),
@@ -245,7 +267,7 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
                   else {})
         step = next_attempt(current.scene, list(rows.values()), tolerance, attempt,
                             time.perf_counter() - start, link_models, free,
-                            named_quantities(result.attrs, STEP_BOUNDS_ATTR), falls, floors)
+                            frozenset(budget.step_bounds), falls, floors)
         lines.append(f"{attempt}: {settings_text(current.scene, link_models)}"
                      f"{' (the last companion at these settings, reused)' if reused else ''}: "
                      f"{step.line}")

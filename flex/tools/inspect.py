@@ -294,8 +294,7 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
     """The case's error budget (:mod:`flex.fidelity.error_budget`): each headline quantity
     with its value, total estimated error (absolute and relative) and terms; how the terms
     were made, what the budget leaves out, the step estimate's validity."""
-    from flex.fidelity.error_budget import budget_rows
-    from flex.fidelity.error_estimate import PREFIX
+    from flex.fidelity.stored_budget import PREFIX, budget_rows
 
     rows = budget_rows(attrs)
     if not rows and f"{PREFIX}validity" not in attrs:
@@ -352,7 +351,7 @@ def stress_lines(attrs: dict[str, Any]) -> list[str]:
     """The peak von Mises stress of each FFRF link (case attributes of
     :func:`flex.bodies.stress.peak_attrs`), where and when, with its estimated error:
     one line per link."""
-    from flex.fidelity.error_estimate import PREFIX
+    from flex.fidelity.stored_budget import PREFIX
 
     lines = []
     for link in ("coupler", "crank"):

@@ -320,8 +320,7 @@ def _cases_section(cases: list[dict[str, Any]]) -> list[str]:
 def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
     """Each case's error budget: a row per headline quantity (value, total estimated error,
     relative, terms), then how the terms were made and what they leave out."""
-    from flex.fidelity.error_budget import TERMS, budget_rows, term_text
-    from flex.fidelity.error_estimate import PREFIX
+    from flex.fidelity.stored_budget import PREFIX, TERMS, budget_rows, term_text
 
     rows, notes = [], {}
     for case in cases:

@@ -42,9 +42,9 @@ from flex.dynamics.link_models import (
     RIGID,
     reduction_for_scene,
 )
-from flex.fidelity.error_budget import budget_rows
 from flex.fidelity.simulation import simulate_case
 from flex.fidelity.softening import compare_with_reference
+from flex.fidelity.stored_budget import budget_rows
 
 Plates = dict[str, tuple[float, float]]  # model -> (thickness [m], mesh size [m])
 #: what the summary reports of each FFRF case's reduction (``notes["reductions"][case]``)

@@ -47,10 +47,10 @@ from flex.data.scene import LINKS, Scene
 from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
 from flex.dynamics.link_models import FFRF, NONLINEAR_FE
-from flex.fidelity.error_budget import CERTIFICATE_ATTR, STEP_BOUNDS_ATTR, named_quantities
-from flex.fidelity.error_estimate import PREFIX, richardson_error
+from flex.fidelity.error_estimate import richardson_error
 from flex.fidelity.headlines import BUILTIN_HEADLINES
 from flex.fidelity.simulation import simulate_case
+from flex.fidelity.stored_budget import CERTIFICATE_ATTR, PREFIX, STEP_BOUNDS_ATTR, named_quantities
 
 #: the reference's step is the run's divided by this (order 2: 16x more accurate where the
 #: run is asymptotic); a second reference at twice it measures the first's step error
