@@ -211,7 +211,7 @@ def simulate(scene: Scene, name: str = "case", *, cache_dir: str | Path | None =
             resolves from, a :class:`flex.config.calibration.Calibration` or its name,
             ``"bundled"`` (the default) or a folder, :func:`flex.config.calibration.
             load_calibration`; ``headlines=``: the headline quantities budgeted and
-            certified, a mapping of name to :class:`flex.fidelity.headlines.Headline`,
+            certified, a mapping of name to :class:`flex.data.headlines.Headline`,
             default the built-in ones); not needed for ordinary use.
     Output:
         a :class:`flex.data.results.CaseResult`: ``status == "ok"``; ``datasets`` maps paths of
@@ -250,7 +250,7 @@ SIMULATE_OPTIONS = {"reduction": "a flex.bodies.reduction.Reduction",
                     "crank_criterion": "a flex.fidelity.laws.Criterion",
                     "calibration": "a flex.config.calibration.Calibration, 'bundled' or a "
                                    "folder",
-                    "headlines": "a mapping of names to flex.fidelity.headlines.Headline"}
+                    "headlines": "a mapping of names to flex.data.headlines.Headline"}
 
 
 def _simulate_options(options: dict[str, Any]) -> dict[str, Any]:
@@ -476,13 +476,13 @@ def _check_options(options: Mapping[str, Any], accepted: Mapping[str, str], func
 
 
 def _check_headlines(headlines: Any) -> None:
-    from flex.fidelity.headlines import Headline
+    from flex.data.headlines import Headline
 
     if headlines is not None and not (isinstance(headlines, Mapping) and all(
             isinstance(name, str) and isinstance(entry, Headline) and entry.name == name
             for name, entry in headlines.items())):
         raise ArgumentError(f"headlines: expected a mapping of names to "
-                            f"flex.fidelity.headlines.Headline entries of the same names, got "
+                            f"flex.data.headlines.Headline entries of the same names, got "
                             f"{_kind(headlines)}")
 
 

@@ -166,7 +166,7 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
     independently)."""
     from flex.api import derive_scene, load_scene
     from flex.config.ladder import FFRF_RUNG
-    from flex.fidelity.headlines import BUILTIN_HEADLINES
+    from flex.data.headlines import BUILTIN_HEADLINES
     from flex.fidelity.simulation import simulate
     from flex.fidelity.stored_budget import TERMS, budget_rows
 
@@ -218,8 +218,8 @@ def test_first_crest_and_crest_gap_of_a_beat_against_closed_forms():
     envelope at t ~ 0), the largest crest 1 + e, and the crests next to the envelope's top
     lie ~ e (1 - cos(W pi / w)) lower: the crest gap, in closed form, while a series with
     one crest has no gap."""
+    from flex.data.headlines import BUILTIN_HEADLINES, crest_gap
     from flex.data.results import Dataset
-    from flex.fidelity.headlines import BUILTIN_HEADLINES, crest_gap
 
     omega, beat, depth = 2 * np.pi * 100.0, 2 * np.pi * 3.0, 0.05
     time_s = np.linspace(0.0, 1.0, 400_001)

@@ -31,9 +31,8 @@ from flex.bodies.exact_beam import (
     exact_beam_section,
     section_stress_peaks,
 )
+from flex.data.headlines import BUILTIN_HEADLINES, first_peak_index
 from flex.experiments.thesis.beams import Material, timoshenko_bending_rad_per_s
-from flex.fidelity.headlines import BUILTIN_HEADLINES
-from flex.fidelity.softening import first_peak_index
 
 #: the thesis's coupler plate (Table 5, model 0): L, t, w [m], E [Pa], rho [kg/m^3], nu
 PLATE = dict(length_m=0.08, thickness_m=0.001, width_m=0.01, youngs_modulus_Pa=200e9,

@@ -339,7 +339,7 @@ def test_twin_cases_model_each_plate_every_way_and_add_references_when_undamped(
 
 
 def test_first_peak_is_the_first_lobe_not_the_ripple_or_the_largest_swing():
-    from flex.fidelity.softening import first_peak_index
+    from flex.data.headlines import first_peak_index
 
     time_s = np.linspace(0.0, 1.0, 2001)
     # first lobe peaks at t = 0.25 (1.0), ripple on it, then a larger negative lobe

@@ -1,4 +1,4 @@
-"""The headline channel (flex.dynamics.advice.channel_datasets, flex.fidelity.headlines):
+"""The headline channel (flex.dynamics.advice.channel_datasets, flex.data.headlines):
 a zero-phase low-pass that keeps a link's first bending crest and drops the ripple of higher
 modes, against closed forms; and the deployment time on it, against a known maximum."""
 
@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from flex.data.headlines import BUILTIN_HEADLINES
 from flex.data.results import Dataset
 from flex.dynamics.advice import CHANNEL_FACTOR, channel_cutoff_Hz, channel_datasets
-from flex.fidelity.headlines import BUILTIN_HEADLINES
 
 
 def _run(time_s, deflection, angle=None):

@@ -32,12 +32,12 @@ from hostile import check_refused, fingerprint, run_cli
 
 from flex.base.errors import FlexError, SimulationError
 from flex.config.calibration import BUNDLED_FOLDER, FILES, load_calibration
+from flex.data.headlines import BUILTIN_HEADLINES, first_maximum_index
 from flex.data.results import CaseResult, Dataset, write_results
 from flex.data.scene import load_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
-from flex.fidelity.criteria import deployment_times, first_maximum_index
+from flex.fidelity.criteria import deployment_times
 from flex.fidelity.error_budget import error_budget
-from flex.fidelity.headlines import BUILTIN_HEADLINES
 from flex.fidelity.stored_budget import UNKNOWN_ATTR, ErrorBudget, budget_rows
 
 # --- 1. a term that could not be measured makes the total unknown ---------------------------

@@ -1,5 +1,5 @@
 """The model ladder and the headline quantities as data (flex.config.ladder,
-flex.fidelity.headlines), from outside the library.
+flex.data.headlines), from outside the library.
 
 - A toy rung (an FFRF body under another name, its own registry entry and ladder row,
   between the FFRF rung and the nonlinear FE coupler) gets, touching no flex module: a
@@ -38,10 +38,10 @@ from flex.config.ladder import (
     next_rung,
 )
 from flex.config.settings import pinned_overrides
+from flex.data.headlines import BUILTIN_HEADLINES, Headline
 from flex.data.results import write_results
 from flex.data.scene import load_scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
-from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 from flex.fidelity.stored_budget import budget_rows
 
 # a coarse 5 mm plate (maxh 5 mm, 4 modes), 2 ms at the rigid 1e-5 s step

@@ -78,8 +78,8 @@ def test_the_prediction_from_a_rigid_run_meets_the_ffrf_coupler(reduction_cache,
     """A 2 mm steel plate coupler, thesis spring and a 5000 N/m one: the prediction from the
     rigid run's loads alone is within [0.8, 1.25] of the FFRF peak deflection over the
     deployment (measured 0.99 and 0.97, nothing fitted)."""
+    from flex.data.headlines import first_maximum_index
     from flex.data.scene import apply_overrides, default_scene
-    from flex.fidelity.criteria import first_maximum_index
     from flex.fidelity.simulation import simulate
 
     scene = apply_overrides(default_scene(), [
@@ -121,7 +121,7 @@ def test_a_rigid_plate_coupler_states_the_bending_its_loads_predict(reduction_ca
     deployment, named a prediction, +- its spread; the FFRF body on the same scene (an
     independent model) lies within that spread."""
     from flex.api import load_scene, simulate
-    from flex.fidelity.headlines import BUILTIN_HEADLINES
+    from flex.data.headlines import BUILTIN_HEADLINES
     from flex.fidelity.predictor import PREDICTION_SPREAD
 
     plate = {"coupler.geometry": "plate", "coupler.thickness_m": 0.002,

@@ -163,7 +163,7 @@ def test_stop_index_skips_a_start_up_ripple():
     time_s = np.linspace(0.0, 1.0, 1001)
     angle = np.sin(np.pi * time_s / 0.8)
     angle[:20] += 1e-2 * np.sin(np.pi * time_s[:20] / 0.004)  # maxima during the ripple
-    from flex.fidelity.criteria import first_maximum_index
+    from flex.data.headlines import first_maximum_index
 
     assert first_maximum_index(angle) < 20
     assert time_s[stop_index(angle)] == pytest.approx(0.4, abs=1e-3)

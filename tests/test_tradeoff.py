@@ -395,8 +395,8 @@ def test_profile_times_flex_phases_and_reads_exudyn_shares():
 
 def test_the_peak_error_is_read_on_the_headline_a_tolerance_applies_to():
     from flex.base.errors import FlexError
+    from flex.data.headlines import BUILTIN_HEADLINES
     from flex.experiments.workprecision.measurement import PEAK_HEADLINE
-    from flex.fidelity.headlines import BUILTIN_HEADLINES
 
     assert BUILTIN_HEADLINES[PEAK_HEADLINE].certified  # what fidelity.tolerance certifies
     time_s = np.linspace(0.0, 1.0, 101)

@@ -20,7 +20,7 @@ The contract of a :class:`Knob`, point by point:
 4. ``order`` and ``ratio``: the convergence of its term under one turn (a difference taken
    ``r^p / (r^p - 1)`` times: Richardson; ``order`` None: the difference taken whole), read per
    headline quantity where ``per_headline_order`` (a mesh: a deflection converges at 2, a
-   stress at 1, :attr:`flex.fidelity.headlines.Headline.mesh_order`); ``prior_fall``: how many
+   stress at 1, :attr:`flex.data.headlines.Headline.mesh_order`); ``prior_fall``: how many
    times its term is predicted to shrink under one turn until refinement has observed it;
 5. ``preparation_s(values, knobs)``: what a link at this value costs to prepare beyond its run
    [s] (meshing, reducing; flex's estimate before anything runs);

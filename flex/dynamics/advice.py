@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SimulationError
+from flex.data.headlines import channel_series
 from flex.data.plates import plate_mass_properties
 from flex.data.results import Dataset
 from flex.data.scene import LINKS, Scene, model_names, quoted
@@ -186,7 +187,7 @@ def channel_cutoff_Hz(scene: Scene,
                       link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
                       ) -> float | None:
     """Cut-off [Hz] of the zero-phase low-pass channel the deployment's headline peaks are
-    read on (:mod:`flex.fidelity.headlines`): :data:`CHANNEL_FACTOR` times the lowest
+    read on (:mod:`flex.data.headlines`): :data:`CHANNEL_FACTOR` times the lowest
     pinned-pinned first bending frequency of the scene's flexible plate links (Euler-
     Bernoulli, :attr:`flex.base.physics.Plate.pinned_pinned_omega`); None when no link is
     flexible (a rigid mechanism has no elastic ringing to filter)."""
@@ -197,11 +198,6 @@ def channel_cutoff_Hz(scene: Scene,
     return CHANNEL_FACTOR * min(omegas) / (2.0 * np.pi) if omegas else None
 
 
-#: the series read on the headline channel, where the run has them (``channel/<path>``)
-CHANNEL_SERIES = ("crank/angle", "coupler/midpoint_deflection", "crank/midpoint_deflection",
-                  "coupler/peak_bending_stress", "crank/peak_bending_stress",
-                  "coupler/peak_von_mises_stress", "crank/peak_von_mises_stress",
-                  "joints/A/force_modulus", "joints/B/force_modulus", "joints/C/force_modulus")
 #: order of the channel's Butterworth low-pass (run forward and backward: zero phase, twice
 #: the attenuation)
 CHANNEL_ORDER = 4
@@ -224,9 +220,10 @@ CHANNEL_DETERMINED = "channel/determined"
 CHANNEL_ATTR = "channel_cutoff_Hz"
 
 
-def channel_datasets(datasets: Mapping[str, Dataset], cutoff_Hz: float | None
-                     ) -> dict[str, Dataset]:
-    """The :data:`CHANNEL_SERIES` a run has, on its headline channel (``channel/<path>``):
+def channel_datasets(datasets: Mapping[str, Dataset], cutoff_Hz: float | None,
+                     series: tuple[str, ...] | None = None) -> dict[str, Dataset]:
+    """The ``series`` a run has (None: those the built-in headlines read on the channel,
+    :func:`flex.data.headlines.channel_series`), on its headline channel (``channel/<path>``):
     low-passed forward and backward (zero phase; SAE J211 / ISO 6487 read crash-test peaks
     on such channels) at ``cutoff_Hz`` (:func:`channel_cutoff_Hz`) by a
     :data:`CHANNEL_ORDER`-th order Butterworth filter; none without a cut-off (nothing
@@ -259,7 +256,7 @@ def channel_datasets(datasets: Mapping[str, Dataset], cutoff_Hz: float | None
         sosfiltfilt(sos, np.asarray(datasets[path].data, dtype=float), axis=0, padlen=pad),
         datasets[path].units, f"{datasets[path].description}, on the headline channel "
         f"(zero-phase {CHANNEL_ORDER}th-order Butterworth low-pass at {cutoff_Hz:.4g} Hz)")
-        for path in CHANNEL_SERIES if path in datasets}
+        for path in (channel_series() if series is None else series) if path in datasets}
 
 
 def extreme_inputs(scene: Scene,

@@ -50,6 +50,7 @@ from flex.base.errors import SimulationError, Terminated
 from flex.base.interrupts import interrupts_not_swallowed
 from flex.base.progress import heartbeat
 from flex.config.settings import check_concrete
+from flex.data.headlines import BUILTIN_HEADLINES, Headline, channel_series
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
 from flex.dynamics.advice import (
@@ -266,14 +267,16 @@ def flexible_link_attrs(scene: Scene, datasets: dict[str, Dataset],
 
 def integrate(scene: Scene, name: str = "case", reduction: Any = None,
               crank_reduction: Any = None, *, cache_dir: Path | None = None,
-              link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> CaseResult:
+              link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
+              headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> CaseResult:
     """Build, integrate and collect one case of a concrete scene (every ``"auto"`` decided
     a layer above, :func:`flex.fidelity.auto.resolve`; here it is refused); raises on
     divergence (see module doc). ``reduction`` / ``crank_reduction``: the reductions of an
     ``ffrf`` coupler / crank (None: :func:`reduction_for_scene` builds them, or loads them from
     ``cache_dir``: the reduction cache folder; None: built in memory, no disk cache).
     ``scene_toml`` holds the scene. ``link_models``: the link models the scene may name
-    (:mod:`flex.dynamics.link_models`).
+    (:mod:`flex.dynamics.link_models`); ``headlines``: the quantities read from it, whose
+    series it stores on the headline channel (:func:`flex.data.headlines.channel_series`).
     """
     check_concrete(scene, link_models=link_models)  # no "auto" left, steps and meshes
     reduction, crank_reduction = scene_reductions(scene, reduction, crank_reduction,
@@ -292,7 +295,7 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     for recorder in recorders:  # its own time: after the check of the sampled datasets
         datasets.update(recorder.datasets())
     cutoff_Hz = channel_cutoff_Hz(scene, link_models)
-    datasets.update(channel_datasets(datasets, cutoff_Hz))
+    datasets.update(channel_datasets(datasets, cutoff_Hz, channel_series(headlines)))
     import tomli_w
 
     result = CaseResult(name, to_toml(scene), datasets, counters=counters,

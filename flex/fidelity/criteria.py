@@ -37,6 +37,7 @@ from flex.config.ladder import (
     FFRF_RUNG,
     LINEAR_FFRF_RUNG,
 )
+from flex.data.headlines import first_maximum_index
 from flex.dynamics.link_models import FFRF, NONLINEAR_FE
 
 CONVENTIONS = ("physical", "thesis")
@@ -82,37 +83,6 @@ def convert_n(n: Any, source: str, target: str) -> Any:
 # ------------------------------------------------------------------------------------------
 # deployment time
 # ------------------------------------------------------------------------------------------
-#: a series whose whole swing is below this, relative to its magnitude (at least 1), has
-#: not moved: round-off of a mechanism at rest (an FFRF coupler at preload 0 swings its crank
-#: by ~1e-13 rad)
-STILL_FRACTION = 1e-9
-#: a maximum counts once the series has risen this fraction of its whole swing above its
-#: lowest value so far: a first step that lowers the crank angle by round-off (4e-8 rad at
-#: h <= 1e-5 s, against a swing of ~1 rad) is not a maximum
-RISE_FRACTION = 1e-3
-
-
-def first_maximum_index(values: np.ndarray) -> int | None:
-    """Index of the first real maximum of a series (the deployment's end on the crank
-    angle): the first sample after which it falls, once it has risen by
-    :data:`RISE_FRACTION` of its whole swing; None when it only rises, only falls, never
-    moves (:data:`STILL_FRACTION`) or holds a value that is not finite. The one formula of
-    the deployment time (:func:`deployment_times`, the error budget's headline, ``flex
-    design``)."""
-    values = np.asarray(values, dtype=float)
-    if len(values) < 3 or not np.all(np.isfinite(values)):
-        return None
-    swing = float(np.max(values) - np.min(values))
-    if swing <= STILL_FRACTION * max(1.0, float(np.max(np.abs(values)))):
-        return None
-    risen = values - np.minimum.accumulate(values) > RISE_FRACTION * swing
-    if not risen.any():
-        return None
-    start = int(np.argmax(risen))
-    falling = np.flatnonzero(np.diff(values[start:]) < 0)
-    return None if len(falling) == 0 else start + int(falling[0])
-
-
 def half_swing_time(time_s: np.ndarray, angle_rad: np.ndarray, stop: int) -> float:
     """Time [s] at which ``angle_rad`` first covers half its rise from sample 0 to sample
     ``stop`` (its maximum, :func:`first_maximum_index`), interpolated linearly."""

@@ -4,7 +4,7 @@ flex can know, term by term, in the quantity's unit and relative to it.
 Contract of :func:`error_budget`: given a finished run of a concrete scene (links rigid,
 ffrf, nonlinear_fe or exact_beam; ``"auto"`` keys resolved) and a way to run companion
 scenes, it returns an :class:`ErrorBudget` with, for each headline quantity of the run
-(:data:`flex.fidelity.headlines.BUILTIN_HEADLINES`: crank angle and slider position at the end
+(:data:`flex.data.headlines.BUILTIN_HEADLINES`: crank angle and slider position at the end
 time, deployment time, peak joint forces, each flexible link's peak midpoint deflection and
 peak bending stress), four named terms and their total [the quantity's units]:
 
@@ -47,11 +47,11 @@ from typing import Any
 from flex.base.errors import FlexError
 from flex.config.knobs import NO_KNOB, Knob, linked_knobs
 from flex.config.ladder import Rung
+from flex.data.headlines import BUILTIN_HEADLINES, Headline, crest_gap
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, apply_overrides, model_names
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.fidelity.error_estimate import estimate_step_error, headline_difference
-from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline, crest_gap
 from flex.fidelity.stored_budget import TERMS, ErrorBudget
 
 
@@ -224,7 +224,7 @@ def error_budget(scene: Scene, result: CaseResult,
     resolved), from companion runs made by ``run_companion`` (see the module doc);
     ``time_scales``: the scene's (:func:`flex.dynamics.advice.time_scales`);
     ``link_models``: the registry of its link models (their flags and rungs choose the
-    terms); ``headlines``: the quantities budgeted (:mod:`flex.fidelity.headlines`)."""
+    terms); ``headlines``: the quantities budgeted (:mod:`flex.data.headlines`)."""
     values = {name: headline.read(result.datasets) for name, headline in headlines.items()}
     values = {name: value for name, value in values.items() if value is not None}
     step = estimate_step_error(scene, result, run_companion, time_scales, headlines)

@@ -8,7 +8,7 @@ a quarter when the run's step leaves a time scale of the scene unresolved (the o
 then be observed) -- and returns an :class:`ErrorEstimate`:
 
 - ``values``: for each headline quantity (``headlines``, default
-  :data:`flex.fidelity.headlines.BUILTIN_HEADLINES`), the estimated error of the run's value
+  :data:`flex.data.headlines.BUILTIN_HEADLINES`), the estimated error of the run's value
   [the quantity's unit], by Richardson extrapolation from the finer runs: with the run at h
   and its companion at h/2, ``|q_h - q_h/2| 2^p / (2^p - 1)`` with the integrator's order p
   (:func:`integrator_order`: 2 for generalized-alpha). With a third run at h/4 the order is
@@ -44,9 +44,9 @@ import numpy as np
 
 from flex.base.errors import FlexError
 from flex.config.knobs import STEP, integrator_order
+from flex.data.headlines import BUILTIN_HEADLINES, Headline
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, apply_overrides
-from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 
 #: a time scale with fewer steps per period than this is outside the asymptotic range
 MIN_STEPS_PER_PERIOD = 10.0
@@ -120,7 +120,7 @@ def estimate_step_error(scene: Scene, result: CaseResult,
     """The estimated step error of ``result``, the run of ``scene`` (concrete models, solver
     keys resolved), from finer companion runs made by ``run_companion`` (see the module
     doc). ``time_scales``: the scene's (:func:`flex.dynamics.advice.time_scales`);
-    ``headlines``: the quantities estimated (:mod:`flex.fidelity.headlines`)."""
+    ``headlines``: the quantities estimated (:mod:`flex.data.headlines`)."""
     sim = scene["simulation"]
     step = float(sim["step_s"])
     unresolved = unresolved_time_scales(time_scales, step)

@@ -28,6 +28,7 @@ from flex.base.errors import FlexError, SceneError, SimulationError
 from flex.config.calibration import Calibration
 from flex.config.knobs import KNOB_KEYS, settings_text
 from flex.config.settings import tolerance_beyond_reach
+from flex.data.headlines import BUILTIN_HEADLINES, Headline
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, to_toml
 from flex.dynamics.advice import VALIDITY_WARNING, time_scales
@@ -35,7 +36,6 @@ from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.dynamics.solver import integrate, scene_reductions
 from flex.fidelity.auto import Resolution, resolve
 from flex.fidelity.error_budget import error_budget
-from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
 from flex.fidelity.laws import Criterion
 from flex.fidelity.refinement import (
     MAX_ATTEMPTS,
@@ -74,7 +74,7 @@ def simulate(scene: Scene, name: str = "case", reduction: Any = None,
     :mod:`flex.fidelity.error_budget`): case attributes ``estimated_error_*``. A failed
     companion leaves the run as it is, its term out, and says why in
     ``estimated_error_leaves_out``. ``headlines``: the quantities budgeted and certified
-    (:mod:`flex.fidelity.headlines`; default: the built-in ones).
+    (:mod:`flex.data.headlines`; default: the built-in ones).
     """
     beyond = tolerance_beyond_reach(scene, calibration, link_models=link_models)
     if beyond:  # said before the (possibly long) work starts, and stored with the result
@@ -125,7 +125,7 @@ def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduc
     result = (replace(made, name=name, scene_toml=to_toml(scene), attrs=dict(made.attrs))
               if made is not None else
               integrate(scene, name, reduction, crank_reduction, cache_dir=cache_dir,
-                        link_models=link_models))
+                        link_models=link_models, headlines=headlines))
     result.attrs.update(_rigid_predictions(scene, result, link_models))
     result.attrs.update(resolution.attrs())
     result.attrs.update(headline_attrs(result.datasets, headlines))
@@ -141,7 +141,7 @@ def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduc
                                                 ("crank", crank_reduction))
                 if built is not None}
     run_companion = _companion_runner(scene, name, prepared, cache_dir, link_models,
-                                      companions)
+                                      headlines, companions)
     scales = time_scales(scene, prepared, link_models)
     budget = error_budget(scene, result, run_companion, scales, link_models, headlines)
     result.attrs.update(budget.attrs())
@@ -155,6 +155,7 @@ def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduc
 
 def _companion_runner(scene: Scene, name: str, prepared: dict[str, Any],
                       cache_dir: Path | None, link_models: Mapping[str, LinkModel],
+                      headlines: Mapping[str, Headline],
                       companions: dict[str, CaseResult] | None
                       ) -> Callable[[Scene], CaseResult]:
     """How the budget runs a companion scene: from ``companions`` where it was made before
@@ -169,7 +170,7 @@ def _companion_runner(scene: Scene, name: str, prepared: dict[str, Any],
         out = integrate(companion, f"{name}_companion",
                         prepared.get("coupler") if same else None,
                         prepared.get("crank") if same else None, cache_dir=cache_dir,
-                        link_models=link_models)
+                        link_models=link_models, headlines=headlines)
         if companions is not None:
             companions[toml] = out
         return out
@@ -306,7 +307,7 @@ def _noise_floors(scene: Scene, result: CaseResult, rows: Mapping[str, Any], nam
         other = integrate(apply_overrides(scene, [
             f"simulation.newton_relative_tolerance={loose!r}", "simulation.output_step_s=0.0",
             "simulation.error_estimate=false"]), f"{name}_noise_floor", cache_dir=cache_dir,
-            link_models=link_models)
+            link_models=link_models, headlines=headlines)
     except SimulationError:
         return {}
     factor = loose / used - 1.0 if loose > used else math.inf
@@ -335,7 +336,7 @@ def _rigid_predictions(scene: Scene, result: CaseResult,
     """What the run's loads predict of its rigid plate links' bending over the deployment
     (:func:`flex.fidelity.predictor.rigid_link_predictions`); none for a drive other than the
     spring (the predictor's measured family) or a run that failed to sample its loads."""
-    from flex.fidelity.headlines import deployment_end
+    from flex.data.headlines import deployment_end
     from flex.fidelity.predictor import rigid_link_predictions
 
     rigid = [link for link in LINKS if link_models[scene[link]["model"]].rigid

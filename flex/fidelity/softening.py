@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.kinematics import chord_components
+from flex.data.headlines import first_peak_index
 from flex.data.results import CaseResult, Dataset
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, FFRF, RIGID
 
@@ -34,20 +35,6 @@ def coupler_compression_N(data: dict[str, np.ndarray], samples: int | None = Non
     axial, _ = chord_components(data["joints/C/force_on_coupler"][:samples],
                                 data["coupler/angle"][:samples])
     return -axial
-
-
-def first_peak_index(deflection: np.ndarray) -> int:
-    """Index of the first extreme: the largest |deflection| of the first lobe.
-
-    The first lobe starts where |deflection| first exceeds 10 % of its largest value and
-    ends where the deflection changes sign (or with the series), so the ripple of higher
-    modes riding on the first swing does not count as a peak.
-    """
-    magnitude = np.abs(deflection)
-    start = int(np.argmax(magnitude > 0.1 * magnitude.max()))
-    sign_changes = np.flatnonzero(np.sign(deflection[start:]) != np.sign(deflection[start]))
-    end = start + int(sign_changes[0]) if len(sign_changes) else len(deflection)
-    return start + int(np.argmax(magnitude[start:end]))
 
 
 Values = dict[str, tuple[Any, str, str]]  # key -> (value, units, description)

@@ -52,8 +52,8 @@ from flex.base.physics import (
     spring_effective_mass_kg,
 )
 from flex.bodies.spring import surge_frequency_fixed_end_mass_Hz
+from flex.data.headlines import first_maximum_index
 from flex.data.scene import SCHEMA
-from flex.fidelity.criteria import first_maximum_index
 from flex.fidelity.probe import FidelityDecision, deployment_probe
 
 #: what ``auto`` multiplies the predicted massless error by before it compares it with the

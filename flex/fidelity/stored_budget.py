@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from flex.fidelity.headlines import BUILTIN_HEADLINES, Headline
+from flex.data.headlines import BUILTIN_HEADLINES, Headline
 
 #: case attribute prefix of an estimated error
 PREFIX = "estimated_error_"
@@ -61,7 +61,7 @@ class ErrorBudget:
     #: the quantities whose step term is a bound (observed order outside the window)
     step_bounds: tuple[str, ...] = ()
     #: the quantities whose total is a bound, not an estimate: the raw whole-run peaks
-    #: (:attr:`flex.fidelity.headlines.Headline.bound`)
+    #: (:attr:`flex.data.headlines.Headline.bound`)
     bounds: tuple[str, ...] = ()
 
     def total(self, quantity: str) -> float:
@@ -156,7 +156,7 @@ STEP_BOUNDS_ATTR = f"{PREFIX}step_bounds"
 #: the quantities whose total is a bound, not an estimate (the raw whole-run peaks),
 #: comma-separated
 BOUNDS_ATTR = f"{PREFIX}bounds"
-#: case attribute prefix of a peak's crest gap (:func:`flex.fidelity.headlines.crest_gap`)
+#: case attribute prefix of a peak's crest gap (:func:`flex.data.headlines.crest_gap`)
 CREST_GAP_PREFIX = "crest_gap_"
 
 

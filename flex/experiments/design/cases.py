@@ -55,13 +55,14 @@ from flex.base.mechanism_checks import (
     transmission_angle_rad,
 )
 from flex.base.thesis import THESIS_ANGLE_MAX_TIME_S, THESIS_SPRING_RATE_N_PER_M
+from flex.data.headlines import first_maximum_index
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import RIGID
 from flex.experiments.fitting.kfit import mesh_size_m
 from flex.experiments.fitting.lawfit import case_data
-from flex.fidelity.criteria import first_maximum_index, quasi_static_stress
+from flex.fidelity.criteria import quasi_static_stress
 from flex.fidelity.predictor import PREDICTION_MARGIN, predict_deflection
 
 CASE_VERSION = 2  # 2: a deployment not completed within the run has no deployment time

@@ -16,6 +16,7 @@ import numpy as np
 from flex.base.mechanism_checks import (
     dead_centre_angles_rad,
 )
+from flex.data.headlines import first_maximum_index
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.experiments.design.cases import (
@@ -28,7 +29,6 @@ from flex.experiments.design.cases import (
     rest_angle_rad,
 )
 from flex.experiments.design.mechanism import mechanism_checks
-from flex.fidelity.criteria import first_maximum_index
 
 # ------------------------------------------------------------------------------------------
 # the table of every case

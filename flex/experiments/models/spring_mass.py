@@ -35,12 +35,10 @@ import numpy as np
 
 from flex.bodies import spring as sp
 from flex.data import tables
+from flex.data.headlines import first_maximum_index
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
-from flex.fidelity.criteria import (
-    first_maximum_index,
-)
 from flex.fidelity.laws import (
     fit_error_law,
 )

@@ -30,9 +30,10 @@ from flex.base.thesis import (
     THESIS_SLIDER_INITIAL_POSITION_M,
     THESIS_SLIDER_TRAVEL_M,
 )
+from flex.data.headlines import first_maximum_index
 from flex.data.results import CaseResult, Dataset
 from flex.dynamics.reference import deviations_from_reference
-from flex.fidelity.criteria import first_maximum_index, half_swing_time
+from flex.fidelity.criteria import half_swing_time
 
 #: thesis sec. 5.5 (values read off its figures, "approx."); delta_t from sec. 6.2:
 #: (key of :func:`measures`, label, thesis value, unit)

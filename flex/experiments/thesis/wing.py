@@ -25,12 +25,12 @@ from flex.base.thesis import (
     THESIS_WING_PEAK_RATE_DEG_PER_S,
     THESIS_WING_PEAK_TIME_S,
 )
+from flex.data.headlines import first_maximum_index
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.reference import crank_mass_properties, solve_reference
 from flex.experiments.thesis.beams import Material, timoshenko_bending_rad_per_s
-from flex.fidelity.criteria import first_maximum_index
 
 WING_POISSON_RATIO = 0.33
 """Poisson's ratio of the aluminium wing (enters the Timoshenko shear term only)."""

@@ -41,6 +41,7 @@ from flex.base.caseloop import run_each
 from flex.base.plotting import figure
 from flex.config.knobs import integrator_order
 from flex.config.settings import resolve_solver_settings
+from flex.data.headlines import BUILTIN_HEADLINES
 from flex.data.plates import is_damped
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import LINKS, Scene
@@ -48,7 +49,6 @@ from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
 from flex.dynamics.link_models import FFRF, NONLINEAR_FE
 from flex.fidelity.error_estimate import richardson_error
-from flex.fidelity.headlines import BUILTIN_HEADLINES
 from flex.fidelity.simulation import simulate_case
 from flex.fidelity.stored_budget import CERTIFICATE_ATTR, PREFIX, STEP_BOUNDS_ATTR, named_quantities
 

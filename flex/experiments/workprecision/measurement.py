@@ -149,7 +149,7 @@ def peak_value(time_s: np.ndarray, signal: np.ndarray) -> float:
     return float(y1 - 0.25 * (y0 - y2) * offset)
 
 
-#: the headline the peak deflection error is measured on (:mod:`flex.fidelity.headlines`)
+#: the headline the peak deflection error is measured on (:mod:`flex.data.headlines`)
 PEAK_HEADLINE = "coupler_deployment_peak_deflection_m"
 
 
@@ -169,7 +169,7 @@ class Observables:
     def of_datasets(datasets: dict[str, Dataset], flexible: bool) -> Observables:
         """From a :class:`~flex.data.results.CaseResult`'s datasets (a flexible coupler's
         :data:`PEAK_HEADLINE` read as the run's headlines read it)."""
-        from flex.fidelity.headlines import BUILTIN_HEADLINES
+        from flex.data.headlines import BUILTIN_HEADLINES
 
         return Observables(np.asarray(datasets["time"].data),
                            np.asarray(datasets["crank/angle"].data),

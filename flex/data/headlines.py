@@ -45,6 +45,53 @@ import numpy as np
 
 #: how a headline quantity is compared between two runs (module doc, point 4)
 KINDS = ("value", "peak", "first_crest")
+#: the series whose first maximum ends the deployment (:func:`deployment_end`)
+DEPLOYMENT_SERIES = "crank/angle"
+
+
+#: a series whose whole swing is below this, relative to its magnitude (at least 1), has
+#: not moved: round-off of a mechanism at rest (an FFRF coupler at preload 0 swings its crank
+#: by ~1e-13 rad)
+STILL_FRACTION = 1e-9
+#: a maximum counts once the series has risen this fraction of its whole swing above its
+#: lowest value so far: a first step that lowers the crank angle by round-off (4e-8 rad at
+#: h <= 1e-5 s, against a swing of ~1 rad) is not a maximum
+RISE_FRACTION = 1e-3
+
+
+def first_maximum_index(values: np.ndarray) -> int | None:
+    """Index of the first real maximum of a series (the deployment's end on the crank
+    angle): the first sample after which it falls, once it has risen by
+    :data:`RISE_FRACTION` of its whole swing; None when it only rises, only falls, never
+    moves (:data:`STILL_FRACTION`) or holds a value that is not finite. The one formula of
+    the deployment time (:func:`deployment_times`, the error budget's headline, ``flex
+    design``)."""
+    values = np.asarray(values, dtype=float)
+    if len(values) < 3 or not np.all(np.isfinite(values)):
+        return None
+    swing = float(np.max(values) - np.min(values))
+    if swing <= STILL_FRACTION * max(1.0, float(np.max(np.abs(values)))):
+        return None
+    risen = values - np.minimum.accumulate(values) > RISE_FRACTION * swing
+    if not risen.any():
+        return None
+    start = int(np.argmax(risen))
+    falling = np.flatnonzero(np.diff(values[start:]) < 0)
+    return None if len(falling) == 0 else start + int(falling[0])
+
+
+def first_peak_index(deflection: np.ndarray) -> int:
+    """Index of the first extreme: the largest |deflection| of the first lobe.
+
+    The first lobe starts where |deflection| first exceeds 10 % of its largest value and
+    ends where the deflection changes sign (or with the series), so the ripple of higher
+    modes riding on the first swing does not count as a peak.
+    """
+    magnitude = np.abs(deflection)
+    start = int(np.argmax(magnitude > 0.1 * magnitude.max()))
+    sign_changes = np.flatnonzero(np.sign(deflection[start:]) != np.sign(deflection[start]))
+    end = start + int(sign_changes[0]) if len(sign_changes) else len(deflection)
+    return start + int(np.argmax(magnitude[start:end]))
 
 
 @dataclass(frozen=True)
@@ -64,6 +111,9 @@ class Headline:
     #: its order of convergence under mesh refinement, what the budget's mesh term
     #: extrapolates with (a displacement or the motion 2, a stress at the outer fibre 1)
     mesh_order: int = 2
+    #: the series it reads on the headline channel (its own and, over the deployment, the
+    #: crank angle that ends it): the run stores them filtered (:func:`channel_series`)
+    channel: tuple[str, ...] = ()
 
     @property
     def bound(self) -> bool:
@@ -95,12 +145,10 @@ def peak_value(path: str) -> Callable[[Mapping[str, Any]], float | None]:
 
 def first_crest_value(path: str) -> Callable[[Mapping[str, Any]], float | None]:
     """Reader of the first crest of ``|path|``: the largest magnitude of the series' first
-    lobe (:func:`flex.fidelity.softening.first_peak_index`), a peak that does not race: the
+    lobe (:func:`flex.data.headlines.first_peak_index`), a peak that does not race: the
     largest crest of an undamped ringing plate can move from one crest to a neighbour a
     fraction of a per cent lower when the phase error changes (docs/criterion.md)."""
     def read(datasets: Mapping[str, Any]) -> float | None:
-        from flex.fidelity.softening import first_peak_index
-
         if path not in datasets:
             return None
         values = channel(datasets, path)
@@ -141,13 +189,11 @@ def channel(datasets: Mapping[str, Any], path: str) -> np.ndarray:
 
 def deployment_end(datasets: Mapping[str, Any]) -> int | None:
     """Index of the deployment's last sample: the crank angle's first maximum
-    (:func:`flex.fidelity.criteria.first_maximum_index`); None when it has none (a constant-
+    (:func:`flex.data.headlines.first_maximum_index`); None when it has none (a constant-
     speed crank, a deployment not reached: the deployment is then the whole run)."""
-    from flex.fidelity.criteria import first_maximum_index
-
-    if "crank/angle" not in datasets:
+    if DEPLOYMENT_SERIES not in datasets:
         return None
-    top = first_maximum_index(channel(datasets, "crank/angle"))
+    top = first_maximum_index(channel(datasets, DEPLOYMENT_SERIES))
     return None if top is None or top == 0 else top
 
 
@@ -166,13 +212,13 @@ def deployment_peak_value(path: str) -> Callable[[Mapping[str, Any]], float | No
 
 def deployment_time_s(datasets: Mapping[str, Any]) -> float | None:
     """Time of the first maximum of the crank angle [s] (delta_t, docs/criterion.md;
-    :func:`flex.fidelity.criteria.first_maximum_index`, which ignores round-off); None
+    :func:`flex.data.headlines.first_maximum_index`, which ignores round-off); None
     when the crank angle has no maximum within the run (a deployment not reached, a
     constant-speed crank, a crank that never moves): missing, not the end time."""
     top = deployment_end(datasets)
     if top is None:
         return None
-    angle = channel(datasets, "crank/angle")
+    angle = channel(datasets, DEPLOYMENT_SERIES)
     time_s = np.asarray(datasets["time"].data, dtype=float)
     # the parabola through the top sample and its neighbours: the maximum between samples
     # (a sample time alone is off by up to half a step, more than the run's own error)
@@ -203,7 +249,8 @@ def _link_headlines(link: str) -> list[list[Headline]]:
                            + " over the deployment" + _CHANNEL_TEXT,
                            deployment_peak_value(path), "value", path, window=DEPLOYMENT,
                            link=link, certified=path == deflection,
-                           mesh_order=2 if path == deflection else 1)
+                           mesh_order=2 if path == deflection else 1,
+                           channel=(path, DEPLOYMENT_SERIES))
                   for path, suffix, what in series]
     whole = [Headline(f"{link}_peak_{suffix}", suffix.rsplit("_", 1)[1],
                       what + " over the whole run (raw)", peak_value(path), "peak", path,
@@ -220,7 +267,7 @@ def _first_crest(link: str) -> Headline:
                     f"|deflection| of the first lobe){_CHANNEL_TEXT}",
                     first_crest_value(deflection), "first_crest", deflection,
                     window="the first lobe of the deflection, on the headline channel",
-                    link=link)
+                    link=link, channel=(deflection,))
 
 
 def _joint_force(joint: str, deployment: bool) -> Headline:
@@ -228,7 +275,8 @@ def _joint_force(joint: str, deployment: bool) -> Headline:
     if deployment:
         return Headline(f"joint_{joint}_deployment_peak_force_N", "N",
                         f"peak force of joint {joint} over the deployment{_CHANNEL_TEXT}",
-                        deployment_peak_value(path), "value", path, window=DEPLOYMENT)
+                        deployment_peak_value(path), "value", path, window=DEPLOYMENT,
+                        channel=(path, DEPLOYMENT_SERIES))
     return Headline(f"joint_{joint}_peak_force_N", "N",
                     f"peak force of joint {joint} over the whole run (raw)", peak_value(path),
                     "peak", path)
@@ -242,7 +290,8 @@ def _builtin() -> dict[str, Headline]:
         Headline("slider_position_end_m", "m", "slider position at the end time",
                  final_value("slider/position"), window="the end time"),
         Headline("deployment_time_s", "s", "deployment time (first maximum of the crank angle)",
-                 deployment_time_s, window="release to the first crank maximum"),
+                 deployment_time_s, window="release to the first crank maximum",
+                 channel=(DEPLOYMENT_SERIES,)),
         # the printed order: over the deployment (deflections, bending stresses, von Mises,
         # joint forces), then the first crests, then the same over the whole run
         *(own[link][0][k] for k in range(3) for link in ("coupler", "crank")),
@@ -257,6 +306,15 @@ def _builtin() -> dict[str, Headline]:
 #: the built-in headline quantities, by name, in the order they are printed (immutable)
 BUILTIN_HEADLINES: Mapping[str, Headline] = MappingProxyType(_builtin())
 
+
+def channel_series(headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> tuple[str, ...]:
+    """The series the ``headlines`` read on the headline channel (each once, the crank angle
+    that ends the deployment first): what a run stores filtered as ``channel/<path>``
+    (:func:`flex.dynamics.advice.channel_datasets`)."""
+    found = [DEPLOYMENT_SERIES] + [path for headline in headlines.values()
+                                   for path in headline.channel]
+    return tuple(dict.fromkeys(found))
+
 __all__ = ["BUILTIN_HEADLINES", "KINDS", "Headline", "channel", "crest_gap", "deployment_end",
-           "deployment_peak_value", "deployment_time_s",
+           "channel_series", "deployment_peak_value", "deployment_time_s",
            "final_value", "first_crest_value", "peak_value"]
