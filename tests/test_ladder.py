@@ -31,6 +31,7 @@ from flex.config.ladder import (
     EXACT_BEAM_RUNG,
     FFRF_RUNG,
     LINEAR_FFRF_RUNG,
+    LUMPED_RIGID_RUNG,
     NONLINEAR_FE_RUNG,
     RIGID_RUNG,
     Rung,
@@ -187,7 +188,8 @@ def test_the_toy_headline_is_in_the_budget_inspect_and_the_report(runs, toy_file
 
 
 @pytest.mark.parametrize("rung, model, values", [
-    (RIGID_RUNG, "rigid", {}),
+    (RIGID_RUNG, "rigid", {"geometry": "plate"}),
+    (LUMPED_RIGID_RUNG, "rigid", {"geometry": "lumped"}),
     (LINEAR_FFRF_RUNG, "ffrf", {"geometric_stiffness": False}),
     (FFRF_RUNG, "ffrf", {"geometric_stiffness": True}),
     (EXACT_BEAM_RUNG, "exact_beam", {}),

@@ -144,10 +144,16 @@ _AGAINST_EXACT_BEAM_TEXT = (
     "beam (the rung above, on the same scene; it holds the beam's own idealization, bounded "
     "by make ladder, and the FFRF body's mesh and step errors: it leans safe)")
 
-#: a rigid link: its elasticity is what the ``auto`` decision predicts from its loads
-RIGID_RUNG = Rung(0, "rigid", leaves_out='the elasticity of the rigid {links} (its bending '
-                  'predicted from the run\'s loads where the link is a plate: predicted_* '
-                  'attributes, a prediction; model = "auto": fidelity_* attributes)')
+#: a rigid plate link: its elasticity is measured on the run's own scene, the difference to a
+#: companion whose link is the geometrically exact beam (the rung the rigid model leaves out
+#: for a plate: what its elasticity changes in every quantity, the motion's included)
+RIGID_RUNG = Rung(0, "rigid", measured_against=_against_exact_beam,
+                  measured_against_text="rigid ({links}): the difference to a companion whose "
+                  "{links} is the geometrically exact beam (the elasticity the rigid model "
+                  "leaves out, measured on the scene)")
+#: a rigid lumped link (a mass and an inertia, no plate): its elasticity is unknown
+LUMPED_RIGID_RUNG = Rung(0, "rigid (lumped)", leaves_out="the elasticity of the lumped rigid "
+                         "{links} (a mass and an inertia: no plate to bend)")
 #: the FFRF body without geometric stiffness: softens wrongly under compression
 LINEAR_FFRF_RUNG = Rung(
     1, "linear FFRF (geometric_stiffness = false)", _linear_ffrf_bound, GEOMETRIC_FFRF_ERROR,
@@ -276,5 +282,6 @@ __all__ = ["EXACT_BEAM_COMPANION_ELEMENTS", "EXACT_BEAM_COMPANION_STEP_S",
            "EXACT_BEAM_ERROR_PER_SLENDERNESS", "EXACT_BEAM_RUNG", "FFRF_MEASURED_LOAD_RATIO",
            "FFRF_MOTION_ERROR_FRACTION", "FFRF_RUNG", "GEOMETRIC_FFRF_ERROR",
            "LINEAR_FFRF_ERROR_FLOOR", "LINEAR_FFRF_ERROR_PER_LOAD", "LINEAR_FFRF_RUNG",
-           "NONLINEAR_FE_RUNG", "RIGID_RUNG", "Climb", "Rung", "climb", "ffrf_rung", "next_rung",
+           "LUMPED_RIGID_RUNG", "NONLINEAR_FE_RUNG", "RIGID_RUNG", "Climb", "Rung", "climb",
+           "ffrf_rung", "next_rung",
            "rungs"]

@@ -97,6 +97,7 @@ from flex.base.physics import Plate
 from flex.base.progress import heartbeat
 from flex.config.ladder import (
     EXACT_BEAM_RUNG,
+    LUMPED_RIGID_RUNG,
     NONLINEAR_FE_RUNG,
     RIGID_RUNG,
     Rung,
@@ -444,7 +445,7 @@ def _nonlinear_fe_solver(settings: dict[str, Any], values: dict[str, Any]) -> No
 
 
 def _rigid_rung(values: Mapping[str, Any]) -> Rung:
-    return RIGID_RUNG
+    return RIGID_RUNG if values.get("geometry") == "plate" else LUMPED_RIGID_RUNG
 
 
 def _nonlinear_fe_rung(values: Mapping[str, Any]) -> Rung:

@@ -157,13 +157,15 @@ def _grouped(links: dict[str, Rung], text: str, joiner: str = " and ") -> list[s
 
 
 def _measured_model_term(scene: Scene, result: CaseResult, companions: _Companions,
-                         bounded: dict[str, Rung]) -> tuple[dict[str, Any], list[str]]:
+                         rungs: dict[str, Rung]) -> tuple[dict[str, Any], list[str]]:
     """The model term of the links whose rung measures it on the run's scene (a companion
-    one rung up, :attr:`flex.config.ladder.Rung.measured_against`): each headline quantity's
-    difference to that companion, the sentence, and under ``""`` the links it measured. A
-    companion the scene cannot run (a model the rung above does not offer for it, e.g. a
-    damped link) leaves its links to the fractions, and says so."""
-    measured = {link: rung for link, rung in bounded.items() if rung.measured_against}
+    one rung up, :attr:`flex.config.ladder.Rung.measured_against`: an FFRF body's, a rigid
+    plate's): each headline quantity's difference to that companion, the sentence, and under
+    ``""`` the links it measured. A companion the scene cannot run (a model the rung above
+    does not offer for it, e.g. a damped link) leaves a bounded rung's links to its measured
+    fractions, and says so; a rung without fractions (rigid) keeps the failure: its term is
+    unknown."""
+    measured = {link: rung for link, rung in rungs.items() if rung.measured_against}
     if not measured:
         return {}, []
     overrides = [override.format(link=link) for link, rung in measured.items()
@@ -171,6 +173,8 @@ def _measured_model_term(scene: Scene, result: CaseResult, companions: _Companio
     failures = len(companions.failures)
     above = companions.run("model", _companion(scene, list(dict.fromkeys(overrides))))
     if above is None:
+        if not all(rung.bounded for rung in measured.values()):
+            return {}, []
         reason = companions.failures.pop(failures).split(": ", 1)[1]
         return {}, [f"not measured on the scene ({reason}): the measured fractions instead"]
     terms: dict[str, Any] = dict(companions.differences(result, above))
@@ -181,38 +185,50 @@ def _measured_model_term(scene: Scene, result: CaseResult, companions: _Companio
 def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
                 leaves_out: list[str], link_models: Mapping[str, LinkModel]
                 ) -> tuple[dict[str, float], str]:
-    """The links' model errors from their rungs (:mod:`flex.config.ladder`): a bounded
-    rung's fractions of what the elasticity changes (the difference to rigid twins), plus
-    its companion's difference; every rung's ``leaves_out`` line, highest first."""
+    """The links' model errors from their rungs (:mod:`flex.config.ladder`): measured on the
+    scene where the rung says so (the difference to a companion one rung up); else a bounded
+    rung's fractions of what the elasticity changes (the difference to rigid twins), plus its
+    companion's difference; every rung's ``leaves_out`` line, highest first."""
     rungs = _rungs(scene, link_models)
-    bounded = {link: rung for link, rung in rungs.items() if rung is not None and rung.bounded}
-    terms, sentences = _measured_model_term(scene, result, companions, bounded)
-    bounded = {link: rung for link, rung in bounded.items() if link not in terms.pop("", {})}
-    if bounded:
-        twin = companions.run("model", _companion(
-            scene, [f'{link}.model="{model_names(link, link_models, rigid=True)[0]}"'
-                    for link in bounded] + [f'{link}.geometry="plate"' for link in bounded]))
-        motion = max(rung.motion_fraction for rung in bounded.values())
-        for name, value in companions.differences(result, twin).items():
-            owner = companions.headlines[name].link
-            terms[name] = math.hypot(terms.get(name, 0.0), value * (
-                bounded[owner].own(scene[owner]) if owner in bounded else motion))
-        sentences += _grouped(bounded, "measured_by")
-        steps_up = {link: rung for link, rung in bounded.items() if rung.companion}
-        if steps_up:
-            above = companions.run("model", _companion(scene, [
-                override.format(link=link) for link, rung in steps_up.items()
-                for override in rung.companion]))
-            for name, value in companions.differences(result, above).items():
-                terms[name] = terms.get(name, 0.0) + value
-            sentences += _grouped(steps_up, "companion_text", ", ")
     placed = {link: rung for link, rung in rungs.items() if rung is not None}
+    terms, sentences = _measured_model_term(scene, result, companions, placed)
+    measured = terms.pop("", set())
+    bounded = {link: rung for link, rung in placed.items()
+               if rung.bounded and link not in measured}
+    if bounded:
+        sentences += _fractions(scene, result, companions, bounded, terms, link_models)
     leaves_out += _grouped(dict(sorted(placed.items(), key=lambda item: -item[1].level)),
                            "leaves_out")
     leaves_out += [f"the {link_models[scene[link]['model']].label or scene[link]['model']} "
                    f"{link}'s model error (its model stands on no rung of the ladder)"
                    for link, rung in rungs.items() if rung is None]
     return terms, "; ".join(sentences) or "no flexible link below the top rung"
+
+
+def _fractions(scene: Scene, result: CaseResult, companions: _Companions,
+               bounded: dict[str, Rung], terms: dict[str, float],
+               link_models: Mapping[str, LinkModel]) -> list[str]:
+    """The bounded rungs' measured fractions of what the elasticity changes (the difference
+    to rigid twins), plus their companions' differences one step up, added to ``terms`` in
+    place; their sentences."""
+    twin = companions.run("model", _companion(
+        scene, [f'{link}.model="{model_names(link, link_models, rigid=True)[0]}"'
+                for link in bounded] + [f'{link}.geometry="plate"' for link in bounded]))
+    motion = max(rung.motion_fraction for rung in bounded.values())
+    for name, value in companions.differences(result, twin).items():
+        owner = companions.headlines[name].link
+        terms[name] = math.hypot(terms.get(name, 0.0), value * (
+            bounded[owner].own(scene[owner]) if owner in bounded else motion))
+    sentences = _grouped(bounded, "measured_by")
+    steps_up = {link: rung for link, rung in bounded.items() if rung.companion}
+    if steps_up:
+        above = companions.run("model", _companion(scene, [
+            override.format(link=link) for link, rung in steps_up.items()
+            for override in rung.companion]))
+        for name, value in companions.differences(result, above).items():
+            terms[name] = terms.get(name, 0.0) + value
+        sentences += _grouped(steps_up, "companion_text", ", ")
+    return sentences
 
 
 def error_budget(scene: Scene, result: CaseResult,
