@@ -43,8 +43,9 @@ from typing import Any
 
 from flex.base.physics import Plate
 from flex.config.calibration import Calibration, calibration_of
+from flex.data.fields import AUTO
 from flex.data.plates import MESH_ASPECT_LIMIT, plate_mass_properties
-from flex.data.scene import AUTO, LINKS
+from flex.data.scene import LINKS
 
 #: steps per first bending period the rule chooses from (make calibrate's grid)
 STEP_GRID = (4, 8, 16, 32, 64, 128)

@@ -42,8 +42,8 @@ from flex.base.errors import SceneError
 from flex.config.calibration import Calibration, calibration_of
 from flex.config.ffrf_rule import RulePick, pick, rule_constants
 from flex.config.knobs import Knob, auto_value, exact_beam_settings, knobs_of
+from flex.data.fields import AUTO
 from flex.data.scene import (
-    AUTO,
     BUILTIN_LINK_SCHEMAS,
     LINKS,
     Scene,

@@ -21,8 +21,8 @@ from typing import Any
 
 from flex.config.knobs import knobs_of, reads_key
 from flex.config.settings import reads_tolerance
+from flex.data.fields import AUTO
 from flex.data.scene import (
-    AUTO,
     BUILTIN_LINK_SCHEMAS,
     LINKS,
     Scene,

@@ -18,7 +18,6 @@ their full entries are :data:`flex.dynamics.link_models.BUILTIN_LINK_MODELS`, bu
 from __future__ import annotations
 
 import copy
-import math
 import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
@@ -30,6 +29,7 @@ from typing import Any
 import tomli_w
 
 from flex.base.errors import SceneError
+from flex.data.fields import AUTO, Field, check_value, show
 from flex.data.plates import (
     EXACT_BEAM_ELEMENTS,
     check_beam_plate,
@@ -45,7 +45,7 @@ from flex.data.steps import (
 Scene = dict[str, dict[str, Any]]
 #: the links whose model a scene chooses
 LINKS = ("crank", "coupler")
-AUTO = "auto"
+
 
 
 @dataclass(frozen=True)
@@ -114,7 +114,7 @@ def link_model(link: str, values: dict[str, Any], link_models: Mapping[str, Any]
     model = values["model"]
     names = model_names(link, link_models)
     if not isinstance(model, str) or model not in names:
-        raise SceneError(f"{link}.model = {_show(model)}: must be one of "
+        raise SceneError(f"{link}.model = {show(model)}: must be one of "
                          + ", ".join(f'"{name}"' for name in [*names, AUTO]))
     return link_models[model]
 
@@ -135,43 +135,6 @@ def meshed_plate(link: str, values: dict[str, Any],
                  ) -> tuple[float, str, str] | None:
     """:func:`flex.data.plates.meshed_plate` for ``link``'s model in ``link_models``."""
     return _meshed_plate(link, values, meshes(link, values, link_models))
-
-
-@dataclass(frozen=True)
-class Field:
-    """One scene key: its type, accepted range and meaning (unit is in the key name)."""
-
-    kind: type | tuple[str, ...]  # float, int, bool, or a tuple of accepted strings
-    doc: str
-    minimum: float | None = None  # inclusive lower bound
-    positive: bool = False  # strictly > 0
-    maximum: float | None = None  # inclusive upper bound
-    below: float | None = None  # strictly < below
-    auto: bool = False  # "auto" accepted too: flex chooses (flex.config.settings)
-    #: value of a key the bundled parameter set does not state (a flex model choice added
-    #: after it was written, not a thesis value): :func:`default_scene` fills it in
-    default: Any = None
-
-    def accepted(self) -> str:
-        """Human-readable accepted range, used in error messages."""
-        return self._accepted() + (' or "auto"' if self.auto else "")
-
-    def _accepted(self) -> str:
-        if isinstance(self.kind, tuple):
-            return "one of " + ", ".join(f'"{c}"' for c in self.kind)
-        if self.kind is bool:
-            return "true or false"
-        parts = []
-        if self.positive:
-            parts.append("> 0")
-        if self.minimum is not None:
-            parts.append(f">= {self.minimum:g}")
-        if self.below is not None:
-            parts.append(f"< {self.below:g}")
-        if self.maximum is not None:
-            parts.append(f"<= {self.maximum:g}")
-        name = "an integer" if self.kind is int else "a finite number"
-        return name + (" " + " and ".join(parts) if parts else "")
 
 
 _POS = {"kind": float, "positive": True}
@@ -433,7 +396,7 @@ def parse_override(item: str) -> tuple[str, str, Any]:
     """``"section.key=value"`` -> ``(section, key, value)`` (value in TOML syntax; a bare
     word is a string); SceneError if it is not of that form."""
     if "=" not in item or "." not in item.split("=", 1)[0]:
-        raise SceneError(f"--set {_show(item)}: expected section.key=value, "
+        raise SceneError(f"--set {show(item)}: expected section.key=value, "
                          f"e.g. coupler.thickness_m=0.003")
     dotted, text = item.split("=", 1)
     section, key = (part.strip() for part in dotted.split(".", 1))
@@ -470,48 +433,12 @@ def validate(scene: Scene, link_models: Mapping[str, Any] = BUILTIN_LINK_SCHEMAS
             field = SCHEMA[section][key]
             if section in LINKS and key == "model":  # the models of the registry given
                 field = replace(field, kind=(*model_names(section, link_models), AUTO))
-            _check_value(f"{section}.{key}", field, value)
+            check_value(f"{section}.{key}", field, value)
     for section, fields in SCHEMA.items():
         for key in fields:
             if key not in scene.get(section, {}):
                 raise SceneError(f"missing key {section}.{key} ({fields[key].doc})")
     _check_geometry(scene, link_models)
-
-
-def _check_value(name: str, field: Field, value: Any) -> None:
-    if field.auto and value == AUTO:
-        return
-    if isinstance(field.kind, tuple):
-        if not isinstance(value, str) or value not in field.kind:
-            raise SceneError(f"{name} = {_show(value)}: must be {field.accepted()}")
-        return
-    if field.kind is bool:
-        if not isinstance(value, bool):
-            raise SceneError(f"{name} = {_show(value)}: must be true or false")
-        return
-    is_number = isinstance(value, int | float) and not isinstance(value, bool)
-    if (not is_number or (field.kind is int and not isinstance(value, int))
-            or not _finite(value) or (field.positive and not value > 0)
-            or (field.minimum is not None and value < field.minimum)
-            or (field.maximum is not None and value > field.maximum)
-            or (field.below is not None and not value < field.below)):
-        raise SceneError(f"{name} = {_show(value)}: must be {field.accepted()}")
-
-
-def _finite(value: float) -> bool:
-    try:
-        return math.isfinite(value)
-    except OverflowError:  # an integer beyond the float range
-        return False
-
-
-def _show(value: Any, limit: int = 60) -> str:
-    """``repr(value)`` shortened to one line: safe inside a one-line error message."""
-    try:
-        text = repr(value)
-    except ValueError:  # an integer beyond Python's digit limit for str()
-        text = "<an integer of thousands of digits>"
-    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def _name(text: str, limit: int = 60) -> str:

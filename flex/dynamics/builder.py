@@ -18,8 +18,9 @@ import numpy as np
 from flex.base.errors import SceneError
 from flex.base.kinematics import crank_pin, slider_crank
 from flex.base.physics import cuboid_inertia_kgm2, cuboid_mass_kg
+from flex.data.fields import AUTO
 from flex.data.plates import plate_mass_properties
-from flex.data.scene import AUTO, Scene
+from flex.data.scene import Scene
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel, entries
 
 os.environ.setdefault("EXUDYN_NO_USER_SETTINGS", "1")

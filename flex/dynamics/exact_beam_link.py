@@ -12,9 +12,10 @@ from typing import Any
 import numpy as np
 
 from flex.base.physics import Plate
+from flex.data.fields import AUTO
 from flex.data.plates import EXACT_BEAM_ELEMENTS
 from flex.data.results import Dataset
-from flex.data.scene import AUTO, Scene
+from flex.data.scene import Scene
 from flex.dynamics.link_outputs import flexible_datasets, flexible_sensors, sensor_data
 
 # ------------------------------------------------------------------------------------------

@@ -103,10 +103,10 @@ from flex.config.ladder import (
     Rung,
     ffrf_rung,
 )
+from flex.data.fields import AUTO
 from flex.data.plates import estimate_mesh, plate_mass_properties
 from flex.data.results import Dataset
 from flex.data.scene import (
-    AUTO,
     BUILTIN_LINK_SCHEMAS,
     LINKS,
     LinkSchema,

@@ -28,7 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from flex.data.scene import AUTO, LINKS, Scene, link_model
+from flex.data.fields import AUTO
+from flex.data.scene import LINKS, Scene, link_model
 from flex.dynamics.builder import Builder, Mechanism, slider_mass_kg
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS
 

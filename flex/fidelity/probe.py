@@ -22,7 +22,7 @@ import numpy as np
 from flex.base.errors import SceneError
 from flex.config.calibration import Calibration
 from flex.config.settings import solver_defaults
-from flex.data.scene import AUTO
+from flex.data.fields import AUTO
 from flex.data.steps import MAX_STEPS
 from flex.dynamics.link_models import RIGID
 from flex.fidelity.criteria import PRIMARY_DELTA_T, deployment_times

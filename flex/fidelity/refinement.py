@@ -32,7 +32,8 @@ from flex.base.errors import SceneError
 from flex.config.knobs import KNOB_KEYS, KNOBS, NO_KNOB, STEP, linked_knobs, preparation_s
 from flex.config.ladder import next_rung
 from flex.config.settings import resolve_solver_settings
-from flex.data.scene import AUTO, Scene, default_scene
+from flex.data.fields import AUTO
+from flex.data.scene import Scene, default_scene
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.link_models import LinkModel
 from flex.dynamics.runtime import estimated_run_time_s
