@@ -41,6 +41,7 @@ from typing import Any
 
 from flex.config.calibration import Calibration
 from flex.config.ffrf_rule import pick
+from flex.config.tolerance import Tolerance
 from flex.data.plates import EXACT_BEAM_ELEMENTS, estimate_mesh
 from flex.data.scene import LINKS, SCHEMA, Scene
 
@@ -260,7 +261,7 @@ def reads_key(entry: Any, key: str) -> bool:
 
 def auto_value(knob: Knob, scene: Scene, link: str, calibration: Calibration | None) -> Any:
     """``knob``'s value for ``link`` from ``scene``'s ``fidelity.tolerance`` (its ``auto``)."""
-    return knob.auto(scene, link, float(scene["fidelity"]["tolerance"]), calibration)
+    return knob.auto(scene, link, Tolerance.of(scene).relative, calibration)
 
 
 def preparation_s(scene: Scene, link_models: Mapping[str, Any]) -> float:

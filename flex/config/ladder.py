@@ -267,11 +267,11 @@ def climb(link: str, values: Mapping[str, Any], load_ratio: float, tolerance: fl
 def next_rung(link: str, values: Mapping[str, Any], link_models: Mapping[str, Any]
               ) -> str | None:
     """The model of the next rung above ``link``'s (scene ``values``) that the refinement may
-    climb to, or None: from a rung with no measured bound (a rigid link has no model term to
-    refine; the top has none above), or a model on no rung."""
+    climb to, or None: from a rung whose model term is neither bounded nor measured (a lumped
+    rigid link; the top has none above), or a model on no rung."""
     entry = link_models[values["model"]]
     current = entry.rung(values) if link in entry.links else None
-    if current is None or not current.bounded:
+    if current is None or not (current.bounded or current.measured_against):
         return None
     above = [name for rung, name in rungs(link, values, link_models, refine=True)
              if rung.level > current.level]

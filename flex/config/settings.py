@@ -42,6 +42,7 @@ from flex.base.errors import SceneError
 from flex.config.calibration import Calibration, calibration_of
 from flex.config.ffrf_rule import RulePick, pick, rule_constants
 from flex.config.knobs import Knob, auto_value, exact_beam_settings, knobs_of
+from flex.config.tolerance import Tolerance
 from flex.data.fields import AUTO
 from flex.data.scene import (
     BUILTIN_LINK_SCHEMAS,
@@ -149,7 +150,7 @@ def choose_entry(scene: Scene, calibration: Calibration | None = None, *,
         what = ("an FFRF crank" if crank.settings == FFRF_RULE
                 else f'coupler.model = "{coupler.name}"')
         return "flexible_fallback", f"no calibrated rule for {what}: {FALLBACK}", None
-    tolerance = float(scene["fidelity"]["tolerance"])
+    tolerance = Tolerance.of(scene).relative
     chosen = pick(scene, tolerance, calibration=calibration)
     if chosen.step_s is None:
         return "flexible_fallback", f"FFRF coupler {chosen.reason}: {FALLBACK}", None
@@ -202,7 +203,7 @@ def tolerance_beyond_reach(scene: Scene, calibration: Calibration | None = None,
     if no ``auto`` choice reads it): a tolerance below :func:`finest_certified_accuracy`
     is met by no model flex has measured (``auto`` then takes its most accurate model, up to
     the nonlinear FE coupler, whose own error is not known to be that small)."""
-    tolerance = float(scene["fidelity"]["tolerance"])
+    tolerance = Tolerance.of(scene).relative
     finest, source = finest_certified_accuracy(calibration)
     if tolerance >= finest * (1 - 1e-9) or not reads_tolerance(scene,
                                                                 link_models=link_models):
@@ -240,7 +241,7 @@ def resolve_solver_settings(scene: Scene, calibration: Calibration | None = None
         reason += (f"; step rounded down to {values['step_s']:.6g} s, a whole number of 4 "
                    f"steps in the end time")
     elif name == "flexible_fallback" and _beam_step(resolved, link_models):
-        tolerance = float(resolved["fidelity"]["tolerance"])
+        tolerance = Tolerance.of(resolved).relative
         values["step_s"] = exact_beam_settings(tolerance)[1]
         reason += (f"; the exact beam's step at tolerance {tolerance:g}: {values['step_s']:g} s "
                    f"(EXACT_BEAM_SETTINGS, measured; a first guess)")

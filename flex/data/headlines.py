@@ -28,8 +28,10 @@ The contract of an entry:
 6. ``link``: the link whose own elastic response it is (its model term is the link's rung's
    ``own_fraction``, :mod:`flex.config.ladder`), or None for a quantity of the motion (the
    rungs' ``motion_fraction``);
-7. ``certified``: :func:`flex.fidelity.simulation.refine` refines until it meets the
-   tolerance; ``crest_gap``: its budget stores the peak's crest gap (:func:`crest_gap`);
+7. ``certified``: a link's own deflection the ``"deflections"`` and
+   ``"flexible_deflections"`` groups of ``fidelity.quantities`` name (:data:`QUANTITY_GROUPS`;
+   refinement refines every quantity asked until it meets the tolerance); ``crest_gap``: its
+   budget stores the peak's crest gap (:func:`crest_gap`);
    ``mesh_order``: its order of convergence under mesh refinement (the budget's mesh term
    extrapolates a finer mesh's difference with it).
 """
@@ -307,6 +309,21 @@ def _builtin() -> dict[str, Headline]:
 BUILTIN_HEADLINES: Mapping[str, Headline] = MappingProxyType(_builtin())
 
 
+#: groups of headline quantities ``fidelity.quantities`` may name besides single quantities:
+#: the motion; each link's own deployment peak deflection (asked: the link is modelled
+#: flexible); the same, of the links that are flexible in the run (asked: no link is made
+#: flexible for it)
+QUANTITY_GROUPS: Mapping[str, tuple[str, ...]] = MappingProxyType({
+    "motion": ("crank_angle_end_rad", "slider_position_end_m", "deployment_time_s"),
+    "deflections": tuple(name for name, entry in BUILTIN_HEADLINES.items() if entry.certified),
+    "flexible_deflections": tuple(name for name, entry in BUILTIN_HEADLINES.items()
+                                  if entry.certified),
+})
+#: what ``fidelity.tolerance`` applies to unless ``fidelity.quantities`` says otherwise: the
+#: motion, and each flexible link's peak deflection over the deployment
+DEFAULT_QUANTITIES = ("motion", "flexible_deflections")
+
+
 def channel_series(headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> tuple[str, ...]:
     """The series the ``headlines`` read on the headline channel (each once, the crank angle
     that ends the deployment first): what a run stores filtered as ``channel/<path>``
@@ -316,5 +333,6 @@ def channel_series(headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> tup
     return tuple(dict.fromkeys(found))
 
 __all__ = ["BUILTIN_HEADLINES", "KINDS", "Headline", "channel", "crest_gap", "deployment_end",
-           "channel_series", "deployment_peak_value", "deployment_time_s",
+           "DEFAULT_QUANTITIES", "QUANTITY_GROUPS", "channel_series", "deployment_peak_value",
+           "deployment_time_s",
            "final_value", "first_crest_value", "peak_value"]

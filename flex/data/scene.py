@@ -30,6 +30,7 @@ import tomli_w
 
 from flex.base.errors import SceneError
 from flex.data.fields import AUTO, Field, check_value, show
+from flex.data.headlines import BUILTIN_HEADLINES, DEFAULT_QUANTITIES, QUANTITY_GROUPS
 from flex.data.plates import (
     EXACT_BEAM_ELEMENTS,
     check_beam_plate,
@@ -268,12 +269,18 @@ SCHEMA: dict[str, dict[str, Field]] = {
                                            "at A, B, C and across the slide line", **_POS),
     },
     "fidelity": {
-        "tolerance": Field(float, "model = \"auto\": accepted error of the rigid model "
-                           "(dimensionless: deflection / L2, crank-angle and slider deviation "
-                           "relative to their swing)", positive=True, maximum=0.5),
-        "refine": Field(bool, "refine step, modes, mesh, rung until the flexible links' "
-                        "peak deflection and first crest meet the tolerance (docs/criterion.md)",
-                        default=False),
+        "tolerance": Field(float, "accepted relative error of each quantity asked "
+                           "(fidelity.quantities), relative to the quantity itself; the rigid "
+                           "decision of model = \"auto\": the predicted deflection relative to "
+                           "the link's length (docs/criterion.md)", positive=True, maximum=0.5),
+        "quantities": Field((*QUANTITY_GROUPS, *BUILTIN_HEADLINES),
+                            "the headline quantities the tolerance applies to: their names, or "
+                            '"motion", "deflections" (the link is made flexible), '
+                            '"flexible_deflections" (of the links that are flexible) '
+                            "(docs/error-budget.md)", many=True,
+                            default=list(DEFAULT_QUANTITIES)),
+        "refine": Field(bool, "refine step, modes, mesh, rung until every quantity asked "
+                        "meets the tolerance (docs/error-budget.md)", default=False),
         "refine_limit_s": Field(float, "refine: none starts after", positive=True, default=600.0),
     },
 }
@@ -315,7 +322,7 @@ def default_scene() -> Scene:
     for section, fields in SCHEMA.items():
         for key, field in fields.items():
             if field.default is not None:
-                scene.setdefault(section, {}).setdefault(key, field.default)
+                scene.setdefault(section, {}).setdefault(key, copy.deepcopy(field.default))
     return scene
 
 

@@ -54,6 +54,7 @@ from flex.config.settings import (
     resolve_link_keys,
     resolve_solver_settings,
 )
+from flex.config.tolerance import Tolerance
 from flex.data.plates import EXACT_BEAM_ELEMENTS
 from flex.data.scene import LINKS, Scene, check_meshed_plate, model_names, to_toml
 from flex.dynamics.link_models import (
@@ -382,7 +383,7 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
     if not (wants_coupler or wants_crank):
         return resolved, decisions
     criterion = criterion or criterion_of(calibration, "coupler")
-    tolerance = float(resolved["fidelity"]["tolerance"])
+    tolerance = Tolerance.of(resolved).relative
     links = " and ".join(f"{link}.model" for link, wants in
                          (("coupler", wants_coupler), ("crank", wants_crank)) if wants)
     try:
@@ -451,6 +452,10 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
     else:
         _decide_by_loads(decision, predict_deflection(probe, coupler).relative_error(
             coupler["length_m"]), tolerance)
+    if link_models[decision.model].rigid and Tolerance.of(resolved).wants_flexible("coupler"):
+        decision.model = FFRF  # asked of itself, its deflection needs a flexible rung
+        decision.reason += ("; fidelity.quantities asks the coupler's own deflection, which a "
+                            "rigid coupler gives as a +-25 % prediction only: a flexible rung")
     if not link_models[decision.model].rigid:
         _climb(decision, coupler, ratio, tolerance, link_models)
     coupler["model"] = decision.model
@@ -489,8 +494,9 @@ def _decide_by_loads(decision: FidelityDecision, predicted_rigid_error: float,
     baseline = decision.model
     decision.model = RIGID if rigid else FFRF
     decision.reason = (
-        f"{decision.link}: the rigid run's loads predict a deflection error of "
-        f"{predicted_rigid_error:.3g} (x {PREDICTION_MARGIN:g} margin: {bound:.3g} "
+        f"{decision.link}: the rigid run's loads predict a deflection of "
+        f"{predicted_rigid_error:.3g} of the {decision.link}'s length, the rigid model's error "
+        f"of the motion (x {PREDICTION_MARGIN:g} margin: {bound:.3g} "
         f"{'<=' if rigid else '>'} tolerance {tolerance:g}); n-law baseline ("
         f"{'agrees' if baseline == decision.model else f'would pick {baseline}'}): "
         + decision.reason.split(": ", 1)[1])
@@ -519,6 +525,11 @@ def _decide_crank(resolved: dict[str, dict[str, Any]], probe: dict[str, np.ndarr
                   "Exudyn eigenvalues at t = 0")
     _crank_by_loads(decision, probe, plate, omega, tolerance,
                     bool(resolved.get("wing", {}).get("enabled", False)))
+    if BUILTIN_LINK_MODELS[decision.model].rigid and Tolerance.of(resolved).wants_flexible(
+            "crank"):
+        decision.model = FFRF
+        decision.reason += ("; fidelity.quantities asks the crank's own deflection, which a "
+                            "rigid crank gives as a prediction only: flexible")
     if not BUILTIN_LINK_MODELS[decision.model].rigid:
         if lumped:
             raise SceneError(f'crank.model = "auto": the criterion says the crank is '
@@ -560,6 +571,6 @@ def _crank_by_loads(decision: FidelityDecision, probe: dict[str, np.ndarray],
         _decide_by_loads(decision, predicted, tolerance)
         return
     decision.predicted_rigid_error = predicted
-    decision.reason += (f"; the rigid run's loads predict a deflection error of "
-                        f"{predicted:.3g} (stored, not deciding: with the wing the crank-angle "
-                        f"error governs, about 3 x the deflection's)")
+    decision.reason += (f"; the rigid run's loads predict a deflection of "
+                        f"{predicted:.3g} of the crank's length (stored, not deciding: with the "
+                        f"wing the crank-angle error governs, about 3 x the deflection's)")

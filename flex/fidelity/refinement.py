@@ -42,8 +42,8 @@ from flex.fidelity.stored_budget import BudgetRow, combined
 #: most attempts of a refinement (each one a run with its whole error budget)
 MAX_ATTEMPTS = 6
 #: refinement's status of a run with no quantity it certifies
-NOTHING_TO_REFINE = ("nothing to refine: no flexible link's deflection to certify (the "
-                     "tolerance bounds a flexible link's own deflection; every link is rigid)")
+NOTHING_TO_REFINE = ("nothing to refine: no quantity the tolerance applies to is in the run "
+                     "(fidelity.quantities; a rigid link has no deflection of its own)")
 
 
 def free_knobs(scene: Scene) -> frozenset[str]:

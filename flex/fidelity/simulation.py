@@ -28,6 +28,7 @@ from flex.base.errors import FlexError, SceneError, SimulationError
 from flex.config.calibration import Calibration
 from flex.config.knobs import KNOB_KEYS, settings_text
 from flex.config.settings import tolerance_beyond_reach
+from flex.config.tolerance import Tolerance
 from flex.data.headlines import BUILTIN_HEADLINES, Headline
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, to_toml
@@ -45,7 +46,14 @@ from flex.fidelity.refinement import (
     next_attempt,
     observed_fall,
 )
-from flex.fidelity.stored_budget import ErrorBudget, headline_attrs
+from flex.fidelity.stored_budget import (
+    BudgetRow,
+    ErrorBudget,
+    coverage_attrs,
+    coverage_text,
+    headline_attrs,
+    tolerance_coverage,
+)
 
 
 def simulate(scene: Scene, name: str = "case", reduction: Any = None,
@@ -103,9 +111,11 @@ def simulate_resolved(resolution: Resolution, name: str = "case", reduction: Any
     attempts): a companion found there is not run again, and neither is the run itself when
     one of them is its scene (the next attempt of a refinement is the last one's finer
     companion); the companions this run makes are added."""
-    return _run_budgeted(resolution, name, reduction, crank_reduction, cache_dir=cache_dir,
-                         beyond=beyond, link_models=link_models, headlines=headlines,
-                         companions=companions)[0]
+    result, budget = _run_budgeted(resolution, name, reduction, crank_reduction,
+                                   cache_dir=cache_dir, beyond=beyond, link_models=link_models,
+                                   headlines=headlines, companions=companions)
+    _state_coverage(result, budget, resolution.scene, name, link_models, refined=False)
+    return result
 
 
 def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduction: Any, *,
@@ -236,11 +246,11 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
                          "refinement follows the error budget; set error_estimate = true or "
                          "refine = false")
     start, lines = time.perf_counter(), []
-    tolerance = float(resolution.scene["fidelity"]["tolerance"])
+    tolerance = Tolerance.of(resolution.scene).relative
     current = resolution
     made: dict[str, CaseResult] = {}  # every companion run so far, by its scene
     falls: dict[str, float] = {}  # each term's fall, observed when its knob was last turned
-    last: tuple[Step, dict[str, Any], CaseResult] | None = None  # the last attempt
+    last: tuple[Step, dict[str, Any], CaseResult, ErrorBudget, Scene] | None = None
     for attempt in range(1, MAX_ATTEMPTS + 1):
         reused = companion_key(current.scene) in made
         try:
@@ -254,10 +264,10 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
                         f"failed: {failed}")
             lines.append(f"{attempt}: {settings_text(current.scene, link_models)}: "
                          f"{step.line}")
-            result = last[2]
+            result, budget, kept = last[2], last[3], last[4]
             break
-        rows = {row.quantity: row for row in budget.rows()
-                if row.quantity in headlines and headlines[row.quantity].certified}
+        kept = current.scene
+        rows = _asked_rows(kept, budget, link_models)
         if last is not None:  # the term whose knob the last attempt turned, on its worst
             fall = observed_fall(last[1].get(last[0].worst), rows.get(last[0].worst),
                                  last[0].term)
@@ -274,11 +284,46 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
                      f"{step.line}")
         if step.refined is None:
             break
-        current, last = replace(current, scene=step.refined), (step, rows, result)
+        last = (step, rows, result, budget, kept)
+        current = replace(current, scene=step.refined)
     result.attrs.update({"refine_status": step.status, "refine_attempts": "\n".join(lines),
                          "refine_wall_time_s": time.perf_counter() - start})
     _say_status(name, step.status, tolerance)
+    _state_coverage(result, budget, kept, name, link_models, refined=True)
     return result
+
+
+def _asked_rows(scene: Scene, budget: ErrorBudget, link_models: Mapping[str, LinkModel]
+                ) -> dict[str, BudgetRow]:
+    """The budget rows of the quantities the tolerance applies to in the run of ``scene``
+    (:meth:`flex.config.tolerance.Tolerance.asked`), by quantity: what refinement chases."""
+    asked = Tolerance.of(scene).asked(_flexible_links(scene, link_models))
+    return {row.quantity: row for row in budget.rows() if row.quantity in asked}
+
+
+def _flexible_links(scene: Scene, link_models: Mapping[str, LinkModel]) -> list[str]:
+    """The links of ``scene`` whose concrete model is not rigid."""
+    return [link for link in LINKS if not link_models[scene[link]["model"]].rigid]
+
+
+def _state_coverage(result: CaseResult, budget: ErrorBudget | None, scene: Scene, name: str,
+                    link_models: Mapping[str, LinkModel], refined: bool) -> None:
+    """Store and say what the tolerance covered (:func:`flex.fidelity.stored_budget.
+    tolerance_coverage`): each quantity asked, met or not; a quantity missed without
+    refinement is a warning naming it and what ``fidelity.refine = true`` would do."""
+    if budget is None:
+        return
+    tolerance = Tolerance.of(scene)
+    coverage = tolerance_coverage(budget.rows(), tolerance.asked(
+        _flexible_links(scene, link_models)), tolerance.relative)
+    result.attrs.update(coverage_attrs(coverage, tolerance.relative))
+    missed = [item for item in coverage if item[1] in ("missed", "unknown")]
+    text = coverage_text(coverage, tolerance.relative)
+    if missed and not refined:
+        text += ("; fidelity.refine = true would turn the knobs of the missed quantities "
+                 "(step, modes, mesh, elements, rung) until they meet it, or say why not")
+    print(f"flex: {'warning' if missed else 'note'}: case {name}: {text}", file=sys.stderr,
+          flush=True)
 
 
 #: the noise floor's companion runs at this many times the run's Newton tolerance (looser, so

@@ -52,6 +52,7 @@ from flex.base.physics import (
     spring_effective_mass_kg,
 )
 from flex.bodies.spring import surge_frequency_fixed_end_mass_Hz
+from flex.config.tolerance import Tolerance
 from flex.data.headlines import first_maximum_index
 from flex.data.scene import SCHEMA
 from flex.fidelity.probe import FidelityDecision, deployment_probe
@@ -213,7 +214,7 @@ def decide_spring(resolved: dict[str, dict[str, Any]]) -> SpringDecision:
     drive = resolved["drive"]
     if drive["kind"] != "spring":
         raise SceneError('drive.spring_model = "auto" needs drive.kind = "spring"')
-    tolerance = float(resolved["fidelity"]["tolerance"])
+    tolerance = Tolerance.of(resolved).relative
     massless = copy.deepcopy(resolved)
     massless["drive"]["spring_model"] = "massless"
     delta_t_s, _, probe = deployment_probe(massless)

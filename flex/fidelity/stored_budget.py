@@ -128,6 +128,65 @@ def _not_measured(terms: list[str]) -> str:
     return f"unknown ({', '.join(terms)} term not measured: see 'unknown')"
 
 
+#: case attribute: what the tolerance covered, one ``quantity<TAB>status<TAB>certified
+#: relative error`` line per quantity asked (status ``met``, ``missed``, ``unknown``: its
+#: budget has no total, ``absent``: the run does not have it)
+COVERAGE_ATTR = "tolerance_covered"
+
+
+def tolerance_coverage(rows: list[BudgetRow], asked: tuple[str, ...], relative: float
+                       ) -> list[tuple[str, str, float]]:
+    """Each quantity ``asked``: its status against the tolerance ``relative`` [1] and its
+    certified relative error (NaN where unknown or absent), from a budget's ``rows``."""
+    by_name = {row.quantity: row for row in rows}
+    out = []
+    for name in asked:
+        row = by_name.get(name)
+        certified = row.certified_relative if row is not None else math.nan
+        status = ("absent" if row is None else "unknown" if not math.isfinite(certified)
+                  else "met" if certified <= relative else "missed")
+        out.append((name, status, certified))
+    return out
+
+
+def coverage_attrs(coverage: list[tuple[str, str, float]], relative: float) -> dict[str, Any]:
+    """Case attributes of :func:`tolerance_coverage`: :data:`COVERAGE_ATTR`,
+    ``tolerance_relative`` [1] and ``tolerance_met`` (every quantity asked that the run has
+    met: none missed, none unknown)."""
+    return {COVERAGE_ATTR: "\n".join(f"{name}\t{status}\t{certified!r}"
+                                     for name, status, certified in coverage),
+            "tolerance_relative": relative,
+            "tolerance_met": all(status in ("met", "absent") for _, status, _ in coverage)}
+
+
+def coverage_text(coverage: list[tuple[str, str, float]], relative: float) -> str:
+    """One line: the tolerance, then the quantities grouped by status with their certified
+    relative errors (``"tolerance 0.1 % of each quantity: met: deployment_time_s (0.045 %);
+    missed: coupler_deployment_peak_deflection_m (0.11 %)"``)."""
+    groups: dict[str, list[str]] = {}
+    for name, status, certified in coverage:
+        shown = f" ({100 * certified:.2g} %)" if math.isfinite(certified) else ""
+        groups.setdefault(status, []).append(name + shown)
+    return (f"tolerance {100 * relative:g} % of each quantity (certified, relative to itself): "
+            + "; ".join(f"{status}: {', '.join(names)}" for status, names in groups.items()))
+
+
+def stored_coverage(attrs: Mapping[str, Any]) -> list[tuple[str, str, float]]:
+    """:func:`tolerance_coverage` as a case stores it (none in a file written before)."""
+    text = attrs.get(COVERAGE_ATTR, "")
+    if isinstance(text, bytes):
+        text = text.decode("utf-8", "replace")
+    out = []
+    for line in str(text).splitlines():
+        parts = line.split("\t")
+        if len(parts) == 3:
+            try:
+                out.append((parts[0], parts[1], float(parts[2])))
+            except ValueError:
+                out.append((parts[0], parts[1], math.nan))
+    return out
+
+
 def headline_attrs(datasets: Mapping[str, Any],
                    headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> dict[str, Any]:
     """A run's headline values as case attributes, ``headline_<quantity>`` [its unit], and
@@ -324,6 +383,8 @@ def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> 
 
 
 __all__ = ["BOUNDS_ATTR", "BOUND_TEXT", "CERTIFICATE_ATTR", "CERTIFICATE_FACTOR", "CONSISTENCY",
-           "CREST_GAP_PREFIX", "DESCRIBED", "HEADLINE_PREFIX", "PREFIX", "STEP_BOUNDS_ATTR",
+           "COVERAGE_ATTR", "CREST_GAP_PREFIX", "DESCRIBED", "HEADLINE_PREFIX", "PREFIX",
+           "STEP_BOUNDS_ATTR",
            "TERMS", "UNKNOWN_ATTR", "BudgetRow", "ErrorBudget", "budget_rows", "combined",
-           "headline_attrs", "named_quantities", "term_text"]
+           "coverage_attrs", "coverage_text", "headline_attrs", "named_quantities",
+           "stored_coverage", "term_text", "tolerance_coverage"]

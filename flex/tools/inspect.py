@@ -294,7 +294,7 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
     """The case's error budget (:mod:`flex.fidelity.error_budget`): each headline quantity
     with its value, total estimated error (absolute and relative) and terms; how the terms
     were made, what the budget leaves out, the step estimate's validity."""
-    from flex.fidelity.stored_budget import PREFIX, budget_rows
+    from flex.fidelity.stored_budget import PREFIX, budget_rows, coverage_text, stored_coverage
 
     rows = budget_rows(attrs)
     if not rows and f"{PREFIX}validity" not in attrs:
@@ -307,6 +307,9 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
     for key in ("method", "leaves_out", "validity", "unknown"):
         if attrs.get(PREFIX + key):
             lines.append(f"    {key.replace('_', ' ')}: {attrs[PREFIX + key]}")
+    coverage = stored_coverage(attrs)
+    if coverage:
+        lines.append(f"    {coverage_text(coverage, float(attrs.get('tolerance_relative', 0)))}")
     lines += _prediction_lines(attrs)
     lines += [f"    crest gap of the {key.removeprefix('crest_gap_').split('_')[0]}'s peak "
               f"deflection: {_quantity(value, 'm')} (the second-largest crest lies this far "

@@ -320,7 +320,14 @@ def _cases_section(cases: list[dict[str, Any]]) -> list[str]:
 def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
     """Each case's error budget: a row per headline quantity (value, total estimated error,
     relative, terms), then how the terms were made and what they leave out."""
-    from flex.fidelity.stored_budget import PREFIX, TERMS, budget_rows, term_text
+    from flex.fidelity.stored_budget import (
+        PREFIX,
+        TERMS,
+        budget_rows,
+        coverage_text,
+        stored_coverage,
+        term_text,
+    )
 
     rows, notes = [], {}
     for case in cases:
@@ -336,6 +343,11 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
             if case["attrs"].get(PREFIX + key):
                 notes.setdefault(key, {}).setdefault(case["attrs"][PREFIX + key], []).append(
                     case["name"])
+        coverage = stored_coverage(case["attrs"])
+        if coverage:
+            notes.setdefault("tolerance", {}).setdefault(coverage_text(
+                coverage, float(case["attrs"].get("tolerance_relative", 0))), []).append(
+                case["name"])
     if not rows:
         return []
     lines = ["Estimated error of each headline quantity (total = the root-sum-square of the "
