@@ -134,8 +134,8 @@ class PlateReference:
 
     def attrs(self) -> dict[str, Any]:
         """The reference as HDF5 attributes: ``plate_<field>``, ``mesh_<field>``, the
-        per-order arrays, the
-        limits, errors and ratios (units in the names) and the format version."""
+        per-order arrays, the limits, errors and ratios (units in the names) and the format
+        version."""
         values = {f"plate_{name}": value for name, value in asdict(self.plate).items()}
         values.update({f"mesh_{name}": value for name, value in asdict(self.mesh).items()})
         values["mesh_grading_ratio"] = GRADING_RATIO
