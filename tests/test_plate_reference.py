@@ -162,11 +162,12 @@ def test_a_second_call_reads_the_cache_and_a_damaged_entry_is_computed_again(tmp
         return original(*args, **kwargs)
 
     monkeypatch.setattr(reference_module, "solve_order", counted)
-    plate, orders = thesis_plate(0.003), (1, 2, 3)
+    plate, orders, mesh = thesis_plate(0.003), (1, 2, 3), HexMesh(2, 1, 2, graded_layers=0)
 
     def call() -> tuple[reference_module.PlateReference, str]:
         stream = io.StringIO()
-        result = plate_reference(plate, orders=orders, cache_dir=tmp_path, stream=stream)
+        result = plate_reference(plate, orders=orders, cache_dir=tmp_path, mesh=mesh,
+                                 stream=stream)
         return result, stream.getvalue()
 
     cold, said = call()
