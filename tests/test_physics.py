@@ -246,3 +246,68 @@ def test_a_plate_value_reads_a_scene_link_and_calls_the_closed_forms():
         0.08, 0.002, 0.01, 200e9, 7850.0, 0.3, 3)
     assert plate.clamped_frequencies(5) == physics.clamped_plate_frequencies(
         0.08, 0.002, 0.01, 200e9, 7850.0, 0.3, 5)
+
+
+# --- Timoshenko closed forms from a section (the plate reference's calibration) ------------
+
+STRIP = dict(length_m=0.08, bending_stiffness_Nm2=200e9 * 0.01 * 0.003**3 / 12,
+             shear_stiffness_N=5 / 6 * 200e9 / 2.6 * 0.01 * 0.003)
+
+
+def test_timoshenko_midpoint_deflection_against_the_beam_equations_solved_numerically():
+    """Independent: the Timoshenko equations E I psi'' + kGA (w' - psi) = 0, kGA (w'' -
+    psi') = -q with w = 0, psi' = 0 at both pins, solved by scipy's collocation."""
+    from scipy.integrate import solve_bvp
+
+    length, bending, shear, load = (STRIP["length_m"], STRIP["bending_stiffness_Nm2"],
+                                    STRIP["shear_stiffness_N"], 2.0)
+
+    def rhs(x, s):  # s = (w, w', psi, psi')
+        return np.vstack([s[1], s[3] - load / shear, s[3],
+                          -shear / bending * (s[1] - s[2])])
+
+    x = np.linspace(0.0, length, 101)
+    solution = solve_bvp(rhs, lambda a, b: np.array([a[0], b[0], a[3], b[3]]), x,
+                         np.zeros((4, x.size)), tol=1e-10, max_nodes=100000)
+    assert solution.success
+    numeric = float(solution.sol(length / 2)[0])
+    closed = physics.pinned_timoshenko_midpoint_deflection_m(load, length, bending, shear)
+    assert closed == pytest.approx(numeric, rel=1e-7)
+    # without shear deformation it is the Euler-Bernoulli beam of the older closed form
+    assert physics.pinned_timoshenko_midpoint_deflection_m(
+        load, length, 200e9 * 0.01 * 0.003**3 / 12, math.inf) == pytest.approx(
+        physics.pinned_beam_midpoint_deflection_m(load * length, length, 0.003, 0.01, 200e9),
+        rel=1e-14)
+    with pytest.raises(ValueError, match="shear_stiffness_N"):
+        physics.pinned_timoshenko_midpoint_deflection_m(load, length, bending, 0.0)
+
+
+def test_timoshenko_pinned_omega_against_the_transfer_matrix_roots_and_euler_bernoulli():
+    """The closed form against the transfer-matrix root search of
+    flex.experiments.thesis.beams (which solves any end condition from the Timoshenko
+    equations), and its Euler-Bernoulli limit."""
+    from flex.experiments.thesis.beams import _timoshenko_roots
+
+    length, bending, shear = (STRIP["length_m"], STRIP["bending_stiffness_Nm2"],
+                              STRIP["shear_stiffness_N"])
+    area, inertia, rho = 0.01 * 0.003, 0.01 * 0.003**3 / 12, 7850.0
+    roots = _timoshenko_roots("pinned-pinned", 3, inertia / (area * length**2),
+                              bending / (shear * length**2), True)
+    by_roots = np.array(roots) / length**2 * math.sqrt(bending / (rho * area))
+    closed = physics.timoshenko_pinned_pinned_omega(np.arange(1, 4), length, bending, shear,
+                                                    rho * area, rho * inertia)
+    np.testing.assert_allclose(closed, by_roots, rtol=1e-9)
+    euler = physics.timoshenko_pinned_pinned_omega(1, length, 200e9 * inertia, math.inf,
+                                                   rho * area, 0.0)
+    assert euler == pytest.approx(physics.pinned_pinned_omega(length, 0.003, 200e9, rho),
+                                  rel=1e-14)
+    assert closed[0] < euler  # shear and rotary inertia soften
+
+
+def test_anticlastic_offset_is_point_four_nu_w_over_l_squared_for_a_thin_strip():
+    thin = physics.anticlastic_centroid_offset(0.08, 1e-9, 0.01, 0.3)
+    assert thin == pytest.approx(0.4 * 0.3 * (0.01 / 0.08) ** 2, rel=1e-12)
+    # a square section does not curl on the mean: the y and z terms cancel
+    assert physics.anticlastic_centroid_offset(0.08, 0.01, 0.01, 0.3) == 0.0
+    assert physics.lame_first_parameter_Pa(200e9, 0.3) == pytest.approx(
+        200e9 * 0.3 / (1.3 * 0.4), rel=1e-15)

@@ -40,9 +40,21 @@ def _check_positive(**values: float) -> None:
             raise ValueError(f"{name} = {value!r}: must be a finite number > 0")
 
 
+def _check_stiffness(shear_stiffness_N: float) -> None:
+    if not shear_stiffness_N > 0:  # math.inf allowed: a beam without shear deformation
+        raise ValueError(f"shear_stiffness_N = {shear_stiffness_N!r}: must be > 0 (or inf)")
+
+
 def shear_modulus_Pa(youngs_modulus_Pa: float, poisson_ratio: float) -> float:
     """Shear modulus of an isotropic material, ``G = E / (2 (1 + nu))`` [Pa]."""
     return youngs_modulus_Pa / (2.0 * (1.0 + poisson_ratio))
+
+
+def lame_first_parameter_Pa(youngs_modulus_Pa: float, poisson_ratio: float) -> float:
+    """Lame's first parameter of an isotropic material, ``lambda = E nu / ((1 + nu) (1 - 2
+    nu))`` [Pa] (with :func:`shear_modulus_Pa`, ``sigma = 2 G eps + lambda tr(eps) I``)."""
+    return youngs_modulus_Pa * poisson_ratio / ((1.0 + poisson_ratio)
+                                                * (1.0 - 2.0 * poisson_ratio))
 
 
 def cuboid_mass_kg(length_m: float, thickness_m: float, width_m: float,
@@ -159,15 +171,95 @@ def pinned_beam_midpoint_deflection_m(transverse_load_N: Any, length_m: float,
 
     Only the load's mean acts at midspan: the antisymmetric part of a linear distribution
     bends the beam into an odd shape, zero at the middle. A uniform load W: ``delta = 5 W
-    L^3 / (384 E I)`` (Timoshenko & Gere, *Mechanics of Materials*, simply supported beam).
+    L^3 / (384 E I)`` (Timoshenko & Gere, *Mechanics of Materials*, simply supported beam;
+    :func:`pinned_timoshenko_midpoint_deflection_m` without its shear part).
     The total load of a rigid link's d'Alembert inertia is the sum of its transverse joint
     reactions, so a rigid run's joint forces give it directly. Arrays broadcast.
     """
     _check_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
                     youngs_modulus_Pa=youngs_modulus_Pa)
     inertia_m4 = width_m * thickness_m**3 / 12
-    return 5.0 * np.asarray(transverse_load_N) * length_m**3 / (384 * youngs_modulus_Pa
-                                                                 * inertia_m4)
+    return _uniform_load_bending_deflection_m(np.asarray(transverse_load_N), length_m,
+                                              youngs_modulus_Pa * inertia_m4)
+
+
+def _uniform_load_bending_deflection_m(total_load_N: Any, length_m: float,
+                                       bending_stiffness_Nm2: float) -> Any:
+    """Bending part ``5 W L^3 / (384 E I)`` [m] of a pinned-pinned beam's midpoint deflection
+    under a uniform load of total ``W`` [N]."""
+    return 5.0 * total_load_N * length_m**3 / (384 * bending_stiffness_Nm2)
+
+
+def pinned_timoshenko_midpoint_deflection_m(line_load_N_per_m: Any, length_m: float,
+                                            bending_stiffness_Nm2: float,
+                                            shear_stiffness_N: float) -> Any:
+    """Static midpoint deflection [m] of a pinned-pinned Timoshenko beam under a uniform
+    transverse load ``q`` [N/m]: the bending part ``5 q L^4 / (384 E I)`` plus the shear
+    part ``q L^2 / (8 kappa G A)`` (``bending_stiffness_Nm2`` E I [N m^2],
+    ``shear_stiffness_N`` kappa G A [N]; ``math.inf``: no shear deformation, the
+    Euler-Bernoulli beam).
+
+    The shear part is the shear force's work, ``int Q^2 / (kappa G A) dx`` by Castigliano
+    with a unit load at midspan: ``M_mid / (kappa G A)`` with ``M_mid = q L^2 / 8``
+    (Timoshenko, *Strength of Materials*, Part I, 3rd ed. 1955, art. 39, effect of the
+    shearing force on the deflection of beams). Arrays broadcast.
+    """
+    _check_positive(length_m=length_m, bending_stiffness_Nm2=bending_stiffness_Nm2)
+    _check_stiffness(shear_stiffness_N)
+    load = np.asarray(line_load_N_per_m)
+    return (_uniform_load_bending_deflection_m(load * length_m, length_m,
+                                               bending_stiffness_Nm2)
+            + load * length_m**2 / (8.0 * shear_stiffness_N))
+
+
+def timoshenko_pinned_pinned_omega(mode_number: Any, length_m: float,
+                                   bending_stiffness_Nm2: float, shear_stiffness_N: float,
+                                   mass_per_length_kg_per_m: float,
+                                   rotary_inertia_kg_m: float) -> Any:
+    """Bending circular frequency [rad/s] of mode ``mode_number`` (1, 2, ...; a float or an
+    array) of a pinned-pinned Timoshenko beam, from its section: ``E I`` [N m^2], ``kappa G
+    A`` [N] (``math.inf``: no shear deformation), ``rho A`` [kg/m], ``rho I`` [kg m] (0: no
+    rotary inertia; both off: Euler-Bernoulli).
+
+    With ``w ~ sin(k x)``, ``psi ~ cos(k x)``, ``k = n pi / L`` the Timoshenko equations give
+    the frequency equation ``rho A rho I / (kappa G A) omega^4 - omega^2 (rho A + rho I k^2 +
+    rho A E I k^2 / (kappa G A)) + E I k^4 = 0``, whose lower root is the bending mode (Han,
+    Benaroya and Wei, *Dynamics of transversely vibrating beams using four engineering
+    theories*, J. Sound Vib. 225 (1999) 935-988, the hinged-hinged Timoshenko beam); here
+    written without cancellation, ``omega^2 = 2 c / (b + sqrt(b^2 - 4 a c))``.
+    """
+    _check_positive(length_m=length_m, bending_stiffness_Nm2=bending_stiffness_Nm2,
+                    mass_per_length_kg_per_m=mass_per_length_kg_per_m)
+    _check_stiffness(shear_stiffness_N)
+    if not (math.isfinite(rotary_inertia_kg_m) and rotary_inertia_kg_m >= 0):
+        raise ValueError(f"rotary_inertia_kg_m = {rotary_inertia_kg_m!r}: must be finite, >= 0")
+    wave_number = np.asarray(mode_number, dtype=float) * math.pi / length_m
+    flexibility = 1.0 / shear_stiffness_N  # 0 without shear deformation
+    quartic = mass_per_length_kg_per_m * rotary_inertia_kg_m * flexibility
+    quadratic = (rotary_inertia_kg_m * wave_number**2 + mass_per_length_kg_per_m
+                 + mass_per_length_kg_per_m * bending_stiffness_Nm2 * wave_number**2
+                 * flexibility)
+    constant = bending_stiffness_Nm2 * wave_number**4
+    discriminant = np.sqrt(quadratic**2 - 4.0 * quartic * constant)
+    return np.sqrt(2.0 * constant / (quadratic + discriminant))
+
+
+def anticlastic_centroid_offset(length_m: float, thickness_m: float, width_m: float,
+                                poisson_ratio: float) -> float:
+    """How much less the centroid of the mid-span section of a pinned-pinned plate strip
+    under a uniform transverse load deflects than the section's mean, relative to the
+    deflection [-]: ``0.4 nu (w^2 - t^2) / L^2`` (``~0.4 nu (w / L)^2`` for a thin strip).
+
+    In bending of curvature ``1/R`` a section does not stay straight (Saint-Venant's pure
+    bending of a prismatic bar, Timoshenko & Goodier, *Theory of Elasticity*, 3rd ed. 1970,
+    art. 103): ``u_y = -(x^2 + nu (y^2 - z^2)) / (2 R)``, ``y`` across the thickness t (the
+    bending direction), ``z`` across the width w. Over the section ``<y^2> = t^2 / 12``,
+    ``<z^2> = w^2 / 12``, so the mean moves ``nu (w^2 - t^2) / (24 R)`` beyond the centroid.
+    At mid-span of a uniform load ``1 / R = (q L^2 / 8) / (E I) = 9.6 delta / L^2`` (delta =
+    ``5 q L^4 / (384 E I)``). An estimate: it neglects the shear part and the ends.
+    """
+    _check_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m)
+    return 0.4 * poisson_ratio * (width_m**2 - thickness_m**2) / length_m**2
 
 
 def pinned_beam_end_moment_midpoint_deflection_m(end_moment_N_m: Any, length_m: float,

@@ -61,7 +61,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.base.physics import Plate
+from flex.base.physics import Plate, lame_first_parameter_Pa, shear_modulus_Pa
 from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction.body import add_plate_markers, as_vector3
 from flex.bodies.reduction.build import END_A, END_B, mid_set, ngsolve_thread_count
@@ -205,9 +205,8 @@ class _HyperelasticForces:
     def __init__(self, plate: NonlinearPlate, offset_m: np.ndarray) -> None:
         import ngsolve as ngs
 
-        mu = plate.youngs_modulus_Pa / (2 * (1 + plate.poisson_ratio))
-        lam = plate.youngs_modulus_Pa * plate.poisson_ratio / (
-            (1 + plate.poisson_ratio) * (1 - 2 * plate.poisson_ratio))
+        mu = shear_modulus_Pa(plate.youngs_modulus_Pa, plate.poisson_ratio)
+        lam = lame_first_parameter_Pa(plate.youngs_modulus_Pa, plate.poisson_ratio)
         space = ngs.NodalFESpace(plate.mesh, order=_MESH_ORDER) ** 3
         if space.ndof != plate.n_dof:
             raise RuntimeError(f"NGsolve space has {space.ndof} coordinates, the plate "

@@ -9,6 +9,7 @@ import time
 from dataclasses import dataclass
 
 from flex.base.errors import SceneError
+from flex.base.physics import lame_first_parameter_Pa
 from flex.bodies.spring import (
     MUSIC_WIRE_YOUNGS_MODULUS_PA,
     SpringDesign,
@@ -211,7 +212,7 @@ def _solve_helix_segment(mesh, design: SpringDesign, f_axial: float, turns: floa
                 + vec(normal_end) * ngs.InnerProduct(vec(np.cross(normal_end, moment_bending)),
                                                      rho) / second_moment)
     shear_mod = design.shear_modulus_Pa
-    lame_lambda = e_mod * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson))
+    lame_lambda = lame_first_parameter_Pa(e_mod, poisson)
 
     def strain(w):
         return ngs.Sym(ngs.Grad(w))

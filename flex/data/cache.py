@@ -1,9 +1,10 @@
 """Caches on disk: an entry proves its content when loaded, is written atomically, and every
 problem names the cache and how to move it.
 
-flex keeps two kinds of cache: the reduction cache (Craig-Bampton reductions of plate
-links, :mod:`flex.bodies.reduction`, and the geometric stiffness beside them) and a sweep's
-case files (:mod:`flex.sweep`, where a rerun resumes). The rules, shared by both:
+flex keeps three kinds of cache: the reduction cache (Craig-Bampton reductions of plate
+links, :mod:`flex.bodies.reduction`, and the geometric stiffness beside them), the plate
+references (converged 3D solves, :mod:`flex.bodies.plate_reference`) and a sweep's case
+files (:mod:`flex.sweep`, where a rerun resumes). The rules, shared by all:
 
 - **content digest** (:func:`content_digest`): an entry stores a SHA-256 of everything a
   run reads from it, computed when it is built; a loader recomputes it and uses the entry
@@ -60,6 +61,10 @@ class Cache:
 REDUCTION_CACHE = Cache("reduction cache", "the reduction cache is safe to delete; "
                                            "FLEX_CACHE_DIR=/other/folder moves it (library "
                                            "calls: cache_dir=)")
+#: the converged 3D plate references (:mod:`flex.bodies.plate_reference`)
+PLATE_REFERENCE_CACHE = Cache("plate reference cache",
+                              "the plate reference cache is safe to delete (its entries are "
+                              "computed again, seconds each); library calls: cache_dir=")
 #: a sweep's case files
 SWEEP_CASES = Cache("sweep case folder", "the case folder is safe to delete (its cases run "
                                          "again); --folder DIR (FLEX_SWEEP_DIR) moves it")

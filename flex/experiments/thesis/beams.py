@@ -251,25 +251,14 @@ def timoshenko_bending_rad_per_s(
 def _pinned_pinned_timoshenko_rad_per_s(
         length_m: float, mode_count: int, youngs_Pa: float, density: float, area: float,
         inertia: float, shear_stiffness_N: float | None, rotary_inertia: bool) -> np.ndarray:
-    """The closed form of a pinned-pinned Timoshenko beam (:func:`timoshenko_bending_rad_per_s`):
-    omega_n, rad/s, n = 1..mode_count; ``shear_stiffness_N`` kappa G A [N], None without shear
-    deformation; SI units."""
-    wave_number = np.arange(1, mode_count + 1) * math.pi / length_m
-    rotary_density = density * inertia if rotary_inertia else 0.0
-    shear_term = (1.0 / shear_stiffness_N) if shear_stiffness_N is not None else 0.0
-    # Divide the determinant by kappa G A (finite form when shear is switched off):
-    # rho A rho I s w^4 - w^2 (rho I k^2 + rho A + rho A E I k^2 s) + E I k^4 = 0.
-    quartic = density * area * rotary_density * shear_term
-    quadratic = (rotary_density * wave_number**2 + density * area
-                 + density * area * youngs_Pa * inertia * wave_number**2 * shear_term)
-    constant = youngs_Pa * inertia * wave_number**4
-    if quartic == 0.0:
-        omega_sq = constant / quadratic
-    else:
-        # Lower root, written to avoid cancellation.
-        discriminant = np.sqrt(quadratic**2 - 4.0 * quartic * constant)
-        omega_sq = 2.0 * constant / (quadratic + discriminant)
-    return np.sqrt(omega_sq)
+    """The closed form of a pinned-pinned Timoshenko beam (:func:`timoshenko_bending_rad_per_s`,
+    :func:`flex.base.physics.timoshenko_pinned_pinned_omega`): omega_n, rad/s, n =
+    1..mode_count; ``shear_stiffness_N`` kappa G A [N], None without shear deformation; SI
+    units."""
+    return physics.timoshenko_pinned_pinned_omega(
+        np.arange(1, mode_count + 1), length_m, youngs_Pa * inertia,
+        math.inf if shear_stiffness_N is None else shear_stiffness_N, density * area,
+        density * inertia if rotary_inertia else 0.0)
 
 
 def _timoshenko_roots(end_condition: str, mode_count: int, slenderness_sq: float,

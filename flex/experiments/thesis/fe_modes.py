@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.base.physics import check_positive
+from flex.base.physics import check_positive, lame_first_parameter_Pa, shear_modulus_Pa
 from flex.experiments.thesis.beams import (
     LINK_BOUNDARY_CONDITIONS,
     MODE_KINDS,
@@ -234,8 +234,7 @@ def _assemble(fes, material: Material, shift: float
 
     trial, test = fes.TnT()
     youngs_Pa, nu = material.youngs_modulus_Pa, material.poissons_ratio
-    shear_Pa = youngs_Pa / (2.0 * (1.0 + nu))
-    lame_Pa = youngs_Pa * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+    shear_Pa, lame_Pa = shear_modulus_Pa(youngs_Pa, nu), lame_first_parameter_Pa(youngs_Pa, nu)
 
     def strain(w):
         return ngs.Sym(ngs.Grad(w))
