@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.linalg import eigh
 
-from flex.base import physics
+from flex.base import spring_waves
 from flex.base.errors import SceneError
 from flex.bodies.spring import surge_frequency_fixed_free_Hz
 from flex.config.settings import pinned_overrides
@@ -56,7 +56,7 @@ def test_rayleigh_mass_is_the_chain_kinetic_energy_in_the_limit(segments):
     mass, _ = chain_matrices(COIL_KG, RATE_N_PER_M, 1e-300, segments)
     profile = np.arange(1, segments + 1) / segments
     effective_kg = float(profile @ mass @ profile)
-    exact = physics.spring_effective_mass_kg(COIL_KG)
+    exact = spring_waves.spring_effective_mass_kg(COIL_KG)
     assert exact == pytest.approx(COIL_KG / 3, rel=1e-15)
     assert effective_kg - exact == pytest.approx(COIL_KG / (6 * segments**2), rel=1e-9)
 
@@ -66,7 +66,7 @@ def test_wave_numbers_against_the_chain_eigenvalues(mass_ratio):
     # 128 segments: the chain's frequencies are within ~1e-4 (second order, 0.09 j^2 / N^2)
     mass, stiffness = chain_matrices(COIL_KG, RATE_N_PER_M, COIL_KG / mass_ratio, 128)
     chain = np.sqrt(eigh(stiffness, mass, eigvals_only=True)[:3])
-    exact = physics.spring_end_mass_wave_numbers(mass_ratio, 3) * math.sqrt(
+    exact = spring_waves.spring_end_mass_wave_numbers(mass_ratio, 3) * math.sqrt(
         RATE_N_PER_M / COIL_KG)
     np.testing.assert_allclose(chain, exact, rtol=3e-4)
 
@@ -77,7 +77,7 @@ def test_fixed_free_surge_period_is_four_root_m_over_k():
     period_s = 2 * math.pi / math.sqrt(eigh(stiffness, mass, eigvals_only=True)[0])
     four_root_s = 4 * math.sqrt(COIL_KG / RATE_N_PER_M)
     assert period_s == pytest.approx(four_root_s, rel=3e-5)
-    beta = physics.spring_end_mass_wave_numbers(1e12, 1)[0]
+    beta = spring_waves.spring_end_mass_wave_numbers(1e12, 1)[0]
     assert 2 * math.pi / beta * math.sqrt(COIL_KG / RATE_N_PER_M) == pytest.approx(
         four_root_s, rel=1e-9)
     assert 1 / surge_frequency_fixed_free_Hz(RATE_N_PER_M, COIL_KG) == pytest.approx(
@@ -94,14 +94,14 @@ def test_released_coil_against_the_chain_released_from_rest(mass_ratio):
     amplitudes = vectors.T @ mass @ start  # mass-normalised modes
     tau = np.linspace(0.0, 12.0, 400)
     chain_end = np.cos(np.outer(tau, np.sqrt(values))) @ (amplitudes * vectors[-1])
-    series = physics.released_spring_end_displacement(mass_ratio, tau)
+    series = spring_waves.released_spring_end_displacement(mass_ratio, tau)
     assert np.max(np.abs(series - chain_end)) < 1e-3
     # and the deviation from Rayleigh's model that the prediction adds, on the chain
-    beta_1 = physics.spring_end_mass_wave_numbers(mass_ratio, 1)[0]
+    beta_1 = spring_waves.spring_end_mass_wave_numbers(mass_ratio, 1)[0]
     tau = np.linspace(0.0, math.pi / beta_1, 2001)
     chain_end = np.cos(np.outer(tau, np.sqrt(values))) @ (amplitudes * vectors[-1])
     rayleigh = np.cos(tau / math.sqrt(1 / mass_ratio + 1 / 3))
-    assert physics.released_spring_rayleigh_deviation(mass_ratio) == pytest.approx(
+    assert spring_waves.released_spring_rayleigh_deviation(mass_ratio) == pytest.approx(
         np.max(np.abs(chain_end - rayleigh)) / 2, rel=3e-3)
 
 

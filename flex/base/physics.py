@@ -34,7 +34,7 @@ BEAM_END_CONDITIONS: tuple[str, ...] = (
 """End conditions of one beam bending plane (first end - second end)."""
 
 
-def _check_positive(**values: float) -> None:
+def require_positive(**values: float) -> None:
     for name, value in values.items():
         if not (math.isfinite(value) and value > 0):
             raise ValueError(f"{name} = {value!r}: must be a finite number > 0")
@@ -83,12 +83,12 @@ def euler_buckling_load_N(length_m: float, thickness_m: float, width_m: float,
     ``P_cr = pi^2 E I / L^2`` with ``I = w t^3 / 12`` (Timoshenko & Gere 1961, ch. 2; ``t``
     the thickness in the mechanism plane, ``w`` the width across it).
     """
-    _check_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
+    require_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
                     youngs_modulus_Pa=youngs_modulus_Pa)
     return math.pi**2 * youngs_modulus_Pa * width_m * thickness_m**3 / 12 / length_m**2
 
 
-def _bisect(function: Callable[[float], float], lower: float, upper: float) -> float:
+def bisect_root(function: Callable[[float], float], lower: float, upper: float) -> float:
     """Root of ``function`` in [lower, upper] (it must change sign there), to the last bit."""
     f_lower = function(lower)
     if f_lower * function(upper) > 0:
@@ -137,14 +137,14 @@ def _beta_l_roots(end_condition: str, mode_count: int) -> tuple[float, ...]:
         elif end_condition in ("free-free", "clamped-clamped"):
             # one sign change within 0.5 of (n + 1/2) pi (the root is within 0.02 of it)
             guess = (n + 0.5) * math.pi
-            roots.append(_bisect(lambda x: math.cos(x) - _sech(x), guess - 0.5, guess + 0.5))
+            roots.append(bisect_root(lambda x: math.cos(x) - _sech(x), guess - 0.5, guess + 0.5))
         elif end_condition == "clamped-free":
             guess = (n - 0.5) * math.pi
-            roots.append(_bisect(lambda x: math.cos(x) + _sech(x), max(guess - 0.5, 1.0),
+            roots.append(bisect_root(lambda x: math.cos(x) + _sech(x), max(guess - 0.5, 1.0),
                                  guess + 0.5))
         else:  # clamped-pinned
             guess = (n + 0.25) * math.pi
-            roots.append(_bisect(lambda x: math.sin(x) - math.cos(x) * math.tanh(x),
+            roots.append(bisect_root(lambda x: math.sin(x) - math.cos(x) * math.tanh(x),
                                  guess - 0.3, guess + 0.3))
     return tuple(roots)
 
@@ -176,7 +176,7 @@ def pinned_beam_midpoint_deflection_m(transverse_load_N: Any, length_m: float,
     The total load of a rigid link's d'Alembert inertia is the sum of its transverse joint
     reactions, so a rigid run's joint forces give it directly. Arrays broadcast.
     """
-    _check_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
+    require_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
                     youngs_modulus_Pa=youngs_modulus_Pa)
     inertia_m4 = width_m * thickness_m**3 / 12
     return _uniform_load_bending_deflection_m(np.asarray(transverse_load_N), length_m,
@@ -204,7 +204,7 @@ def pinned_timoshenko_midpoint_deflection_m(line_load_N_per_m: Any, length_m: fl
     (Timoshenko, *Strength of Materials*, Part I, 3rd ed. 1955, art. 39, effect of the
     shearing force on the deflection of beams). Arrays broadcast.
     """
-    _check_positive(length_m=length_m, bending_stiffness_Nm2=bending_stiffness_Nm2)
+    require_positive(length_m=length_m, bending_stiffness_Nm2=bending_stiffness_Nm2)
     _check_stiffness(shear_stiffness_N)
     load = np.asarray(line_load_N_per_m)
     return (_uniform_load_bending_deflection_m(load * length_m, length_m,
@@ -228,7 +228,7 @@ def timoshenko_pinned_pinned_omega(mode_number: Any, length_m: float,
     theories*, J. Sound Vib. 225 (1999) 935-988, the hinged-hinged Timoshenko beam); here
     written without cancellation, ``omega^2 = 2 c / (b + sqrt(b^2 - 4 a c))``.
     """
-    _check_positive(length_m=length_m, bending_stiffness_Nm2=bending_stiffness_Nm2,
+    require_positive(length_m=length_m, bending_stiffness_Nm2=bending_stiffness_Nm2,
                     mass_per_length_kg_per_m=mass_per_length_kg_per_m)
     _check_stiffness(shear_stiffness_N)
     if not (math.isfinite(rotary_inertia_kg_m) and rotary_inertia_kg_m >= 0):
@@ -258,7 +258,7 @@ def anticlastic_centroid_offset(length_m: float, thickness_m: float, width_m: fl
     At mid-span of a uniform load ``1 / R = (q L^2 / 8) / (E I) = 9.6 delta / L^2`` (delta =
     ``5 q L^4 / (384 E I)``). An estimate: it neglects the shear part and the ends.
     """
-    _check_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m)
+    require_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m)
     return 0.4 * poisson_ratio * (width_m**2 - thickness_m**2) / length_m**2
 
 
@@ -277,7 +277,7 @@ def pinned_beam_end_moment_midpoint_deflection_m(end_moment_N_m: Any, length_m: 
     above the midpoint value). The crank of a mechanism with a wing welded at its pivot
     carries the wing's inertia moment there. Arrays broadcast.
     """
-    _check_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
+    require_positive(length_m=length_m, thickness_m=thickness_m, width_m=width_m,
                     youngs_modulus_Pa=youngs_modulus_Pa)
     inertia_m4 = width_m * thickness_m**3 / 12
     return np.asarray(end_moment_N_m) * length_m**2 / (16 * youngs_modulus_Pa * inertia_m4)
@@ -314,7 +314,7 @@ def pinned_pinned_omega(length_m: float, height_m: float, youngs_modulus_Pa: flo
     took pi = 3.1416). The finite-element value of :class:`flex.bodies.reduction.Reduction` is
     within 2.4 % of it up to t = 10 mm (L/t = 8).
     """
-    _check_positive(length_m=length_m, height_m=height_m,
+    require_positive(length_m=length_m, height_m=height_m,
                     youngs_modulus_Pa=youngs_modulus_Pa, density_kg_per_m3=density_kg_per_m3)
     return euler_bernoulli_omega(math.pi, length_m, height_m, youngs_modulus_Pa,
                                  density_kg_per_m3)
@@ -549,78 +549,3 @@ class Plate:
         return in_plane_fixed_interface_omegas(*self.sizes_m, self.youngs_modulus_Pa,
                                                self.density_kg_per_m3, self.poisson_ratio,
                                                count)
-
-
-# --- the deployment spring as a rod: Rayleigh's effective mass, the released coil ------------
-
-def spring_effective_mass_kg(spring_mass_kg: float) -> float:
-    """Rayleigh's effective mass [kg] of a uniform spring of mass ``m_s`` [kg] fixed at one
-    end, its other end moving with the load: ``m_s / 3``.
-
-    Quasi-statically each coil moves in proportion to its distance from the fixed end (a
-    linear velocity profile), so the coil's kinetic energy is ``int_0^1 m_s (v xi)^2 / 2
-    d xi = (m_s / 3) v^2 / 2`` with v the moving end's speed (Rayleigh, *The Theory of
-    Sound*, 1877, vol. 1, sec. 156; Shigley sec. 10-8 for coil springs).
-    """
-    _check_positive(spring_mass_kg=spring_mass_kg)
-    return spring_mass_kg / 3.0
-
-
-def spring_end_mass_wave_numbers(mass_ratio: float, count: int) -> np.ndarray:
-    """Wave numbers ``beta_j`` [rad], j = 1..count, of a uniform spring (rate k, mass m_s) fixed
-    at one end and carrying a point mass M at the other: the roots of ``beta tan(beta) =
-    m_s / M`` (``mass_ratio`` = m_s / M > 0), one in each ``((j-1) pi, (j-1) pi + pi/2)``.
-
-    The mode shapes are ``sin(beta_j x / L)``, the circular frequencies ``beta_j sqrt(k /
-    m_s)`` (a rod with a tip mass, Blevins 1979, ch. 8). M -> 0 gives the fixed-free spring,
-    ``(j - 1/2) pi`` (the first period ``4 sqrt(m_s / k)``); m_s << M gives ``beta_1^2 ->
-    m_s / M``, i.e. ``omega_1^2 -> k / M``. Solved by bisection to the last bit, as ``beta
-    sin(beta) - mu cos(beta) = 0`` (no poles).
-    """
-    _check_positive(mass_ratio=mass_ratio)
-    roots = []
-    for j in range(count):
-        lower = j * math.pi
-        roots.append(_bisect(lambda b: b * math.sin(b) - mass_ratio * math.cos(b),
-                             lower, lower + math.pi / 2))
-    return np.array(roots)
-
-
-def released_spring_end_displacement(mass_ratio: float, scaled_time: Any,
-                                     modes: int = 64) -> np.ndarray:
-    """End displacement, as a fraction of its initial value, of a uniform spring (rate k,
-    mass m_s) fixed at one end and carrying a point mass M at the other, released at rest
-    from a uniform compression (the deployment spring at t = 0), at ``scaled_time`` ``t
-    sqrt(k / m_s)`` [-] (``mass_ratio`` = m_s / M).
-
-    Modal series over the first ``modes`` modes of :func:`spring_end_mass_wave_numbers`:
-    ``x(t) / x_0 = sum_j a_j sin(beta_j) cos(beta_j tau)``, ``a_j`` the projection of the
-    linear initial shape ``xi`` on ``sin(beta_j xi)`` in the inner product of the spring and
-    its end mass (``m_s int_0^1 f g d xi + M f(1) g(1)``, in which the modes are orthogonal):
-    ``a_j = [(sin b - b cos b) / b^2 + sin(b) / mu] / [1/2 - sin(2 b) / (4 b) + sin(b)^2 /
-    mu]``. The terms fall fast: 64 modes hold the series to 1e-5 of x_0.
-    """
-    beta = spring_end_mass_wave_numbers(mass_ratio, modes)
-    sin_b = np.sin(beta)
-    shape = (sin_b - beta * np.cos(beta)) / beta**2 + sin_b / mass_ratio
-    norm = 0.5 - np.sin(2.0 * beta) / (4.0 * beta) + sin_b**2 / mass_ratio
-    tau = np.asarray(scaled_time, dtype=float)
-    return np.cos(np.multiply.outer(tau, beta)) @ (shape / norm * sin_b)
-
-
-def released_spring_rayleigh_deviation(mass_ratio: float, modes: int = 64,
-                                       samples: int = 2001) -> float:
-    """Largest deviation of the released spring's end (:func:`released_spring_end_displacement`)
-    from its Rayleigh model, a massless spring on the mass M + m_s / 3
-    (:func:`spring_effective_mass_kg`; ``cos(tau / sqrt(1/mu + 1/3))``), over the spring's
-    first half period ``pi / beta_1`` (its swing), relative to that swing (2 x_0) [-].
-
-    What the coil's waves (surge) and the shift of its first frequency from Rayleigh's add
-    to the quasi-static effect of its mass; ``mass_ratio`` = m_s / M. Of order mu^2 for a
-    light coil: 2.7e-4 at mu = 0.1, 0.013 at 1, 0.063 at 3.
-    """
-    beta_1 = spring_end_mass_wave_numbers(mass_ratio, 1)[0]
-    tau = np.linspace(0.0, math.pi / beta_1, samples)
-    exact = released_spring_end_displacement(mass_ratio, tau, modes)
-    rayleigh = np.cos(tau / math.sqrt(1.0 / mass_ratio + 1.0 / 3.0))
-    return float(np.max(np.abs(exact - rayleigh)) / 2.0)

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 from typing import Literal
 
 from flex.base.errors import SceneError
-from flex.base.physics import TWO_PI, n_values, spring_end_mass_wave_numbers
+from flex.base.physics import TWO_PI, n_values
+from flex.base.spring_waves import spring_end_mass_wave_numbers
 from flex.base.thesis import (
     THESIS_ACTIVE_COILS,
     THESIS_ANGLE_MAX_TIME_S,
@@ -471,7 +472,7 @@ def surge_frequency_fixed_end_mass_Hz(rate_N_per_m: float, active_mass_kg: float
                                       end_mass_kg: float) -> float:
     """First frequency [Hz] of a spring (rate k, distributed mass m) fixed at one end and
     carrying a point mass M at the other: ``beta tan(beta) = m / M``
-    (:func:`flex.base.physics.spring_end_mass_wave_numbers`), ``omega = beta sqrt(k / m)``
+    (:func:`flex.base.spring_waves.spring_end_mass_wave_numbers`), ``omega = beta sqrt(k / m)``
     (a bar with a tip mass). M -> 0 gives the fixed-free value."""
     k = require_positive("rate_N_per_m", rate_N_per_m, "N/m")
     m = require_positive("active_mass_kg", active_mass_kg, "kg")

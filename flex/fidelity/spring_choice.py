@@ -7,7 +7,7 @@ relative to swing and travel: the ``governing_error`` of :mod:`flex.experiments.
 is predicted here, with no fit, as the sum of two parts:
 
 - **quasi-static** (:func:`rayleigh_warp`): the coil carries Rayleigh's ``m_s / 3`` on the
-  slider (:func:`flex.base.physics.spring_effective_mass_kg`). The mechanism is one degree of
+  slider (:func:`flex.base.spring_waves.spring_effective_mass_kg`). The mechanism is one degree of
   freedom: its kinetic energy is ``M(s) v^2 / 2``, ``M(s)`` its mass reduced to the slider
   (``2 E_kin / v^2`` of the probe, every sample), and the spring's work depends on the path
   only. Adding ``m_s / 3`` therefore keeps the path and slows the motion along it by
@@ -15,7 +15,7 @@ is predicted here, with no fit, as the sum of two parts:
   deviation between the two over the slower deployment is the prediction; past its first
   crank-angle maximum the massless run retraces its path (undamped: time reversal), which
   extends the probe. The peak-speed change is ``sqrt(M / (M + m_s / 3))`` at equal path.
-- **surge** (:func:`flex.base.physics.released_spring_rayleigh_deviation`): the released coil
+- **surge** (:func:`flex.base.spring_waves.released_spring_rayleigh_deviation`): the released coil
   (uniformly compressed, at rest; fixed at the frame, the slider at its other end: the
   chain's boundary conditions) against its Rayleigh model, a linear spring carrying the
   mechanism's smallest reduced mass ``M_min``: its waves and the shift of its first
@@ -45,12 +45,8 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.base.physics import (
-    TWO_PI,
-    n_values,
-    released_spring_rayleigh_deviation,
-    spring_effective_mass_kg,
-)
+from flex.base.physics import TWO_PI, n_values
+from flex.base.spring_waves import released_spring_rayleigh_deviation, spring_effective_mass_kg
 from flex.bodies.spring import surge_frequency_fixed_end_mass_Hz
 from flex.config.tolerance import Tolerance
 from flex.data.headlines import first_maximum_index
