@@ -282,8 +282,8 @@ def test_the_ladder_takes_ffrf_when_its_model_error_meets_the_tolerance():
 def test_auto_reads_the_tolerance_against_the_deflection_past_rigid():
     # 1 mm plate: the rigid probe predicts ~0.2 % of the length (rigid at 1 %); at 1e-3 rigid
     # is refused and the FFRF body's model error (0.5 % of the deflection, measured up to
-    # 0.35 %) does not meet 0.1 % of the deflection; the exact beam's (0.05 t / L: 0.0625 %)
-    # does
+    # 0.35 %) does not meet 0.1 % of the deflection; the calibrated exact beam's (measured on
+    # the plate's 3-D reference: ~4e-5) does
     from flex.fidelity.auto import decide_links
 
     def scene(tolerance: float):
@@ -293,7 +293,7 @@ def test_auto_reads_the_tolerance_against_the_deflection_past_rigid():
     tight, (decision,) = decide_links(scene(1e-3))
     assert tight["coupler"]["model"] == decision.model == "exact_beam"
     assert ("ladder: exact_beam (FFRF model error 0.005 of the deflection, make ladder's "
-            "measured bound, > tolerance 0.001; exact beam model error 0.000625"
+            "measured bound, > tolerance 0.001; exact beam (calibrated) model error "
             in decision.reason)
     loose, (decision,) = decide_links(scene(1e-2))
     assert loose["coupler"]["model"] == "rigid"

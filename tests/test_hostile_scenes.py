@@ -62,7 +62,8 @@ WRONG_TYPES = [(f"{section}.{key}", _wrong_type(field))
 def test_every_key_with_a_wrong_type_is_refused(name, value):
     outcome = check_refused(scene_cmd(f"{name}={value}"), [name, "must be"])
     assert "true or false" in outcome.stderr or "one of" in outcome.stderr \
-        or "integer" in outcome.stderr or "finite number" in outcome.stderr
+        or "integer" in outcome.stderr or "finite number" in outcome.stderr \
+        or "a list of one or more" in outcome.stderr
 
 
 # ------------------------------------------------------------------------------------------

@@ -119,4 +119,4 @@ def test_each_bounded_rung_holds_its_bound_against_the_rung_above(name, reductio
         Plate.of(plate))
     mine = _peak([*scene, *own], reduction_cache)
     other = _peak([*scene, *above], reduction_cache)
-    assert abs(mine - other) / other <= rung.bound(plate, load_ratio)
+    assert abs(mine - other) / other <= rung.bound(plate, load_ratio, reduction_cache)

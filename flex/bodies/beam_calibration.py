@@ -71,6 +71,17 @@ class BeamCalibration:
                 + 0.5 * self.bending_stiffness_factor_error / self.bending_stiffness_factor)
 
     @property
+    def idealization(self) -> float:
+        """What the calibrated beam may still differ from the 3-D plate by, relative to its
+        deflection [-]: the factor's error, plus twice the larger of the calibrated
+        frequency's residual and what that check cannot resolve (a stiffness goes with the
+        square of a frequency). Linear: the anticlastic stiffening of large deflections
+        (~0.2 % beta^2, the reference notes) is not in it."""
+        return (self.bending_stiffness_factor_error / self.bending_stiffness_factor
+                + 2.0 * max(abs(self.frequency_relative_difference),
+                            self.frequency_relative_uncertainty))
+
+    @property
     def shear_share(self) -> float:
         """Shear part of the uncalibrated beam's deflection [-]."""
         return self.beam_shear_deflection_m / self.beam_deflection_m
@@ -88,7 +99,7 @@ class BeamCalibration:
                       uncalibrated_frequency_relative_difference=(
                           self.uncalibrated_frequency_relative_difference),
                       frequency_relative_uncertainty=self.frequency_relative_uncertainty,
-                      shear_share=self.shear_share)
+                      shear_share=self.shear_share, idealization=self.idealization)
         return values
 
 

@@ -25,7 +25,8 @@ with the parabolic shear stress of a rectangle, 3 Q / (2 A) (1 - (y / c)^2).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -53,6 +54,9 @@ class ExactBeamSection:
     shear_stiffness_N: float
     mass_per_length_kg_per_m: float
     rotary_inertia_kg_m: float
+    #: its calibration against the 3-D plate (:meth:`flex.bodies.beam_calibration.
+    #: BeamCalibration.attrs`; empty: the uncalibrated section)
+    calibration: Mapping[str, float] = field(default_factory=dict)
 
     @property
     def outer_fibre_m(self) -> float:

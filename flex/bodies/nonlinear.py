@@ -64,7 +64,8 @@ from flex.base.errors import SceneError
 from flex.base.physics import Plate, lame_first_parameter_Pa, shear_modulus_Pa
 from flex.bodies.plate import PlateLink, plate_mesh
 from flex.bodies.reduction.body import add_plate_markers, as_vector3
-from flex.bodies.reduction.build import END_A, END_B, mid_set, ngsolve_thread_count
+from flex.bodies.reduction.build import END_A, END_B, ngsolve_thread_count
+from flex.bodies.section_mean import fem_tetrahedra, section_mean_weights
 from flex.data.results import Dataset
 
 _MESH_ORDER = 2  # as the reduction: linear tets lock in bending
@@ -138,7 +139,7 @@ def build_nonlinear_plate(plate: Plate, mesh_size_m: float, *,
                                   boundaryNamesList=[END_A, END_B])
     positions = fem.GetNodePositionsAsArray()
     face_sets = _face_sets(fem)
-    mid_nodes, mid_weights = mid_set(positions, length_m, mesh_size_m)
+    mid_nodes, mid_weights = section_mean_weights(positions, fem_tetrahedra(fem), length_m / 2)
 
     def centre(nodes: np.ndarray, weights: np.ndarray) -> np.ndarray:
         return np.asarray(weights) @ positions[nodes]

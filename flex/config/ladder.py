@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 
@@ -40,10 +41,10 @@ class Rung:
     #: given the link's scene values and the rigid probe's compression / Euler load (what
     #: ``auto`` climbs on); None: no bound (a rigid link: its elasticity is predicted from
     #: its loads; the top rung)
-    bound: Callable[[Mapping[str, Any], float], float] | None = None
+    bound: Callable[[Mapping[str, Any], float, Path | None], float] | None = None
     #: the budget's model term: fractions of what the elasticity changes in the link's own
     #: quantities (a number, or a function of the link's scene values) and in the motion
-    own_fraction: float | Callable[[Mapping[str, Any]], float] = 0.0
+    own_fraction: float | Callable[[Mapping[str, Any], Path | None], float] = 0.0
     motion_fraction: float = 0.0
     #: overrides (``{link}`` stands for the link) of a companion one step up whose
     #: difference the model term adds, and the sentence that says so (``{links}``)
@@ -67,9 +68,10 @@ class Rung:
         """Its model error is bounded by measured fractions (the budget's model term)."""
         return self.bound is not None
 
-    def own(self, values: Mapping[str, Any]) -> float:
+    def own(self, values: Mapping[str, Any], cache_dir: Path | None = None) -> float:
         """Its own fraction [1] for a link's scene ``values``."""
-        return self.own_fraction(values) if callable(self.own_fraction) else self.own_fraction
+        return (self.own_fraction(values, cache_dir) if callable(self.own_fraction)
+                else self.own_fraction)
 
 
 GEOMETRIC_FFRF_ERROR = 0.005
@@ -100,11 +102,13 @@ body represents with one axial mode), up to 0.16 on the crank angle."""
 FFRF_MEASURED_LOAD_RATIO = 0.33
 
 
-def _geometric_ffrf_bound(values: Mapping[str, Any], load_ratio: float) -> float:
+def _geometric_ffrf_bound(values: Mapping[str, Any], load_ratio: float,
+                          cache_dir: Path | None = None) -> float:
     return GEOMETRIC_FFRF_ERROR if load_ratio <= FFRF_MEASURED_LOAD_RATIO else math.inf
 
 
-def _linear_ffrf_bound(values: Mapping[str, Any], load_ratio: float) -> float:
+def _linear_ffrf_bound(values: Mapping[str, Any], load_ratio: float,
+                       cache_dir: Path | None = None) -> float:
     if load_ratio > FFRF_MEASURED_LOAD_RATIO:
         return math.inf
     return LINEAR_FFRF_ERROR_FLOOR + LINEAR_FFRF_ERROR_PER_LOAD * load_ratio
@@ -185,11 +189,12 @@ coupler about +0.1 % at 2 and 3 mm. The bound at 1 mm rests on the FE coupler's 
 there being of the same size (not measured)."""
 
 
-def _exact_beam_bound(values: Mapping[str, Any], load_ratio: float) -> float:
+def _exact_beam_bound(values: Mapping[str, Any], load_ratio: float,
+                      cache_dir: Path | None = None) -> float:
     return EXACT_BEAM_ERROR_PER_SLENDERNESS * values["thickness_m"] / values["length_m"]
 
 
-def _exact_beam_own(values: Mapping[str, Any]) -> float:
+def _exact_beam_own(values: Mapping[str, Any], cache_dir: Path | None = None) -> float:
     return _exact_beam_bound(values, 0.0)
 
 
@@ -239,10 +244,11 @@ class Climb:
 
 
 def climb(link: str, values: Mapping[str, Any], load_ratio: float, tolerance: float,
-          link_models: Mapping[str, Any]) -> Climb:
+          link_models: Mapping[str, Any], cache_dir: Path | None = None) -> Climb:
     """Past rigid: the lowest rung ``auto`` may pick whose bound (relative to the link's own
-    deflection, at ``load_ratio``, the rigid probe's compression / Euler load) meets
-    ``tolerance``, else the highest one (ValueError when ``auto`` may pick none)."""
+    deflection, at ``load_ratio``, the rigid probe's compression / Euler load; a bound
+    measured per plate reads and keeps its reference in ``cache_dir``) meets ``tolerance``,
+    else the highest one (ValueError when ``auto`` may pick none)."""
     options = [(rung, name) for rung, name in rungs(link, values, link_models, auto=True)
                if not link_models[name].rigid and link_models[name].auto_choice]
     if not options:
@@ -251,7 +257,7 @@ def climb(link: str, values: Mapping[str, Any], load_ratio: float, tolerance: fl
     for rung, name in options:
         if rung.bound is None:
             return Climb(name, rung, "; ".join(tried))
-        relative = rung.bound(values, load_ratio)
+        relative = rung.bound(values, load_ratio, cache_dir)
         meets = relative <= tolerance
         tried.append(f"{rung.name} model error {relative:.3g} of the deflection, make ladder's "
                      f"measured bound, {'<=' if meets else '>'} tolerance {tolerance:g}"

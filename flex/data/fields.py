@@ -32,6 +32,8 @@ class Field:
     default: Any = None
     #: a list (a TOML array) of one or more distinct values of ``kind``'s choices
     many: bool = False
+    #: the accepted values in words, where listing every choice would not fit a message
+    choices_text: str = ""
 
     def accepted(self) -> str:
         """Human-readable accepted range, used in error messages."""
@@ -40,6 +42,8 @@ class Field:
         return self._accepted() + (' or "auto"' if self.auto else "")
 
     def _accepted(self) -> str:
+        if self.choices_text:
+            return self.choices_text
         if isinstance(self.kind, tuple):
             return "one of " + ", ".join(f'"{c}"' for c in self.kind)
         if self.kind is bool:

@@ -20,8 +20,11 @@ The contract of an entry:
    such differences): ``"value"`` (the values' difference), ``"peak"`` (the largest
    ``|series|`` over ``window``: :func:`flex.fidelity.error_estimate.peak_difference`, which
    also counts a crest that moves), ``"first_crest"`` (the largest ``|series|`` of its first
-   lobe; a rigid twin's missing series counts as zero); ``series``: the dataset it is read
-   from (peaks and crests). A ``"peak"`` is a raw maximum over the whole run: it races
+   lobe; a rigid twin's missing series counts as zero), ``"history"`` (a whole curve: its
+   value is the series' peak ``|series|``, its difference to another run the largest
+   difference of the two curves over the run, :func:`history_difference`: the error of the
+   curve, relative to its peak); ``series``: the dataset it is read from. A ``"peak"`` is a
+   raw maximum over the whole run: it races
    between the sub-crests of undamped ringing and has no order of convergence, so its
    budget is a *bound*, not an estimate (:attr:`Headline.bound`), and says so;
 5. ``window``: the part of the run it is read over, in words;
@@ -46,7 +49,7 @@ from typing import Any
 import numpy as np
 
 #: how a headline quantity is compared between two runs (module doc, point 4)
-KINDS = ("value", "peak", "first_crest")
+KINDS = ("value", "peak", "first_crest", "history")
 #: the series whose first maximum ends the deployment (:func:`deployment_end`)
 DEPLOYMENT_SERIES = "crank/angle"
 
@@ -158,6 +161,20 @@ def first_crest_value(path: str) -> Callable[[Mapping[str, Any]], float | None]:
             return None
         return float(abs(values[first_peak_index(values)]))
     return read
+
+
+def history_difference(run: Mapping[str, Any], other: Mapping[str, Any], path: str
+                       ) -> float:
+    """The largest difference of two runs' curves ``path`` over the run [its unit]: the
+    other run interpolated on the run's times (a run without the series counts as zero: a
+    rigid twin has no deflection)."""
+    time_s = np.asarray(run["time"].data, dtype=float)
+    mine = np.asarray(run[path].data, dtype=float)
+    if path not in other:
+        return float(np.max(np.abs(mine)))
+    theirs = np.interp(time_s, np.asarray(other["time"].data, dtype=float),
+                       np.asarray(other[path].data, dtype=float))
+    return float(np.max(np.abs(mine - theirs)))
 
 
 def crest_gap(values: np.ndarray) -> float | None:
@@ -284,6 +301,15 @@ def _joint_force(joint: str, deployment: bool) -> Headline:
                     "peak", path)
 
 
+def _history(path: str, what: str, link: str | None) -> Headline:
+    """The curve ``path`` as a headline: its value the peak, its error the largest
+    difference to a finer run over the whole run (``estimated_error_history_<path>``)."""
+    return Headline(f"history_{path.replace('/', '_')}", "m" if path.endswith(("position",
+                    "deflection")) else "rad", f"{what} over the whole run (value: its peak "
+                    "|value|; error: the largest difference of the curve)", peak_value(path),
+                    "history", path, link=link)
+
+
 def _builtin() -> dict[str, Headline]:
     own = {link: _link_headlines(link) for link in ("coupler", "crank")}
     entries = [
@@ -301,6 +327,10 @@ def _builtin() -> dict[str, Headline]:
         *(_first_crest(link) for link in ("coupler", "crank")),
         *(own[link][1][k] for k in range(3) for link in ("coupler", "crank")),
         *(_joint_force(joint, False) for joint in "ABC"),
+        _history("crank/angle", "crank angle history", None),
+        _history("slider/position", "slider position history", None),
+        *(_history(f"{link}/midpoint_deflection", f"elastic midpoint deflection history of the "
+                   f"{link}", link) for link in ("coupler", "crank")),
     ]
     return {entry.name: entry for entry in entries}
 
@@ -335,4 +365,4 @@ def channel_series(headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> tup
 __all__ = ["BUILTIN_HEADLINES", "KINDS", "Headline", "channel", "crest_gap", "deployment_end",
            "DEFAULT_QUANTITIES", "QUANTITY_GROUPS", "channel_series", "deployment_peak_value",
            "deployment_time_s",
-           "final_value", "first_crest_value", "peak_value"]
+           "final_value", "history_difference", "first_crest_value", "peak_value"]

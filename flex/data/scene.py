@@ -278,7 +278,10 @@ SCHEMA: dict[str, dict[str, Field]] = {
                             '"motion", "deflections" (the link is made flexible), '
                             '"flexible_deflections" (of the links that are flexible) '
                             "(docs/error-budget.md)", many=True,
-                            default=list(DEFAULT_QUANTITIES)),
+                            default=list(DEFAULT_QUANTITIES),
+                            choices_text="a group (" + ", ".join(QUANTITY_GROUPS) + ") or a "
+                            "headline quantity's name (flex inspect lists them; "
+                            "docs/error-budget.md)"),
         "refine": Field(bool, "refine step, modes, mesh, rung until every quantity asked "
                         "meets the tolerance (docs/error-budget.md)", default=False),
         "refine_limit_s": Field(float, "refine: none starts after", positive=True, default=600.0),

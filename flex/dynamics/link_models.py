@@ -96,7 +96,6 @@ from flex.base.errors import SceneError
 from flex.base.physics import Plate
 from flex.base.progress import heartbeat
 from flex.config.ladder import (
-    EXACT_BEAM_RUNG,
     LUMPED_RIGID_RUNG,
     NONLINEAR_FE_RUNG,
     RIGID_RUNG,
@@ -115,6 +114,7 @@ from flex.data.scene import (
     link_model,
 )
 from flex.dynamics.exact_beam_link import (
+    CALIBRATED_BEAM_RUNG,
     add_exact_beam,
     exact_beam_datasets,
     exact_beam_sensors,
@@ -453,7 +453,7 @@ def _nonlinear_fe_rung(values: Mapping[str, Any]) -> Rung:
 
 
 def _exact_beam_rung(values: Mapping[str, Any]) -> Rung:
-    return EXACT_BEAM_RUNG
+    return CALIBRATED_BEAM_RUNG
 
 
 # ------------------------------------------------------------------------------------------

@@ -301,6 +301,9 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     result = CaseResult(name, to_toml(scene), datasets, counters=counters,
                         solver_settings_toml=tomli_w.dumps(settings))
     result.attrs.update(flexible_link_attrs(scene, datasets, mechanism_reductions(mech)))
+    for link, handles in (("crank", mech.crank), ("coupler", mech.coupler)):
+        calibration = getattr(handles.get("section"), "calibration", None) or {}
+        result.attrs.update({f"{link}_beam_{key}": value for key, value in calibration.items()})
     if cutoff_Hz is not None:
         result.attrs[CHANNEL_ATTR] = cutoff_Hz
     warning = validity_warning(scene, datasets, link_models)

@@ -399,7 +399,7 @@ def decide_links(scene: Mapping[str, Mapping[str, Any]],
                          f'> 0 or set the link model ("rigid", "ffrf")')
     if wants_coupler:
         decision, how = _decide_coupler(resolved, probe, delta_t_s, how, tolerance, criterion,
-                                        calibration, link_models)
+                                        calibration, link_models, cache_dir)
         decisions.append(decision)
     if wants_crank:
         decisions.append(_decide_crank(resolved, probe, delta_t_s, how, tolerance,
@@ -431,8 +431,8 @@ def _mode_cut(decision: FidelityDecision, resolved: dict[str, dict[str, Any]], l
 def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.ndarray],
                     delta_t_s: float, how: str, tolerance: float, criterion: Criterion,
                     calibration: Calibration | None = None,
-                    link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
-                    ) -> tuple[FidelityDecision, str]:
+                    link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
+                    cache_dir: Path | None = None) -> tuple[FidelityDecision, str]:
     """The coupler's decision (near buckling, beyond :data:`EULER_LOAD_LIMIT` x its Euler
     load, rigid is not offered and the ladder decides); returns it and ``how`` with the
     compressive load added."""
@@ -457,7 +457,7 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
         decision.reason += ("; fidelity.quantities asks the coupler's own deflection, which a "
                             "rigid coupler gives as a +-25 % prediction only: a flexible rung")
     if not link_models[decision.model].rigid:
-        _climb(decision, coupler, ratio, tolerance, link_models)
+        _climb(decision, coupler, ratio, tolerance, link_models, cache_dir)
     coupler["model"] = decision.model
     if MODES.name in link_models[decision.model].knobs:
         _mode_cut(decision, resolved, "coupler", k_phys, delta_t_s, calibration)
@@ -468,13 +468,13 @@ def _decide_coupler(resolved: dict[str, dict[str, Any]], probe: dict[str, np.nda
 
 
 def _climb(decision: FidelityDecision, coupler: dict[str, Any], load_ratio: float,
-           tolerance: float, link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS
-           ) -> None:
+           tolerance: float, link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
+           cache_dir: Path | None = None) -> None:
     """Past rigid, the lowest rung of the ladder whose measured model error relative to the
     deflection meets ``tolerance`` (:func:`flex.config.ladder.climb`), else the highest
     (in place: ``decision.model``; refused when that model has no damping and the coupler
     is damped)."""
-    chosen = climb("coupler", coupler, load_ratio, tolerance, link_models)
+    chosen = climb("coupler", coupler, load_ratio, tolerance, link_models, cache_dir)
     decision.reason += f"; ladder: {chosen.model} ({chosen.reason})"
     if not link_models[chosen.model].damped and coupler["damping_ratio"] != 0:
         raise SceneError(f'coupler.model = "auto": {decision.reason}; the '

@@ -171,7 +171,7 @@ def flexible_rung(load_ratio: float, tolerance: float, geometric_stiffness: bool
     probe's compression / Euler load, without ``geometric_stiffness``), else
     ``"nonlinear_fe"``; and the FFRF rung's relative model error. All dimensionless."""
     rung = FFRF_RUNG if geometric_stiffness else LINEAR_FFRF_RUNG
-    relative = rung.bound({}, load_ratio)
+    relative = rung.bound({}, load_ratio, None)
     return (FFRF if relative <= tolerance else NONLINEAR_FE), relative
 
 

@@ -42,6 +42,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Mapping
+from pathlib import Path
 from typing import Any
 
 from flex.base.errors import FlexError
@@ -183,8 +184,8 @@ def _measured_model_term(scene: Scene, result: CaseResult, companions: _Companio
 
 
 def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
-                leaves_out: list[str], link_models: Mapping[str, LinkModel]
-                ) -> tuple[dict[str, float], str]:
+                leaves_out: list[str], link_models: Mapping[str, LinkModel],
+                cache_dir: Path | None = None) -> tuple[dict[str, float], str]:
     """The links' model errors from their rungs (:mod:`flex.config.ladder`): measured on the
     scene where the rung says so (the difference to a companion one rung up); else a bounded
     rung's fractions of what the elasticity changes (the difference to rigid twins), plus its
@@ -196,7 +197,8 @@ def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
     bounded = {link: rung for link, rung in placed.items()
                if rung.bounded and link not in measured}
     if bounded:
-        sentences += _fractions(scene, result, companions, bounded, terms, link_models)
+        sentences += _fractions(scene, result, companions, bounded, terms, link_models,
+                                cache_dir)
     leaves_out += _grouped(dict(sorted(placed.items(), key=lambda item: -item[1].level)),
                            "leaves_out")
     leaves_out += [f"the {link_models[scene[link]['model']].label or scene[link]['model']} "
@@ -207,7 +209,7 @@ def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
 
 def _fractions(scene: Scene, result: CaseResult, companions: _Companions,
                bounded: dict[str, Rung], terms: dict[str, float],
-               link_models: Mapping[str, LinkModel]) -> list[str]:
+               link_models: Mapping[str, LinkModel], cache_dir: Path | None) -> list[str]:
     """The bounded rungs' measured fractions of what the elasticity changes (the difference
     to rigid twins), plus their companions' differences one step up, added to ``terms`` in
     place; their sentences."""
@@ -218,7 +220,7 @@ def _fractions(scene: Scene, result: CaseResult, companions: _Companions,
     for name, value in companions.differences(result, twin).items():
         owner = companions.headlines[name].link
         terms[name] = math.hypot(terms.get(name, 0.0), value * (
-            bounded[owner].own(scene[owner]) if owner in bounded else motion))
+            bounded[owner].own(scene[owner], cache_dir) if owner in bounded else motion))
     sentences = _grouped(bounded, "measured_by")
     steps_up = {link: rung for link, rung in bounded.items() if rung.companion}
     if steps_up:
@@ -235,12 +237,14 @@ def error_budget(scene: Scene, result: CaseResult,
                  run_companion: Callable[[Scene], CaseResult],
                  time_scales: list[tuple[float, float, str]],
                  link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS,
-                 headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> ErrorBudget:
+                 headlines: Mapping[str, Headline] = BUILTIN_HEADLINES,
+                 cache_dir: Path | None = None) -> ErrorBudget:
     """The error budget of ``result``, the run of ``scene`` (concrete models, solver keys
     resolved), from companion runs made by ``run_companion`` (see the module doc);
     ``time_scales``: the scene's (:func:`flex.dynamics.advice.time_scales`);
     ``link_models``: the registry of its link models (their flags and rungs choose the
-    terms); ``headlines``: the quantities budgeted (:mod:`flex.data.headlines`)."""
+    terms); ``headlines``: the quantities budgeted (:mod:`flex.data.headlines`);
+    ``cache_dir``: where a rung measured per plate keeps its reference (the exact beam's)."""
     values = {name: headline.read(result.datasets) for name, headline in headlines.items()}
     values = {name: value for name, value in values.items() if value is not None}
     step = estimate_step_error(scene, result, run_companion, time_scales, headlines)
@@ -248,7 +252,8 @@ def error_budget(scene: Scene, result: CaseResult,
     leaves_out = ["the spring's and joints' idealizations (massless spring unless chained, "
                   "ideal pins)"]
     knobbed, knob_how = _knob_terms(scene, result, companions, link_models)
-    model, model_how = _model_term(scene, result, companions, leaves_out, link_models)
+    model, model_how = _model_term(scene, result, companions, leaves_out, link_models,
+                                   cache_dir)
     failed = {failure.split(":")[0] for failure in companions.failures}
     if not step.values:
         failed.add("step")

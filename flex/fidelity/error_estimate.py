@@ -44,7 +44,7 @@ import numpy as np
 
 from flex.base.errors import FlexError
 from flex.config.knobs import STEP, integrator_order
-from flex.data.headlines import BUILTIN_HEADLINES, Headline
+from flex.data.headlines import BUILTIN_HEADLINES, Headline, history_difference
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, apply_overrides
 
@@ -71,6 +71,10 @@ def headline_difference(headline: Headline, run: Mapping[str, Any], other: Mappi
         if headline.series not in other:
             return mine
         return peak_difference(run, other, headline.series)
+    if headline.kind == "history":
+        if headline.series not in other and headline.link is None:
+            return None
+        return history_difference(run, other, headline.series)
     value = headline.read(other)
     if value is None and headline.link is not None:  # a rigid twin: none of its own
         value = 0.0
@@ -165,6 +169,8 @@ def _difference(headline: Headline, run: Mapping[str, Any], other: Mapping[str, 
                 values: list[float]) -> float:
     if headline.kind == "peak":
         return peak_difference(run, other, headline.series)
+    if headline.kind == "history":
+        return history_difference(run, other, headline.series)
     return abs(values[0] - values[1])
 
 

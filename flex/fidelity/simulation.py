@@ -153,7 +153,8 @@ def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduc
     run_companion = _companion_runner(scene, name, prepared, cache_dir, link_models,
                                       headlines, companions)
     scales = time_scales(scene, prepared, link_models)
-    budget = error_budget(scene, result, run_companion, scales, link_models, headlines)
+    budget = error_budget(scene, result, run_companion, scales, link_models, headlines,
+                          cache_dir)
     result.attrs.update(budget.attrs())
     _warn_unresolved_drive(result, scales, float(scene["simulation"]["step_s"]))
     if budget.unknown:
@@ -308,22 +309,24 @@ def _flexible_links(scene: Scene, link_models: Mapping[str, LinkModel]) -> list[
 
 def _state_coverage(result: CaseResult, budget: ErrorBudget | None, scene: Scene, name: str,
                     link_models: Mapping[str, LinkModel], refined: bool) -> None:
-    """Store and say what the tolerance covered (:func:`flex.fidelity.stored_budget.
-    tolerance_coverage`): each quantity asked, met or not; a quantity missed without
-    refinement is a warning naming it and what ``fidelity.refine = true`` would do."""
+    """Store what the tolerance covered (:func:`flex.fidelity.stored_budget.
+    tolerance_coverage`): each quantity asked, met or not; a quantity missed (or unknown) is
+    a warning on stderr naming it, and, without refinement, what ``fidelity.refine = true``
+    would do (a run that met it says so in ``inspect``, the report and ``flex run
+    simulate``'s line)."""
     if budget is None:
         return
     tolerance = Tolerance.of(scene)
     coverage = tolerance_coverage(budget.rows(), tolerance.asked(
         _flexible_links(scene, link_models)), tolerance.relative)
     result.attrs.update(coverage_attrs(coverage, tolerance.relative))
-    missed = [item for item in coverage if item[1] in ("missed", "unknown")]
+    if not any(status in ("missed", "unknown") for _, status, _ in coverage):
+        return  # met: stored, printed by inspect and the report (and flex run simulate)
     text = coverage_text(coverage, tolerance.relative)
-    if missed and not refined:
+    if not refined:
         text += ("; fidelity.refine = true would turn the knobs of the missed quantities "
                  "(step, modes, mesh, elements, rung) until they meet it, or say why not")
-    print(f"flex: {'warning' if missed else 'note'}: case {name}: {text}", file=sys.stderr,
-          flush=True)
+    print(f"flex: warning: case {name}: {text}", file=sys.stderr, flush=True)
 
 
 #: the noise floor's companion runs at this many times the run's Newton tolerance (looser, so

@@ -33,6 +33,7 @@ from flex.bodies.reduction.cache import (
     meta_digest,
     say_unproven,
 )
+from flex.bodies.section_mean import fem_tetrahedra, section_mean_weights
 from flex.data.cache import (
     REDUCTION_CACHE,
     store,
@@ -135,35 +136,6 @@ def _node_set(fem, name: str) -> dict:
         if node_set["Name"] == name:
             return node_set
     raise KeyError(name)
-
-
-def mid_set(positions: np.ndarray, length_m: float, mesh_size_m: float,
-            ) -> tuple[np.ndarray, np.ndarray]:
-    """Nodes of a thin slab around x = length/2 and weights placing their centre there.
-
-    A tetrahedral mesh has no node plane at mid-length, so the marker averages a slab of
-    half-width mesh_size/4 (widened until it holds >= 8 nodes). Equal weights are corrected by
-    the smallest change that puts the weighted reference centre exactly at (L/2, 0, 0); if that
-    would make a weight non-positive the equal weights are kept (centre then off by << h).
-    The slab average differs from the mid-section value by O((h/L)^2) in the deflection.
-    """
-    distance = np.abs(positions[:, 0] - length_m / 2)
-    half_width = 0.25 * mesh_size_m
-    nodes = np.flatnonzero(distance <= half_width)
-    while len(nodes) < 8:
-        half_width *= 1.5
-        nodes = np.flatnonzero(distance <= half_width)
-    weights = np.full(len(nodes), 1.0 / len(nodes))
-    constraint = np.vstack([np.ones(len(nodes)), positions[nodes].T])  # sum, x, y, z
-    target = np.array([1.0, length_m / 2, 0.0, 0.0])
-    try:
-        correction = constraint.T @ np.linalg.solve(constraint @ constraint.T,
-                                                    target - constraint @ weights)
-        if np.all(weights + correction > 0):
-            weights = weights + correction
-    except np.linalg.LinAlgError:
-        pass
-    return nodes, unit_sum(weights)
 
 
 def unit_sum(weights: np.ndarray) -> np.ndarray:
@@ -378,8 +350,8 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
                                  parameters["density_kg_per_m3"])
     fem.ComputePostProcessingModesNGsolve(space, material=material,
                                           outputVariableType=exu.OutputVariableType.StressLocal)
-    positions = fem.GetNodePositionsAsArray()
-    mid_nodes, mid_weights = mid_set(positions, length_m, parameters["mesh_size_m"])
+    mid_nodes, mid_weights = section_mean_weights(fem.GetNodePositionsAsArray(),
+                                                  fem_tetrahedra(fem), length_m / 2)
     fem.nodeSets.append({"Name": MID, "NodeNumbers": mid_nodes, "NodeWeights": mid_weights})
 
     from exudyn.FEM import ObjectFFRFreducedOrderInterface

@@ -21,7 +21,8 @@ from flex.data.cache import (
 )
 
 #: Bump when the content or layout of a cache file changes; old entries are then rebuilt.
-CACHE_FORMAT_VERSION = 2  # 2: the chord frame (end_a rotation static modes)
+CACHE_FORMAT_VERSION = 3  # 2: the chord frame (end_a rotation static modes); 3: the mid-span
+# marker reads the section mean (flex.bodies.section_mean)
 
 
 def reduction_cache_dir(environ: Mapping[str, str]) -> Path:

@@ -140,7 +140,7 @@ def exact_beam_bound(scene: Scene) -> tuple[float, str]:
     deflection, :data:`flex.config.ladder.EXACT_BEAM_RUNG`) and what it is."""
     from flex.config.ladder import EXACT_BEAM_ERROR_PER_SLENDERNESS, EXACT_BEAM_RUNG
 
-    return (EXACT_BEAM_RUNG.own(scene["coupler"]),
+    return (EXACT_BEAM_RUNG.own(scene["coupler"], None),
             f"the exact beam's idealization: the ladder's bound "
             f"{EXACT_BEAM_ERROR_PER_SLENDERNESS:g} x thickness / length of the coupler's "
             f"deflection (taken for every measure)")
