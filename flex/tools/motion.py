@@ -206,6 +206,7 @@ def case_motion(path: str | Path, case: str | None = None, *,
     data, attrs = _read_case(path, case)
     if attrs.get("status") != "ok":
         raise FlexError(f"{where} failed ({attrs.get('message', '')}): nothing to export")
+    _check_motion(data, where)
     scene = case_scene(attrs, where)
     models = {link: model_entry(scene[link]["model"], where, link_models)
               for link in LINKS}
@@ -224,6 +225,45 @@ def case_motion(path: str | Path, case: str | None = None, *,
         bodies.append(replace(body, model=models[link].name))
     bodies.append(_slider_body(scene))
     return CaseMotion(path, case, scene, data, attrs, bodies, extra, readers)
+
+
+#: the stored series every case's motion is drawn from (a link model's own are checked by
+#: the dimensions of :data:`MOTION_SHAPES` when present; its reader says which it needs)
+MOTION_SERIES = ("time", "crank/angle", "coupler/angle")
+#: series a motion is drawn from, by the end of their name: their dimensions, samples first
+#: (0: any; the reader checks the columns against the reduction)
+MOTION_SHAPES = {"time": 1, "/angle": 1, "/chord_change": 1, "/frame_angle": 1,
+                 "/frame_position": 2, "/modal_coordinates": 0, "/nodal/time": 1,
+                 "/nodal/position": 3}
+
+
+def _check_motion(data: dict[str, np.ndarray], where: str) -> None:
+    """Refuse (FlexError, one line) a case whose :data:`MOTION_SERIES` are missing, or whose
+    series of :data:`MOTION_SHAPES` are not finite numbers, one row per stored time (per
+    nodal snapshot under ``nodal/``), of their dimensions: a file edited or damaged stopped
+    export and animate on ``KeyError: 'time'`` or a broadcasting error, as internal errors."""
+    for name in MOTION_SERIES:
+        if name not in data:
+            raise FlexError(f"{where} has no dataset '{name}' (every flex run stores it: the "
+                            f"file was edited or damaged): rerun the case")
+    for name, values in data.items():
+        ndim = next((n for end, n in MOTION_SHAPES.items() if name.endswith(end)), -1)
+        if ndim < 0:
+            continue
+        rows = np.shape(data.get(name.split("nodal/")[0] + "nodal/time" if "nodal/" in name
+                                 else "time"))[:1]
+        values = np.asarray(values)
+        if (values.ndim != (ndim or max(values.ndim, 1)) or values.shape[:1] != rows
+                or values.size == 0 or values.dtype.kind not in "iuf"
+                or not np.isfinite(values).all()):
+            raise FlexError(f"{where}: dataset '{name}' is not {ndim or 'an array of'}"
+                            f"{'-dimensional' if ndim else ''} finite "
+                            f"numbers with one row per stored time (shape {values.shape}, "
+                            f"{values.dtype}; rows expected: {rows[0] if rows else '?'}): the "
+                            f"file was edited or damaged, rerun the case")
+    if np.any(np.diff(data["time"]) < 0):
+        raise FlexError(f"{where}: its time is not in order (the file was edited or damaged): "
+                        f"rerun the case")
 
 
 def _slider_body(scene: Scene) -> Body:
