@@ -155,17 +155,21 @@ def _respond(time_s: np.ndarray, signed_static_m: np.ndarray, compression_N: np.
     """The quasi-static history amplified by its compression, the first mode's oscillator
     response to it, and the ramp-load-factor bound (one link, one window)."""
     static = np.abs(signed_static_m)
-    amplified = static * axial_load_amplification(compression_N, euler_N)
+    amplification = axial_load_amplification(compression_N, euler_N)
+    amplified = static * amplification
     period = 2 * np.pi / omega_rad_per_s
     peak_index = int(np.argmax(amplified))
     starts_high = static[0] >= STEP_FRACTION * static.max()
     rise = 0.0 if starts_high else float(time_s[peak_index] - time_s[0])
     factor = float(ramp_load_factor(rise, period))
+    ratio = float(max(compression_N.max(), 0.0) / euler_N)
+    if not np.all(np.isfinite(amplification)):  # at or beyond the Euler load: it buckles
+        return DeflectionPrediction(np.inf, np.inf, np.inf, factor, rise, float(period), ratio)
     response = oscillator_response(time_s, np.sign(signed_static_m) * amplified,
                                    omega_rad_per_s, damping_ratio)
     return DeflectionPrediction(float(np.max(np.abs(response))), float(amplified[peak_index]),
                                 float(factor * amplified[peak_index]), factor, rise,
-                                float(period), float(max(compression_N.max(), 0.0) / euler_N))
+                                float(period), ratio)
 
 
 def oscillator_response(time_s: np.ndarray, quasi_static: np.ndarray, omega_rad_per_s: float,
@@ -208,6 +212,8 @@ def rigid_link_predictions(scene: Mapping[str, Mapping[str, Any]],
     out: dict[str, Any] = {}
     for link in rigid_links:
         prediction = predict_deflection(series, scene[link], link, window_end_s)
+        if not np.isfinite(prediction.peak_deflection_m):  # buckled: none (a validity
+            continue  # warning says so, flex.dynamics.advice); it was "nan +- nan"
         values = {f"{link}_peak_deflection_m": prediction.peak_deflection_m}
         if link == "coupler" and prediction.quasi_static_peak_m > 0:
             plate = Plate.of(scene[link])
@@ -220,13 +226,21 @@ def rigid_link_predictions(scene: Mapping[str, Mapping[str, Any]],
         for name, value in values.items():
             out[f"{PREDICTED_PREFIX}{name}"] = value
             out[f"{PREDICTED_PREFIX}{name}_error"] = PREDICTION_SPREAD * value
+    predicted = [link for link in rigid_links if f"{PREDICTED_PREFIX}{link}_peak_deflection_m"
+                 in out]
+    buckled = [link for link in rigid_links if link not in predicted]
     if out:
         out[f"{PREDICTED_PREFIX}method"] = (
-            f"a prediction, not a run: the rigid {' and '.join(rigid_links)}'s own loads on a "
+            f"a prediction, not a run: the rigid {' and '.join(predicted)}'s own loads on a "
             f"pinned beam, amplified by the axial compression, through the first bending "
             f"mode's oscillator (flex.fidelity.predictor), over the deployment; its error, "
             f"{PREDICTION_SPREAD:g} of it, from the measured spread against FFRF bodies "
             f"(0.79-1.23 over 27 scenes)")
+    if buckled:
+        out[f"{PREDICTED_PREFIX}method"] = "; ".join(filter(None, [
+            out.get(f"{PREDICTED_PREFIX}method", ""),
+            f"none for the rigid {' and '.join(buckled)}: compressed to its plate's Euler load "
+            f"or beyond, where a plate buckles"]))
     return out
 
 

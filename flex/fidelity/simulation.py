@@ -154,6 +154,7 @@ def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduc
                                       headlines, companions)
     scales = time_scales(scene, prepared, link_models)
     budget = error_budget(scene, result, run_companion, scales, link_models, headlines)
+    _unbounded_beyond_load(scene, result, budget, link_models, headlines)
     result.attrs.update(budget.attrs())
     _warn_unresolved_drive(result, scales, float(scene["simulation"]["step_s"]))
     if budget.unknown:
@@ -197,6 +198,35 @@ def companion_key(scene: Scene) -> str | None:
         return None
     return to_toml(apply_overrides(scene, ["simulation.output_step_s=0.0",
                                            "simulation.error_estimate=false"]))
+
+
+def _unbounded_beyond_load(scene: Scene, result: CaseResult, budget: Any,
+                           link_models: Mapping[str, LinkModel],
+                           headlines: Mapping[str, Headline]) -> None:
+    """The coupler's own quantities get an unknown model term (no certificate) when the run
+    compressed it beyond the load up to which its rung's model error was measured (no bound
+    at the run's compression / Euler load, or beyond the rung's ``measured_load_ratio``,
+    :mod:`flex.config.ladder`): an exact beam 1.5-100 x beyond its Euler load was certified
+    to 0.07-5 %."""
+    from flex.base.physics import Plate
+    from flex.fidelity.criteria import euler_load_ratio
+
+    coupler = scene["coupler"]
+    rung = link_models[coupler["model"]].rung(coupler)
+    needed = ("joints/B/force_on_coupler", "joints/C/force_on_coupler", "coupler/angle")
+    if rung is None or rung.bound is None or not all(n in result.datasets for n in needed):
+        return
+    ratio = euler_load_ratio(*(np.asarray(result.datasets[n].data) for n in needed),
+                             Plate.of(coupler))
+    if math.isfinite(rung.bound(coupler, ratio)) and ratio <= rung.measured_load_ratio:
+        return
+    own = [name for name in budget.terms if headlines[name].link == "coupler"]
+    for name in own:
+        budget.terms[name]["model"] = math.nan
+    if own:
+        budget.unknown.append(f"model: the coupler is compressed to {ratio:.3g} x its Euler "
+                              f"load, where the {rung.name} model's error was never measured "
+                              f"(no bound: see the validity warning)")
 
 
 def _warn_unresolved_drive(result: CaseResult, scales: list[tuple[float, float, str]],
