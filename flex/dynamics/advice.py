@@ -340,9 +340,12 @@ def divergence_advice(scene: Scene, reductions: dict[str, Any] | None = None,
                 and sim["spectral_radius"] == 1.0):
             parts.append("simulation.spectral_radius = 1 leaves the index-3 constraint modes "
                          "undamped: try 0.9 or less")
-        else:
-            parts.append(f"no input is {EXTREME_FACTOR:g}x from the bundled scene: check the "
-                         f"solver settings ([simulation])")
+        else:  # it said "check the solver settings" to users who had set none
+            used = ", ".join(f"{key} = {sim[key]!r}" for key in (
+                "step_s", "newton", "newton_relative_tolerance", "spectral_radius"))
+            parts.append(f"no input is {EXTREME_FACTOR:g}x from the bundled scene; the run "
+                         f"used {used} (flex's own where [simulation] says \"auto\"): flex "
+                         f"knows no cause; please report the scene")
     return "; ".join(parts)
 
 

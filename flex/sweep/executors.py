@@ -185,6 +185,10 @@ class ProcessExecutor(Executor):
         self._pool = self._new_pool()
 
 
+#: seconds a Dask scheduler without workers is given for one to join before it is refused
+WORKER_WAIT_S = 30.0
+
+
 class DaskExecutor(Executor):
     """A ``dask.distributed.Client``: to ``address``, or to a new loopback ``LocalCluster``.
 
@@ -213,8 +217,28 @@ class DaskExecutor(Executor):
                 self.client = Client(address, timeout="20s")
             except OSError as exc:
                 raise FlexError(f"scheduler {address}: cannot connect ({exc})") from None
-            self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
+            self.workers = self._wait_for_workers(address)
             self.description = f"Dask scheduler {address} ({self.workers} workers)"
+
+    def _wait_for_workers(self, address: str) -> int:
+        """The scheduler's workers, once it has one: said when it has none yet, refused
+        after :data:`WORKER_WAIT_S` (a sweep on a scheduler without workers waited in
+        silence, for ever)."""
+        import sys
+
+        found = len(self.client.scheduler_info().get("workers", {}))
+        if found:
+            return found
+        print(f"flex: scheduler {address} has no worker yet: waiting up to "
+              f"{WORKER_WAIT_S:g} s for one", file=sys.stderr, flush=True)
+        try:
+            self.client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+        except (TimeoutError, OSError) as exc:
+            self.client.close()
+            raise FlexError(f"scheduler {address}: no worker joined within "
+                            f"{WORKER_WAIT_S:g} s (start some: dask worker {address}; or "
+                            f"run without --scheduler) ({type(exc).__name__})") from None
+        return max(1, len(self.client.scheduler_info().get("workers", {})))
 
     def submit(self, function: Callable[..., Any], *args: Any) -> Any:
         return self.client.submit(function, *args, pure=False)

@@ -44,6 +44,7 @@ from flex.dynamics.link_models import BUILTIN_LINK_MODELS, RIGID, LinkModel
 from flex.dynamics.link_outputs import RIGID_MOTION, Body, BodyState, MotionReader
 
 __all__ = ["Body", "BodyState", "CaseMotion", "case_motion", "case_scene", "model_entry",
+           "motion_problem",
            "pick_case", "sample_indices", "top_faces", "SLIDER_BLOCK"]
 
 #: the slider block's length and height as fractions of the coupler length (drawing only)
@@ -211,20 +212,37 @@ def case_motion(path: str | Path, case: str | None = None, *,
     models = {link: model_entry(scene[link]["model"], where, link_models)
               for link in LINKS}
     readers = {link: model.stored_motion for link, model in models.items()}
-    if all(reader.kind == RIGID_MOTION.kind for reader in readers.values()):
-        raise FlexError(f"{where} has no flexible link (crank and coupler rigid): flex export "
-                        f"and animate show FFRF and nonlinear FE links")
-    unread = [f"the {models[link].label} {link}" for link, reader in readers.items()
-              if reader.body is None or reader.state is None]
-    if unread:
-        raise FlexError(f"{where}: {' and '.join(unread)} stores no motion that flex export "
-                        f"and animate read back (they show FFRF and nonlinear FE links)")
+    problem = motion_problem(scene, link_models)
+    if problem:
+        raise FlexError(f"{where}: {problem}")
     bodies, extra = [], {}
     for link, reader in readers.items():
         body, extra[link] = reader.body(link, scene, data, attrs, where, cache_dir)
         bodies.append(replace(body, model=models[link].name))
     bodies.append(_slider_body(scene))
     return CaseMotion(path, case, scene, data, attrs, bodies, extra, readers)
+
+
+def motion_problem(scene: Scene,
+                   link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> str:
+    """Why a case of ``scene`` cannot be exported or animated ("" when it can, or may: a
+    link whose model ``auto`` decides at run time, or one not in ``link_models``): both
+    links rigid, or a flexible link whose model stores no motion that export and animate
+    read back (an exact beam)."""
+    models = [scene[link]["model"] for link in LINKS]
+    if any(model not in link_models for model in models):
+        return ""
+    entries = {link: link_models[model] for link, model in zip(LINKS, models, strict=True)}
+    readers = {link: entry.stored_motion for link, entry in entries.items()}
+    if all(reader.kind == RIGID_MOTION.kind for reader in readers.values()):
+        return ("no flexible link (crank and coupler rigid): flex export and animate show "
+                "FFRF and nonlinear FE links")
+    unread = [f"the {entries[link].label} {link}" for link, reader in readers.items()
+              if reader.body is None or reader.state is None]
+    if unread:
+        return (f"{' and '.join(unread)} stores no motion that flex export and animate read "
+                f"back (they show FFRF and nonlinear FE links)")
+    return ""
 
 
 #: the stored series every case's motion is drawn from (a link model's own are checked by
