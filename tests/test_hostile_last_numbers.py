@@ -178,3 +178,17 @@ def test_a_malformed_certificate_factor_is_said(budgeted, tmp_path, command, fac
     assert outcome.status == EXIT_OK, outcome.stderr
     text = outcome.stdout if command == "inspect" else out.read_text()
     assert "certificate_factor" in text and "unknown (malformed" in text
+
+
+@pytest.mark.parametrize("sets, link, why", [
+    (['coupler.geometry="plate"', "drive.spring_preload_m=0"], "coupler", "round-off"),
+    (['coupler.geometry="plate"', "drive.spring_stiffness_N_per_m=0"], "coupler", "round-off"),
+    (['crank.geometry="plate"', "crank.thickness_m=0.0001"], "crank", "buckles"),
+    (['crank.geometry="plate"', "crank.thickness_m=0.00005",
+      'coupler.geometry="plate"', "coupler.thickness_m=0.0002"], "crank", "buckles")],
+    ids=["no-preload", "no-spring", "thin-crank", "thin-both"])
+def test_a_rigid_link_s_prediction_is_none_where_it_would_mean_nothing(tmp_path, sets, link,
+                                                                      why):
+    attrs, text = _run(tmp_path, *sets, *SHORT[1:])
+    assert not [key for key in attrs if key.startswith(f"predicted_{link}_")]
+    assert f"none for the rigid {link}: " in text and why in text

@@ -207,13 +207,20 @@ def rigid_link_predictions(scene: Mapping[str, Mapping[str, Any]],
     :func:`flex.fidelity.criteria.quasi_static_stress`, amplified as the deflection is), each
     with ``..._error`` (:data:`PREDICTION_SPREAD` of it) and one ``predicted_method`` line.
     ``rigid_links``: the rigid links with plate geometry."""
+    from flex.data.headlines import ROUNDOFF_ULPS
     from flex.fidelity.criteria import quasi_static_stress
 
     out: dict[str, Any] = {}
+    skipped: dict[str, str] = {}
     for link in rigid_links:
         prediction = predict_deflection(series, scene[link], link, window_end_s)
-        if not np.isfinite(prediction.peak_deflection_m):  # buckled: none (a validity
-            continue  # warning says so, flex.dynamics.advice); it was "nan +- nan"
+        if not np.isfinite(prediction.peak_deflection_m):  # it was "nan +- nan"
+            skipped[link] = "compressed to its plate's Euler load or beyond, where it buckles"
+            continue
+        if prediction.peak_deflection_m <= ROUNDOFF_ULPS * np.finfo(float).eps * float(
+                scene[link]["length_m"]):  # loads at round-off: it was "4.9e-16 m +- 25 %"
+            skipped[link] = "its loads bend it by round-off only (nothing loads it)"
+            continue
         values = {f"{link}_peak_deflection_m": prediction.peak_deflection_m}
         if link == "coupler" and prediction.quasi_static_peak_m > 0:
             plate = Plate.of(scene[link])
@@ -226,21 +233,15 @@ def rigid_link_predictions(scene: Mapping[str, Mapping[str, Any]],
         for name, value in values.items():
             out[f"{PREDICTED_PREFIX}{name}"] = value
             out[f"{PREDICTED_PREFIX}{name}_error"] = PREDICTION_SPREAD * value
-    predicted = [link for link in rigid_links if f"{PREDICTED_PREFIX}{link}_peak_deflection_m"
-                 in out]
-    buckled = [link for link in rigid_links if link not in predicted]
-    if out:
-        out[f"{PREDICTED_PREFIX}method"] = (
-            f"a prediction, not a run: the rigid {' and '.join(predicted)}'s own loads on a "
-            f"pinned beam, amplified by the axial compression, through the first bending "
-            f"mode's oscillator (flex.fidelity.predictor), over the deployment; its error, "
-            f"{PREDICTION_SPREAD:g} of it, from the measured spread against FFRF bodies "
-            f"(0.79-1.23 over 27 scenes)")
-    if buckled:
-        out[f"{PREDICTED_PREFIX}method"] = "; ".join(filter(None, [
-            out.get(f"{PREDICTED_PREFIX}method", ""),
-            f"none for the rigid {' and '.join(buckled)}: compressed to its plate's Euler load "
-            f"or beyond, where a plate buckles"]))
+    predicted = [link for link in rigid_links if link not in skipped]
+    method = [f"a prediction, not a run: the rigid {' and '.join(predicted)}'s own loads on a "
+              f"pinned beam, amplified by the axial compression, through the first bending "
+              f"mode's oscillator (flex.fidelity.predictor), over the deployment; its error, "
+              f"{PREDICTION_SPREAD:g} of it, from the measured spread against FFRF bodies "
+              f"(0.79-1.23 over 27 scenes)"] if predicted else []
+    method += [f"none for the rigid {link}: {why}" for link, why in skipped.items()]
+    if method:
+        out[f"{PREDICTED_PREFIX}method"] = "; ".join(method)
     return out
 
 
