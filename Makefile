@@ -74,11 +74,18 @@ force-rerun: ;
 # (no earlier file) writes a failed run to $@ itself: it is moved to <study>.failed.h5 here.
 # Whatever else changed $@ in a failed run (an interrupt while drawing figures) gets $@'s
 # earlier time stamp back, kept in results/.<study>.h5.before during the run.
+# `kill <make>` (SIGTERM) reaches only make's shells: each passes it on to its flex run and
+# waits for it to end (before, the shell died, flex and its workers computed on, and
+# .<study>.h5.before stayed behind). A Ctrl-C reaches flex from the terminal itself.
 define run-study
 @before=$(@D)/.$(@F).before; mkdir -p $(@D); \
 if [ -e $@ ]; then touch -r $@ $$before; else rm -f $$before; fi; \
 echo "$(RUN) $*"; \
-$(RUN) $* || { status=$$?; \
+run=; stop=; trap 'stop=TERM; [ -n "$$run" ] && kill -TERM $$run 2>/dev/null' TERM HUP; \
+trap : INT; $(RUN) $* & run=$$!; [ -n "$$stop" ] && kill -TERM $$run 2>/dev/null; \
+wait $$run; status=$$?; \
+while kill -0 $$run 2>/dev/null; do wait $$run; status=$$?; done; \
+[ $$status -eq 0 ] || { \
 	if [ -e $$before ]; then touch -r $$before $@; \
 	elif [ -e $@ ]; then mv -f $@ $(@:.h5=.failed.h5); \
 		echo "make: $@ came from a failed run: moved to $(@:.h5=.failed.h5)" >&2; fi; \

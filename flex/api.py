@@ -175,6 +175,11 @@ def _link_models(given: Mapping[str, Any] | None, run: bool = True) -> Mapping[s
             raise ArgumentError(f"link_models = {_shown(given)}: must be a mapping of link "
                                 "model names to flex.dynamics.link_models.LinkModel entries "
                                 f"(got {_kind(given)})")
+        for key, entry in given.items():  # an entry under another name ran as that one
+            if getattr(entry, "name", key) != key:
+                raise ArgumentError(f"link_models[{_shown(key)}] is the entry named "
+                                    f"{_shown(getattr(entry, 'name', None))}: a registry "
+                                    f"names each entry by its own name")
         return given
     if not run:
         from flex.data.scene import BUILTIN_LINK_SCHEMAS
@@ -258,6 +263,7 @@ def _simulate_options(options: dict[str, Any]) -> dict[str, Any]:
     otherwise), a calibration named by name or folder loaded."""
     _check_options(options, SIMULATE_OPTIONS, "simulate")
     _check_headlines(options.get("headlines"))
+    _check_kinds(options)
     if isinstance(options.get("calibration"), str | Path):
         from flex.config.calibration import load_calibration
 
@@ -473,6 +479,21 @@ def _check_options(options: Mapping[str, Any], accepted: Mapping[str, str], func
             listed = "; ".join(f"{name}: {what}" for name, what in accepted.items())
             raise ArgumentError(f"{function}: unknown keyword argument {key!r}; accepted "
                                 f"beside the named ones: {listed}")
+
+
+def _check_kinds(options: Mapping[str, Any]) -> None:
+    """The calibration and criteria of :data:`SIMULATE_OPTIONS` of their kinds (``calibration
+    = 123`` came back as an AttributeError from inside the run)."""
+    from flex.config.calibration import Calibration
+    from flex.fidelity.laws import Criterion
+
+    kinds = {"calibration": (Calibration, str, Path), "criterion": (Criterion,),
+             "crank_criterion": (Criterion,)}
+    for key, accepted in kinds.items():
+        value = options.get(key)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, accepted)):
+            raise ArgumentError(f"{key} = {_shown(value)}: must be {SIMULATE_OPTIONS[key]} "
+                                f"(got {_kind(value)})")
 
 
 def _check_headlines(headlines: Any) -> None:

@@ -368,8 +368,9 @@ def main(argv: list[str] | None = None) -> int:
     except OSError as exc:  # an output or input the operating system refused
         if received:  # an interrupt inside a C extension can surface as any error
             return _interrupted(exc, received)
-        where = f" '{exc.filename}'" if exc.filename else ""
-        print(f"flex: error: cannot access{where}: {exc.strerror or exc}", file=sys.stderr)
+        where = (f"cannot access '{exc.filename}'" if exc.filename else
+                 "a file could not be read or written (the system named none)")
+        print(f"flex: error: {where}: {exc.strerror or exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except Exception as exc:  # noqa: BLE001 - the last line of defence: no traceback
         if received:  # e.g. Ctrl-C during an import comes back as "ImportError"
@@ -462,6 +463,21 @@ def _dispatch(argv: list[str] | None) -> int:
     return _result_tool(args)
 
 
+def _check_animate(study: str, source: str | None, overrides: list[str]) -> None:
+    """``--animate`` for a study none of whose cases flex animate can show is refused before
+    anything runs (an exact-beam coupler's run wrote its result, figure and report, then
+    exited 2); a case decided at run time (``auto``) may be shown."""
+    from flex.study import load_study, study_scene
+    from flex.tools.motion import motion_problem
+
+    module = load_study(study)
+    problems = {motion_problem(scene)
+                for scene in module.cases(study_scene(module, source, overrides)).values()}
+    if "" not in problems:
+        raise FlexError(f"--animate: no case of study '{study}' can be animated: "
+                        f"{sorted(problems)[0]}; run without --animate")
+
+
 def _run(args: argparse.Namespace) -> int:
     from flex.study import from_environment, load_study, run_study
 
@@ -482,6 +498,8 @@ def _run(args: argparse.Namespace) -> int:
             check_scheduler(args.scheduler)
         except FlexError as exc:
             raise FlexError(f"--{exc}") from None
+    if args.animate:
+        _check_animate(args.study, args.scene, args.overrides)
     sweep = None
     if getattr(load_study(args.study), "SWEEP", False):
         import dataclasses

@@ -332,7 +332,7 @@ def run_study(name: str, source: str | Path | None = None, overrides: list[str] 
                 raise ResultFileError(str(exc).replace(str(staging.result), str(target))
                                       ) from None
             if draw and output.as_expected:
-                module.figures(output.results, output.summary, staging.figures())
+                _draw(module, output, staging.figures(), target)
             planned = staging.planned_figures()
             text = render_report(staging.result, staging.report_target.parent,
                                  shown_as=target,
@@ -377,6 +377,17 @@ def _write_output(output: StudyOutput, target: Path, scene: Scene) -> Path:
                          output.summary.datasets,
                          {"wall_time_s": output.wall_time_s, "failed_cases": len(failed),
                           "summary_report": output.summary.report})
+
+
+def _draw(module: ModuleType, output: Any, folder: Path, target: Path) -> None:
+    """The study's figures into ``folder`` (staged); a write the system refuses (a full
+    disk) names where they go (it said "cannot access: No space left on device")."""
+    try:
+        module.figures(output.results, output.summary, folder)
+    except OSError as exc:
+        raise OutputError(f"cannot write the figures of '{target}' (in "
+                          f"{target.parent / 'figures'}): {exc.strerror or exc}; the previous "
+                          f"result file, figures and report (if any) are unchanged") from None
 
 
 def _report(output: StudyOutput, path: Path, quiet: bool) -> None:

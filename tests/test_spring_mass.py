@@ -165,7 +165,9 @@ def test_stop_index_skips_a_start_up_ripple():
     angle[:20] += 1e-2 * np.sin(np.pi * time_s[:20] / 0.004)  # maxima during the ripple
     from flex.data.headlines import first_maximum_index
 
-    assert first_maximum_index(angle) < 20
+    # the ripple's tops, which the rise later passes by far more than they rose, are not a
+    # first maximum either (since issue 48: a crank held by its damper's wiggle)
+    assert time_s[first_maximum_index(angle)] == pytest.approx(0.4, abs=1e-3)
     assert time_s[stop_index(angle)] == pytest.approx(0.4, abs=1e-3)
 
 

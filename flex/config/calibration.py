@@ -126,8 +126,9 @@ def _read(folder: Path, part: str, required: bool) -> str | None:
             raise FlexError(f"calibration folder '{folder}' has no {FILES[part]} (a "
                             f"calibration folder holds {', '.join(FILES.values())})") from None
         return None
-    except OSError as exc:
-        raise FlexError(f"calibration file '{path}' cannot be read: {exc.strerror}") from None
+    except (OSError, UnicodeDecodeError) as exc:  # not UTF-8: it came back as a Python error
+        raise FlexError(f"calibration file '{path}' cannot be read: "
+                        f"{getattr(exc, 'strerror', None) or exc}") from None
 
 
 def _parse(folder: Path, part: str, text: str) -> dict[str, Any]:
@@ -211,8 +212,9 @@ def _read_file(path: Path) -> str:
     except FileNotFoundError:
         study = STUDY_OF[path.name]
         raise FlexError(f"'{path}' does not exist: run 'make {study}' first") from None
-    except OSError as exc:
-        raise FlexError(f"'{path}' cannot be read: {exc.strerror}") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise FlexError(f"'{path}' cannot be read: "
+                        f"{getattr(exc, 'strerror', None) or exc}") from None
 
 
 def _check_toml(path: Path, text: str) -> None:

@@ -56,8 +56,9 @@ DEPLOYMENT_SERIES = "crank/angle"
 
 #: a series whose whole swing is below this, relative to its magnitude (at least 1), has
 #: not moved: round-off of a mechanism at rest (an FFRF coupler at preload 0 swings its crank
-#: by ~1e-13 rad)
-STILL_FRACTION = 1e-9
+#: by ~1e-13 rad), or the integrator's start transient of a crank held by its damper (1e9-
+#: 1e11 N s/m: ~1e-9 rad, stated as a deployment of 2e-5 s); a deployment turns ~1 rad
+STILL_FRACTION = 1e-6
 #: a maximum counts once the series has risen this fraction of its whole swing above its
 #: lowest value so far: a first step that lowers the crank angle by round-off (4e-8 rad at
 #: h <= 1e-5 s, against a swing of ~1 rad) is not a maximum
@@ -77,12 +78,19 @@ def first_maximum_index(values: np.ndarray) -> int | None:
     swing = float(np.max(values) - np.min(values))
     if swing <= STILL_FRACTION * max(1.0, float(np.max(np.abs(values)))):
         return None
-    risen = values - np.minimum.accumulate(values) > RISE_FRACTION * swing
+    rise = values - np.minimum.accumulate(values)
+    risen = rise > RISE_FRACTION * swing
     if not risen.any():
         return None
     start = int(np.argmax(risen))
-    falling = np.flatnonzero(np.diff(values[start:]) < 0)
-    return None if len(falling) == 0 else start + int(falling[0])
+    step = np.diff(values[start:])
+    tops = start + np.flatnonzero((step < 0) & np.r_[True, step[:-1] >= 0])
+    # a top the series later passes by more than it rose to it is a wiggle on the way (a
+    # crank held by its damper: a step-scale wiggle of 1e-9 rad within a creep of 3e-8 rad
+    # was a "deployment" of 2e-5 s), not the deployment's end
+    later = np.maximum.accumulate(values[::-1])[::-1]
+    real = tops[later[tops] - values[tops] <= rise[tops]]
+    return int(real[0]) if real.size else None
 
 
 def first_peak_index(deflection: np.ndarray) -> int:
@@ -177,6 +185,37 @@ def history_difference(run: Mapping[str, Any], other: Mapping[str, Any], path: s
     return float(np.max(np.abs(mine - theirs)))
 
 
+#: a midpoint deflection is a difference of positions the size of the mechanism: within
+#: this many units in the last place of those positions it is their round-off, not a
+#: deflection (an exact beam run for 1e-9 s stated 9e-17 m "+- 0.062 %")
+ROUNDOFF_ULPS = 64.0
+
+
+def deflection_resolution_m(datasets: Mapping[str, Any], link: str) -> float:
+    """The round-off of ``<link>/midpoint_deflection`` [m]: :data:`ROUNDOFF_ULPS` units in
+    the last place of the link's midpoint position (0 without it)."""
+    path = f"{link}/midpoint_position"
+    if path not in datasets:
+        return 0.0
+    values = np.abs(np.asarray(datasets[path].data, dtype=float))
+    if not values.size or not np.isfinite(values).all():
+        return 0.0
+    return ROUNDOFF_ULPS * float(np.finfo(float).eps) * float(values.max())
+
+
+def above_roundoff(read: Callable[[Mapping[str, Any]], float | None], link: str
+                   ) -> Callable[[Mapping[str, Any]], float | None]:
+    """``read``, None where its value is within the round-off of the link's deflection
+    (:func:`deflection_resolution_m`): missing, not a number with an error stated as if it
+    meant something."""
+    def checked(datasets: Mapping[str, Any]) -> float | None:
+        value = read(datasets)
+        if value is None or abs(value) <= deflection_resolution_m(datasets, link):
+            return None
+        return value
+    return checked
+
+
 def crest_gap(values: np.ndarray) -> float | None:
     """How far the second-largest crest of ``|values|`` lies below the largest [the series'
     units]: a peak's crest uncertainty (an error of the run larger than this may have picked
@@ -266,17 +305,25 @@ def _link_headlines(link: str) -> list[list[Headline]]:
                f"peak von Mises stress of the {link}{away}")]
     deployment = [Headline(f"{link}_deployment_peak_{suffix}", suffix.rsplit("_", 1)[1], what
                            + " over the deployment" + _CHANNEL_TEXT,
-                           deployment_peak_value(path), "value", path, window=DEPLOYMENT,
+                           _reader(deployment_peak_value(path), path, link), "value", path,
+                           window=DEPLOYMENT,
                            link=link, certified=path == deflection,
                            mesh_order=2 if path == deflection else 1,
                            channel=(path, DEPLOYMENT_SERIES))
                   for path, suffix, what in series]
     whole = [Headline(f"{link}_peak_{suffix}", suffix.rsplit("_", 1)[1],
-                      what + " over the whole run (raw)", peak_value(path), "peak", path,
+                      what + " over the whole run (raw)",
+                      _reader(peak_value(path), path, link), "peak", path,
                       link=link, crest_gap=path == deflection,
                       mesh_order=2 if path == deflection else 1)
              for path, suffix, what in series]
     return [deployment, whole]
+
+
+def _reader(read: Callable[[Mapping[str, Any]], float | None], path: str, link: str
+            ) -> Callable[[Mapping[str, Any]], float | None]:
+    """A link quantity's reader: a deflection's within its round-off is missing."""
+    return above_roundoff(read, link) if path.endswith("/midpoint_deflection") else read
 
 
 def _first_crest(link: str) -> Headline:
@@ -284,7 +331,8 @@ def _first_crest(link: str) -> Headline:
     return Headline(f"{link}_first_crest_deflection_m", "m",
                     f"first crest of the elastic midpoint deflection of the {link} (largest "
                     f"|deflection| of the first lobe){_CHANNEL_TEXT}",
-                    first_crest_value(deflection), "first_crest", deflection,
+                    above_roundoff(first_crest_value(deflection), link), "first_crest",
+                    deflection,
                     window="the first lobe of the deflection, on the headline channel",
                     link=link, channel=(deflection,))
 
@@ -362,7 +410,8 @@ def channel_series(headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> tup
                                    for path in headline.channel]
     return tuple(dict.fromkeys(found))
 
-__all__ = ["BUILTIN_HEADLINES", "KINDS", "Headline", "channel", "crest_gap", "deployment_end",
+__all__ = ["BUILTIN_HEADLINES", "KINDS", "Headline", "above_roundoff", "channel", "crest_gap",
+           "deflection_resolution_m", "deployment_end",
            "DEFAULT_QUANTITIES", "QUANTITY_GROUPS", "channel_series", "deployment_peak_value",
            "deployment_time_s",
            "final_value", "history_difference", "first_crest_value", "peak_value"]

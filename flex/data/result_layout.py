@@ -245,6 +245,10 @@ def _check_time(dataset, path: str, label) -> int:
         raise refuse(f"holds {'text' if dataset.dtype.kind in 'OSU' else dataset.dtype}")
     if dataset.shape[0] == 0:
         raise refuse("has no samples")
+    units = dataset.attrs.get("units", "s")
+    units = units.decode("utf-8", "replace") if isinstance(units, bytes) else units
+    if units != "s":  # relabelled (ms): compared, plotted and exported as seconds
+        raise refuse(f"has units {str(units)[:20]!r}")
     values = dataset[()]
     finite = np.isfinite(values)
     if not finite.all():

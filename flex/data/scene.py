@@ -211,7 +211,7 @@ SCHEMA: dict[str, dict[str, Field]] = {
         "span_m": Field(doc="wing span, from the crank pivot A along the crank", **_POS),
         "chord_m": Field(doc="wing chord, in the mechanism plane across the span", **_POS),
         "thickness_m": Field(doc="wing thickness, out of the mechanism plane", **_POS),
-        "density_kg_per_m3": Field(doc="wing material density", **_POS),
+        "density_kg_per_m3": Field(doc="wing material density (a solid's)", **_DENSITY),
         "youngs_modulus_Pa": Field(doc="wing material Young's modulus", **_POS),
     },
     "slider": {

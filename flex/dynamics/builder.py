@@ -311,6 +311,11 @@ class Builder:
         """Weld the wing's root marker to the crank's marker at A (a rigid-body marker, or
         the joint face of a flexible crank); return the joint. Its reaction torque is the
         wing root bending moment in the mechanism plane."""
+        if "localHT" not in self.mbs.GetMarker(crank_root):  # a scene no check has seen:
+            # a budget's companion one rung up (an exact-beam crank) was an internal error
+            raise SceneError(f'crank.model = "{self.scene["crank"]["model"]}" carries no wing '
+                             "(the weld at A needs a frame its nodes do not have); accepted: "
+                             "wing.enabled = false")
         # both markers turned back by the crank angle: the weld frame is global at t = 0
         crank_rotation = rotation_z(self.init.crank_angle_rad)
         markers = [_turned_marker(self.mbs, marker, crank_rotation.T)

@@ -61,11 +61,26 @@ def collect(mech: Mechanism) -> dict[str, Dataset]:
                                      "slide line; slider angle in rad)")
 
     for link, model in mech.models.items():  # the link model's own (the coupler's)
-        out.update(model.datasets(mech, link, time_s))
+        out.update(_own_datasets(model, link, model.datasets(mech, link, time_s), out))
     if mech.wing:
         out.update(_wing_datasets(mech))
     out.update(_energy_datasets(mech, out["slider/displacement"].data, time_s))
     return out
+
+
+def _own_datasets(model: Any, link: str, datasets: dict[str, Dataset],
+                  collected: dict[str, Dataset]) -> dict[str, Dataset]:
+    """A link model's datasets, refused (ArgumentError: the registry given is at fault) when
+    one is not its link's (``<link>/...``) or replaces one already collected: a toy model that
+    wrote ``crank/angle`` ran as ok, its crank angle silently replaced."""
+    from flex.base.errors import ArgumentError
+
+    foreign = [name for name in datasets if not name.startswith(f"{link}/") or name in collected]
+    if foreign:
+        raise ArgumentError(f"link model {model.name!r} ({link}) writes {', '.join(foreign)}: a "
+                            f"link model's datasets are its own link's, {link}/..., and never "
+                            f"replace the mechanism's (fix the entry's datasets function)")
+    return datasets
 
 
 def _joint_forces(mech: Mechanism) -> dict[str, np.ndarray]:

@@ -369,6 +369,9 @@ def load_criterion(path: str | Path | None = None) -> Criterion:
     except FileNotFoundError:
         raise FlexError(f"criterion file '{path}' does not exist; run 'make kfit' and "
                         f"'make calibration-install' to create it") from None
+    except (OSError, UnicodeDecodeError) as exc:  # a folder, unreadable, not UTF-8
+        raise FlexError(f"criterion file '{path}' cannot be read: "
+                        f"{getattr(exc, 'strerror', None) or exc}") from None
     return parse_criterion(text, str(path))
 
 

@@ -155,17 +155,21 @@ def _respond(time_s: np.ndarray, signed_static_m: np.ndarray, compression_N: np.
     """The quasi-static history amplified by its compression, the first mode's oscillator
     response to it, and the ramp-load-factor bound (one link, one window)."""
     static = np.abs(signed_static_m)
-    amplified = static * axial_load_amplification(compression_N, euler_N)
+    amplification = axial_load_amplification(compression_N, euler_N)
+    amplified = static * amplification
     period = 2 * np.pi / omega_rad_per_s
     peak_index = int(np.argmax(amplified))
     starts_high = static[0] >= STEP_FRACTION * static.max()
     rise = 0.0 if starts_high else float(time_s[peak_index] - time_s[0])
     factor = float(ramp_load_factor(rise, period))
+    ratio = float(max(compression_N.max(), 0.0) / euler_N)
+    if not np.all(np.isfinite(amplification)):  # at or beyond the Euler load: it buckles
+        return DeflectionPrediction(np.inf, np.inf, np.inf, factor, rise, float(period), ratio)
     response = oscillator_response(time_s, np.sign(signed_static_m) * amplified,
                                    omega_rad_per_s, damping_ratio)
     return DeflectionPrediction(float(np.max(np.abs(response))), float(amplified[peak_index]),
                                 float(factor * amplified[peak_index]), factor, rise,
-                                float(period), float(max(compression_N.max(), 0.0) / euler_N))
+                                float(period), ratio)
 
 
 def oscillator_response(time_s: np.ndarray, quasi_static: np.ndarray, omega_rad_per_s: float,
@@ -203,11 +207,20 @@ def rigid_link_predictions(scene: Mapping[str, Mapping[str, Any]],
     :func:`flex.fidelity.criteria.quasi_static_stress`, amplified as the deflection is), each
     with ``..._error`` (:data:`PREDICTION_SPREAD` of it) and one ``predicted_method`` line.
     ``rigid_links``: the rigid links with plate geometry."""
+    from flex.data.headlines import ROUNDOFF_ULPS
     from flex.fidelity.criteria import quasi_static_stress
 
     out: dict[str, Any] = {}
+    skipped: dict[str, str] = {}
     for link in rigid_links:
         prediction = predict_deflection(series, scene[link], link, window_end_s)
+        if not np.isfinite(prediction.peak_deflection_m):  # it was "nan +- nan"
+            skipped[link] = "compressed to its plate's Euler load or beyond, where it buckles"
+            continue
+        if prediction.peak_deflection_m <= ROUNDOFF_ULPS * np.finfo(float).eps * float(
+                scene[link]["length_m"]):  # loads at round-off: it was "4.9e-16 m +- 25 %"
+            skipped[link] = "its loads bend it by round-off only (nothing loads it)"
+            continue
         values = {f"{link}_peak_deflection_m": prediction.peak_deflection_m}
         if link == "coupler" and prediction.quasi_static_peak_m > 0:
             plate = Plate.of(scene[link])
@@ -220,13 +233,15 @@ def rigid_link_predictions(scene: Mapping[str, Mapping[str, Any]],
         for name, value in values.items():
             out[f"{PREDICTED_PREFIX}{name}"] = value
             out[f"{PREDICTED_PREFIX}{name}_error"] = PREDICTION_SPREAD * value
-    if out:
-        out[f"{PREDICTED_PREFIX}method"] = (
-            f"a prediction, not a run: the rigid {' and '.join(rigid_links)}'s own loads on a "
-            f"pinned beam, amplified by the axial compression, through the first bending "
-            f"mode's oscillator (flex.fidelity.predictor), over the deployment; its error, "
-            f"{PREDICTION_SPREAD:g} of it, from the measured spread against FFRF bodies "
-            f"(0.79-1.23 over 27 scenes)")
+    predicted = [link for link in rigid_links if link not in skipped]
+    method = [f"a prediction, not a run: the rigid {' and '.join(predicted)}'s own loads on a "
+              f"pinned beam, amplified by the axial compression, through the first bending "
+              f"mode's oscillator (flex.fidelity.predictor), over the deployment; its error, "
+              f"{PREDICTION_SPREAD:g} of it, from the measured spread against FFRF bodies "
+              f"(0.79-1.23 over 27 scenes)"] if predicted else []
+    method += [f"none for the rigid {link}: {why}" for link, why in skipped.items()]
+    if method:
+        out[f"{PREDICTED_PREFIX}method"] = "; ".join(method)
     return out
 
 

@@ -155,6 +155,7 @@ def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduc
     scales = time_scales(scene, prepared, link_models)
     budget = error_budget(scene, result, run_companion, scales, link_models, headlines,
                           cache_dir)
+    _unbounded_beyond_load(scene, result, budget, link_models, headlines, cache_dir)
     result.attrs.update(budget.attrs())
     _warn_unresolved_drive(result, scales, float(scene["simulation"]["step_s"]))
     if budget.unknown:
@@ -198,6 +199,41 @@ def companion_key(scene: Scene) -> str | None:
         return None
     return to_toml(apply_overrides(scene, ["simulation.output_step_s=0.0",
                                            "simulation.error_estimate=false"]))
+
+
+def _unbounded_beyond_load(scene: Scene, result: CaseResult, budget: Any,
+                           link_models: Mapping[str, LinkModel],
+                           headlines: Mapping[str, Headline],
+                           cache_dir: Path | None = None) -> None:
+    """Model terms that are unknown (no certificate) when the run compressed the coupler
+    beyond the load up to which they were measured: its own quantities' when its rung has no
+    bound there (or the run lies beyond the rung's ``measured_load_ratio``,
+    :mod:`flex.config.ladder`: an exact beam 1.5-100 x beyond its Euler load was certified
+    to 0.07-5 %), every quantity's when the term is the difference to an exact-beam
+    companion beyond the beam's (a rigid 0.3 mm plate's 'met' against a buckled beam)."""
+    from flex.base.physics import Plate
+    from flex.config.ladder import EXACT_BEAM_MEASURED_LOAD_RATIO
+    from flex.fidelity.criteria import euler_load_ratio
+
+    coupler = scene["coupler"]
+    rung = link_models[coupler["model"]].rung(coupler)
+    needed = ("joints/B/force_on_coupler", "joints/C/force_on_coupler", "coupler/angle")
+    if rung is None or not all(n in result.datasets for n in needed):
+        return
+    ratio = euler_load_ratio(*(np.asarray(result.datasets[n].data) for n in needed),
+                             Plate.of(coupler))
+    against = rung.measured_against is not None and ratio > EXACT_BEAM_MEASURED_LOAD_RATIO
+    unbounded = rung.bound is not None and not (math.isfinite(rung.bound(coupler, ratio,
+                                                                         cache_dir))
+                                                and ratio <= rung.measured_load_ratio)
+    names = list(budget.terms) if against else [
+        name for name in budget.terms if unbounded and headlines[name].link == "coupler"]
+    for name in names:
+        budget.terms[name]["model"] = math.nan
+    if names:
+        budget.unknown.append(f"model: the coupler is compressed to {ratio:.3g} x its Euler "
+                              f"load, where the {rung.name} model's error was never measured "
+                              f"(no bound: see the validity warning)")
 
 
 def _warn_unresolved_drive(result: CaseResult, scales: list[tuple[float, float, str]],

@@ -240,6 +240,21 @@ class BudgetRow:
     certificate_factor: float = math.nan
     #: the total is a bound, not an estimate (a raw whole-run peak, :data:`BOUNDS_ATTR`)
     bound: bool = False
+    #: why a stored certificate factor cannot be used ("" if it can, or none is stored)
+    certificate_problem: str = ""
+
+    @property
+    def value_text(self) -> str:
+        """The value with its units, or ``no value`` (not ``nan``) when none is stored."""
+        return f"{self.value:.6g} {self.units}" if math.isfinite(self.value) else "no value"
+
+    @property
+    def certificate_text(self) -> str:
+        """The certificate with its units, ``unknown (why)`` for a stored factor that cannot
+        be used (it vanished without a word), or "" for a file written before them."""
+        if math.isfinite(self.certificate):
+            return f"{self.certificate:.2g} {self.units}"
+        return f"unknown ({self.certificate_problem})" if self.certificate_problem else ""
 
     @property
     def certificate(self) -> float:
@@ -258,12 +273,12 @@ class BudgetRow:
         or ``what: value units +- unknown (why)`` for a budget with a problem."""
         terms = ", ".join(f"{term} {term_text(value)}" for term, value in self.terms.items())
         if self.problem:
-            return (f"{self.what}: {self.value:.6g} {self.units} +- {self.problem}"
+            return (f"{self.what}: {self.value_text} +- {self.problem}"
                     + (f" (terms: {terms})" if terms else ""))
         relative = (f" ({100 * self.relative:.2g} %)" if math.isfinite(self.relative)
                     else "")
-        certificate = (f", certificate {self.certificate:.2g} {self.units}"
-                       if math.isfinite(self.certificate) else "")
+        certificate = (f", certificate {self.certificate_text}" if self.certificate_text
+                       else "")
         kind = (f"a bound, not an estimate: {BOUND_TEXT}" if self.bound else "estimate")
         return (f"{self.what}: {self.value:.6g} {self.units} +- {self.total:.2g} "
                 f"{self.units}{relative} ({kind}{certificate}; root-sum-square of {terms})")
@@ -328,9 +343,12 @@ def budget_rows(attrs: Mapping[str, Any]) -> list[BudgetRow]:
         if not any(key in attrs for key in keys):
             continue
         rows.append(_budget_row(attrs, quantity, units, what))
-    factor, _ = _number(dict(attrs), CERTIFICATE_ATTR)
+    factor, problem = _number(dict(attrs), CERTIFICATE_ATTR)
     if factor is not None and math.isfinite(factor) and factor >= 1.0:
         rows = [replace(row, certificate_factor=factor) for row in rows]
+    elif factor is not None:  # stored but unusable: said, not dropped without a word
+        problem = problem or f"malformed: attribute {CERTIFICATE_ATTR} = {factor:g} (< 1)"
+        rows = [replace(row, certificate_problem=problem) for row in rows]
     bounds = named_quantities(attrs)
     return [replace(row, bound=True) if row.quantity in bounds else row for row in rows]
 
@@ -364,6 +382,9 @@ def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> 
     unmeasured = [term for term, number in terms.items() if math.isnan(number)]
     if problems:
         problem = problems[0]
+    elif not math.isfinite(value):  # it printed "nan m +- ..."
+        problem = (f"unknown (no value stored: attribute {HEADLINE_PREFIX}{quantity} is "
+                   f"missing or not a number)")
     elif total is None:
         problem = ("unknown (no estimated error stored)" if f"{PREFIX}method" in attrs else
                    "unknown (not estimated: the run had simulation.error_estimate = false)")

@@ -177,14 +177,15 @@ class _Progress:
         print(text, file=self.stream, flush=True)
         self.last_line = time.monotonic()
 
-    def _status(self, final: bool = False) -> None:
-        """One plain line: cases finished of all, the counts, time elapsed and left."""
+    def _status(self, final: str = "") -> None:
+        """One plain line: cases finished of all, the counts, time elapsed and left (or
+        ``final``: how the sweep ended)."""
         finished = self.done + self.failed
         elapsed = time.monotonic() - self.start
         text = (f"{self.description}: {finished}/{self.total} cases ({self._counts()}), "
                 f"{duration_text(elapsed)} elapsed")
         if final:
-            text += ", finished"
+            text += f", {final}"
         elif finished:
             text += f", ~{duration_text(elapsed / finished * (self.total - finished))} left"
         self._line(text)
@@ -223,11 +224,15 @@ class _Progress:
         elif self.plain:
             self._line(text)
 
-    def close(self) -> None:
+    def close(self, how: str = "finished") -> None:
+        """The last line: ``how`` the sweep ended (finished, interrupted, stopped by an
+        error): an interrupted sweep's last line said "0/56 cases ... finished"."""
         if self.bar is not None:
+            if how != "finished":
+                self.bar.write(f"{self.description}: {how}")
             self.bar.close()
         elif self.plain:
-            self._status(final=True)
+            self._status(final=how)
 
 
 def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
@@ -266,14 +271,17 @@ def run_sweep(scenes: Mapping[str, Scene], folder: str | Path,
     results = _resumable(scenes, folder, digests, retry_failed)
     run = _SweepRun(scenes, folder, case_function, digests, results, executor, study,
                     progress)
+    how = "stopped by an error"
     try:
         run.submit_all(prepare, prepare_key)
         run.drain()
+        how = "finished"
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM: the running cases are abandoned
+        how = "interrupted"
         executor.abort()
         raise
     finally:
-        run.bar.close()
+        run.bar.close(how)
         if own_executor:
             executor.close()
     outcome = run.outcome

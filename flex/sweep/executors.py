@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from flex.base.errors import FlexError
+from flex.base.lifetime import die_with_parent
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, to_toml
 
@@ -120,6 +121,10 @@ class SerialExecutor(Executor):
         return set(futures)
 
 
+#: seconds an aborted worker gets to end on SIGTERM before it is killed (SIGKILL)
+ABORT_GRACE_S = 2.0
+
+
 class ProcessExecutor(Executor):
     """``concurrent.futures.ProcessPoolExecutor`` with ``workers`` spawned processes."""
 
@@ -131,8 +136,14 @@ class ProcessExecutor(Executor):
         self.workers = int(workers or os.cpu_count() or 1)
         # spawn, not fork: Exudyn and NGsolve hold threads that a fork would copy half-way
         self._context = multiprocessing.get_context("spawn")
-        self._pool = ProcessPoolExecutor(self.workers, mp_context=self._context)
+        self._pool = self._new_pool()
         self.description = f"local processes ({self.workers} workers)"
+
+    def _new_pool(self) -> ProcessPoolExecutor:
+        """A pool whose workers end with this process (:func:`die_with_parent`), however it
+        ends: a run killed with SIGKILL left its workers computing for minutes."""
+        return ProcessPoolExecutor(self.workers, mp_context=self._context,
+                                   initializer=die_with_parent, initargs=(os.getpid(),))
 
     def submit(self, function: Callable[..., Any], *args: Any) -> Future:
         return self._pool.submit(function, *args)
@@ -142,7 +153,7 @@ class ProcessExecutor(Executor):
 
     def restart(self) -> None:
         self._pool.shutdown(wait=False, cancel_futures=True)
-        self._pool = ProcessPoolExecutor(self.workers, mp_context=self._context)
+        self._pool = self._new_pool()
 
     def isolated(self) -> Executor:
         return ProcessExecutor(1)
@@ -151,18 +162,31 @@ class ProcessExecutor(Executor):
         self._pool.shutdown(wait=True, cancel_futures=True)
 
     def abort(self) -> None:
-        """Cancel what waits and terminate the workers: a worker in a minutes-long eigen-solve
-        does not see a signal (an interrupted ``make calibrate`` said "terminated" and went on
-        for minutes, joining its workers). A new pool serves any later submission."""
+        """Cancel what waits and end the workers: SIGTERM, then SIGKILL for those still
+        there after :data:`ABORT_GRACE_S` (a worker in a minutes-long eigen-solve, or in an
+        Exudyn solve that turns SIGTERM into an exception and asks for the next case, does
+        not end on SIGTERM: an interrupted ``flex run calibrate --workers 2`` went on for
+        minutes, joining its workers). A new pool serves any later submission."""
         import multiprocessing
+        import time
 
         self._pool.shutdown(wait=False, cancel_futures=True)
         # every child process of this (interrupted) process, the pool's workers among them
-        for child in multiprocessing.active_children():
+        children = multiprocessing.active_children()
+        for child in children:
             child.terminate()
-        for child in multiprocessing.active_children():
-            child.join(timeout=5.0)
-        self._pool = ProcessPoolExecutor(self.workers, mp_context=self._context)
+        deadline = time.monotonic() + ABORT_GRACE_S
+        for child in children:
+            child.join(timeout=max(0.0, deadline - time.monotonic()))
+        for child in children:
+            if child.is_alive():
+                child.kill()
+                child.join(timeout=ABORT_GRACE_S)
+        self._pool = self._new_pool()
+
+
+#: seconds a Dask scheduler without workers is given for one to join before it is refused
+WORKER_WAIT_S = 30.0
 
 
 class DaskExecutor(Executor):
@@ -193,8 +217,28 @@ class DaskExecutor(Executor):
                 self.client = Client(address, timeout="20s")
             except OSError as exc:
                 raise FlexError(f"scheduler {address}: cannot connect ({exc})") from None
-            self.workers = max(1, len(self.client.scheduler_info().get("workers", {})))
+            self.workers = self._wait_for_workers(address)
             self.description = f"Dask scheduler {address} ({self.workers} workers)"
+
+    def _wait_for_workers(self, address: str) -> int:
+        """The scheduler's workers, once it has one: said when it has none yet, refused
+        after :data:`WORKER_WAIT_S` (a sweep on a scheduler without workers waited in
+        silence, for ever)."""
+        import sys
+
+        found = len(self.client.scheduler_info().get("workers", {}))
+        if found:
+            return found
+        print(f"flex: scheduler {address} has no worker yet: waiting up to "
+              f"{WORKER_WAIT_S:g} s for one", file=sys.stderr, flush=True)
+        try:
+            self.client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+        except (TimeoutError, OSError) as exc:
+            self.client.close()
+            raise FlexError(f"scheduler {address}: no worker joined within "
+                            f"{WORKER_WAIT_S:g} s (start some: dask worker {address}; or "
+                            f"run without --scheduler) ({type(exc).__name__})") from None
+        return max(1, len(self.client.scheduler_info().get("workers", {})))
 
     def submit(self, function: Callable[..., Any], *args: Any) -> Any:
         return self.client.submit(function, *args, pure=False)

@@ -31,6 +31,7 @@ from types import MappingProxyType
 import numpy as np
 
 from flex.base.errors import FlexError, OutputError
+from flex.base.progress import heartbeat
 from flex.data.outputs import check_replaceable, check_writable_folder, has_marker
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
 from flex.tools.motion import Body, CaseMotion, case_motion, top_faces
@@ -172,6 +173,10 @@ def animate_case(source: str | Path, case: str | None, out: str | Path, *, frame
     out = Path(out)
     if out.suffix.lower() not in (".mp4", ".gif", ".png"):
         raise FlexError(f"--out {out}: must end in .mp4, .gif or .png (one frame)")
+    if at_time_s is not None and out.suffix.lower() != ".png":  # it was ignored
+        raise FlexError(f"--time {at_time_s!r}: picks the one frame of a .png; an animation "
+                        f"({out.suffix}) shows every stored time: drop --time, or write a "
+                        f".png")
     if isinstance(fps, bool) or not isinstance(fps, int) or not 1 <= fps <= 120:
         raise FlexError(f"--fps {fps!r}: must be an integer in 1..120")
     if magnification is not None and not (math.isfinite(magnification) and magnification > 0):
@@ -349,7 +354,7 @@ def animate_results(result: str | Path, *, cache_dir: Path | None = None,
     (:func:`default_animation_path`), yielding each animation once it is written (``flex run
     --animate``)."""
     from flex.data.results import attribute_value, case_names, reading
-    from flex.tools.motion import case_scene
+    from flex.tools.motion import case_scene, motion_problem
 
     result = Path(result)
     chosen = []
@@ -358,15 +363,22 @@ def animate_results(result: str | Path, *, cache_dir: Path | None = None,
             attrs = {k: attribute_value(v) for k, v in h5[f"cases/{name}"].attrs.items()}
             if attrs.get("status") != "ok":
                 continue
-            scene = case_scene(attrs, f"{result} case {name}")
-            if any(scene[link]["model"] not in BUILTIN_LINK_MODELS
-                   or not BUILTIN_LINK_MODELS[scene[link]["model"]].rigid
-                   for link in ("crank", "coupler")):
+            problem = motion_problem(case_scene(attrs, f"{result} case {name}"))
+            if not problem:
                 chosen.append(name)
+            elif not problem.startswith("no flexible link"):  # said, not skipped silently
+                print(f"flex: note: case {name} is not animated: {problem}", file=sys.stderr,
+                      flush=True)
     # figures/ beside a result file is flex's own folder: a run replaces its figures there
     for name in chosen:
-        yield animate_case(result, name, default_animation_path(result, name), frames=frames,
-                           cache_dir=cache_dir, force=True)
+        path = default_animation_path(result, name)
+        # a phase named, then a line every few seconds: "still working (last line: [1/1]
+        # done)" was all stderr said for 37 s
+        print(f"flex: animating case {name} -> {path}", file=sys.stderr, flush=True)
+        with heartbeat(f"animating case {name}"):
+            done = animate_case(result, name, path, frames=frames, cache_dir=cache_dir,
+                                force=True)
+        yield done
 
 
 __all__ = ["Animation", "animate_case", "animate_results", "chord_deflection",

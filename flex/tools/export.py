@@ -111,6 +111,9 @@ def export_case(source: str | Path, case: str | None, out_dir: str | Path, every
     The HDF5 file is assembled in memory (about its compressed size) and then written.
     ``link_models``: the registry the case's models are read from."""
     sample_indices(1, every)  # a bad --every is refused before anything is read
+    if not str(out_dir).strip():  # '' was the current folder
+        raise OutputError(f"--out {str(out_dir)!r}: an empty folder name; give the output "
+                          f"folder (e.g. exported/, or . for the current one)")
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise OutputError(f"--out {out}: is a file, not a folder")

@@ -336,7 +336,7 @@ def _prediction_lines(attrs: dict[str, Any]) -> list[str]:
         what = name.removesuffix(f"_{unit}").replace("_", " ")
         lines.append(f"    predicted {what} (rigid link, a prediction): {_quantity(value, unit)}"
                      + (f" +- {_quantity(error, unit)}" if error is not None else ""))
-    if lines and attrs.get(f"{PREDICTED_PREFIX}method"):
+    if attrs.get(f"{PREDICTED_PREFIX}method"):  # also when it says why there is none
         lines.append(f"    prediction: {attrs[f'{PREDICTED_PREFIX}method']}")
     return lines
 

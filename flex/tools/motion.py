@@ -44,6 +44,7 @@ from flex.dynamics.link_models import BUILTIN_LINK_MODELS, RIGID, LinkModel
 from flex.dynamics.link_outputs import RIGID_MOTION, Body, BodyState, MotionReader
 
 __all__ = ["Body", "BodyState", "CaseMotion", "case_motion", "case_scene", "model_entry",
+           "motion_problem",
            "pick_case", "sample_indices", "top_faces", "SLIDER_BLOCK"]
 
 #: the slider block's length and height as fractions of the coupler length (drawing only)
@@ -206,24 +207,81 @@ def case_motion(path: str | Path, case: str | None = None, *,
     data, attrs = _read_case(path, case)
     if attrs.get("status") != "ok":
         raise FlexError(f"{where} failed ({attrs.get('message', '')}): nothing to export")
+    _check_motion(data, where)
     scene = case_scene(attrs, where)
     models = {link: model_entry(scene[link]["model"], where, link_models)
               for link in LINKS}
     readers = {link: model.stored_motion for link, model in models.items()}
-    if all(reader.kind == RIGID_MOTION.kind for reader in readers.values()):
-        raise FlexError(f"{where} has no flexible link (crank and coupler rigid): flex export "
-                        f"and animate show FFRF and nonlinear FE links")
-    unread = [f"the {models[link].label} {link}" for link, reader in readers.items()
-              if reader.body is None or reader.state is None]
-    if unread:
-        raise FlexError(f"{where}: {' and '.join(unread)} stores no motion that flex export "
-                        f"and animate read back (they show FFRF and nonlinear FE links)")
+    problem = motion_problem(scene, link_models)
+    if problem:
+        raise FlexError(f"{where}: {problem}")
     bodies, extra = [], {}
     for link, reader in readers.items():
         body, extra[link] = reader.body(link, scene, data, attrs, where, cache_dir)
         bodies.append(replace(body, model=models[link].name))
     bodies.append(_slider_body(scene))
     return CaseMotion(path, case, scene, data, attrs, bodies, extra, readers)
+
+
+def motion_problem(scene: Scene,
+                   link_models: Mapping[str, LinkModel] = BUILTIN_LINK_MODELS) -> str:
+    """Why a case of ``scene`` cannot be exported or animated ("" when it can, or may: a
+    link whose model ``auto`` decides at run time, or one not in ``link_models``): both
+    links rigid, or a flexible link whose model stores no motion that export and animate
+    read back (an exact beam)."""
+    models = [scene[link]["model"] for link in LINKS]
+    if any(model not in link_models for model in models):
+        return ""
+    entries = {link: link_models[model] for link, model in zip(LINKS, models, strict=True)}
+    readers = {link: entry.stored_motion for link, entry in entries.items()}
+    if all(reader.kind == RIGID_MOTION.kind for reader in readers.values()):
+        return ("no flexible link (crank and coupler rigid): flex export and animate show "
+                "FFRF and nonlinear FE links")
+    unread = [f"the {entries[link].label} {link}" for link, reader in readers.items()
+              if reader.body is None or reader.state is None]
+    if unread:
+        return (f"{' and '.join(unread)} stores no motion that flex export and animate read "
+                f"back (they show FFRF and nonlinear FE links)")
+    return ""
+
+
+#: the stored series every case's motion is drawn from (a link model's own are checked by
+#: the dimensions of :data:`MOTION_SHAPES` when present; its reader says which it needs)
+MOTION_SERIES = ("time", "crank/angle", "coupler/angle")
+#: series a motion is drawn from, by the end of their name: their dimensions, samples first
+#: (0: any; the reader checks the columns against the reduction)
+MOTION_SHAPES = {"time": 1, "/angle": 1, "/chord_change": 1, "/frame_angle": 1,
+                 "/frame_position": 2, "/modal_coordinates": 0, "/nodal/time": 1,
+                 "/nodal/position": 3}
+
+
+def _check_motion(data: dict[str, np.ndarray], where: str) -> None:
+    """Refuse (FlexError, one line) a case whose :data:`MOTION_SERIES` are missing, or whose
+    series of :data:`MOTION_SHAPES` are not finite numbers, one row per stored time (per
+    nodal snapshot under ``nodal/``), of their dimensions: a file edited or damaged stopped
+    export and animate on ``KeyError: 'time'`` or a broadcasting error, as internal errors."""
+    for name in MOTION_SERIES:
+        if name not in data:
+            raise FlexError(f"{where} has no dataset '{name}' (every flex run stores it: the "
+                            f"file was edited or damaged): rerun the case")
+    for name, values in data.items():
+        ndim = next((n for end, n in MOTION_SHAPES.items() if name.endswith(end)), -1)
+        if ndim < 0:
+            continue
+        rows = np.shape(data.get(name.split("nodal/")[0] + "nodal/time" if "nodal/" in name
+                                 else "time"))[:1]
+        values = np.asarray(values)
+        if (values.ndim != (ndim or max(values.ndim, 1)) or values.shape[:1] != rows
+                or values.size == 0 or values.dtype.kind not in "iuf"
+                or not np.isfinite(values).all()):
+            raise FlexError(f"{where}: dataset '{name}' is not {ndim or 'an array of'}"
+                            f"{'-dimensional' if ndim else ''} finite "
+                            f"numbers with one row per stored time (shape {values.shape}, "
+                            f"{values.dtype}; rows expected: {rows[0] if rows else '?'}): the "
+                            f"file was edited or damaged, rerun the case")
+    if np.any(np.diff(data["time"]) < 0):
+        raise FlexError(f"{where}: its time is not in order (the file was edited or damaged): "
+                        f"rerun the case")
 
 
 def _slider_body(scene: Scene) -> Body:

@@ -174,6 +174,9 @@ def plot_curves(path: str | Path, specs: Sequence[str], others: Sequence[str | P
     """
     if not specs:
         raise FlexError("plot needs at least one PATH, e.g. crank/angle")
+    if out is not None and not str(out).strip():  # '' wrote the default figure instead
+        raise OutputError(f"--out {str(out)!r}: an empty file name; give a figure file, "
+                          f".png, .pdf or .svg (or leave --out out for the default)")
     target = Path(out) if out else default_output(path, specs)
     files = [path, *others]
     _check_output(target, files, "--out" if out else "the default figure")

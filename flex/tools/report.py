@@ -332,12 +332,11 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
     rows, notes = [], {}
     for case in cases:
         for row in budget_rows(case["attrs"]):
-            rows.append([_code(case["name"]), row.what, f"{row.value:.6g} {row.units}",
+            rows.append([_code(case["name"]), row.what, row.value_text,
                          row.problem or f"{'bound ' if row.bound else ''}{row.total:.2g} "
                                         f"{row.units}",
                          f"{100 * row.relative:.2g} %" if math.isfinite(row.relative) else "-",
-                         f"{row.certificate:.2g} {row.units}"
-                         if math.isfinite(row.certificate) else "-",
+                         row.certificate_text or "-",
                          *(term_text(row.terms[t]) if t in row.terms else "-" for t in TERMS)])
         for key in ("method", "leaves_out", "validity", "unknown"):
             if case["attrs"].get(PREFIX + key):

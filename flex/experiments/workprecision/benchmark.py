@@ -451,6 +451,25 @@ def repository_root() -> Path | None:
     return None
 
 
+def _run_make(argv: list[str], root: Path, env: dict[str, str]
+              ) -> subprocess.CompletedProcess:
+    """``argv`` (a make) in ``root``, ending with this process however it ends: SIGTERM
+    when it is killed (:func:`flex.base.lifetime.dying_with_this_process`) or interrupted
+    (make passes SIGTERM on to its recipes, each to its flex run; subprocess.run would
+    SIGKILL make and leave its runs computing)."""
+    from flex.base.lifetime import dying_with_this_process
+
+    with subprocess.Popen(dying_with_this_process(argv), cwd=root, env=env, text=True,
+                          stdout=subprocess.PIPE, stderr=subprocess.PIPE) as proc:
+        try:
+            out, err = proc.communicate()
+        except BaseException:
+            proc.terminate()
+            proc.wait()
+            raise
+    return subprocess.CompletedProcess(argv, proc.returncode, out, err)
+
+
 def bench_make_all(say: Say, notes: dict[str, Any], run: bool = True) -> None:
     """``make all FORCE=1`` [s] in the repository holding flex, with an empty reduction cache
     (cold) and again with it filled (warm); skipped when not ``run`` (``FLEX_BENCH_MAKE=0``).
@@ -471,8 +490,7 @@ def bench_make_all(say: Say, notes: dict[str, Any], run: bool = True) -> None:
         for label in ("cold", "warm"):
             say(f"make all ({label} reduction cache)")
             start = time.perf_counter()
-            done = subprocess.run(["make", "all", "FORCE=1"], cwd=root, env=env,
-                                  capture_output=True, text=True, check=False)
+            done = _run_make(["make", "all", "FORCE=1"], root, env)
             out[f"{label}_s"] = time.perf_counter() - start
             out[f"{label}_returncode"] = done.returncode
             if done.returncode:
