@@ -241,8 +241,10 @@ def _result_tools(commands) -> None:
     compare.add_argument("file_a", metavar="A.h5")
     compare.add_argument("file_b", metavar="B.h5")
     compare.add_argument("paths", nargs="*", metavar="PATH", help=PATH_HELP)
-    compare.add_argument("--rtol", type=float, default=DEFAULT_RTOL,
-                         help=f"relative tolerance, times max|b| (default {DEFAULT_RTOL:g})")
+    compare.add_argument("--rtol", type=float, default=None,
+                         help=f"relative tolerance, times max|b| (default: a curve whose cases "
+                              f"state their history errors is allowed their root-sum-square, "
+                              f"any other {DEFAULT_RTOL:g})")
     compare.add_argument("--atol", type=float, default=DEFAULT_ATOL,
                          help=f"absolute tolerance in the curve's units (default "
                               f"{DEFAULT_ATOL:g})")

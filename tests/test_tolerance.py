@@ -64,3 +64,25 @@ def test_a_missed_tolerance_without_refine_is_a_warning_naming_the_quantity(caps
     assert "fidelity.refine = true" in line
     assert result.attrs["tolerance_met"] is False or not result.attrs["tolerance_met"]
     assert "coupler_deployment_peak_deflection_m\tmissed" in result.attrs["tolerance_covered"]
+
+
+def test_compare_allows_the_stated_history_errors_when_no_rtol_is_given(tmp_path):
+    """Two runs of a rigid 2 mm plate, the second at half the step: their crank-angle curves
+    differ by the first's step error, which its stated history error covers; with a tight
+    --rtol the same difference fails."""
+    from flex.tools.compare import compare_files
+    from hostile import run_cli
+
+    files = []
+    for name, step in (("coarse", "2e-5"), ("fine", "1e-5")):
+        out = tmp_path / f"{name}.h5"
+        outcome = run_cli(["run", "simulate", "--no-figures", "--quiet", "--out", str(out),
+                           "--set", 'coupler.geometry="plate"', "--set",
+                           "coupler.thickness_m=0.002", "--set", "simulation.end_time_s=0.005",
+                           "--set", f"simulation.step_s={step}"])
+        assert outcome.status == 0, outcome.stderr
+        files.append(out)
+    stated = compare_files(*files, ["cases/case/crank/angle"])
+    (row,) = stated.deviations
+    assert row.passed and "stated history errors" in row.note and row.max_abs_deviation > 0
+    assert not compare_files(*files, ["cases/case/crank/angle"], rtol=1e-12).passed

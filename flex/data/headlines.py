@@ -354,7 +354,8 @@ def _history(path: str, what: str, link: str | None) -> Headline:
     difference to a finer run over the whole run (``estimated_error_history_<path>``)."""
     return Headline(f"history_{path.replace('/', '_')}", "m" if path.endswith(("position",
                     "deflection")) else "rad", f"{what} over the whole run (value: its peak "
-                    "|value|; error: the largest difference of the curve)", peak_value(path),
+                    "|value|; error: the largest difference of the curve)",
+                    above_roundoff(peak_value(path), link) if link else peak_value(path),
                     "history", path, link=link)
 
 

@@ -130,6 +130,10 @@ class Comparison:
     skipped: list[str] = field(default_factory=list)
     #: compare the overlap when A does not cover B's time span (``--partial``)
     partial: bool = False
+    #: no ``--rtol`` given: a curve whose case states its history error
+    #: (``estimated_error_history_<path>``, :mod:`flex.fidelity.stored_budget`) is allowed
+    #: ``atol`` + the root-sum-square of the two files' stated errors instead
+    stated: bool = False
 
     @property
     def failures(self) -> list[Deviation]:
@@ -143,7 +147,8 @@ class Comparison:
     def command(self) -> str:
         """The shell command that repeats this comparison."""
         return shlex.join(["python", "-m", "flex", "compare", self.file_a, self.file_b,
-                           "--rtol", f"{self.rtol:g}", "--atol", f"{self.atol:g}",
+                           *([] if self.stated else ["--rtol", f"{self.rtol:g}"]),
+                           "--atol", f"{self.atol:g}",
                            *(["--interp", self.interpolation]
                              if self.interpolation != "cubic" else []),
                            *(["--partial"] if self.partial else []), *self.specs])
@@ -158,7 +163,9 @@ class Comparison:
                             f"row)")
         lines = [f"A: {self.file_a}", f"B: {self.file_b}",
                  f"pass if max|a - b| <= atol + rtol * max|b| for each curve (and column): "
-                 f"rtol = {self.rtol:g}, atol = {self.atol:g}"]
+                 f"rtol = {self.rtol:g}, atol = {self.atol:g}"
+                 + ("; a curve whose cases state their history errors: atol + their "
+                    "root-sum-square (no --rtol given)" if self.stated else "")]
         lines += [base.describe(self.interpolation) for base in self.time_bases]
         rows = sorted(self.deviations, key=lambda d: (d.passed, -d.ratio))
         shown = [d for i, d in enumerate(rows) if not d.passed or limit <= 0 or i < limit]
@@ -272,25 +279,30 @@ class _Side:
     units: str
     time_s: np.ndarray | None
     case: str | None
+    #: the curve's stated history error [its units] (None: its case states none)
+    stated_error: float | None = None
 
 
 def compare_files(file_a: str | Path, file_b: str | Path, specs: Sequence[str] = (),
-                  rtol: float = DEFAULT_RTOL, atol: float = DEFAULT_ATOL,
+                  rtol: float | None = None, atol: float = DEFAULT_ATOL,
                   interpolation: str = "cubic", partial: bool = False) -> Comparison:
     """Compare the datasets ``specs`` name (all common ones when empty) of two result files.
 
     See the module documentation for the rule; ``partial``: compare a curve that does not
-    cover B's time span on the overlap (else it fails). Raises
+    cover B's time span on the overlap (else it fails). ``rtol`` None: a curve whose cases
+    state their history errors is allowed ``atol`` + their root-sum-square, any other
+    :data:`DEFAULT_RTOL`. Raises
     :class:`~flex.base.errors.FlexError` (:class:`ResultFileError` for a bad file or a
     missing path) when nothing can be compared.
     """
+    stated, rtol = rtol is None, DEFAULT_RTOL if rtol is None else rtol
     for name, value in (("rtol", rtol), ("atol", atol)):
         if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
             raise FlexError(f"--{name} = {value!r}: must be a finite number >= 0")
     if interpolation not in INTERPOLATIONS:
         raise FlexError(f"--interp {interpolation!r}: must be one of {', '.join(INTERPOLATIONS)}")
     report = Comparison(str(file_a), str(file_b), float(rtol), float(atol), interpolation,
-                        list(specs), partial=bool(partial))
+                        list(specs), partial=bool(partial), stated=stated)
     with reading(file_a) as h5a, reading(file_b) as h5b:
         pairs = _pairs(h5a, h5b, report, specs)
         if not pairs and not report.deviations:
@@ -470,7 +482,12 @@ def _load(h5, path: str, column: int | None, label: str) -> _Side:
                 raise ResultFileError(f"result file '{label}': cases/{case}/time is not "
                                       f"strictly increasing")
             time_s = candidate
-    return _Side(path, values, units, time_s, case)
+    stated = None
+    if time_s is not None and column is None:
+        value = h5[f"cases/{case}"].attrs.get(f"estimated_error_history_{rel.replace('/', '_')}")
+        stated = float(value) if isinstance(value, int | float | np.floating) and \
+            math.isfinite(value) and value >= 0 else None
+    return _Side(path, values, units, time_s, case, stated)
 
 
 def _numeric(values: Any) -> bool:
@@ -529,6 +546,12 @@ def _compare_sides(a: _Side, b: _Side, column: int | None, report: Comparison,
     if a.time_s is not None and short:
         rows = [(*row[:6], "; ".join(filter(None, [row[6], f"partial: {short}"])))
                 for row in rows]
+    if report.stated and a.time_s is not None and (a.stated_error, b.stated_error) != (None,
+                                                                                      None):
+        allowed = report.atol + math.hypot(a.stated_error or 0.0, b.stated_error or 0.0)
+        rows = [(col, worst, allowed, worst <= allowed, time_s, where,
+                 "; ".join(filter(None, [note, "allowed: the stated history errors"])))
+                for col, worst, _, _, time_s, where, note in rows]
     return [Deviation(a.path, b.path, col, a.units, worst, allowed, passed, time_s, where, note)
             for col, worst, allowed, passed, time_s, where, note in rows]
 
