@@ -243,8 +243,11 @@ def resolve_solver_settings(scene: Scene, calibration: Calibration | None = None
     elif name == "flexible_fallback" and _beam_step(resolved, link_models):
         tolerance = Tolerance.of(resolved).relative
         values["step_s"] = exact_beam_settings(tolerance)[1]
-        reason += (f"; the exact beam's step at tolerance {tolerance:g}: {values['step_s']:g} s "
-                   f"(EXACT_BEAM_SETTINGS, measured; a first guess)")
+        reason = (f"exact beam coupler at fidelity.tolerance = {tolerance:g}: its first guess, "
+                  f"step {values['step_s']:g} s (and its elements; flex.config.knobs."
+                  f"EXACT_BEAM_SETTINGS, measured on the 0.5-1 mm thesis plates, not calibrated "
+                  f"over a family as the FFRF rule is: the run's error budget certifies what it "
+                  f"achieved), the flexible solver settings otherwise")
     for key in AUTO_KEYS:
         if resolved["simulation"][key] == AUTO:
             resolved["simulation"][key] = filled[key] = values[key]

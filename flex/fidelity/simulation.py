@@ -27,7 +27,7 @@ import numpy as np
 from flex.base.errors import FlexError, SceneError, SimulationError
 from flex.config.calibration import Calibration
 from flex.config.knobs import KNOB_KEYS, settings_text
-from flex.config.settings import tolerance_beyond_reach
+from flex.config.settings import FALLBACK, tolerance_beyond_reach
 from flex.config.tolerance import Tolerance
 from flex.data.headlines import BUILTIN_HEADLINES, Headline
 from flex.data.results import CaseResult
@@ -139,7 +139,7 @@ def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduc
     result.attrs.update(_rigid_predictions(scene, result, link_models))
     result.attrs.update(resolution.attrs())
     result.attrs.update(headline_attrs(result.datasets, headlines))
-    if result.attrs.get("solver_defaults_entry") == "flexible_fallback":
+    if FALLBACK in str(result.attrs.get("solver_defaults_reason", "")):
         print(f"flex: note: case {name}: outside the calibrated family: "
               f"{result.attrs.get('solver_defaults_reason', '')}", file=sys.stderr, flush=True)
     if beyond:
