@@ -28,6 +28,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from flex.config.tolerance import Tolerance
+
 
 @dataclass(frozen=True)
 class Rung:
@@ -123,20 +125,29 @@ _FFRF_MEASURED_BY = (
     f"{FFRF_MOTION_ERROR_FRACTION:g} of what the elasticity changes in the motion and the "
     f"joint forces (make flexible; the difference to rigid twins)")
 
-#: elements of the exact beam companion that measures an FFRF link's model term: its own
-#: element error must stay below the term it measures. Measured on the 2 mm thesis plate's
-#: deployment peak deflection (h = 1e-5 s): 32 / 64 / 128 elements 35.269 / 35.343 / 35.360
-#: um, observed order 2.2, so 128 elements lie ~0.016 % below the element limit (32: 0.28 %)
-EXACT_BEAM_COMPANION_ELEMENTS = 128
-#: the companion's step [s] at most (its step error: 0.007 % from 1e-5 to 5e-6 s, 2 mm)
-EXACT_BEAM_COMPANION_STEP_S = 1e-5
+#: the exact beam companion that measures a link's model term (an FFRF body's, a rigid
+#: plate's), sized to the tolerance: its own error must stay well below the term it measures
+#: (it leans the term safe). Rows: (tolerance at or above, elements, step at most [s]),
+#: tightest last: its elements' and step's error on the deployment peak at most a third of the
+#: tolerance. Measured against 256 elements at 2.5e-6 s (thesis deployment, 30 ms):
+#: 32 elements at 2e-5 s 0.30 / 0.21 / 0.15 % (0.7 / 1 / 3 mm; 0.3 s), 64 at 2e-5 s 0.07 /
+#: 0.04 / 0.03 % (0.5-0.7 s), 128 at 1e-5 s 0.011 / 0.006 / 0.001 % (2-2.5 s); at 4e-5 s the
+#: 3 mm plate's step error reached 0.37 %
+EXACT_BEAM_COMPANIONS = ((0.01, 32, 2e-5), (0.003, 64, 2e-5), (0.0, 128, 1e-5))
+
+
+def exact_beam_companion(tolerance: float) -> tuple[int, float]:
+    """The exact beam companion's elements and largest step [s] at ``tolerance`` [1]: the
+    first row of :data:`EXACT_BEAM_COMPANIONS` it reaches."""
+    return next((elements, step) for floor, elements, step in EXACT_BEAM_COMPANIONS
+                if tolerance >= floor)
 
 
 def _against_exact_beam(scene: Mapping[str, Any]) -> tuple[str, ...]:
-    """A scene's overrides that put a link on the exact beam rung, with
-    :data:`EXACT_BEAM_COMPANION_ELEMENTS` elements, at the run's step or
-    :data:`EXACT_BEAM_COMPANION_STEP_S`, whichever is finer."""
-    elements, step_s = EXACT_BEAM_COMPANION_ELEMENTS, EXACT_BEAM_COMPANION_STEP_S
+    """A scene's overrides that put a link on the exact beam rung, sized to the scene's
+    tolerance (:func:`exact_beam_companion`), at the run's step or the companion's, whichever
+    is finer (a whole number of companion steps per run step: the same end time)."""
+    elements, step_s = exact_beam_companion(Tolerance.of(scene).relative)
     run_step_s = float(scene["simulation"]["step_s"])
     end_s = float(scene["simulation"]["end_time_s"])
     if step_s < run_step_s:  # a whole number of beam steps per run step: same end time
@@ -297,7 +308,7 @@ def next_rung(link: str, values: Mapping[str, Any], link_models: Mapping[str, An
     return above[0] if above else None
 
 
-__all__ = ["EXACT_BEAM_COMPANION_ELEMENTS", "EXACT_BEAM_COMPANION_STEP_S",
+__all__ = ["EXACT_BEAM_COMPANIONS", "exact_beam_companion",
            "EXACT_BEAM_ERROR_PER_SLENDERNESS", "EXACT_BEAM_MEASURED_LOAD_RATIO",
            "EXACT_BEAM_RUNG", "FFRF_MEASURED_LOAD_RATIO",
            "FFRF_MOTION_ERROR_FRACTION", "FFRF_RUNG", "GEOMETRIC_FFRF_ERROR",
