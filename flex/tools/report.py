@@ -263,6 +263,8 @@ def _title_section(path: Path, folder: Path, root: dict[str, Any]) -> list[str]:
              f"every number below is read from that file.", "", "## Study report", ""]
     report = root.get("summary_report")
     if isinstance(report, str) and report.strip():
+        if "\n|---" in report:  # the study wrote Markdown (its tables): shown as written
+            return lines + [report.strip(), ""]
         return lines + ["The study's printed report (root attribute `summary_report`):", "",
                         *_fenced(report)]
     return lines + ["This file has no study report (root attribute `summary_report`): it "

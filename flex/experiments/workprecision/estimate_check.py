@@ -252,15 +252,15 @@ def _report(rows: list[dict[str, Any]], ratio: np.ndarray, references: dict[str,
     lines = [f"error budgets: the stored total against the true error ({len(rows)} pairs, "
              f"{int(judged.sum())} judged; targets: true / estimated within "
              f"[1/{PESSIMISM:g}, {OPTIMISM:g}] for judged pairs, at most "
-             f"{100 * FLAGGED_SHARE:g} % flagged, no certificate exceeded)",
-             f"  flagged outside the asymptotic range: {int(flagged.sum())} of {len(rows)} "
+             f"{100 * FLAGGED_SHARE:g} % flagged, no certificate exceeded)", "",
+             f"- flagged outside the asymptotic range: {int(flagged.sum())} of {len(rows)} "
              f"pairs ({100 * flagged.mean() if rows else 0:.0f} %); certificates exceeded by "
              f"a known true error: {len(exceeded)}"
              + "".join(f"; {r['case']} {r['quantity']} (true {r['true']:.3g}, certificate "
                        f"{r['certificate']:.3g})" for r in exceeded)]
     if bound.any():
         spread = [r["true"] / r["estimated"] for r in known_bounds if r["estimated"] > 0]
-        lines.append(f"  bounds (raw whole-run peaks, no order of convergence: checked "
+        lines.append(f"- bounds (raw whole-run peaks, no order of convergence: checked "
                      f"against their certificates, not judged as estimates): "
                      f"{int(bound.sum())} pairs, {len(known_bounds)} with a known true error"
                      + (f", true / bound {min(spread):.2g} to {max(spread):.2g}"
@@ -271,20 +271,21 @@ def _report(rows: list[dict[str, Any]], ratio: np.ndarray, references: dict[str,
             if is_judged:
                 by_scene.setdefault(row["case"], []).append(bool(is_inside))
         within = [scene for scene, flags in by_scene.items() if all(flags)]
-        lines.append(f"  {int((inside & judged).sum())} of {int(judged.sum())} judged pairs "
+        lines.append(f"- {int((inside & judged).sum())} of {int(judged.sum())} judged pairs "
                      f"within the target; most optimistic true/estimated "
                      f"{ratio[judged].max():.3g}, most pessimistic {ratio[judged].min():.3g}; "
                      f"scenes with every judged pair within: {len(within)} of "
                      f"{len(by_scene)}")
-    lines.append(f"  {'case':24s} {'quantity':30s} {'estimated':>10s} {'true':>10s} "
-                 f"{'true/est':>8s} {'largest':>7s}  note")
+    lines += ["", "| case | quantity | estimated | true | true / estimated | largest term | note |",
+              "|---|---|---:|---:|---:|---|---|"]
     for row, value in zip(rows, ratio, strict=True):
-        note = row["why"] or ("" if 1 / PESSIMISM <= value <= OPTIMISM else "OUTSIDE")
+        note = row["why"] or ("" if 1 / PESSIMISM <= value <= OPTIMISM else "**outside**")
         if row["same_model"]:
             note += " (the model term unchecked: no higher rung computes it)"
-        lines.append(f"  {row['case']:24s} {row['quantity']:30s} {row['estimated']:10.3g} "
-                     f"{row['true']:10.3g} {value:8.3g} {row['largest_term']:>7s}  {note}")
-    lines.append("  references: " + "; ".join(f"{name}: {text}" for name, text in
+        lines.append(f"| {row['case']} | {row['quantity']} | {row['estimated']:.3g} | "
+                     f"{row['true']:.3g} | {value:.3g} | {row['largest_term']} | {note} |")
+    lines.append("")
+    lines.append("- references: " + "; ".join(f"{name}: {text}" for name, text in
                                               references.items() if text))
     return "\n".join(lines)
 

@@ -156,11 +156,11 @@ def reference_lines(scene_name: str, reference: Reference, reference_time_s: flo
                     ) -> list[str]:
     """Report lines: the reference, its accuracy and each knob's evidence."""
     verdict = "converged" if reference.converged else "NOT converged"
-    lines = [f"  {scene_name}: reference {reference.description}; accuracy "
+    lines = ["", f"### {scene_name}", "", f"- reference {reference.description}; accuracy "
              f"{reference.accuracy:.1e} ({verdict} to {reference.tolerance:g}; "
              f"{reference_time_s:.0f} s in all); evidence:"]
     for n, e in reference.evidence.items():
-        lines.append(f"      {n}: estimate {e['error']:.2e}"
+        lines.append(f"  - {n}: estimate {e['error']:.2e}"
                      + (f", changes {e['change_fine']:.2e} / {e['change_coarse']:.2e}, "
                         f"order {e['order']:.2f}, "
                         f"{'asymptotic' if e['asymptotic'] else 'fallback'}"
@@ -193,23 +193,24 @@ def recommendations(group: str, measurements: Sequence[Measurement], reference: 
                      "wall_time": m.wall_time_s if m else np.nan,
                      "error": m.error if m else np.nan,
                      "knobs": rec.reason or repr(m.setting.knobs())})
-        lines.append(f"    {rec.level * 100:g} %: {describe(m) if m else rec.reason}")
+        lines.append(f"- {rec.level * 100:g} %: {describe(m) if m else rec.reason}")
         if m is None and "certify" in rec.reason:
             unchecked = [c for c in measurements if c.ok and c.setting.engine == "exudyn"
                          and c.error <= rec.level]
             if unchecked:
-                lines.append(f"      (fastest within it if the reference were exact: "
+                lines.append(f"  - (fastest within it if the reference were exact: "
                              f"{describe(fastest(unchecked))})")
     return table_datasets(rows, RECOMMENDED_COLUMNS, f"{group}/recommended"), lines
 
 
 def _front_lines(measurements: Sequence[Measurement], front: Sequence[int]) -> list[str]:
+    """The Pareto front as a Markdown table (fastest first), and what failed."""
     failed = [m for m in measurements if not m.ok]
-    return ["    Pareto front: " + "; ".join(
-        f"{measurements[i].setting.label} ({measurements[i].wall_time_s * 1e3:.1f} ms, "
-        f"{measurements[i].error:.1e})" for i in front),
-        f"    {len(measurements)} settings, {len(failed)} failed"
-        + "".join(f"\n      failed {m.setting.label}: {m.message[:160]}" for m in failed)]
+    return (["", "| Pareto front: setting | wall time [ms] | relative error |", "|---|---:|---:|"]
+            + [f"| {measurements[i].setting.label} | {measurements[i].wall_time_s * 1e3:.1f} | "
+               f"{measurements[i].error:.1e} |" for i in front]
+            + ["", f"- {len(measurements)} settings, {len(failed)} failed"]
+            + [f"  - failed {m.setting.label}: {m.message[:160]}" for m in failed])
 
 
 def summarize_work_precision(runs: Mapping[str, SceneRuns], scenes: Mapping[str, Scene],
@@ -243,7 +244,7 @@ def summarize_work_precision(runs: Mapping[str, SceneRuns], scenes: Mapping[str,
             lines += check_lines
         scipy = [m for m in measurements if m.ok and m.setting.engine == "scipy"]
         if scipy:
-            lines.append("    scipy reference DAE: " + "; ".join(
+            lines.append("- scipy reference DAE: " + "; ".join(
                 f"{m.setting.label}: {m.wall_time_s * 1e3:.1f} ms, {m.error:.1e}"
                 for m in scipy))
     return datasets, "\n".join(lines)
