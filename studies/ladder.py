@@ -10,8 +10,10 @@ reference), over max(1.1 first bending periods, 5 ms). Stored per thickness unde
 ``/summary/t<t>mm``: each model's peak elastic midpoint deflection, its relative
 difference to the nonlinear FE peak, the wall times, the coupler's largest compression
 over its Euler load, and a model's validity warning where it has one (the FFRF bodies
-beyond the Euler load: a linear-in-load model has nothing to hold a buckled plate). ~3 min
-on 2 cores, most of it the nonlinear FE runs.
+beyond the Euler load: a linear-in-load model has nothing to hold a buckled plate). Then each
+rung against the p-converged 3-D plate of 0.5-3 mm on its linear first bending frequency
+(:mod:`flex.experiments.models.linear_reference`: the exact beam uncalibrated and calibrated,
+the order-2 tetrahedra). ~3 min on 2 cores, most of it the nonlinear FE runs.
 """
 
 from __future__ import annotations
@@ -32,6 +34,7 @@ from flex.experiments.models.ladder import (
     rung_scenes,
     simulate_model,
 )
+from flex.experiments.models.linear_reference import linear_summary
 from flex.study import StudyRun, Summary
 
 NAME = "ladder"
@@ -44,6 +47,9 @@ OVERRIDES = pinned_overrides()
 PLATES = {0.3: (2.0, 2.5e-5), 0.5: (2.0, 5e-5), 0.6: (2.0, 5e-5), 0.7: (2.0, 5e-5),
           1.0: (2.0, 5e-5), 2.0: (2.0, 2.5e-5), 3.0: (3.0, 2.5e-5), 5.0: (5.0, 1e-5),
           10.0: (5.0, 5e-6)}
+
+#: the plates compared with their p-converged 3-D reference too [mm]
+LINEAR_MM = (0.5, 0.7, 1.0, 2.0, 3.0)
 
 
 def _label(thickness_mm: float) -> str:
@@ -82,10 +88,13 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
               and abs(r.difference_to_reference.get("ffrf", math.nan)) <= 0.01]
     beam = [r.thickness_m * 1e3 for r in rungs
             if abs(r.difference_to_reference.get("exact_beam", math.nan)) <= 0.001]
+    linear, table = linear_summary(scene, {t * 1e-3: PLATES[t][0] * 1e-3 for t in LINEAR_MM},
+                                   run.cache_dir)
+    datasets.update(linear)
     report = (ladder_table(rungs) + "\n\nflex's default FFRF body within 1 % of the "
               f"nonlinear FE peak at t = {', '.join(f'{t:g}' for t in within) or 'none'} mm; "
               f"the exact beam within 0.1 % at t = {', '.join(f'{t:g}' for t in beam) or 'none'}"
-              " mm (the FE coupler's own mesh error is of that size).")
+              " mm (the FE coupler's own mesh error is of that size).\n\n" + table)
     return Summary(datasets, report)
 
 
