@@ -29,8 +29,13 @@ _EDGES = ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))
 
 def _midpoint_nodes(positions: np.ndarray, tets: np.ndarray, scale: float
                     ) -> dict[tuple[int, int], int]:
-    """Each tetrahedron edge's mid-edge node (quadratic tetrahedra; none for linear ones)."""
-    index = {tuple(np.round(point / scale, 7)): node for node, point in enumerate(positions)}
+    """Each edge's mid-edge node of the tetrahedra ``tets`` (quadratic tetrahedra; none for
+    linear ones), found by position."""
+    x = positions[tets, 0]  # a mid-edge node lies within its tetrahedra's span
+    nearby = np.flatnonzero((positions[:, 0] >= x.min() - 1e-9 * scale)
+                            & (positions[:, 0] <= x.max() + 1e-9 * scale))
+    keys = np.round(positions[nearby] / scale, 7)
+    index = {tuple(key): int(node) for node, key in zip(nearby, keys, strict=True)}
     out = {}
     for tet in tets:
         for i, j in _EDGES:
@@ -82,6 +87,9 @@ def section_mean_weights(positions: np.ndarray, tets: Iterable[Iterable[int]], x
     positions = np.asarray(positions, dtype=float)
     tets = np.asarray(list(map(list, tets)), dtype=np.int64)
     scale = float(np.max(np.ptp(positions, axis=0)))
+    x = positions[tets, 0]  # only the tetrahedra the plane may cut
+    near = PLANE_TOLERANCE * scale
+    tets = tets[(x.min(axis=1) <= x_m + near) & (x.max(axis=1) >= x_m - near)]
     midpoints = _midpoint_nodes(positions, tets, scale)
     weights: dict[int, float] = {}
     area = 0.0

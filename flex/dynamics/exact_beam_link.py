@@ -85,17 +85,6 @@ def calibrated_section(plate: Plate, cache_dir: Path | None) -> Any:
                    calibration=calibration.attrs())
 
 
-def uncalibrated_section(scene: Scene, link: str, given: Any, cache_dir: Path | None) -> Any:
-    """The plate's beam section as its closed forms give it (E, kappa = 5/6), no
-    calibration: what the exact beam was before the 3-D reference (a model's ``prepare``)."""
-    from flex.bodies.exact_beam import exact_beam_section
-
-    if given is not None:
-        return given
-    beam_elements(link, scene[link])
-    return exact_beam_section(Plate.of(scene[link]))
-
-
 def _calibrated_own(values: Mapping[str, Any], cache_dir: Path | None = None) -> float:
     return float(beam_calibration_of(Plate.of(values), cache_dir).idealization)
 
@@ -204,6 +193,5 @@ def exact_beam_solver(settings: dict[str, Any], values: dict[str, Any]) -> None:
 
 __all__ = ["CALIBRATED_BEAM_RUNG", "EXACT_BEAM_NEWTON_ELEMENTS", "EXACT_BEAM_NEWTON_TOLERANCES",
            "STEP_COST_EXACT_BEAM_S", "beam_calibration_of", "calibrated_section",
-           "uncalibrated_section",
            "add_exact_beam", "beam_elements", "exact_beam_datasets", "exact_beam_newton_tolerances",
            "exact_beam_sensors", "exact_beam_solver", "exact_beam_step_cost_s", "prepare_beam"]
