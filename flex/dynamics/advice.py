@@ -244,14 +244,14 @@ def channel_datasets(datasets: Mapping[str, Dataset], cutoff_Hz: float | None,
     flexible), when the sampling holds nothing above it or when the run is shorter than
     twice the channel's undetermined tail; with them :data:`CHANNEL_DETERMINED`, which marks
     that tail (:data:`CHANNEL_EDGE_PERIODS`)."""
-    from scipy.signal import butter, sosfiltfilt
-
     time_s = np.asarray(datasets["time"].data, dtype=float)
     if cutoff_Hz is None or time_s.size < 16:
         return {}
     sample_s = float(np.median(np.diff(time_s)))
     if not cutoff_Hz < CHANNEL_NYQUIST_FRACTION * 0.5 / sample_s:
         return {}
+    from scipy.signal import butter, sosfiltfilt  # ~1 s to import: only where a channel is
+
     sos = butter(CHANNEL_ORDER, cutoff_Hz, fs=1.0 / sample_s, output="sos")
     # padding (odd extension) of CHANNEL_PAD_PERIODS cut-off periods: the filter's transient
     # has died out before the series starts (scipy's default, 27 samples, left a 1 % error on
