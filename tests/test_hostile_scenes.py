@@ -458,8 +458,10 @@ def test_a_thin_ffrf_plate_run_carries_the_validity_warning(reduction_cache):
 # ------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("sets, unused, used", [
     ([], ["coupler.thickness_m", "crank.mesh_size_m", "wing.span_m",
-          "drive.crank_speed_rad_per_s", "simulation.penalty_stiffness_N_per_m",
-          "fidelity.tolerance"], ["coupler.mass_kg", "drive.spring_preload_m"]),
+          "drive.crank_speed_rad_per_s", "simulation.penalty_stiffness_N_per_m"],
+     ["coupler.mass_kg", "drive.spring_preload_m", "fidelity.tolerance"]),
+    # the tolerance is read by every run's budget (what it covered), not without one
+    (["simulation.error_estimate=false"], ["fidelity.tolerance", "fidelity.quantities"], []),
     (['coupler.geometry="plate"'], ["coupler.mass_kg", "coupler.youngs_modulus_Pa"],
      ["coupler.thickness_m", "coupler.density_kg_per_m3"]),
     (['coupler.geometry="plate"', 'coupler.model="ffrf"'], ["coupler.inertia_kgm2"],

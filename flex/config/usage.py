@@ -97,10 +97,14 @@ def unused_keys(scene: Scene, read_by_study: Iterable[str] = frozenset(), *,
             unused[f"simulation.{key}"] = ('simulation.integrator = "generalized_alpha": used '
                                            'with integrator = "explicit_penalty"')
     refine = scene["fidelity"].get("refine", False)
-    if not refine and not reads_tolerance(scene, link_models=link_models):
-        unused["fidelity.tolerance"] = ('no "auto" choice reads it: used by model = "auto" '
-                                        'links, by "auto" solver keys of an FFRF coupler '
-                                        "on a rigid crank, and by fidelity.refine = true")
+    if not (refine or sim.get("error_estimate", True)
+            or reads_tolerance(scene, link_models=link_models)):
+        for key in ("tolerance", "quantities"):
+            unused[f"fidelity.{key}"] = (
+                'no "auto" choice reads it and simulation.error_estimate = false (no budget '
+                'to state what the tolerance covers): used by model = "auto" links, by "auto" '
+                "solver keys of an FFRF coupler on a rigid crank, by a run's error budget and "
+                "by fidelity.refine = true")
     if not refine:
         unused["fidelity.refine_limit_s"] = "used with fidelity.refine = true"
     for name in read_by_study:
