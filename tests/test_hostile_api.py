@@ -226,7 +226,9 @@ UNUSED = [
     ({"coupler.modes": 4}, ["coupler.modes", "lumped"]),
     ({"simulation.penalty_stiffness_N_per_m": 1e7}, ["penalty_stiffness_N_per_m"]),
     ({"drive.spring_segments": 12}, ["drive.spring_segments", "massless"]),
-    ({"fidelity.tolerance": 0.05}, ["fidelity.tolerance", "auto"]),
+    # (fidelity.tolerance is read by every run's budget: refused only without one,
+    # tests/test_hostile_scenes.py)
+    ({"fidelity.refine_limit_s": 10.0}, ["fidelity.refine_limit_s", "refine"]),
 ]
 
 
