@@ -189,12 +189,17 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
     beam = simulate(derive_scene(scene, [
         *(override.format(link="coupler") for override in FFRF_RUNG.measured_against(scene)),
         "simulation.error_estimate=false"]))
+    own_error = FFRF_RUNG.measured_against_error(scene)  # the beam companion's own bound
     for name in ("coupler_deployment_peak_deflection_m", "coupler_first_crest_deflection_m"):
         difference = abs(BUILTIN_HEADLINES[name].read(beam.datasets) - rows[name].value)
-        assert rows[name].terms["model"] == pytest.approx(difference, rel=1e-6)
-    assert deflection.terms["modes"] > 0 and deflection.terms["mesh"] > 0
+        assert rows[name].terms["model"] == pytest.approx(
+            difference + own_error * abs(rows[name].value), rel=1e-6)
+    # the model term met the tolerance: the modes and mesh errors it holds are not measured
+    # apart (their companions do not run)
+    assert deflection.terms["modes"] == 0 and deflection.terms["mesh"] == 0
     method = result.attrs["estimated_error_method"]
-    assert "coupler 2 -> 4" in method and "coupler 0.005 -> 0.0025 m" in method
+    assert "coupler's modes: inside the model term" in method
+    assert "coupler's mesh: inside the model term" in method
     # the first crest: a headline of its own, with the whole budget; the peak's crest gap
     crest = rows["coupler_first_crest_deflection_m"]
     assert set(crest.terms) == set(TERMS) and 0 < crest.value <= deflection.value
@@ -203,7 +208,10 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
     # the quantities whose step term is a bound, stored as data: those the validity names
     bounded = [name for name in result.attrs["estimated_error_step_bounds"].split(", ") if name]
     validity = result.attrs["estimated_error_validity"]
-    assert all(f"{name} (observed order" in validity for name in bounded)
+    if "the order was not observed" in validity:  # no second companion: every term a bound
+        assert set(bounded) == set(rows)
+    else:
+        assert all(f"{name} (observed order" in validity for name in bounded)
     assert bool(bounded) == ("are bounds" in validity)
     # the raw whole-run peaks: their totals are bounds, stored and printed as such; the
     # deployment's peaks and the first crest are estimates
@@ -211,6 +219,28 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
         name for name in rows if BUILTIN_HEADLINES[name].kind == "peak"} != set()
     assert "a bound, not an estimate" in deflection.text()
     assert "(estimate" in rows["coupler_deployment_peak_deflection_m"].text()
+
+
+def test_a_model_term_missing_the_tolerance_has_its_knobs_measured_apart(reduction_cache):
+    """The same coarse plate at a tolerance its model term misses: the modes and mesh
+    companions run, each term measured on its own (what refinement and the reader need to
+    know which knob to turn)."""
+    from flex.api import load_scene
+    from flex.fidelity.simulation import simulate
+    from flex.fidelity.stored_budget import budget_rows
+
+    scene = load_scene(overrides=['coupler.geometry="plate"', 'coupler.model="ffrf"',
+                                  "coupler.thickness_m=0.005", "coupler.mesh_size_m=0.005",
+                                  "coupler.modes=2", "simulation.end_time_s=0.003",
+                                  "simulation.step_s=2.5e-5", "fidelity.tolerance=0.0001"])
+    result = simulate(scene, cache_dir=reduction_cache)
+    deflection = {row.quantity: row for row in budget_rows(result.attrs)}[
+        "coupler_peak_deflection_m"]
+    assert deflection.terms["model"] > 1e-4 * abs(deflection.value)
+    assert deflection.terms["modes"] > 0 and deflection.terms["mesh"] > 0
+    method = result.attrs["estimated_error_method"]
+    assert "coupler 2 -> 4" in method and "coupler 0.005 -> 0.0025 m" in method
+    assert "inside the model term" not in method
 
 
 def test_first_crest_and_crest_gap_of_a_beat_against_closed_forms():

@@ -148,7 +148,8 @@ def test_a_damaged_entry_is_rebuilt_replaced_and_said_once(entry, tmp_path, caps
     assert red_cache.load_cached(target, key) is not None  # replaced by a whole entry
     again = red.build_reduction(*PLATE, folder)
     assert again.from_cache and capsys.readouterr().err == ""
-    assert sorted(p.name for p in folder.iterdir()) == [path.name]  # no temporary left
+    # no temporary left: the entry, and the FFRF interface made with it beside it
+    assert sorted(p.name for p in folder.iterdir()) == sorted([path.name, f"{key}.ffrf.hdf5"])
 
 
 def _assert_cache_line(err: str, *words: str) -> None:

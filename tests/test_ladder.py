@@ -117,8 +117,8 @@ def test_a_model_on_no_rung_says_its_model_error_is_left_out():
     registry = MappingProxyType({**BUILTIN_LINK_MODELS, TOY: offladder})
     scene = load_scene(overrides=[*PLATE, f'coupler.model="{TOY}"'], link_models=registry)
     leaves_out: list[str] = []
-    terms, how = _model_term(scene, None, None, leaves_out, registry)
-    assert terms == {} and how == "no flexible link below the top rung"
+    terms, how, measured = _model_term(scene, None, None, leaves_out, registry)
+    assert terms == {} and how == "no flexible link below the top rung" and not measured
     assert any("stands on no rung of the ladder" in line for line in leaves_out)
 
 

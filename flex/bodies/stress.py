@@ -47,7 +47,7 @@ FINGERPRINT_RTOL = 1e-6
 #: the regions of the peaks: name -> description
 REGIONS = {"away": "away from the joint faces (one thickness from each end left out)",
            "at_joints": "within one thickness of a joint face (end faces held rigid)"}
-_CHUNK_VALUES = 4_000_000  # bound (samples x nodes x 6) temporaries
+_CHUNK_VALUES = 4_000_000  # bound (samples x nodes) temporaries
 
 
 # ------------------------------------------------------------------------------------------
@@ -110,26 +110,41 @@ def region_nodes(reduction: Any) -> dict[str, np.ndarray]:
 # ------------------------------------------------------------------------------------------
 # peaks
 # ------------------------------------------------------------------------------------------
+#: the von Mises form: sigma_vm^2 = s^T P s for the stress components s (order xx, yy, zz,
+#: yz, xz, xy)
+VON_MISES_FORM = np.array([[1.0, -0.5, -0.5, 0.0, 0.0, 0.0], [-0.5, 1.0, -0.5, 0.0, 0.0, 0.0],
+                           [-0.5, -0.5, 1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 3.0, 0.0, 0.0],
+                           [0.0, 0.0, 0.0, 0.0, 3.0, 0.0], [0.0, 0.0, 0.0, 0.0, 0.0, 3.0]])
+
+
 def von_mises_history(reduction: Any, modal_coordinates: np.ndarray, nodes: np.ndarray
                       ) -> tuple[np.ndarray, np.ndarray]:
     """Per sample, the largest von Mises stress over ``nodes`` [Pa] and the node where it
-    occurs (a mesh node index): two arrays of shape (samples,)."""
+    occurs (a mesh node index): two arrays of shape (samples,).
+
+    The stress is linear in the modal coordinates q, so sigma_vm^2 = q^T A_n q at node n with
+    A_n = S_n P S_n^T (S_n: the node's stress modes, P: :data:`VON_MISES_FORM`): one matrix
+    product of the samples' q_i q_j (i <= j) with the nodes' A_n entries gives every
+    sample's squares at every node (measured 4-5x faster than forming the six components
+    and combining them)."""
     coordinates = _as_coordinates(reduction, modal_coordinates)
     nodes = np.asarray(nodes)
     if nodes.size == 0:
         return np.full(len(coordinates), np.nan), np.full(len(coordinates), -1)
-    modes = stress_modes(reduction)[nodes]
-    # (modes, nodes x 6): each chunk's stresses in one matrix product (BLAS; an einsum of
-    # the same sum ran without it, ~10x slower)
-    columns = np.ascontiguousarray(modes.transpose(1, 0, 2).reshape(modes.shape[1], -1))
+    modes = stress_modes(reduction)[nodes]  # (nodes, m, 6)
+    forms = np.einsum("nic,cd,njd->nij", modes, VON_MISES_FORM, modes, optimize=True)
+    upper_i, upper_j = np.triu_indices(modes.shape[1])
+    weights = forms[:, upper_i, upper_j] * np.where(upper_i == upper_j, 1.0, 2.0)
+    columns = np.ascontiguousarray(weights.T)  # (pairs, nodes)
     peaks = np.empty(len(coordinates))
     where = np.empty(len(coordinates), dtype=np.int64)
-    chunk = max(1, _CHUNK_VALUES // (6 * len(nodes)))
+    chunk = max(1, _CHUNK_VALUES // len(nodes))
     for start in range(0, len(coordinates), chunk):
         part = coordinates[start:start + chunk]
-        values = von_mises((part @ columns).reshape(len(part), len(nodes), len(COMPONENTS)))
-        best = np.argmax(values, axis=1)
-        peaks[start:start + chunk] = values[np.arange(len(best)), best]
+        squares = (part[:, upper_i] * part[:, upper_j]) @ columns
+        best = np.argmax(squares, axis=1)
+        peaks[start:start + chunk] = np.sqrt(np.maximum(squares[np.arange(len(best)), best],
+                                                        0.0))
         where[start:start + chunk] = nodes[best]
     return peaks, where
 

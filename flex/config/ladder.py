@@ -59,6 +59,14 @@ class Rung:
     #: companion's difference, not the fractions (None: the fractions)
     measured_against: Callable[[Mapping[str, Any]], tuple[str, ...]] | None = None
     measured_against_text: str = ""
+    #: the ``measured_against`` companion's own error on the link's own quantities, relative
+    #: to them [1], for a scene (added to the term: its sign is unknown)
+    measured_against_error: Callable[[Mapping[str, Any]], float] | None = None
+    #: the ``measured_against`` companion resolves the link's own knobs (an FFRF body's
+    #: modes and mesh: the exact beam has neither), so its difference holds their errors
+    #: too: the budget measures them apart only when that difference is a sizable share of
+    #: the tolerance (:mod:`flex.fidelity.error_budget`)
+    resolves_knobs: bool = False
     #: what a budget leaves out for links on this rung (``{links}``)
     leaves_out: str = ""
     #: ``auto`` may climb onto it; the refinement may climb onto it
@@ -126,21 +134,32 @@ _FFRF_MEASURED_BY = (
     f"joint forces (make flexible; the difference to rigid twins)")
 
 #: the exact beam companion that measures a link's model term (an FFRF body's, a rigid
-#: plate's), sized to the tolerance: its own error must stay well below the term it measures
-#: (it leans the term safe). Rows: (tolerance at or above, elements, step at most [s]),
-#: tightest last: its elements' and step's error on the deployment peak at most a third of the
+#: plate's), sized to the tolerance: its own error must stay well below the term it measures.
+#: Rows: (tolerance at or above, elements, step at most [s], own error at most), tightest
+#: last: its elements' and step's error on the deployment peak at most a third of the
 #: tolerance. Measured against 256 elements at 2.5e-6 s (thesis deployment, 30 ms):
 #: 32 elements at 2e-5 s 0.30 / 0.21 / 0.15 % (0.7 / 1 / 3 mm; 0.3 s), 64 at 2e-5 s 0.07 /
 #: 0.04 / 0.03 % (0.5-0.7 s), 128 at 1e-5 s 0.011 / 0.006 / 0.001 % (2-2.5 s); at 4e-5 s the
 #: 3 mm plate's step error reached 0.37 %
-EXACT_BEAM_COMPANIONS = ((0.01, 32, 2e-5), (0.003, 64, 2e-5), (0.0, 128, 1e-5))
+EXACT_BEAM_COMPANIONS = ((0.01, 32, 2e-5, 0.0033), (0.003, 64, 2e-5, 0.001),
+                         (0.0, 128, 1e-5, 0.0002))
+"""Rows (tolerance at or above, elements, step at most [s], own error at most [1]): the last
+column bounds the companion's own error on the link's own quantities relative to them (above
+the measured values; the model term adds it, since its sign is unknown)."""
 
 
 def exact_beam_companion(tolerance: float) -> tuple[int, float]:
     """The exact beam companion's elements and largest step [s] at ``tolerance`` [1]: the
     first row of :data:`EXACT_BEAM_COMPANIONS` it reaches."""
-    return next((elements, step) for floor, elements, step in EXACT_BEAM_COMPANIONS
+    return next((elements, step) for floor, elements, step, _ in EXACT_BEAM_COMPANIONS
                 if tolerance >= floor)
+
+
+def _exact_beam_companion_error(scene: Mapping[str, Any]) -> float:
+    """The exact beam companion's own error bound [1] at ``scene``'s tolerance (the last
+    column of :data:`EXACT_BEAM_COMPANIONS`)."""
+    tolerance = Tolerance.of(scene).relative
+    return next(error for floor, _, _, error in EXACT_BEAM_COMPANIONS if tolerance >= floor)
 
 
 def _against_exact_beam(scene: Mapping[str, Any]) -> tuple[str, ...]:
@@ -159,8 +178,9 @@ def _against_exact_beam(scene: Mapping[str, Any]) -> tuple[str, ...]:
 
 _AGAINST_EXACT_BEAM_TEXT = (
     "FFRF ({links}): the difference to a companion whose {links} is the geometrically exact "
-    "beam (the rung above, on the same scene; it holds the beam's own idealization, bounded "
-    "by make ladder, and the FFRF body's mesh and step errors: it leans safe)")
+    "beam, calibrated on the plate (the rung above, on the same scene: the difference holds "
+    "the FFRF body's modes, mesh and step errors), plus the companion's own error bound on "
+    "the link's own quantities (its elements and step, beside its measured idealization)")
 
 #: a rigid plate link: its elasticity is measured on the run's own scene, the difference to a
 #: companion whose link is the geometrically exact beam (the rung the rigid model leaves out
@@ -178,12 +198,14 @@ LINEAR_FFRF_RUNG = Rung(
     FFRF_MOTION_ERROR_FRACTION, ("{link}.geometric_stiffness=true",),
     "linear FFRF ({links}): plus the difference to a companion with geometric stiffness",
     _FFRF_MEASURED_BY, measured_against=_against_exact_beam,
-    measured_against_text="linear " + _AGAINST_EXACT_BEAM_TEXT)
+    measured_against_text="linear " + _AGAINST_EXACT_BEAM_TEXT, resolves_knobs=True,
+    measured_against_error=_exact_beam_companion_error)
 #: flex's default flexible body: FFRF in the chord frame with geometric stiffness
 FFRF_RUNG = Rung(2, "FFRF", _geometric_ffrf_bound, GEOMETRIC_FFRF_ERROR,
                  FFRF_MOTION_ERROR_FRACTION, measured_by=_FFRF_MEASURED_BY,
                  measured_against=_against_exact_beam,
-                 measured_against_text=_AGAINST_EXACT_BEAM_TEXT)
+                 measured_against_text=_AGAINST_EXACT_BEAM_TEXT, resolves_knobs=True,
+                 measured_against_error=_exact_beam_companion_error)
 EXACT_BEAM_ERROR_PER_SLENDERNESS = 0.05
 """The geometrically exact beam's model error against the 3-D plate, relative to the link's
 own deflection, per thickness / length (its idealization: plane sections, a pin at the

@@ -221,6 +221,11 @@ def entries(scene: Scene, link_models: Mapping[str, LinkModel]) -> dict[str, Lin
     return {link: entry_of(link, scene, link_models) for link in LINKS}
 
 
+def flexible_links(scene: Scene, link_models: Mapping[str, LinkModel]) -> list[str]:
+    """The links of a concrete ``scene`` whose model is not rigid."""
+    return [link for link in LINKS if not link_models[scene[link]["model"]].rigid]
+
+
 # ------------------------------------------------------------------------------------------
 # rigid: a rigid body of the link's mass properties
 # ------------------------------------------------------------------------------------------
@@ -489,4 +494,5 @@ BUILTIN_LINK_MODELS: Mapping[str, LinkModel] = MappingProxyType({
     for name, schema in BUILTIN_LINK_SCHEMAS.items()})
 
 __all__ = ["LinkModel", "BUILTIN_LINK_MODELS", "STORED_MOTIONS", "RIGID", "FFRF",
-           "NONLINEAR_FE", "EXACT_BEAM", "entry_of", "entries", "reduction_for_scene"]
+           "NONLINEAR_FE", "EXACT_BEAM", "entry_of", "entries", "flexible_links",
+           "reduction_for_scene"]

@@ -48,10 +48,11 @@ from typing import Any
 from flex.base.errors import FlexError
 from flex.config.knobs import NO_KNOB, Knob, linked_knobs
 from flex.config.ladder import Rung
+from flex.config.tolerance import Tolerance
 from flex.data.headlines import BUILTIN_HEADLINES, Headline, crest_gap
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, apply_overrides, model_names
-from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel, flexible_links
 from flex.fidelity.error_estimate import estimate_step_error, headline_difference
 from flex.fidelity.stored_budget import TERMS, ErrorBudget
 
@@ -100,20 +101,52 @@ class _Companions:
 
 
 def _knob_terms(scene: Scene, result: CaseResult, companions: _Companions,
-                link_models: Mapping[str, LinkModel]
+                link_models: Mapping[str, LinkModel], inside: set[str] = frozenset()
                 ) -> tuple[dict[str, dict[str, float]], dict[str, str]]:
     """The terms the link knobs measure (:mod:`flex.config.knobs`: modes, mesh, a beam's
     elements), by term: for each knob the scene's links have, the difference to a companion
     with that knob turned once on each of them, times the knob's extrapolation factor; a
-    term's knobs add. Returns the terms and one sentence per term."""
+    term's knobs add. The knobs of the ``inside`` links are not measured apart: the model
+    term's companion resolves them (:func:`_inside_model`). Returns the terms and one
+    sentence per term."""
     terms: dict[str, dict[str, float]] = {term: {} for term in NO_KNOB}
     sentences: dict[str, list[str]] = {term: [] for term in NO_KNOB}
-    for knob, links in linked_knobs(scene, link_models):
+    for knob, all_links in linked_knobs(scene, link_models):
+        links = [link for link in all_links if link not in inside]
+        if len(links) < len(all_links):
+            sentences[knob.term].append(INSIDE_TEXT.format(
+                knob=knob.name, links=" and ".join(sorted(set(all_links) - set(links)))))
+        if not links:
+            continue
         values, sentence = _knob_term(knob, links, scene, result, companions)
         for name, value in values.items():
             terms[knob.term][name] = terms[knob.term].get(name, 0.0) + value
         sentences[knob.term].append(sentence)
     return terms, {term: "; ".join(said) or NO_KNOB[term][0] for term, said in sentences.items()}
+
+
+#: a link knob's sentence when the model term's companion holds its error
+INSIDE_TEXT = ("{links}'s {knob}: inside the model term (its companion one rung up resolves "
+               "them, and its difference met the tolerance: not measured apart)")
+#: the share of each asked quantity's allowance (the tolerance times the quantity) the model
+#: term may take for the knob errors it holds to go unmeasured apart: the whole (a term that
+#: misses the tolerance has each knob's companion run: refinement and the reader then see
+#: which knob to turn)
+INSIDE_SHARE = 1.0
+
+
+def _inside_model(model: Mapping[str, float], measured: set[str],
+                  rungs: Mapping[str, Rung | None], allowances: Mapping[str, float]
+                  ) -> set[str]:
+    """The links whose knob errors the model term holds and need not be measured apart:
+    measured against a companion that resolves their knobs
+    (:attr:`flex.config.ladder.Rung.resolves_knobs`), with every asked quantity's model
+    term within :data:`INSIDE_SHARE` of its allowance [its unit]."""
+    if not all(model.get(name, math.nan) <= INSIDE_SHARE * allowance
+               for name, allowance in allowances.items()):
+        return set()
+    return {link for link in measured
+            if (rung := rungs.get(link)) is not None and rung.resolves_knobs}
 
 
 def _knob_term(knob: Knob, links: list[str], scene: Scene, result: CaseResult,
@@ -179,13 +212,18 @@ def _measured_model_term(scene: Scene, result: CaseResult, companions: _Companio
         reason = companions.failures.pop(failures).split(": ", 1)[1]
         return {}, [f"not measured on the scene ({reason}): the measured fractions instead"]
     terms: dict[str, Any] = dict(companions.differences(result, above))
+    for name in terms:  # the companion's own error on a measured link's own quantities
+        rung = measured.get(companions.headlines[name].link)
+        if rung is not None and rung.measured_against_error is not None:
+            value = companions.headlines[name].read(result.datasets)
+            terms[name] += rung.measured_against_error(scene) * abs(value or 0.0)
     terms[""] = set(measured)
     return terms, _grouped(measured, "measured_against_text")
 
 
 def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
                 leaves_out: list[str], link_models: Mapping[str, LinkModel],
-                cache_dir: Path | None = None) -> tuple[dict[str, float], str]:
+                cache_dir: Path | None = None) -> tuple[dict[str, float], str, set[str]]:
     """The links' model errors from their rungs (:mod:`flex.config.ladder`): measured on the
     scene where the rung says so (the difference to a companion one rung up); else a bounded
     rung's fractions of what the elasticity changes (the difference to rigid twins), plus its
@@ -204,7 +242,7 @@ def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
     leaves_out += [f"the {link_models[scene[link]['model']].label or scene[link]['model']} "
                    f"{link}'s model error (its model stands on no rung of the ladder)"
                    for link, rung in rungs.items() if rung is None]
-    return terms, "; ".join(sentences) or "no flexible link below the top rung"
+    return terms, "; ".join(sentences) or "no flexible link below the top rung", measured
 
 
 def _fractions(scene: Scene, result: CaseResult, companions: _Companions,
@@ -247,13 +285,18 @@ def error_budget(scene: Scene, result: CaseResult,
     ``cache_dir``: where a rung measured per plate keeps its reference (the exact beam's)."""
     values = {name: headline.read(result.datasets) for name, headline in headlines.items()}
     values = {name: value for name, value in values.items() if value is not None}
-    step = estimate_step_error(scene, result, run_companion, time_scales, headlines)
+    tolerance = Tolerance.of(scene)
+    allowances = {name: tolerance.relative * abs(values[name]) for name in
+                  tolerance.asked(flexible_links(scene, link_models)) if name in values}
+    step = estimate_step_error(scene, result, run_companion, time_scales, headlines,
+                               allowances)
     companions = _Companions(run_companion, headlines)
     leaves_out = ["the spring's and joints' idealizations (massless spring unless chained, "
                   "ideal pins)"]
-    knobbed, knob_how = _knob_terms(scene, result, companions, link_models)
-    model, model_how = _model_term(scene, result, companions, leaves_out, link_models,
-                                   cache_dir)
+    model, model_how, measured_links = _model_term(scene, result, companions, leaves_out,
+                                                   link_models, cache_dir)
+    inside = _inside_model(model, measured_links, _rungs(scene, link_models), allowances)
+    knobbed, knob_how = _knob_terms(scene, result, companions, link_models, inside)
     failed = {failure.split(":")[0] for failure in companions.failures}
     if not step.values:
         failed.add("step")

@@ -55,6 +55,9 @@ ORDER_WINDOW = 0.5
 #: outside the window the step term is a bound: this many times the larger difference of
 #: the three runs (a grid convergence index's safety factor for an unproven order)
 BOUND_FACTOR = 3.0
+#: the share of a quantity's allowance (the tolerance times the quantity) the step term may
+#: take as an unobserved bound: the second, finer companion then runs no more
+BOUND_SHARE = 1.0 / 3.0
 
 
 def headline_difference(headline: Headline, run: Mapping[str, Any], other: Mapping[str, Any]
@@ -120,33 +123,37 @@ def unresolved_time_scales(time_scales: list[tuple[float, float, str]], step_s: 
 def estimate_step_error(scene: Scene, result: CaseResult,
                         run_companion: Callable[[Scene], CaseResult],
                         time_scales: list[tuple[float, float, str]],
-                        headlines: Mapping[str, Headline] = BUILTIN_HEADLINES) -> ErrorEstimate:
+                        headlines: Mapping[str, Headline] = BUILTIN_HEADLINES,
+                        allowances: Mapping[str, float] | None = None) -> ErrorEstimate:
     """The estimated step error of ``result``, the run of ``scene`` (concrete models, solver
     keys resolved), from finer companion runs made by ``run_companion`` (see the module
     doc). ``time_scales``: the scene's (:func:`flex.dynamics.advice.time_scales`);
-    ``headlines``: the quantities estimated (:mod:`flex.data.headlines`)."""
+    ``headlines``: the quantities estimated (:mod:`flex.data.headlines`); ``allowances``:
+    the error the tolerance allows each quantity it applies to [its unit]: where the run's
+    step leaves a time scale unresolved and the bound from the first companion alone
+    (:data:`BOUND_FACTOR` times its difference) stays within :data:`BOUND_SHARE` of every
+    allowance, the second companion is not run (its order would change nothing the
+    tolerance asks) and every value is that bound."""
     sim = scene["simulation"]
     step = float(sim["step_s"])
     unresolved = unresolved_time_scales(time_scales, step)
     order = integrator_order(sim)
     steps = [step, STEP.finer(step)] + ([STEP.finer(STEP.finer(step))] if unresolved else [])
-    at = ", ".join(f"{h:g}" for h in steps[1:])
-    method = (f"step halving: {'companion runs' if len(steps) > 2 else 'a companion run'} at "
-              f"h = {at} s (the run: {step:g} s), Richardson extrapolation with the "
-              + (f"observed order (within {ORDER_WINDOW:g} of the integrator's {order}; "
-                 f"outside it a bound, {BOUND_FACTOR:g}x the larger difference)"
-                 if len(steps) > 2 else f"integrator's order {order}") + ".")
     start = time.perf_counter()
     runs = [result.datasets]
     for companion_step in steps[1:]:
+        if len(runs) == 2 and allowances is not None and _bound_suffices(
+                headlines, runs, allowances):
+            steps = steps[:2]
+            break
         try:
             runs.append(run_companion(apply_overrides(scene, [
                 f"simulation.step_s={companion_step!r}", "simulation.output_step_s=0.0",
                 "simulation.error_estimate=false"])).datasets)
         except FlexError as exc:
-            return ErrorEstimate({}, method, f"not estimated: the companion run at "
-                                 f"{companion_step:g} s failed ({exc})",
-                                 time.perf_counter() - start)
+            return ErrorEstimate({}, _method(steps, step, order, unresolved),
+                                 f"not estimated: the companion run at {companion_step:g} s "
+                                 f"failed ({exc})", time.perf_counter() - start)
     values: dict[str, float] = {}
     bounds: dict[str, float] = {}
     for name, headline in headlines.items():
@@ -158,11 +165,43 @@ def estimate_step_error(scene: Scene, result: CaseResult,
             continue
         differences = [_difference(headline, runs[k], runs[k + 1], read_values[k:k + 2])
                        for k in range(len(runs) - 1)]
+        if unresolved and len(differences) == 1:  # the order was not observed: a bound
+            values[name], bounds[name] = BOUND_FACTOR * differences[0], math.nan
+            continue
         values[name], observed = finer_estimate(differences, order)
         if observed is not None:
             bounds[name] = observed
-    return ErrorEstimate(values, method, _validity(unresolved, bounds),
-                         time.perf_counter() - start, bounds)
+    return ErrorEstimate(values, _method(steps, step, order, unresolved),
+                         _validity(unresolved, bounds), time.perf_counter() - start, bounds)
+
+
+def _method(steps: list[float], step: float, order: int, unresolved: list[str]) -> str:
+    at = ", ".join(f"{h:g}" for h in steps[1:])
+    if len(steps) > 2:
+        how = (f"the observed order (within {ORDER_WINDOW:g} of the integrator's {order}; "
+               f"outside it a bound, {BOUND_FACTOR:g}x the larger difference)")
+    elif unresolved:
+        how = (f"no second companion: the bound {BOUND_FACTOR:g}x the difference (the order "
+               f"unobserved) met the tolerance")
+    else:
+        how = f"the integrator's order {order}"
+    return (f"step halving: {'companion runs' if len(steps) > 2 else 'a companion run'} at "
+            f"h = {at} s (the run: {step:g} s), Richardson extrapolation with {how}.")
+
+
+def _bound_suffices(headlines: Mapping[str, Headline], runs: list[Mapping[str, Any]],
+                    allowances: Mapping[str, float]) -> bool:
+    """Whether :data:`BOUND_FACTOR` times the first companion's difference stays within
+    :data:`BOUND_SHARE` of each quantity's allowance [its unit]."""
+    for name, allowance in allowances.items():
+        headline = headlines.get(name)
+        values = [None if headline is None else headline.read(datasets) for datasets in runs]
+        if headline is None or any(value is None for value in values):
+            return False
+        difference = _difference(headline, runs[0], runs[1], values)
+        if not BOUND_FACTOR * difference <= BOUND_SHARE * allowance:
+            return False
+    return True
 
 
 def _difference(headline: Headline, run: Mapping[str, Any], other: Mapping[str, Any],
@@ -194,8 +233,11 @@ def _validity(unresolved: list[str], bounds: dict[str, float]) -> str:
     if not unresolved:
         return (f"asymptotic: every time scale of the scene has at least "
                 f"{MIN_STEPS_PER_PERIOD:g} steps per period")
-    text = ("outside the asymptotic range for " + "; ".join(unresolved)
-            + ": the order was observed on a second, finer companion")
+    text = "outside the asymptotic range for " + "; ".join(unresolved)
+    if bounds and all(math.isnan(order) for order in bounds.values()):
+        return text + (": the order was not observed (its bound met the tolerance): the step "
+                       "terms are bounds")
+    text += ": the order was observed on a second, finer companion"
     if bounds:
         text += (" and left the window for " + ", ".join(
             f"{name} (observed order {order:.2g})" for name, order in bounds.items())
@@ -246,6 +288,6 @@ def _crest(magnitude: np.ndarray) -> np.ndarray:
     return np.arange(start, end)
 
 
-__all__ = ["BOUND_FACTOR", "ErrorEstimate", "MIN_STEPS_PER_PERIOD", "ORDER_WINDOW",
+__all__ = ["BOUND_FACTOR", "BOUND_SHARE", "ErrorEstimate", "MIN_STEPS_PER_PERIOD", "ORDER_WINDOW",
            "estimate_step_error", "finer_estimate", "headline_difference",
            "peak_difference", "richardson_error", "unresolved_time_scales"]

@@ -33,7 +33,7 @@ from flex.data.headlines import BUILTIN_HEADLINES, Headline
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, to_toml
 from flex.dynamics.advice import VALIDITY_WARNING, time_scales
-from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel
+from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel, flexible_links
 from flex.dynamics.solver import integrate, scene_reductions
 from flex.fidelity.auto import Resolution, resolve
 from flex.fidelity.error_budget import error_budget
@@ -334,13 +334,8 @@ def _asked_rows(scene: Scene, budget: ErrorBudget, link_models: Mapping[str, Lin
                 ) -> dict[str, BudgetRow]:
     """The budget rows of the quantities the tolerance applies to in the run of ``scene``
     (:meth:`flex.config.tolerance.Tolerance.asked`), by quantity: what refinement chases."""
-    asked = Tolerance.of(scene).asked(_flexible_links(scene, link_models))
+    asked = Tolerance.of(scene).asked(flexible_links(scene, link_models))
     return {row.quantity: row for row in budget.rows() if row.quantity in asked}
-
-
-def _flexible_links(scene: Scene, link_models: Mapping[str, LinkModel]) -> list[str]:
-    """The links of ``scene`` whose concrete model is not rigid."""
-    return [link for link in LINKS if not link_models[scene[link]["model"]].rigid]
 
 
 def _state_coverage(result: CaseResult, budget: ErrorBudget | None, scene: Scene, name: str,
@@ -354,7 +349,7 @@ def _state_coverage(result: CaseResult, budget: ErrorBudget | None, scene: Scene
         return
     tolerance = Tolerance.of(scene)
     coverage = tolerance_coverage(budget.rows(), tolerance.asked(
-        _flexible_links(scene, link_models)), tolerance.relative)
+        flexible_links(scene, link_models)), tolerance.relative)
     result.attrs.update(coverage_attrs(coverage, tolerance.relative))
     if not any(status in ("missed", "unknown") for _, status, _ in coverage):
         return  # met: stored, printed by inspect and the report (and flex run simulate)

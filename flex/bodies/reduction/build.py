@@ -33,6 +33,7 @@ from flex.bodies.reduction.cache import (
     meta_digest,
     say_unproven,
 )
+from flex.bodies.reduction.interface_cache import ffrf_interface, interface_path
 from flex.bodies.section_mean import fem_tetrahedra, section_mean_weights
 from flex.data.cache import (
     REDUCTION_CACHE,
@@ -95,12 +96,12 @@ class Reduction(PlateLink):
         """The ``ObjectFFRFreducedOrderInterface`` of this reduction, made once and reused.
 
         Its constructor projects the full mass matrix on the basis (the costly part of adding
-        a body), so several systems built from one reduction share it.
+        a body), so several systems built from one reduction share it, and its arrays are
+        kept beside the reduction's cache entry (:mod:`flex.bodies.reduction.interface_cache`).
         """
         if self._ffrf_interface is None:
-            from exudyn.FEM import ObjectFFRFreducedOrderInterface
-
-            self._ffrf_interface = ObjectFFRFreducedOrderInterface(self.fem)
+            self._ffrf_interface = ffrf_interface(self.fem,
+                                                  interface_path(self.cache_file, self.key))
         return self._ffrf_interface
 
 
@@ -145,7 +146,7 @@ def unit_sum(weights: np.ndarray) -> np.ndarray:
     return weights / math.fsum(weights)
 
 
-def _pinned_pinned_frequency_Hz(ffrf_interface, reduction_length_m: float,
+def _pinned_pinned_frequency_Hz(interface, reduction_length_m: float,
                                 thickness_m: float, width_m: float,
                                 nodes_end_a, weights_end_a, nodes_end_b, weights_end_b,
                                 ) -> float:
@@ -164,7 +165,7 @@ def _pinned_pinned_frequency_Hz(ffrf_interface, reduction_length_m: float,
 
     system_container = exu.SystemContainer()
     mbs = system_container.AddSystem()
-    body = ffrf_interface.AddObjectFFRFreducedOrder(mbs, positionRef=[0.0, 0.0, 0.0])
+    body = interface.AddObjectFFRFreducedOrder(mbs, positionRef=[0.0, 0.0, 0.0])
     ground = mbs.AddObject(eii.ObjectGround())
     for nodes, weights, x in ((nodes_end_a, weights_end_a, 0.0),
                               (nodes_end_b, weights_end_b, reduction_length_m)):
@@ -245,8 +246,8 @@ def build_reduction(plate: Plate, mesh_size_m: float, modes: int,
     parameters = _reduction_parameters(sizes, poisson_ratio, modes, mode_selection, mesh_order)
     key = cache_key(parameters)
     cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"
-    fem, ffrf_interface, from_cache, cache_file = _cached_or_built(parameters, key, cache_file,
-                                                                   ngsolve_threads)
+    fem, made, from_cache, cache_file = _cached_or_built(parameters, key, cache_file,
+                                                         ngsolve_threads)
     meta = fem.metaData["flex"]
     return Reduction(
         fem=fem, **sizes, poisson_ratio=float(poisson_ratio), modes=int(modes),
@@ -258,7 +259,7 @@ def build_reduction(plate: Plate, mesh_size_m: float, modes: int,
         cold_build_time_s=float(meta["cold_build_time_s"]),
         build_time_s=time.perf_counter() - start, from_cache=from_cache,
         cache_file=cache_file, key=key, mesh_order=int(mesh_order),
-        _ffrf_interface=ffrf_interface,
+        _ffrf_interface=made,
     )
 
 
@@ -289,16 +290,18 @@ def _cached_or_built(parameters: dict[str, Any], key: str, cache_file: Path | No
     is kept)."""
     fem = load_cached(cache_file, key) if cache_file is not None else None
     from_cache = fem is not None
-    ffrf_interface = None
+    made = None
     if fem is None:
         say_unproven(cache_file)
         with ngsolve_thread_count(ngsolve_threads):
-            fem, ffrf_interface = _build_fem(parameters, key)
+            fem, made = _build_fem(parameters, key)
         if cache_file is not None and not store(
                 cache_file, lambda temporary: fem.SaveToFile(str(temporary), mode="HDF5"),
                 REDUCTION_CACHE):
             cache_file = None  # not kept (said): nothing is cached beside it either
-    return fem, ffrf_interface, from_cache, cache_file
+        elif cache_file is not None:
+            ffrf_interface(fem, interface_path(cache_file, key), made=made)
+    return fem, made, from_cache, cache_file
 
 
 def _node_set_fields(fem) -> dict[str, np.ndarray]:
@@ -356,23 +359,23 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
 
     from exudyn.FEM import ObjectFFRFreducedOrderInterface
 
-    ffrf_interface = ObjectFFRFreducedOrderInterface(fem)
+    interface = ObjectFFRFreducedOrderInterface(fem)
     end_a, end_b = _node_set(fem, END_A), _node_set(fem, END_B)
     pinned_pinned = _pinned_pinned_frequency_Hz(
-        ffrf_interface, length_m, parameters["thickness_m"], parameters["width_m"],
+        interface, length_m, parameters["thickness_m"], parameters["width_m"],
         end_a["NodeNumbers"], end_a["NodeWeights"], end_b["NodeNumbers"], end_b["NodeWeights"])
     fem.metaData["flex"] = {
         "key": key,
         "format_version": CACHE_FORMAT_VERSION,
         "parameters": json.dumps(parameters, sort_keys=True),
         "pinned_pinned_frequency_Hz": pinned_pinned,
-        "mass_kg": float(ffrf_interface.totalMass),
+        "mass_kg": float(interface.totalMass),
         "n_elements": int(mesh.ne),
         "cold_build_time_s": time.perf_counter() - start,
         "digest": fem_content_digest(fem),
     }
     fem.metaData["flex"]["meta_digest"] = meta_digest(fem.metaData["flex"])
     # handed to the Reduction (not stored): saves re-projecting on the first add
-    return fem, ffrf_interface
+    return fem, interface
 
 
