@@ -70,8 +70,9 @@ def test_compare_allows_the_stated_history_errors_when_no_rtol_is_given(tmp_path
     """Two runs of a rigid 2 mm plate, the second at half the step: their crank-angle curves
     differ by the first's step error, which its stated history error covers; with a tight
     --rtol the same difference fails."""
-    from flex.tools.compare import compare_files
     from hostile import run_cli
+
+    from flex.tools.compare import compare_files
 
     files = []
     for name, step in (("coarse", "2e-5"), ("fine", "1e-5")):

@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SimulationError
+from flex.base.lowpass import zero_phase_lowpass
 from flex.data.headlines import channel_series
 from flex.data.plates import plate_mass_properties
 from flex.data.results import Dataset
@@ -240,19 +241,16 @@ def channel_datasets(datasets: Mapping[str, Dataset], cutoff_Hz: float | None,
     :func:`flex.data.headlines.channel_series`), on its headline channel (``channel/<path>``):
     low-passed forward and backward (zero phase; SAE J211 / ISO 6487 read crash-test peaks
     on such channels) at ``cutoff_Hz`` (:func:`channel_cutoff_Hz`) by a
-    :data:`CHANNEL_ORDER`-th order Butterworth filter; none without a cut-off (nothing
-    flexible), when the sampling holds nothing above it or when the run is shorter than
-    twice the channel's undetermined tail; with them :data:`CHANNEL_DETERMINED`, which marks
-    that tail (:data:`CHANNEL_EDGE_PERIODS`)."""
+    :data:`CHANNEL_ORDER`-th order Butterworth filter (:mod:`flex.base.lowpass`); none
+    without a cut-off (nothing flexible), when the sampling holds nothing above it or when
+    the run is shorter than twice the channel's undetermined tail; with them
+    :data:`CHANNEL_DETERMINED`, which marks that tail (:data:`CHANNEL_EDGE_PERIODS`)."""
     time_s = np.asarray(datasets["time"].data, dtype=float)
     if cutoff_Hz is None or time_s.size < 16:
         return {}
     sample_s = float(np.median(np.diff(time_s)))
     if not cutoff_Hz < CHANNEL_NYQUIST_FRACTION * 0.5 / sample_s:
         return {}
-    from scipy.signal import butter, sosfiltfilt  # ~1 s to import: only where a channel is
-
-    sos = butter(CHANNEL_ORDER, cutoff_Hz, fs=1.0 / sample_s, output="sos")
     # padding (odd extension) of CHANNEL_PAD_PERIODS cut-off periods: the filter's transient
     # has died out before the series starts (scipy's default, 27 samples, left a 1 % error on
     # a crest 0.8 ms after the start at a 1 kHz cut-off; tests/test_headline_channel.py)
@@ -267,7 +265,8 @@ def channel_datasets(datasets: Mapping[str, Dataset], cutoff_Hz: float | None,
         f"0 within {CHANNEL_EDGE_PERIODS:g} cut-off periods of the run's end (the filter reads "
         f"its padding there; the headlines are not read on those samples)")} | {
         f"channel/{path}": Dataset(
-        sosfiltfilt(sos, np.asarray(datasets[path].data, dtype=float), axis=0, padlen=pad),
+        zero_phase_lowpass(np.asarray(datasets[path].data, dtype=float), CHANNEL_ORDER,
+                           cutoff_Hz, 1.0 / sample_s, pad),
         datasets[path].units, f"{datasets[path].description}, on the headline channel "
         f"(zero-phase {CHANNEL_ORDER}th-order Butterworth low-pass at {cutoff_Hz:.4g} Hz)")
         for path in (channel_series() if series is None else series) if path in datasets}
