@@ -50,12 +50,13 @@ def run_cli(capsys, *args: str) -> tuple[int, str, str]:
 def test_inspect_lists_cases_datasets_units_provenance_and_scene(study_files, capsys):
     status, out, _ = run_cli(capsys, "inspect", study_files["dynamics"])
     assert status == 0
-    for fragment in ("study    dynamics", "cases/preload_22mm  ok; 3001 samples",
+    # 6001 samples: the case reports its step's finest companion (h / 2) with its budget
+    for fragment in ("study    dynamics", "cases/preload_22mm  ok; 6001 samples",
                      "scene: the file's scene with drive.spring_preload_m = 0.011",
                      "exudyn 1.13", "git ", "created  ", "[drive]", "spring_preload_m = 0.022"):
         assert fragment in out, fragment
     line = next(x for x in out.splitlines() if x.strip().startswith("crank/angle "))
-    assert line.split()[1:4] == ["(3001,)", "rad", "crank"]
+    assert line.split()[1:4] == ["(6001,)", "rad", "crank"]
     assert "= 7.8" in out or "relative_drift" in out  # summary scalars show their value
 
 
@@ -69,7 +70,7 @@ def test_inspect_json_for_scripts(study_files, capsys):
     case = info["cases"]["preload_11mm"]
     assert case["status"] == "ok" and case["scene_changes"] == {"drive.spring_preload_m": 0.011}
     angle = next(d for d in case["datasets"] if d["path"] == "crank/angle")
-    assert angle["units"] == "rad" and angle["shape"] == [3001]
+    assert angle["units"] == "rad" and angle["shape"] == [6001]  # the finest run (h / 2)
 
 
 def test_inspect_one_dataset_with_the_case_shorthand(study_files, capsys):
@@ -290,7 +291,7 @@ def test_a_real_process_prints_no_traceback(bad_files):
 
 def test_to_xarray_gives_a_time_coordinate_and_units(study_files):
     ds = to_xarray(study_files["dynamics"], "preload_22mm")
-    assert ds.sizes["time"] == 3001 and ds["time"].attrs["units"] == "s"
+    assert ds.sizes["time"] == 6001 and ds["time"].attrs["units"] == "s"  # h / 2 reported
     angle = ds["crank/angle"]
     assert angle.dims == ("time",) and angle.attrs["units"] == "rad"
     assert ds["joints/B/force_on_coupler"].dims == ("time", "xy")
@@ -310,7 +311,7 @@ def test_plain_xarray_opens_a_case_group(study_files):
     group = "cases/preload_22mm/crank"
     with xr.open_dataset(study_files["dynamics"], group=group, engine="h5netcdf",
                          phony_dims="sort") as ds:
-        assert ds["angle"].attrs["units"] == "rad" and ds["angle"].size == 3001
+        assert ds["angle"].attrs["units"] == "rad" and ds["angle"].size == 6001
     with xr.open_dataset(study_files["dynamics"], group="cases/preload_22mm",
                          engine="h5netcdf", phony_dims="sort") as ds:
         assert ds["time"].attrs["units"] == "s"

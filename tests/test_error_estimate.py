@@ -46,6 +46,105 @@ def test_the_finer_companions_estimate_is_exact_for_a_pure_power_law(order):
         pytest.approx(abs(constant) * step ** order, rel=1e-9), None)
 
 
+@pytest.mark.parametrize("order", [1, 2, 4])
+def test_the_finest_runs_estimate_is_exact_for_a_pure_power_law(order):
+    """q(h) = q* + C h^p: the finest run's error, C (h/2)^p from two runs and C (h/4)^p
+    from three (the order observed)."""
+    from flex.fidelity.error_estimate import finest_estimate
+
+    exact, constant, step = 1.25, -3.0e4, 1e-3
+    values = [exact + constant * (step / 2**k) ** order for k in range(3)]
+    differences = [abs(values[0] - values[1]), abs(values[1] - values[2])]
+    assert finest_estimate(differences[:1], order) == (
+        pytest.approx(abs(constant) * (step / 2) ** order, rel=1e-9), None)
+    assert finest_estimate(differences, order) == (
+        pytest.approx(abs(constant) * (step / 4) ** order, rel=1e-9), None)
+
+
+def _power_law_companions(exact, constant, order, ran):
+    """A companion runner whose crank angle at the end follows q* + C h^p."""
+    from flex.data.results import CaseResult, Dataset
+
+    def companion(scene):
+        step = scene["simulation"]["step_s"]
+        ran.append(step)
+        value = exact + constant * step ** order
+        return CaseResult("c", "", {"time": Dataset(np.array([0.0, 1e-3]), "s"),
+                                    "crank/angle": Dataset(np.array([0.0, value]), "rad")})
+    return companion
+
+
+@pytest.mark.parametrize("allowance, expected_runs", [(1.0, 1), (1e-9, 2)])
+def test_the_second_companion_runs_only_where_the_tolerance_needs_its_order(
+        allowance, expected_runs):
+    """A time scale unresolved: the first companion's bound (3x its difference) within the
+    allowance leaves the order unobserved and every term that bound; a tight allowance runs
+    the second companion, which observes the order (here exact)."""
+    from flex.api import load_scene
+    from flex.fidelity.error_estimate import estimate_step_error
+
+    scene = load_scene(overrides=["simulation.step_s=1e-4", "simulation.end_time_s=1e-3"])
+    ran: list[float] = []
+    companion = _power_law_companions(0.5, 200.0, 2, ran)
+    result = companion(scene)
+    ran.clear()
+    estimate = estimate_step_error(scene, result, companion, [(5e-4, 20.0, "a mode")],
+                                   allowances={"crank_angle_end_rad": allowance},
+                                   report_finest=True)
+    assert len(ran) == expected_runs
+    error = estimate.values["crank_angle_end_rad"]
+    if expected_runs == 1:
+        assert error == pytest.approx(3.0 * 200.0 * (1e-4**2 - 5e-5**2), rel=1e-9)
+        assert "not observed" in estimate.validity
+    else:
+        assert error == pytest.approx(200.0 * 2.5e-5**2, rel=1e-6)  # the h/4 run's own
+    assert estimate.finest is not None and estimate.finest.datasets["crank/angle"].data[-1] \
+        == pytest.approx(0.5 + 200.0 * ran[-1] ** 2)
+
+
+def test_a_budgeted_run_reports_its_steps_finest_companion():
+    """The rigid default mechanism (every time scale resolved: one companion at h/2): the
+    case is the h/2 run (its curves and values equal an independent run at h/2) and its step
+    term is that run's Richardson error, |q_h - q_h/2| / 3."""
+    from flex.api import load_scene
+    from flex.fidelity.simulation import simulate
+
+    base = ["simulation.end_time_s=0.01", "simulation.step_s=1e-4"]
+    case = simulate(load_scene(overrides=base))
+    plain = [simulate(load_scene(overrides=[*base[:1], f"simulation.step_s={h}",
+                                            "simulation.error_estimate=false"]))
+             for h in (1e-4, 5e-5)]
+    assert "finest companion, at 5e-05 s" in case.attrs["reported_run"]
+    np.testing.assert_allclose(case.datasets["crank/angle"].data,
+                               plain[1].datasets["crank/angle"].data, rtol=1e-12)
+    ends = [run.datasets["crank/angle"].data[-1] for run in plain]
+    assert case.attrs["headline_crank_angle_end_rad"] == pytest.approx(ends[1], rel=1e-12)
+    assert case.attrs["estimated_error_crank_angle_end_rad_step"] == pytest.approx(
+        abs(ends[0] - ends[1]) / 3.0, rel=1e-9)
+    assert "step_s = 5e-05" in case.scene_toml
+
+
+def test_an_ffrf_bodys_fastest_time_scale_is_its_axial_end_mode(reduction_cache):
+    """The reduced body's highest frequency, end B's static modes included: near the
+    fixed-free rod's axial one (Blevins: c / 4L), far above its retained bending modes."""
+    from flex.api import load_scene
+    from flex.base.physics import axial_omega
+    from flex.dynamics.link_models import BUILTIN_LINK_MODELS
+    from flex.dynamics.solver import scene_reductions
+
+    scene = load_scene(overrides=['coupler.geometry="plate"', 'coupler.model="ffrf"',
+                                  "coupler.thickness_m=0.003", "coupler.modes=1",
+                                  "coupler.mesh_size_m=0.005"])
+    reduction, _ = scene_reductions(scene, None, None, cache_dir=reduction_cache)
+    omega, what = BUILTIN_LINK_MODELS["ffrf"].time_scale("coupler", scene["coupler"],
+                                                          reduction)
+    coupler = scene["coupler"]
+    rod = axial_omega(0.5, coupler["length_m"], coupler["youngs_modulus_Pa"],
+                      coupler["density_kg_per_m3"])
+    assert 1.0 <= omega / rod <= 1.2 and "reduced body" in what
+    assert omega > 3 * 2 * np.pi * reduction.fixed_interface_frequencies_Hz.max()
+
+
 def test_an_order_outside_the_window_makes_the_term_a_bound():
     """q(h) = q* + c h (first order where the integrator's is 2, as under-resolved content
     converges): the three runs show order 1, outside the window: the term is a bound,

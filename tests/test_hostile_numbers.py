@@ -122,8 +122,9 @@ def test_a_budget_whose_companions_all_ran_is_known():
 
 def test_the_stiff_springs_coarse_step_states_its_error_not_zero(tmp_path):
     """The issue's example: spring 2e5 N/m at 4e-4 s, 10x off the run at the automatic step;
-    its budget once said +- 0 (its coarser companion diverged). The finer companion (2e-4 s)
-    states an error that covers the true one (measured against the automatic step's run)."""
+    its budget once said +- 0 (its coarser companion diverged). The finer companion (2e-4 s),
+    the case reported, states an error that covers its true one (measured against the
+    automatic step's run)."""
     from flex.api import load_scene, simulate
 
     out = tmp_path / "stiff.h5"
@@ -141,7 +142,7 @@ def test_the_stiff_springs_coarse_step_states_its_error_not_zero(tmp_path):
         attrs = dict(file["cases"][next(iter(file["cases"]))].attrs)
     fine = simulate(load_scene(overrides=[*stiff, "simulation.error_estimate=false"]))
     true = abs(attrs["headline_crank_angle_end_rad"] - fine.datasets["crank/angle"].data[-1])
-    assert true > 0.1  # the coarse run is far off
+    assert true > 0.05  # the case (the finest companion, 2e-4 s) is still far off
     assert 0.5 * true <= attrs["estimated_error_crank_angle_end_rad"] <= 3 * true
 
 

@@ -152,7 +152,9 @@ def test_solver_settings_report_the_resolved_values():
 
 def test_a_default_ffrf_run_uses_and_records_the_chosen_settings(reduction_cache):
     step = _rule_step()[0]
-    result = simulate(load_scene(None, PLATE + [f"simulation.end_time_s={12 * step!r}"]),
+    # without a budget: the run itself is the case (with one, its step's finest companion)
+    result = simulate(load_scene(None, PLATE + [f"simulation.end_time_s={12 * step!r}",
+                                                "simulation.error_estimate=false"]),
                       "default", cache_dir=reduction_cache)
     time_s = result.datasets["time"].data
     assert len(time_s) == 13 and time_s[1] - time_s[0] == pytest.approx(step)

@@ -93,7 +93,7 @@ from typing import Any
 import numpy as np
 
 from flex.base.errors import SceneError
-from flex.base.physics import Plate
+from flex.base.physics import Plate, axial_omega
 from flex.base.progress import heartbeat
 from flex.config.ladder import (
     LUMPED_RIGID_RUNG,
@@ -371,10 +371,17 @@ def highest_retained_omega(values: dict[str, Any]) -> float:
 
 def _ffrf_time_scale(link: str, values: dict[str, Any], reduction: Any
                      ) -> tuple[float, str]:
+    """The fastest motion the FFRF body carries: its highest retained mode or, above it, the
+    axial one its end B static modes carry (the joint forces ring with it)."""
     if reduction is not None:
-        hertz = float(np.max(reduction.fixed_interface_frequencies_Hz))
-        return 2 * np.pi * hertz, "highest retained mode"
-    return highest_retained_omega(values), "highest retained mode (beam estimate)"
+        hertz = max(float(np.max(reduction.fixed_interface_frequencies_Hz)),
+                    reduction.highest_body_frequency_Hz)
+        return 2 * np.pi * hertz, "highest frequency of the reduced body (end modes included)"
+    axial = axial_omega(0.5, float(values["length_m"]), float(values["youngs_modulus_Pa"]),
+                        float(values["density_kg_per_m3"]))
+    return (max(highest_retained_omega(values), axial),
+            "highest frequency of the reduced body (beam estimate: the fixed-free rod's "
+            "axial one, or the highest retained mode)")
 
 
 def _ffrf_step_cost_s(values: dict[str, Any], modes: int | None) -> float:

@@ -212,11 +212,21 @@ def _measured_model_term(scene: Scene, result: CaseResult, companions: _Companio
         reason = companions.failures.pop(failures).split(": ", 1)[1]
         return {}, [f"not measured on the scene ({reason}): the measured fractions instead"]
     terms: dict[str, Any] = dict(companions.differences(result, above))
-    for name in terms:  # the companion's own error on a measured link's own quantities
-        rung = measured.get(companions.headlines[name].link)
+    errors = [rung.measured_against_error(scene) for rung in measured.values()
+              if rung.measured_against_error is not None]
+    for name in terms:  # the companion's own error, sign unknown: on a measured link's own
+        # quantities and on the joints' force peaks (the elastic ringing it resolves only to
+        # that error sets them; a peak of the motion's series that names no link)
+        headline = companions.headlines[name]
+        rung = measured.get(headline.link)
         if rung is not None and rung.measured_against_error is not None:
-            value = companions.headlines[name].read(result.datasets)
-            terms[name] += rung.measured_against_error(scene) * abs(value or 0.0)
+            error = rung.measured_against_error(scene)
+        elif (headline.link is None and headline.series is not None
+              and headline.kind != "history" and errors):
+            error = max(errors)
+        else:
+            continue
+        terms[name] += error * abs(headline.read(result.datasets) or 0.0)
     terms[""] = set(measured)
     return terms, _grouped(measured, "measured_against_text")
 
@@ -288,13 +298,18 @@ def error_budget(scene: Scene, result: CaseResult,
     tolerance = Tolerance.of(scene)
     allowances = {name: tolerance.relative * abs(values[name]) for name in
                   tolerance.asked(flexible_links(scene, link_models)) if name in values}
+    # the finest step companion is reported where it stores what the run would (every step)
     step = estimate_step_error(scene, result, run_companion, time_scales, headlines,
-                               allowances)
+                               allowances, float(scene["simulation"]["output_step_s"]) == 0.0)
+    if step.finest is not None:
+        values = {name: headlines[name].read(step.finest.datasets) for name in values}
     companions = _Companions(run_companion, headlines)
     leaves_out = ["the spring's and joints' idealizations (massless spring unless chained, "
                   "ideal pins)"]
-    model, model_how, measured_links = _model_term(scene, result, companions, leaves_out,
-                                                   link_models, cache_dir)
+    # the model term against the run reported (the finest where it is): its companion one
+    # rung up runs at its own, finer step, so the difference is the reported run's
+    model, model_how, measured_links = _model_term(scene, step.finest or result, companions,
+                                                   leaves_out, link_models, cache_dir)
     inside = _inside_model(model, measured_links, _rungs(scene, link_models), allowances)
     knobbed, knob_how = _knob_terms(scene, result, companions, link_models, inside)
     failed = {failure.split(":")[0] for failure in companions.failures}
@@ -310,11 +325,12 @@ def error_budget(scene: Scene, result: CaseResult,
     return ErrorBudget(values, terms, {k: v for k, v in methods.items() if k not in failed},
                        leaves_out, step.validity,
                        step.companion_wall_time_s + companions.wall_time_s,
-                       _crest_gaps(result, values, headlines),
+                       _crest_gaps(step.finest or result, values, headlines),
                        {name: (headlines[name].unit, headlines[name].what) for name in values},
                        _unknown(terms, failed, [f"step: {step.validity}", *companions.failures],
                                 headlines), tuple(step.bounds),
-                       tuple(name for name in values if headlines[name].bound))
+                       tuple(name for name in values if headlines[name].bound),
+                       step.finest)
 
 
 def _unknown(terms: dict[str, dict[str, float]], failed: set[str], failures: list[str],

@@ -57,7 +57,7 @@ ORDER_WINDOW = 0.5
 BOUND_FACTOR = 3.0
 #: the share of a quantity's allowance (the tolerance times the quantity) the step term may
 #: take as an unobserved bound: the second, finer companion then runs no more
-BOUND_SHARE = 1.0 / 3.0
+BOUND_SHARE = 0.7
 
 
 def headline_difference(headline: Headline, run: Mapping[str, Any], other: Mapping[str, Any]
@@ -95,6 +95,8 @@ class ErrorEstimate:
     #: the quantities whose value is a bound (outside the asymptotic range), with the order
     #: their three runs showed
     bounds: dict[str, float] = field(default_factory=dict)
+    #: the finest companion run when ``values`` are its errors (``report_finest``), else None
+    finest: CaseResult | None = None
 
 
 
@@ -124,7 +126,8 @@ def estimate_step_error(scene: Scene, result: CaseResult,
                         run_companion: Callable[[Scene], CaseResult],
                         time_scales: list[tuple[float, float, str]],
                         headlines: Mapping[str, Headline] = BUILTIN_HEADLINES,
-                        allowances: Mapping[str, float] | None = None) -> ErrorEstimate:
+                        allowances: Mapping[str, float] | None = None,
+                        report_finest: bool = False) -> ErrorEstimate:
     """The estimated step error of ``result``, the run of ``scene`` (concrete models, solver
     keys resolved), from finer companion runs made by ``run_companion`` (see the module
     doc). ``time_scales``: the scene's (:func:`flex.dynamics.advice.time_scales`);
@@ -133,27 +136,45 @@ def estimate_step_error(scene: Scene, result: CaseResult,
     step leaves a time scale unresolved and the bound from the first companion alone
     (:data:`BOUND_FACTOR` times its difference) stays within :data:`BOUND_SHARE` of every
     allowance, the second companion is not run (its order would change nothing the
-    tolerance asks) and every value is that bound."""
+    tolerance asks) and every value is that bound. ``report_finest``: the values are the
+    errors of the finest companion (returned as ``finest``: the run a caller reports), not
+    of ``result``: ``|q_h - q_h/2| / (2^p - 1)`` (with a third run, of its last difference
+    at the observed order)."""
     sim = scene["simulation"]
     step = float(sim["step_s"])
     unresolved = unresolved_time_scales(time_scales, step)
     order = integrator_order(sim)
     steps = [step, STEP.finer(step)] + ([STEP.finer(STEP.finer(step))] if unresolved else [])
     start = time.perf_counter()
-    runs = [result.datasets]
+    made = [result]
     for companion_step in steps[1:]:
-        if len(runs) == 2 and allowances is not None and _bound_suffices(
-                headlines, runs, allowances):
+        if len(made) == 2 and allowances is not None and _bound_suffices(
+                headlines, [run.datasets for run in made], allowances):
             steps = steps[:2]
             break
         try:
-            runs.append(run_companion(apply_overrides(scene, [
+            made.append(run_companion(apply_overrides(scene, [
                 f"simulation.step_s={companion_step!r}", "simulation.output_step_s=0.0",
-                "simulation.error_estimate=false"])).datasets)
+                "simulation.error_estimate=false"])))
         except FlexError as exc:
-            return ErrorEstimate({}, _method(steps, step, order, unresolved),
+            return ErrorEstimate({}, _method(steps, step, order, unresolved, False),
                                  f"not estimated: the companion run at {companion_step:g} s "
                                  f"failed ({exc})", time.perf_counter() - start)
+    # the finest run is reported only where it has every quantity the run has
+    report_finest = report_finest and all(
+        headline.read(made[-1].datasets) is not None for headline in headlines.values()
+        if headline.read(result.datasets) is not None)
+    values, bounds = _step_values(headlines, [run.datasets for run in made], order,
+                                  bool(unresolved), report_finest)
+    return ErrorEstimate(values, _method(steps, step, order, unresolved, report_finest),
+                         _validity(unresolved, bounds), time.perf_counter() - start, bounds,
+                         made[-1] if report_finest else None)
+
+
+def _step_values(headlines: Mapping[str, Headline], runs: list[Mapping[str, Any]], order: int,
+                 unresolved: bool, finest: bool) -> tuple[dict[str, float], dict[str, float]]:
+    """Each quantity's step error (of the run, or of the finest run) and the quantities
+    whose value is a bound, with their observed order (NaN: not observed)."""
     values: dict[str, float] = {}
     bounds: dict[str, float] = {}
     for name, headline in headlines.items():
@@ -168,14 +189,15 @@ def estimate_step_error(scene: Scene, result: CaseResult,
         if unresolved and len(differences) == 1:  # the order was not observed: a bound
             values[name], bounds[name] = BOUND_FACTOR * differences[0], math.nan
             continue
-        values[name], observed = finer_estimate(differences, order)
+        values[name], observed = (finest_estimate if finest else finer_estimate)(differences,
+                                                                                  order)
         if observed is not None:
             bounds[name] = observed
-    return ErrorEstimate(values, _method(steps, step, order, unresolved),
-                         _validity(unresolved, bounds), time.perf_counter() - start, bounds)
+    return values, bounds
 
 
-def _method(steps: list[float], step: float, order: int, unresolved: list[str]) -> str:
+def _method(steps: list[float], step: float, order: int, unresolved: list[str],
+            finest: bool) -> str:
     at = ", ".join(f"{h:g}" for h in steps[1:])
     if len(steps) > 2:
         how = (f"the observed order (within {ORDER_WINDOW:g} of the integrator's {order}; "
@@ -185,8 +207,11 @@ def _method(steps: list[float], step: float, order: int, unresolved: list[str]) 
                f"unobserved) met the tolerance")
     else:
         how = f"the integrator's order {order}"
+    reported = (f" The finest run (h = {steps[-1]:g} s) is the one reported; the term is its "
+                f"error." if finest else "")
     return (f"step halving: {'companion runs' if len(steps) > 2 else 'a companion run'} at "
-            f"h = {at} s (the run: {step:g} s), Richardson extrapolation with {how}.")
+            f"h = {at} s (the run: {step:g} s), Richardson extrapolation with {how}."
+            + reported)
 
 
 def _bound_suffices(headlines: Mapping[str, Headline], runs: list[Mapping[str, Any]],
@@ -227,6 +252,24 @@ def finer_estimate(differences: list[float], order: int) -> tuple[float, float |
     if abs(observed - order) <= ORDER_WINDOW:
         return richardson_error(first, 0.0, 1.0, 0.5, observed), None
     return BOUND_FACTOR * max(first, second), observed
+
+
+def finest_estimate(differences: list[float], order: int) -> tuple[float, float | None]:
+    """The finest run's step error from the differences of the runs at h, h/2 (and h/4),
+    for an integrator of ``order``: the last difference over ``2^p - 1``, at the observed
+    order when three runs show one inside :data:`ORDER_WINDOW`; outside it a bound,
+    :data:`BOUND_FACTOR` times the larger difference, with the observed order (None: an
+    estimate)."""
+    last = differences[-1]
+    if len(differences) < 2:
+        return richardson_error(last, 0.0, 0.5, 1.0, order), None
+    first = differences[0]
+    if first == 0.0 and last == 0.0:
+        return 0.0, None
+    observed = math.log2(first / last) if first > 0 and last > 0 else math.nan
+    if abs(observed - order) <= ORDER_WINDOW:
+        return richardson_error(last, 0.0, 0.5, 1.0, observed), None
+    return BOUND_FACTOR * max(first, last), observed
 
 
 def _validity(unresolved: list[str], bounds: dict[str, float]) -> str:
@@ -288,6 +331,7 @@ def _crest(magnitude: np.ndarray) -> np.ndarray:
     return np.arange(start, end)
 
 
-__all__ = ["BOUND_FACTOR", "BOUND_SHARE", "ErrorEstimate", "MIN_STEPS_PER_PERIOD", "ORDER_WINDOW",
-           "estimate_step_error", "finer_estimate", "headline_difference",
+__all__ = ["BOUND_FACTOR", "BOUND_SHARE", "ErrorEstimate", "MIN_STEPS_PER_PERIOD",
+           "ORDER_WINDOW", "estimate_step_error", "finer_estimate", "finest_estimate",
+           "headline_difference",
            "peak_difference", "richardson_error", "unresolved_time_scales"]

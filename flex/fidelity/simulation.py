@@ -136,15 +136,10 @@ def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduc
               if made is not None else
               integrate(scene, name, reduction, crank_reduction, cache_dir=cache_dir,
                         link_models=link_models, headlines=headlines))
-    result.attrs.update(_rigid_predictions(scene, result, link_models))
-    result.attrs.update(resolution.attrs())
-    result.attrs.update(headline_attrs(result.datasets, headlines))
+    _case_attrs(result, scene, resolution, beyond, link_models, headlines)
     if FALLBACK in str(result.attrs.get("solver_defaults_reason", "")):
         print(f"flex: note: case {name}: outside the calibrated family: "
               f"{result.attrs.get('solver_defaults_reason', '')}", file=sys.stderr, flush=True)
-    if beyond:
-        result.attrs[VALIDITY_WARNING] = "; ".join(
-            filter(None, [str(result.attrs.get(VALIDITY_WARNING, "")), beyond]))
     if not scene["simulation"]["error_estimate"]:
         return result, None
     prepared = {link: built for link, built in (("coupler", reduction),
@@ -155,6 +150,9 @@ def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduc
     scales = time_scales(scene, prepared, link_models)
     budget = error_budget(scene, result, run_companion, scales, link_models, headlines,
                           cache_dir)
+    if budget.reported_run is not None:
+        result = _finest_reported(budget.reported_run, result, scene, resolution, beyond,
+                                  link_models, headlines)
     _unbounded_beyond_load(scene, result, budget, link_models, headlines, cache_dir)
     result.attrs.update(budget.attrs())
     _warn_unresolved_drive(result, scales, float(scene["simulation"]["step_s"]))
@@ -163,6 +161,46 @@ def _run_budgeted(resolution: Resolution, name: str, reduction: Any, crank_reduc
               f"{', '.join(budget.unknown_quantities())}: {'; '.join(budget.unknown)}",
               file=sys.stderr, flush=True)
     return result, budget
+
+
+#: case attribute naming the run a case reports when it is its step's finest companion
+REPORTED_RUN_ATTR = "reported_run"
+
+
+def _case_attrs(result: CaseResult, scene: Scene, resolution: Resolution, beyond: str,
+                link_models: Mapping[str, LinkModel], headlines: Mapping[str, Headline]
+                ) -> None:
+    """The attributes every reported run carries beside its integration's: the rigid
+    links' predictions, the resolution's, the headline values and the validity warning of a
+    tolerance beyond reach (in place)."""
+    result.attrs.update(_rigid_predictions(scene, result, link_models))
+    result.attrs.update(resolution.attrs())
+    result.attrs.update(headline_attrs(result.datasets, headlines))
+    if beyond:
+        result.attrs[VALIDITY_WARNING] = "; ".join(
+            filter(None, [str(result.attrs.get(VALIDITY_WARNING, "")), beyond]))
+
+
+def _finest_reported(finest: CaseResult, run: CaseResult, scene: Scene,
+                     resolution: Resolution, beyond: str,
+                     link_models: Mapping[str, LinkModel], headlines: Mapping[str, Headline]
+                     ) -> CaseResult:
+    """The step's finest companion as the case: its curves and values with the scene at
+    its step (the budget states its error, :mod:`flex.fidelity.error_budget`), named and
+    attributed as the run, which stays its coarser companion."""
+    import tomllib
+
+    from flex.data.scene import apply_overrides
+
+    step_s = float(tomllib.loads(finest.scene_toml)["simulation"]["step_s"])
+    at = apply_overrides(scene, [f"simulation.step_s={step_s!r}"])
+    out = replace(finest, name=run.name, scene_toml=to_toml(at), attrs=dict(finest.attrs))
+    _case_attrs(out, at, resolution, beyond, link_models, headlines)
+    out.attrs[REPORTED_RUN_ATTR] = (
+        f"the step's finest companion, at {step_s:g} s: its values and curves, with the "
+        f"error the budget extrapolates for it (the run at {scene['simulation']['step_s']:g} "
+        f"s is its coarser companion)")
+    return out
 
 
 def _companion_runner(scene: Scene, name: str, prepared: dict[str, Any],

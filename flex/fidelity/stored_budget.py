@@ -63,6 +63,10 @@ class ErrorBudget:
     #: the quantities whose total is a bound, not an estimate: the raw whole-run peaks
     #: (:attr:`flex.data.headlines.Headline.bound`)
     bounds: tuple[str, ...] = ()
+    #: the run whose values the budget states when it is not the run itself: the step's
+    #: finest companion (:func:`flex.fidelity.error_estimate.estimate_step_error`'s
+    #: ``finest``; a :class:`flex.data.results.CaseResult`), reported in the run's place
+    reported_run: Any = field(default=None, repr=False, compare=False)
 
     def total(self, quantity: str) -> float:
         """The root-sum-square of the quantity's terms [its units] (module doc)."""
