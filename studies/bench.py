@@ -20,6 +20,9 @@ medians of :data:`REPEATS` runs, and each comparison is a ratio of two times mea
   (4, 2, 1 mm) and mode count (6, 12, 24), joint markers on every face node (before) and on
   the fewest nodes (now), alternating runs.
 - ``reduction``: build time of the 1 mm plate reduction, cold (empty cache) and from cache.
+- ``budget``: the thesis plates (0.7-3 mm, FFRF, 1 %, flex's settings): each run with its error
+  budget against the run alone, and the 1 mm plate's command line (whole process, figures)
+  against the same run in process; ratios of medians.
 - ``make_all``: ``make all`` end to end with an empty reduction cache (cold) and again with
   it filled (warm); ``FLEX_BENCH_MAKE=0`` skips it.
 
@@ -42,6 +45,7 @@ from flex.data.results import CaseResult
 from flex.data.scene import Scene, derived_scenes
 from flex.experiments.workprecision.benchmark import BenchPlan, PlatesPlan, StepCostPlan, run_bench
 from flex.experiments.workprecision.benchmark_report import bench_figures, bench_summary
+from flex.experiments.workprecision.budget_cost import BudgetPlan
 from flex.experiments.workprecision.measurement import Setting
 from flex.experiments.workprecision.reference_plans import ReferencePlan
 from flex.study import StudyRun, Summary
@@ -123,6 +127,11 @@ PLAN = BenchPlan(
                            "coupler.thickness_m=0.002", "coupler.youngs_modulus_Pa=70e9",
                            "coupler.density_kg_per_m3=2700.0", "coupler.poisson_ratio=0.33"]},
                       tolerances=(0.01, 0.001), targets_s={0.01: 0.3, 0.001: 2.0}),
+    # issue 49: the thesis plates at 1 %, flex's own settings; the 1 mm plate's command line
+    budget=BudgetPlan({f"{mm:g}mm": ['coupler.geometry="plate"', 'coupler.model="ffrf"',
+                                     f"coupler.thickness_m={mm / 1000!r}",
+                                     "simulation.end_time_s=0.03"]
+                       for mm in (0.7, 1, 2, 3)}, 0.01, "1mm"),
 )
 
 

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from flex.data.scene import apply_overrides, default_scene
 from flex.experiments.workprecision.benchmark import StepCostPlan, bench_step_cost
 from flex.experiments.workprecision.measurement import ReductionPool
@@ -53,3 +55,35 @@ def test_make_all_is_timed_in_the_clone_that_holds_flex():
     root = repository_root()
     assert root == Path(flex.__file__).resolve().parents[1]
     assert "\nall: " in (root / "Makefile").read_text()
+
+
+def test_the_budget_part_reports_its_ratios_from_its_own_medians():
+    """The table rows and datasets of the ``budget`` part come from the notes' medians: a
+    ratio is the run with its budget over the run alone, the command line over in process."""
+    from flex.experiments.workprecision.benchmark_report import _budget_rows  # noqa: PLC2701
+
+    notes = {"budget": [{"plate": "1mm", "run_s": 0.2, "budget_s": 0.9, "ratio": 4.5}],
+             "command_line": {"plate": "1mm", "command_s": 1.9, "in_process_s": 0.9,
+                              "ratio": 1.9 / 0.9}}
+    datasets: dict = {}
+    rows = _budget_rows(notes, datasets)
+    assert rows[0][:2] == ("budget at 1 %: 1mm", "4.5x")
+    assert rows[1][:2] == ("command line: 1mm", "1.90 s") and "(2.1x)" in rows[1][2]
+    assert datasets["budget/1mm/ratio"].data == 4.5
+    assert datasets["command_line/command_s"].units == "s"
+
+
+@pytest.mark.slow
+def test_the_budget_part_times_the_run_its_budget_and_the_command_line(reduction_cache):
+    from flex.experiments.workprecision.budget_cost import BudgetPlan, bench_budget
+
+    plate = ['coupler.geometry="plate"', 'coupler.model="ffrf"', "coupler.thickness_m=0.003",
+             "simulation.end_time_s=0.003"]
+    notes: dict = {}
+    bench_budget(BudgetPlan({"3mm": plate}, 0.01, "3mm"), 1, reduction_cache, lambda _: None,
+                 notes)
+    (row,) = notes["budget"]
+    assert row["budget_s"] > row["run_s"] > 0 and row["ratio"] == pytest.approx(
+        row["budget_s"] / row["run_s"])
+    line = notes["command_line"]
+    assert line["command_s"] > line["in_process_s"] > 0

@@ -28,6 +28,8 @@ EDGES = {
     ("dynamics/builder.py", "<module>"): "os.environ.setdefault('EXUDYN_NO_USER_SETTINGS')",
     # the environment of a child `make` process (with its own FLEX_CACHE_DIR)
     ("experiments/workprecision/benchmark.py", "bench_make_all"): "the child make's environment",
+    ("experiments/workprecision/budget_cost.py", "_command_line"):
+        "the timed command line's environment (the cache folder set)",
 }
 
 

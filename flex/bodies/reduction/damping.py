@@ -24,7 +24,6 @@ if any) get no damping.
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 
 from flex.base.errors import SceneError
 
@@ -53,6 +52,8 @@ def modal_band_damping_matrix(mass: np.ndarray, stiffness: np.ndarray
     mass = 0.5 * (np.asarray(mass, dtype=float) + np.asarray(mass, dtype=float).T)
     stiffness = 0.5 * (np.asarray(stiffness, dtype=float)
                        + np.asarray(stiffness, dtype=float).T)
+    import scipy.linalg  # ~75 ms: only where a body has band damping
+
     try:
         eigenvalues, shapes = scipy.linalg.eigh(stiffness, mass)  # Phi^T M Phi = I
     except np.linalg.LinAlgError:

@@ -21,6 +21,10 @@ same run. :func:`run_bench` runs the six parts of a :class:`BenchPlan` in order,
 - ``plates`` (:func:`bench_plates`, when the plan has a :class:`PlatesPlan`): plates of other
   thicknesses and materials at flex's own settings per tolerance, against converged
   references;
+- ``budget`` (:func:`flex.experiments.workprecision.budget_cost.bench_budget`, when the plan
+  has a :class:`~flex.experiments.workprecision.budget_cost.BudgetPlan`): the 1 % answer's
+  cost, the run with its budget against the run alone and the command line against the run
+  in process;
 - ``make_all`` (:func:`bench_make_all`): ``make all FORCE=1`` with an empty reduction cache and
   again with it filled (``make_all`` False, the bench study's ``FLEX_BENCH_MAKE=0``, skips
   it).
@@ -53,6 +57,7 @@ from flex.base.physics import Plate
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.dynamics.link_models import NONLINEAR_FE
+from flex.experiments.workprecision.budget_cost import BudgetPlan, bench_budget
 from flex.experiments.workprecision.measurement import (
     Measurement,
     Progress,
@@ -129,6 +134,8 @@ class BenchPlan:
     nonlinear_coarse: Setting
     step_cost: StepCostPlan | None = None
     plates: PlatesPlan | None = None
+    #: what the 1 % answer costs (:mod:`flex.experiments.workprecision.budget_cost`)
+    budget: BudgetPlan | None = None
 
 
 def _g(value: float) -> str:
@@ -506,7 +513,7 @@ def run_bench(scenes: Mapping[str, Scene], plan: BenchPlan, repeats: int,
               progress: Progress | None = None, notes: dict[str, Any] | None = None, *,
               cache_dir: Path | None = None, nonlinear: bool = True, make_all: bool = True
               ) -> dict[str, CaseResult]:
-    """Run the six parts in order on ``scenes["rigid"]`` and ``scenes["ffrf_1mm"]`` (see the
+    """Run the seven parts in order on ``scenes["rigid"]`` and ``scenes["ffrf_1mm"]`` (see the
     module doc); each part's failure is stored, the others still run.
 
     ``cache_dir``: the reduction cache folder of the timed runs (None: reductions built in
@@ -526,6 +533,8 @@ def run_bench(scenes: Mapping[str, Scene], plan: BenchPlan, repeats: int,
             scenes["ffrf_1mm"], plan.step_cost, repeats, pool, say, notes)),
         ("plates", lambda say: plan.plates and bench_plates(
             scenes["ffrf_1mm"], plan.plates, repeats, pool, say, notes)),
+        ("budget", lambda say: plan.budget and bench_budget(
+            plan.budget, repeats, cache_dir, say, notes)),
         ("make_all", lambda say: bench_make_all(say, notes, make_all))]
     for index, (name, part) in enumerate(parts):
         if progress:

@@ -256,6 +256,31 @@ def _plates_rows(rows: list[Mapping[str, Any]], datasets: dict[str, Dataset]) ->
     return out
 
 
+def _budget_rows(notes: Mapping[str, Any], datasets: dict[str, Dataset]) -> list[Row]:
+    """``budget/...`` (per plate: the run alone, with its budget, their ratio) and
+    ``command_line/...``, and a table row each."""
+    out: list[Row] = []
+    for r in notes.get("budget", []):
+        for key, units, text in (("run_s", "s", "median in-process run without its budget"),
+                                 ("budget_s", "s", "median in-process run with its budget"),
+                                 ("ratio", "1", "with its budget / without")):
+            _put(datasets, f"budget/{r['plate']}/{key}", r[key], units, text)
+        out.append((f"budget at 1 %: {r['plate']}", f"{r['ratio']:.1f}x",
+                    f"run {r['run_s']:.3f} s, with its error budget {r['budget_s']:.3f} s "
+                    f"(in process, warm; medians)"))
+    line = notes.get("command_line")
+    if line:
+        for key, units, text in (("command_s", "s", "median whole-process command line, "
+                                  "warm, with its figures"),
+                                 ("in_process_s", "s", "median in-process run, same scene"),
+                                 ("ratio", "1", "command line / in process")):
+            _put(datasets, f"command_line/{key}", line[key], units, text)
+        out.append((f"command line: {line['plate']}", f"{line['command_s']:.2f} s",
+                    f"flex run simulate, whole process with figures, warm; in process "
+                    f"{line['in_process_s']:.2f} s ({line['ratio']:.1f}x)"))
+    return out
+
+
 def bench_summary(notes: Mapping[str, Any], plan: BenchPlan) -> tuple[dict[str, Dataset], str]:
     """Datasets and the printed table of a benchmark run (see the module doc)."""
     datasets: dict[str, Dataset] = {}
@@ -270,6 +295,7 @@ def bench_summary(notes: Mapping[str, Any], plan: BenchPlan) -> tuple[dict[str, 
     rows += _step_cost_rows(notes.get("step_cost", []), datasets)
     rows += _newton_rows(notes.get("newton", []), datasets)
     rows += _plates_rows(notes.get("plates", []), datasets)
+    rows += _budget_rows(notes, datasets)
     rows += _cache_rows(notes, datasets)
     rows += [(key, "failed", value[:150]) for key, value in notes.items()
              if key.endswith("_failed")]
