@@ -3,9 +3,10 @@ them back from a stored case, checking and printing them -- one module for the s
 apart from computing it (:mod:`flex.fidelity.error_budget`).
 
 An :class:`ErrorBudget` holds each headline quantity's value and its terms (step, modes, mesh,
-model) [the quantity's unit]; its total is their root-sum-square (:func:`combined`), its
-certificate the total times :data:`CERTIFICATE_FACTOR`. :meth:`ErrorBudget.attrs` writes it as
-case attributes (``headline_<quantity>``, ``estimated_error_<quantity>``, ``..._<term>``, ...);
+model) [the quantity's unit]; its total is their root-sum-square (:func:`combined`; a
+bound's, their sum), its certificate the total times :data:`CERTIFICATE_FACTOR`.
+:meth:`ErrorBudget.attrs` writes it as case attributes (``headline_<quantity>``,
+``estimated_error_<quantity>``, ``..._<term>``, ...);
 :func:`budget_rows` reads a stored case's attributes back as :class:`BudgetRow` s, checking each
 (unknown, inconsistent, malformed); :meth:`ErrorBudget.rows` gives the same rows from memory
 (what refinement decides on, with no round trip through the attributes);
@@ -69,8 +70,9 @@ class ErrorBudget:
     reported_run: Any = field(default=None, repr=False, compare=False)
 
     def total(self, quantity: str) -> float:
-        """The root-sum-square of the quantity's terms [its units] (module doc)."""
-        return combined(self.terms[quantity].values())
+        """The root-sum-square of the quantity's terms [its units] (module doc); a bound's
+        (:attr:`bounds`) their sum."""
+        return combined(self.terms[quantity].values(), quantity in self.bounds)
 
     def relative(self, quantity: str) -> float:
         """The total over the quantity's magnitude (NaN for a zero quantity)."""
@@ -205,8 +207,11 @@ def headline_attrs(datasets: Mapping[str, Any],
     return out
 
 
-def combined(terms: Any) -> float:
-    """The total of independent error terms: their root-sum-square [their units]."""
+def combined(terms: Any, bound: bool = False) -> float:
+    """The total of independent error terms: their root-sum-square [their units]; of a
+    bound's terms (a raw whole-run peak's: no independence to lean on) their sum."""
+    if bound:
+        return float(math.fsum(terms))
     return float(math.sqrt(math.fsum(value * value for value in terms)))
 
 
@@ -346,7 +351,8 @@ def budget_rows(attrs: Mapping[str, Any]) -> list[BudgetRow]:
                 *(f"{PREFIX}{quantity}_{term}" for term in TERMS)]
         if not any(key in attrs for key in keys):
             continue
-        rows.append(_budget_row(attrs, quantity, units, what))
+        rows.append(_budget_row(attrs, quantity, units, what,
+                                quantity in named_quantities(attrs)))
     factor, problem = _number(dict(attrs), CERTIFICATE_ATTR)
     if factor is not None and math.isfinite(factor) and factor >= 1.0:
         rows = [replace(row, certificate_factor=factor) for row in rows]
@@ -367,7 +373,8 @@ def named_quantities(attrs: Mapping[str, Any], key: str = BOUNDS_ATTR) -> frozen
         if isinstance(value, str) else frozenset()
 
 
-def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> BudgetRow:
+def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str,
+                bound: bool = False) -> BudgetRow:
     """:func:`budget_rows`' row of one quantity."""
     total, problem = _number(attrs, f"{PREFIX}{quantity}")
     terms, problems = {}, [problem] if problem else []
@@ -396,9 +403,10 @@ def _budget_row(attrs: dict[str, Any], quantity: str, units: str, what: str) -> 
         problem = _not_measured(unmeasured)
     elif math.isnan(total):
         problem = "unknown (the stored total is not a number)"
-    elif abs(total - combined(terms.values())) > CONSISTENCY * max(total, 1e-300):
+    elif abs(total - combined(terms.values(), bound)) > CONSISTENCY * max(total, 1e-300):
         problem = (f"inconsistent (stored total {total:.3g} {units} is not the "
-                   f"root-sum-square of its terms, {combined(terms.values()):.3g} {units})")
+                   f"{'sum' if bound else 'root-sum-square'} of its terms, "
+                   f"{combined(terms.values(), bound):.3g} {units})")
     if problem:
         return BudgetRow(quantity, what, units, value, math.nan, math.nan, terms, problem)
     stored, _ = _number(attrs, f"{PREFIX}{quantity}_relative")
