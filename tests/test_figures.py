@@ -342,7 +342,8 @@ def test_estimates_figure_and_summary_synthetic(tmp_path, reviewed):
     assert "most optimistic true/estimated 100" in result.report
     assert "scenes with every judged pair within: 2 of 3" in result.report
     paths = estimates.figures(results, result, tmp_path)
-    check_pngs(paths, tmp_path, {"estimates.png"})
+    check_pngs(paths, tmp_path, {"estimates-pairs.png",
+                                 "estimates-ratio-crank_angle_end_rad.png"})
 
 
 # ------------------------------------------------------------------------------------------

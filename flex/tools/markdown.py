@@ -46,10 +46,13 @@ def cell(value: Any) -> str:
     return " ".join(text.split()).replace("|", "\\|")
 
 
-def table(header: list[str], rows: list[list[Any]]) -> list[str]:
-    """A Markdown table (then an empty line) of ``rows`` under ``header``."""
+def table(header: list[str], rows: list[list[Any]], right: list[bool] | None = None
+          ) -> list[str]:
+    """A Markdown table (then an empty line) of ``rows`` under ``header``; the columns
+    ``right`` marks (numbers) aligned right."""
+    right = right or [False] * len(header)
     lines = ["| " + " | ".join(cell(h) for h in header) + " |",
-             "|" + "|".join("---" for _ in header) + "|"]
+             "|" + "|".join("---:" if flag else "---" for flag in right) + "|"]
     lines += ["| " + " | ".join(cell(value) for value in row) + " |" for row in rows]
     return lines + [""]
 

@@ -73,17 +73,24 @@ def _tables(items: Sequence[Any]) -> dict[str, list[Any]]:
 
 def _table_lines(columns: list[Any]) -> list[str]:
     """A findings table: its title in bold, the table (units in the headers of numeric
-    columns), what each column is."""
+    columns, numbers aligned right), what each column is (folded)."""
     first = columns[0]
     title = str(first.attrs.get(TITLE_ATTR) or first.group)
+    numeric = [item.data.dtype.kind in "iuf" for item in columns]
     header = [with_unit(str(item.attrs.get(LABEL_ATTR) or item.name),
-                        "" if item.is_text or item.data.dtype.kind == "b" else item.units)
-              for item in columns]
+                        item.units if number and (item.data.dtype.kind == "f"
+                                                  or item.units not in ("", "1")) else "")
+              for item, number in zip(columns, numeric, strict=True)]
     lines = [f"**{title}**", ""]
     length = min(len(item.data) for item in columns)
     if length == 0:
         return lines + ["(no rows)", ""]
-    lines += table(header, [[item.data[row] for item in columns] for row in range(length)])
-    legend = [f"{label}: {item.description}" for label, item in zip(header, columns, strict=True)
+    lines += table(header, [[item.data[row] for item in columns] for row in range(length)],
+                   numeric)
+    legend = [f"- {label}: {item.description}" for label, item
+              in zip(header, columns, strict=True)
               if item.description and item.description != label]
-    return lines + ([*wrap_markdown("Columns: " + "; ".join(legend) + "."), ""] if legend else [])
+    if not legend:
+        return lines
+    return lines + ["<details><summary>Columns</summary>", "", *wrap_markdown("\n".join(legend)),
+                    "", "</details>", ""]
