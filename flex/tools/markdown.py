@@ -16,6 +16,10 @@ import numpy as np
 
 #: prose lines are wrapped to this many characters [characters]
 WIDTH = 100
+#: a table cell longer than this is shown as a note below its table [characters]
+LONG_CELL = 80
+#: a table wider than this is split into tables of fewer columns [characters]
+LINE = 200
 _LIST_ITEM = re.compile(r"^(\s*(?:[-*+]|\d+[.)])\s+)")
 
 
@@ -46,15 +50,47 @@ def cell(value: Any) -> str:
     return " ".join(text.split()).replace("|", "\\|")
 
 
-def table(header: list[str], rows: list[list[Any]], right: list[bool] | None = None
-          ) -> list[str]:
+def table(header: list[str], rows: list[list[Any]], right: list[bool] | None = None,
+          long_cell: int | None = LONG_CELL, width: int | None = LINE) -> list[str]:
     """A Markdown table (then an empty line) of ``rows`` under ``header``; the columns
-    ``right`` marks (numbers) aligned right."""
-    right = right or [False] * len(header)
-    lines = ["| " + " | ".join(cell(h) for h in header) + " |",
-             "|" + "|".join("---:" if flag else "---" for flag in right) + "|"]
-    lines += ["| " + " | ".join(cell(value) for value in row) + " |" for row in rows]
-    return lines + [""]
+    ``right`` marks (numbers) aligned right.
+
+    A cell longer than ``long_cell`` characters shows ``note <n>`` and its text follows the
+    table as note ``n`` (one note per distinct text, wrapped to short lines); a table wider
+    than ``width`` characters is split into tables of fewer columns, each repeating the
+    first column (the row's name). None: no limit."""
+    right = list(right or [False] * len(header))
+    head = [cell(h) for h in header]
+    body = [[cell(value) for value in row] for row in rows]
+    notes: dict[str, int] = {}
+    for row in body:
+        for index, text in enumerate(row):
+            if long_cell is not None and len(text) > long_cell:
+                row[index] = f"note {notes.setdefault(text, len(notes) + 1)}"
+    lines: list[str] = []
+    for columns in _column_groups(head, body, width):
+        lines += ["| " + " | ".join(head[i] for i in columns) + " |",
+                  "|" + "|".join("---:" if right[i] else "---" for i in columns) + "|"]
+        lines += ["| " + " | ".join(row[i] for i in columns) + " |" for row in body] + [""]
+    for text, number in notes.items():
+        lines += wrap_markdown(f"- note {number}: {text}")
+    return lines + ([""] if notes else [])
+
+
+def _column_groups(head: list[str], body: list[list[str]], width: int | None
+                   ) -> list[list[int]]:
+    """The columns of each table a table is split into (see :func:`table`): all of them
+    when its lines fit in ``width``, else the first with as many more as fit, in order."""
+    sizes = [max([len(head[i]), *(len(row[i]) for row in body)]) + 3
+             for i in range(len(head))]
+    if width is None or sum(sizes) + 1 <= width or len(head) < 3:
+        return [list(range(len(head)))]
+    groups: list[list[int]] = [[0]]
+    for index in range(1, len(head)):
+        if len(groups[-1]) > 1 and sum(sizes[i] for i in groups[-1]) + sizes[index] + 1 > width:
+            groups.append([0])
+        groups[-1].append(index)
+    return groups
 
 
 def fenced(text: str, language: str = "text") -> list[str]:

@@ -41,7 +41,7 @@ from flex.data.outputs import RESULT_SUFFIXES, check_writable_folder, figures_fo
 from flex.data.results import atomic_path, attribute_value, case_names, reading
 from flex.tools.inspect import stress_lines
 from flex.tools.markdown import cell, code, fenced, format_value, table, with_unit
-from flex.tools.report_findings import is_findings_column, study_report_lines
+from flex.tools.report_findings import columns_legend, is_findings_column, study_report_lines
 
 REPORT_SUFFIX = ".md"
 #: arrays with more elements than this are summarised (shape, minimum, maximum)
@@ -53,6 +53,10 @@ PROVENANCE_KEYS = ("flex_format", "study", "flex_version", "git_commit", "git_di
 #: root attributes shown in their own sections (not in the table of other attributes)
 SHOWN_ELSEWHERE = ("scene_toml", "summary_report", "summary_findings")
 CASE_KNOWN = ("status", "message", "scene_toml", "solver_settings_toml", "validity_warning")
+#: a case's notes longer than this are shown below the cases table [characters]
+CASE_NOTES = 300
+#: a scalar's value or description longer than this is shown below its table [characters]
+DESCRIPTION = 160
 COUNTER_TITLES = {"steps": "steps", "newton_iterations": "Newton iterations",
                   "jacobian_updates": "Jacobian updates", "wall_time_s": "wall time [s]"}
 
@@ -268,7 +272,7 @@ def _cases_section(cases: list[dict[str, Any]]) -> list[str]:
                      else "-",
                      *(attrs.get(f"counter_{key}", "-") for key in counters),
                      "<br>".join(_case_notes(attrs))])
-    lines += table(header, rows)
+    lines += table(header, rows, long_cell=CASE_NOTES, width=None)
     return lines + _budget_section(cases) + _case_attributes(cases)
 
 
@@ -309,7 +313,7 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
              "refinement decides on, the estimate times its stated safety factor; a raw "
              "whole-run peak's error is a bound, not an estimate, marked so):", ""]
     lines += table(["case", "quantity", "value", "estimated error", "relative",
-                     "certificate", *TERMS], rows)
+                     "certificate", *TERMS], rows, long_cell=None, width=None)
     for key, texts in notes.items():
         for text, names in texts.items():
             who = "every case" if len(names) == len(cases) else ", ".join(map(code, names))
@@ -410,7 +414,8 @@ def _group_lines(items: list[_Item]) -> list[str]:
     lines: list[str] = []
     if scalars:
         lines += table(["name", "value", "unit", "description"],
-                        [[code(i.name), i.data[()], i.units, i.description] for i in scalars])
+                       [[code(i.name), i.data[()], i.units, i.description] for i in scalars],
+                       long_cell=DESCRIPTION)
     lengths = Counter(len(item.data) for item in vectors)
     for length in dict.fromkeys(len(item.data) for item in vectors):
         members = [item for item in vectors if len(item.data) == length]
@@ -429,11 +434,14 @@ def _group_lines(items: list[_Item]) -> list[str]:
 
 def _columns_table(items: list[_Item]) -> list[str]:
     """1-D arrays of one length as the columns of one table (short text first, as row
-    labels; long text last), then what each column is."""
-    def order(item: _Item) -> int:
+    labels, the one with the most distinct values leading: it names the rows where a wide
+    table is split; long text last), then what each column is (folded)."""
+    def order(item: _Item) -> tuple[int, int]:
         if not item.is_text:
-            return 1
-        return 0 if max(len(str(value)) for value in item.data) <= 40 else 2
+            return 1, 0
+        if max(len(str(value)) for value in item.data) > 40:
+            return 2, 0
+        return 0, -len(set(item.data))
 
     items = sorted(items, key=order)
     header = [with_unit(item.name, "" if item.is_text else item.units) for item in items]
@@ -441,7 +449,7 @@ def _columns_table(items: list[_Item]) -> list[str]:
     lines = table(header, rows)
     legend = [f"{code(item.name)}: {cell(item.description)}" for item in items
               if item.description and item.description != item.name]
-    return lines + ([f"Columns: {'; '.join(legend)}.", ""] if legend else [])
+    return lines + columns_legend(legend)
 
 
 def _vector_line(item: _Item) -> str:

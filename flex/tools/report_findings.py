@@ -87,10 +87,15 @@ def _table_lines(columns: list[Any]) -> list[str]:
         return lines + ["(no rows)", ""]
     lines += table(header, [[item.data[row] for item in columns] for row in range(length)],
                    numeric)
-    legend = [f"- {label}: {item.description}" for label, item
-              in zip(header, columns, strict=True)
-              if item.description and item.description != label]
-    if not legend:
-        return lines
-    return lines + ["<details><summary>Columns</summary>", "", *wrap_markdown("\n".join(legend)),
-                    "", "</details>", ""]
+    return lines + columns_legend([f"{label}: {item.description}" for label, item
+                                   in zip(header, columns, strict=True)
+                                   if item.description and item.description != label])
+
+
+def columns_legend(entries: Sequence[str]) -> list[str]:
+    """What each column of a table is (``entries``: ``"name: description"``), folded: a
+    list under "Columns" that opens on a click; nothing without entries."""
+    if not entries:
+        return []
+    return ["<details><summary>Columns</summary>", "",
+            *wrap_markdown("\n".join(f"- {entry}" for entry in entries)), "", "</details>", ""]
