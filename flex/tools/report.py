@@ -40,7 +40,7 @@ from flex.base.errors import OutputError
 from flex.data.outputs import RESULT_SUFFIXES, check_writable_folder, figures_folder
 from flex.data.results import atomic_path, attribute_value, case_names, reading
 from flex.tools.inspect import stress_lines
-from flex.tools.markdown import cell, code, fenced, format_value, table, with_unit
+from flex.tools.markdown import cell, code, fenced, format_value, table, with_unit, wrap_markdown
 from flex.tools.report_findings import columns_legend, is_findings_column, study_report_lines
 
 REPORT_SUFFIX = ".md"
@@ -382,7 +382,7 @@ def _case_attributes(cases: list[dict[str, Any]]) -> list[str]:
     for name, attrs in extra.items():
         if attrs:
             shown = "; ".join(f"{key} = {cell(value)}" for key, value in attrs.items())
-            lines.append(f"- {code(name)}: {shown}")
+            lines += wrap_markdown(f"- {code(name)}: {shown}")
     return lines + [""]
 
 
@@ -422,7 +422,8 @@ def _group_lines(items: list[_Item]) -> list[str]:
         if lengths[length] >= 2 and length > 0:
             lines += _columns_table(members)
         else:
-            lines += [_vector_line(item) for item in members] + [""]
+            lines += [line for item in members for line in wrap_markdown(_vector_line(item))]
+            lines.append("")
     for item in matrices:
         lines += _matrix_table(item)
     if large:
