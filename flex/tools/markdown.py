@@ -63,18 +63,29 @@ def table(header: list[str], rows: list[list[Any]], right: list[bool] | None = N
     head = [cell(h) for h in header]
     body = [[cell(value) for value in row] for row in rows]
     notes: dict[str, int] = {}
-    for row in body:
-        for index, text in enumerate(row):
-            if long_cell is not None and len(text) > long_cell:
-                row[index] = f"note {notes.setdefault(text, len(notes) + 1)}"
+    body = [[noted(text, notes, long_cell) for text in row] for row in body]
     lines: list[str] = []
     for columns in _column_groups(head, body, width):
         lines += ["| " + " | ".join(head[i] for i in columns) + " |",
                   "|" + "|".join("---:" if right[i] else "---" for i in columns) + "|"]
         lines += ["| " + " | ".join(row[i] for i in columns) + " |" for row in body] + [""]
-    for text, number in notes.items():
-        lines += wrap_markdown(f"- note {number}: {text}")
-    return lines + ([""] if notes else [])
+    return lines + note_lines(notes)
+
+
+def noted(text: str, notes: dict[str, int], limit: int | None = LONG_CELL) -> str:
+    """``text``, or ``note <n>`` when it is longer than ``limit`` characters (None: never):
+    its number in ``notes`` (text -> number), added there if new."""
+    if limit is None or len(text) <= limit:
+        return text
+    return f"note {notes.setdefault(text, len(notes) + 1)}"
+
+
+def note_lines(notes: dict[str, int]) -> list[str]:
+    """The notes of :func:`noted` as a list (each wrapped to short lines), then an empty
+    line; nothing without notes."""
+    lines = [line for text, number in notes.items()
+             for line in wrap_markdown(f"- note {number}: {text}")]
+    return lines + [""] if lines else []
 
 
 def _column_groups(head: list[str], body: list[list[str]], width: int | None

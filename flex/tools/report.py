@@ -40,7 +40,17 @@ from flex.base.errors import OutputError
 from flex.data.outputs import RESULT_SUFFIXES, check_writable_folder, figures_folder
 from flex.data.results import atomic_path, attribute_value, case_names, reading
 from flex.tools.inspect import stress_lines
-from flex.tools.markdown import cell, code, fenced, format_value, table, with_unit, wrap_markdown
+from flex.tools.markdown import (
+    cell,
+    code,
+    fenced,
+    format_value,
+    note_lines,
+    noted,
+    table,
+    with_unit,
+    wrap_markdown,
+)
 from flex.tools.report_findings import columns_legend, is_findings_column, study_report_lines
 
 REPORT_SUFFIX = ".md"
@@ -53,8 +63,9 @@ PROVENANCE_KEYS = ("flex_format", "study", "flex_version", "git_commit", "git_di
 #: root attributes shown in their own sections (not in the table of other attributes)
 SHOWN_ELSEWHERE = ("scene_toml", "summary_report", "summary_findings")
 CASE_KNOWN = ("status", "message", "scene_toml", "solver_settings_toml", "validity_warning")
-#: a case's notes longer than this are shown below the cases table [characters]
-CASE_NOTES = 300
+#: a case's note longer than this is shown below the cases table, once for the cases that
+#: share it [characters]
+CASE_NOTE = 100
 #: a scalar's value or description longer than this is shown below its table [characters]
 DESCRIPTION = 160
 COUNTER_TITLES = {"steps": "steps", "newton_iterations": "Newton iterations",
@@ -261,7 +272,7 @@ def _cases_section(cases: list[dict[str, Any]]) -> list[str]:
     counters = _counter_keys(cases)
     header = ["case", "status", "samples", "t [s]",
               *(COUNTER_TITLES.get(key, key.replace("_", " ")) for key in counters), "notes"]
-    rows = []
+    rows, notes = [], {}
     for case in cases:
         attrs, time_s = case["attrs"], case["time"]
         has_time = time_s is not None and np.ndim(time_s) == 1 and len(time_s)
@@ -271,8 +282,9 @@ def _cases_section(cases: list[dict[str, Any]]) -> list[str]:
                      f"{format_value(time_s[0])} .. {format_value(time_s[-1])}" if has_time
                      else "-",
                      *(attrs.get(f"counter_{key}", "-") for key in counters),
-                     "<br>".join(_case_notes(attrs))])
-    lines += table(header, rows, long_cell=CASE_NOTES, width=None)
+                     "<br>".join(noted(" ".join(note.split()), notes, CASE_NOTE)
+                                 for note in _case_notes(attrs))])
+    lines += table(header, rows, long_cell=None, width=None) + note_lines(notes)
     return lines + _budget_section(cases) + _case_attributes(cases)
 
 
@@ -308,10 +320,11 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
                 case["name"])
     if not rows:
         return []
-    lines = ["Estimated error of each headline quantity (total = the root-sum-square of the "
-             "terms, in the quantity's unit: what the error is; certificate = the bound "
-             "refinement decides on, the estimate times its stated safety factor; a raw "
-             "whole-run peak's error is a bound, not an estimate, marked so):", ""]
+    lines = [*wrap_markdown("Estimated error of each headline quantity (total = the "
+                            "root-sum-square of the terms, in the quantity's unit: what the "
+                            "error is; certificate = the bound refinement decides on, the "
+                            "estimate times its stated safety factor; a raw whole-run peak's "
+                            "error is a bound, not an estimate, marked so):"), ""]
     lines += table(["case", "quantity", "value", "estimated error", "relative",
                      "certificate", *TERMS], rows, long_cell=None, width=None)
     for key, texts in notes.items():
