@@ -213,7 +213,8 @@ def test_design_like_refusals_are_notes_not_700_character_cells(tmp_path):
     cases += [CaseResult("angle_10_again", "", attrs={"design_outcome": "refused",
                                                       "design_reason": REASON.format(load=0.1)}),
               CaseResult("angle_60", "", attrs={"design_outcome": "simulated",
-                                                "design_model": "rigid"})]
+                                                "design_model": "rigid",
+                                                "validity_warning": REASON[:300]})]
     report = written(tmp_path, "design", Summary({}, "# Design\n\n| a | b |\n|---|---|\n"),
                      cases)
     assert len(REASON) > 700 and max(map(len, outside_folds(report))) <= LINE
@@ -225,3 +226,11 @@ def test_design_like_refusals_are_notes_not_700_character_cells(tmp_path):
     attributes = report.split("Other case attributes:")[1]
     note = " ".join(attributes.split(f"- {reason['angle_10']}: ")[1].split("\n- ")[0].split())
     assert note == REASON.format(load=0.1)
+    # a long note of the cases table: below it, the row pointing to it
+    (row,) = [row for row in table_rows(report, report.split("## Cases")[1].split("\n")[2])
+              if row[0] == "`angle_60`"]
+    number = row[-1].split()[-1]
+    assert row[-1] == f"note {number}"
+    below = report.split("## Cases")[1].split(f"- note {number}: ")[1]
+    below = below.split("\n\n")[0].split("\n- ")[0]
+    assert " ".join(below.split()) == f"**validity warning**: {' '.join(REASON[:300].split())}"
