@@ -371,18 +371,22 @@ def _columns(datasets: Mapping[str, Dataset], prefix: str) -> dict[str, np.ndarr
             if key.startswith(prefix) and "/" not in key[len(prefix):]}
 
 
-def _scene_findings(scene: str, datasets: Mapping[str, Dataset], order: int
-                    ) -> tuple[dict[str, Dataset], list[str]]:
-    """One scene's findings tables (Pareto front, recommendations, rule picks) and bullets."""
-    runs = _columns(datasets, f"{scene}/runs/")
+def _front(runs: Mapping[str, np.ndarray]) -> np.ndarray:
+    """The rows of a run table on its Pareto front, fastest first."""
     front = np.flatnonzero(runs["on_pareto_front"].astype(bool))
-    front = front[np.argsort(runs["wall_time"][front], kind="stable")]
+    return front[np.argsort(runs["wall_time"][front], kind="stable")]
+
+
+def _scene_tables(scene: str, datasets: Mapping[str, Dataset], order: int
+                  ) -> dict[str, Dataset]:
+    """One scene's findings tables: its Pareto front, the fastest flex setting per accuracy
+    level and (FFRF) the rule's picks, ordered after the previous scenes' (``order``)."""
+    runs = _columns(datasets, f"{scene}/runs/")
     tables = findings_table(f"front_{scene}", f"Pareto front, scene {scene}",
                             [{"setting": str(runs["label"][i]),
                               "wall_time": runs["wall_time"][i], "error": runs["error"][i]}
-                             for i in front], FRONT_COLUMNS, 3 * order,
+                             for i in _front(runs)], FRONT_COLUMNS, 3 * order,
                             {"wall_time": "wall time"})
-    places = [f"[[table:front_{scene}]]"]
     levels = _columns(datasets, f"{scene}/recommended/")
     if levels:
         rows = [{"level": level, "setting": str(setting) or f"none: {knobs}",
@@ -392,7 +396,6 @@ def _scene_findings(scene: str, datasets: Mapping[str, Dataset], order: int
         tables |= findings_table(f"levels_{scene}", f"Fastest flex setting per accuracy "
                                  f"level, scene {scene}", rows, LEVEL_COLUMNS,
                                  3 * order + 1, {"wall_time": "wall time"})
-        places.append(f"[[table:levels_{scene}]]")
     rule = _columns(datasets, f"{scene}/rule/")
     if rule:
         rows = [{key: rule[key][i] for key in RULE_PICK_COLUMNS}
@@ -400,7 +403,13 @@ def _scene_findings(scene: str, datasets: Mapping[str, Dataset], order: int
         tables |= findings_table(f"rule_{scene}", f"The flex rule's picks, scene {scene}", rows,
                                  RULE_PICK_COLUMNS, 3 * order + 2,
                                  {"wall_time": "wall time", "on_pareto_front": "on the front"})
-        places.append(f"[[table:rule_{scene}]]")
+    return tables
+
+
+def _scene_bullets(scene: str, datasets: Mapping[str, Dataset]) -> list[str]:
+    """One scene's heading and bullets: its reference, how many runs (failed, on the front),
+    the bundled defaults' verdict."""
+    runs = _columns(datasets, f"{scene}/runs/")
     ok = runs["status"] == "ok"
     reference = _columns(datasets, f"{scene}/reference/")
     lines = ["", f"### {scene}", "",
@@ -408,13 +417,14 @@ def _scene_findings(scene: str, datasets: Mapping[str, Dataset], order: int
              f"{float(reference.get('accuracy', np.nan)):.1e} "
              f"({'converged' if reference.get('converged') else 'NOT converged'} to "
              f"{float(reference.get('tolerance', np.nan)):g})",
-             f"- {len(ok)} settings, {int((~ok).sum())} failed; {len(front)} on the Pareto front"]
+             f"- {len(ok)} settings, {int((~ok).sum())} failed; {len(_front(runs))} on the "
+             f"Pareto front"]
     default = _columns(datasets, f"{scene}/default/")
     if "matches_table" in default:
         verdict = "confirmed" if default["matches_table"] else "NOT confirmed"
         lines.append(f"- bundled solver defaults: {verdict} (the fastest run within their "
                      f"tolerance: {default.get('setting') or '-'})")
-    return tables, [*lines, "", *places]
+    return [*lines, ""]
 
 
 def tradeoff_findings(datasets: Mapping[str, Dataset]) -> tuple[dict[str, Dataset], str]:
@@ -426,7 +436,9 @@ def tradeoff_findings(datasets: Mapping[str, Dataset]) -> tuple[dict[str, Datase
     lines = [f"Work-precision of every knob. {HEADER[len('work-precision ('):-1].capitalize()}."]
     scenes = dict.fromkeys(key.split("/runs/")[0] for key in datasets if "/runs/" in key)
     for order, scene in enumerate(scenes):
-        scene_tables, scene_lines = _scene_findings(scene, datasets, order)
+        scene_tables = _scene_tables(scene, datasets, order)
         tables |= scene_tables
-        lines += scene_lines
+        lines += _scene_bullets(scene, datasets)
+        lines += [f"[[table:{key.split('/')[1]}]]" for key in dict.fromkeys(
+            key.rsplit("/", 1)[0] for key in scene_tables)]
     return tables, "\n".join(lines)
