@@ -100,14 +100,17 @@ def test_findings_tables_are_shown_from_the_data_where_the_findings_place_them(t
 def test_long_cells_become_notes_and_wide_tables_are_split():
     rows = [[f"case_{i}", REASON.format(load=0.6), *range(12)] for i in range(3)]
     rows.append(["case_3", REASON.format(load=0.7), *range(12)])
-    lines = table(["case", "reason", *(f"column number {i}" for i in range(12))], rows)
+    lines = table(["case", "reason", *(f"column number {i}" for i in range(12))], rows,
+                  [False, False, *[True] * 12])
     assert max(map(len, lines)) <= LINE
     text = "\n".join(lines)
-    assert text.count("| note 1 |") == 3 and text.count("| note 2 |") == 1  # one per text
+    first = text.split("\n\n")[0]
+    assert first.count("| note 1 |") == 3 and first.count("| note 2 |") == 1  # one per text
+    assert text.count("- note 1: ") == 1 and text.count("- note 2: ") == 1
     notes = " ".join(" ".join(text.split("- note 1: ")[1].split("- note 2: ")[0].split()).split())
     assert notes == REASON.format(load=0.6)
-    headers = [line for line in lines if line.startswith("| case |")]
-    assert len(headers) >= 2  # split, each part naming the rows
+    headers = [line for line in lines if line.startswith("| case | reason |")]
+    assert len(headers) >= 2  # split, each part naming the rows (the leading text columns)
     shown = {cell for line in headers for cell in line.strip("|").split(" | ")}
     assert {f"column number {i}" for i in range(12)} <= {cell.strip() for cell in shown}
     assert all(len(cell) <= LONG_CELL for line in lines if line.startswith("|")

@@ -58,14 +58,14 @@ def table(header: list[str], rows: list[list[Any]], right: list[bool] | None = N
     A cell longer than ``long_cell`` characters shows ``note <n>`` and its text follows the
     table as note ``n`` (one note per distinct text, wrapped to short lines); a table wider
     than ``width`` characters is split into tables of fewer columns, each repeating the
-    first column (the row's name). None: no limit."""
+    row's names (its leading text columns, up to two). None: no limit."""
     right = list(right or [False] * len(header))
     head = [cell(h) for h in header]
     body = [[cell(value) for value in row] for row in rows]
     notes: dict[str, int] = {}
     body = [[noted(text, notes, long_cell) for text in row] for row in body]
     lines: list[str] = []
-    for columns in _column_groups(head, body, width):
+    for columns in _column_groups(head, body, width, right):
         lines += ["| " + " | ".join(head[i] for i in columns) + " |",
                   "|" + "|".join("---:" if right[i] else "---" for i in columns) + "|"]
         lines += ["| " + " | ".join(row[i] for i in columns) + " |" for row in body] + [""]
@@ -88,18 +88,24 @@ def note_lines(notes: dict[str, int]) -> list[str]:
     return lines + [""] if lines else []
 
 
-def _column_groups(head: list[str], body: list[list[str]], width: int | None
-                   ) -> list[list[int]]:
+def _column_groups(head: list[str], body: list[list[str]], width: int | None,
+                   right: list[bool]) -> list[list[int]]:
     """The columns of each table a table is split into (see :func:`table`): all of them
-    when its lines fit in ``width``, else the first with as many more as fit, in order."""
+    when its lines fit in ``width``, else the row's names (its leading text columns, up to
+    two: those not aligned ``right``) with as many more as fit, in order."""
     sizes = [max([len(head[i]), *(len(row[i]) for row in body)]) + 3
              for i in range(len(head))]
     if width is None or sum(sizes) + 1 <= width or len(head) < 3:
         return [list(range(len(head)))]
-    groups: list[list[int]] = [[0]]
-    for index in range(1, len(head)):
-        if len(groups[-1]) > 1 and sum(sizes[i] for i in groups[-1]) + sizes[index] + 1 > width:
-            groups.append([0])
+    key = [0]
+    while (len(key) < 2 and key[-1] + 1 < len(head) - 1 and not right[key[-1] + 1]
+           and sum(sizes[i] for i in key) + sizes[key[-1] + 1] <= width // 2):
+        key.append(key[-1] + 1)
+    groups: list[list[int]] = [list(key)]
+    for index in range(len(key), len(head)):
+        if len(groups[-1]) > len(key) and sum(sizes[i] for i in groups[-1]) + sizes[index] + 1 \
+                > width:
+            groups.append(list(key))
         groups[-1].append(index)
     return groups
 

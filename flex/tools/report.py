@@ -460,7 +460,7 @@ def _columns_table(items: list[_Item]) -> list[str]:
     items = sorted(items, key=order)
     header = [with_unit(item.name, "" if item.is_text else item.units) for item in items]
     rows = [[item.data[row] for item in items] for row in range(len(items[0].data))]
-    lines = table(header, rows)
+    lines = table(header, rows, [item.data.dtype.kind in "iuf" for item in items])
     legend = [f"{code(item.name)}: {cell(item.description)}" for item in items
               if item.description and item.description != item.name]
     return lines + columns_legend(legend)
