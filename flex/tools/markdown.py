@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 import textwrap
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -51,19 +52,24 @@ def cell(value: Any) -> str:
 
 
 def table(header: list[str], rows: list[list[Any]], right: list[bool] | None = None,
-          long_cell: int | None = LONG_CELL, width: int | None = LINE) -> list[str]:
+          long_cell: int | Sequence[int | None] | None = LONG_CELL,
+          width: int | None = LINE) -> list[str]:
     """A Markdown table (then an empty line) of ``rows`` under ``header``; the columns
     ``right`` marks (numbers) aligned right.
 
     A cell longer than ``long_cell`` characters shows ``note <n>`` and its text follows the
     table as note ``n`` (one note per distinct text, wrapped to short lines); a table wider
     than ``width`` characters is split into tables of fewer columns, each repeating the
-    row's names (its leading text columns, up to two). None: no limit."""
+    row's names (its leading text columns, up to two). None: no limit; ``long_cell`` may
+    give one limit per column."""
     right = list(right or [False] * len(header))
     head = [cell(h) for h in header]
     body = [[cell(value) for value in row] for row in rows]
     notes: dict[str, int] = {}
-    body = [[noted(text, notes, long_cell) for text in row] for row in body]
+    limits = (list(long_cell) if isinstance(long_cell, Sequence)
+              else [long_cell] * len(header))
+    body = [[noted(text, notes, limit) for text, limit in zip(row, limits, strict=True)]
+            for row in body]
     lines: list[str] = []
     for columns in _column_groups(head, body, width, right):
         lines += ["| " + " | ".join(head[i] for i in columns) + " |",

@@ -66,6 +66,9 @@ CASE_KNOWN = ("status", "message", "scene_toml", "solver_settings_toml", "validi
 #: a case's note longer than this is shown below the cases table, once for the cases that
 #: share it [characters]
 CASE_NOTE = 100
+#: a budget cell (beside the quantity's name) longer than this is shown below the budget
+#: table, once for the rows sharing it [characters]
+BUDGET_CELL = 60
 #: a scalar's value or description longer than this is shown below its table [characters]
 DESCRIPTION = 160
 COUNTER_TITLES = {"steps": "steps", "newton_iterations": "Newton iterations",
@@ -326,7 +329,8 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
                             "estimate times its stated safety factor; a raw whole-run peak's "
                             "error is a bound, not an estimate, marked so):"), ""]
     lines += table(["case", "quantity", "value", "estimated error", "relative",
-                     "certificate", *TERMS], rows, long_cell=None, width=None)
+                     "certificate", *TERMS], rows, long_cell=[None, None] + [BUDGET_CELL] * (
+                         4 + len(TERMS)), width=None)
     for key, texts in notes.items():
         for text, names in texts.items():
             who = "every case" if len(names) == len(cases) else ", ".join(map(code, names))
