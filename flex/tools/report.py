@@ -20,8 +20,11 @@ report holds, in this order:
 6. the resolved scene (root attribute ``scene_toml``), folded.
 
 Numbers are shown with 4 significant digits (:func:`format_value`); integers and booleans
-as they are. A study run writes ``reports/<stem>.md`` beside its result file
-(:func:`default_report_path`, :func:`write_report`).
+as they are. A table cell longer than a few words is a note below its table (one note per
+distinct text), a table wider than a line is split into tables repeating the row names, and
+prose is wrapped to short lines (:func:`flex.tools.markdown.table`,
+:func:`flex.tools.markdown.wrap_markdown`). A study run writes ``reports/<stem>.md`` beside
+its result file (:func:`default_report_path`, :func:`write_report`).
 """
 
 from __future__ import annotations
