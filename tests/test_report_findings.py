@@ -75,6 +75,7 @@ def test_findings_tables_are_shown_from_the_data_where_the_findings_place_them(t
                                  {"wall_time": "wall time"}),
                 **findings_table("late", "Shown after the findings", ROWS[:1], COLUMNS, 2),
                 **findings_table("early", "Shown first of the rest", ROWS[1:], COLUMNS, 0),
+                **findings_table("none", "An empty table", [], COLUMNS, 3),
                 "other/x": Dataset(np.arange(3.0), "m", "a plain column")}
     long_report = "the printed report: " + "x " * 200
     findings = "Two findings.\n\n- one bullet\n\n[[table:front]]\n\nAfter the front."
@@ -84,6 +85,7 @@ def test_findings_tables_are_shown_from_the_data_where_the_findings_place_them(t
     assert study.index("- one bullet") < study.index(header) < study.index("After the front.")
     assert study.index("After the front.") < study.index("Shown first of the rest") < study.index(
         "Shown after the findings")
+    assert "**An empty table**\n\n(no rows)" in study
     rows = table_rows(report, header)
     assert rows == [[row["setting"], format_value(row["wall_time"]), format_value(row["error"]),
                      str(row["steps"])] for row in ROWS]
