@@ -6,7 +6,7 @@ A study is a module in ``studies/`` that declares what it runs and what it store
     DESCRIPTION = "one line"
     OVERRIDES = ["drive.kind=\"constant_speed\"", ...]   # applied to the base scene
     def cases(scene) -> dict[str, Scene]                   # the scenes it simulates
-    def summarize(scene, results, run) -> Summary          # tables, report text
+    def summarize(scene, results, run) -> Summary          # tables, report, findings
     def figures(results, summary, folder) -> list[Path]    # PNGs (optional)
 
 Optionally ``def simulate_cases(scenes, run: StudyRun) -> dict[str, CaseResult]`` replaces
