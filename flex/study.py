@@ -6,7 +6,7 @@ A study is a module in ``studies/`` that declares what it runs and what it store
     DESCRIPTION = "one line"
     OVERRIDES = ["drive.kind=\"constant_speed\"", ...]   # applied to the base scene
     def cases(scene) -> dict[str, Scene]                   # the scenes it simulates
-    def summarize(scene, results, run) -> Summary          # tables, report text
+    def summarize(scene, results, run) -> Summary          # tables, report, findings
     def figures(results, summary, folder) -> list[Path]    # PNGs (optional)
 
 Optionally ``def simulate_cases(scenes, run: StudyRun) -> dict[str, CaseResult]`` replaces
@@ -81,6 +81,11 @@ class Summary:
     report: str = ""
     #: what the study's figures draw beyond the stored datasets (not written to the file)
     figure_data: dict[str, Any] = field(default_factory=dict)
+    #: the findings in short Markdown (bullets, a line ``[[table:<name>]]`` where a findings
+    #: table goes, :func:`flex.data.tables.findings_table`): root attribute
+    #: ``summary_findings``, what the report shows instead of the printed ``report`` (kept in
+    #: the file, folded in the report)
+    findings: str = ""
 
 
 @dataclass
@@ -376,7 +381,9 @@ def _write_output(output: StudyOutput, target: Path, scene: Scene) -> Path:
     return write_results(target, output.name, list(output.results.values()), to_toml(scene),
                          output.summary.datasets,
                          {"wall_time_s": output.wall_time_s, "failed_cases": len(failed),
-                          "summary_report": output.summary.report})
+                          "summary_report": output.summary.report,
+                          **({"summary_findings": output.summary.findings}
+                             if output.summary.findings else {})})
 
 
 def _draw(module: ModuleType, output: Any, folder: Path, target: Path) -> None:

@@ -8,7 +8,9 @@ coupler at a quarter of the step, mesh-corrected; rigid plate couplers, 0.7-3 mm
 deployment, against the calibrated exact beam, the flexible truth their user gets; lumped rigid
 links against the same rigid model at a quarter of the step). Stored per case: the run, its
 ``estimated_error_*``, ``true_error_*``, ``reference_accuracy_*`` and ``estimate_ratio_*``
-attributes; under ``/summary/pairs`` one entry per case and headline quantity. Targets (issue
+attributes; under ``/summary/pairs`` one entry per case and headline quantity; the findings
+and their tables (``/summary/findings``) and a figure per quantity
+(:mod:`flex.experiments.workprecision.estimate_report`). Targets (issue
 35): true / estimated within [1/2, 1.5] for every pair in the asymptotic range, at most 10 % of
 the pairs flagged outside it, no certificate exceeded; on at least 12 scenes (thin and thick
 plates, springs, a constant-speed drive, the crank as FFRF, damped). The flexible scenes run the
@@ -27,6 +29,7 @@ from flex.experiments.workprecision.estimate_check import (
     draw_estimates,
     estimate_summary,
 )
+from flex.experiments.workprecision.estimate_report import draw_ratio_figures, estimate_findings
 from flex.study import StudyRun, Summary
 
 NAME = "estimates"
@@ -75,11 +78,13 @@ def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseRes
 
 def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
-    return Summary(*estimate_summary(results))
+    datasets, report = estimate_summary(results)
+    tables, findings = estimate_findings(results)
+    return Summary(datasets | tables, report, findings=findings)
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:
-    return draw_estimates(summary.datasets, folder)
+    return draw_estimates(summary.datasets, folder) + draw_ratio_figures(summary.datasets, folder)
 
 
 if __name__ == "__main__":

@@ -28,6 +28,7 @@ from flex.experiments.workprecision.rule_check import rule_settings
 from flex.experiments.workprecision.tradeoff import run_work_precision
 from flex.experiments.workprecision.tradeoff_report import (
     summarize_work_precision,
+    tradeoff_findings,
     work_precision_figures,
 )
 from flex.study import StudyRun, Summary
@@ -181,10 +182,13 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
     """Per scene the run table, the reference and its evidence, the recommendations and the
     defaults check
-    (:func:`flex.experiments.workprecision.tradeoff_report.summarize_work_precision`)."""
+    (:func:`flex.experiments.workprecision.tradeoff_report.summarize_work_precision`); the
+    findings: per scene its Pareto front, levels and rule picks as tables
+    (``tradeoff_findings``)."""
     datasets, report = summarize_work_precision(run.notes.get("runs", {}), cases(scene),
                                                 FFRF_DEFAULT_SCENE)
-    return Summary(datasets, report)
+    tables, findings = tradeoff_findings(datasets)
+    return Summary(datasets | tables, report, findings=findings)
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:

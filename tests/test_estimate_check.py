@@ -5,7 +5,7 @@ reported by name."""
 from __future__ import annotations
 
 from flex.data.results import CaseResult
-from flex.experiments.workprecision.estimate_check import _rows, estimate_summary
+from flex.experiments.workprecision.estimate_check import estimate_summary, pair_rows
 from flex.fidelity.stored_budget import BOUNDS_ATTR, CERTIFICATE_ATTR, STEP_BOUNDS_ATTR
 
 PEAK, END = "coupler_deployment_peak_deflection_m", "crank_angle_end_rad"
@@ -22,7 +22,7 @@ def _case(true_peak: float, bounded: str) -> CaseResult:
 
 
 def test_a_bounded_step_term_is_flagged_not_judged():
-    rows = {row["quantity"]: row for row in _rows({"a": _case(1.5e-7, PEAK)})}
+    rows = {row["quantity"]: row for row in pair_rows({"a": _case(1.5e-7, PEAK)})}
     assert rows[PEAK]["flagged"] and not rows[PEAK]["judged"]
     assert "flagged" in rows[PEAK]["why"]
     assert rows[END]["judged"] and not rows[END]["flagged"]
@@ -39,7 +39,7 @@ def test_a_true_error_above_its_certificate_is_named():
 def test_a_raw_peak_is_a_bound_checked_against_its_certificate_not_judged():
     case = _case(1e-9, "")  # 200x below its "estimate": pessimistic, as a bound may be
     case.attrs[BOUNDS_ATTR] = PEAK
-    rows = {row["quantity"]: row for row in _rows({"a": case})}
+    rows = {row["quantity"]: row for row in pair_rows({"a": case})}
     assert rows[PEAK]["bound"] and not rows[PEAK]["judged"] and "bound" in rows[PEAK]["why"]
     assert rows[END]["judged"] and not rows[END]["bound"]
     _, report = estimate_summary({"a": case})

@@ -342,7 +342,53 @@ def test_estimates_figure_and_summary_synthetic(tmp_path, reviewed):
     assert "most optimistic true/estimated 100" in result.report
     assert "scenes with every judged pair within: 2 of 3" in result.report
     paths = estimates.figures(results, result, tmp_path)
-    check_pngs(paths, tmp_path, {"estimates.png"})
+    check_pngs(paths, tmp_path, {"estimates-pairs.png",
+                                 "estimates-ratio-crank_angle_end_rad.png"})
+
+
+def test_estimates_ratio_figure_per_quantity_synthetic(tmp_path, reviewed, monkeypatch):
+    """One figure per quantity: a row per scene (named; a pair with no ratio says why), the
+    ratios on a log axis, the target band [1/2, 1.5] shaded."""
+    from flex.experiments.workprecision.estimate_check import OPTIMISM, PESSIMISM
+    from flex.study import StudyRun
+    from studies import estimates
+
+    drawn = []
+    save = matplotlib.figure.Figure.savefig
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig",
+                        lambda self, path, *a, **k: (drawn.append((Path(path).name, self)),
+                                                     save(self, path, *a, **k))[1])
+    quantities = ("crank_angle_end_rad", "slider_position_end_m", "deployment_time_s")
+    results = {}
+    for index, ratio in enumerate((0.9, 1.3, 40.0)):
+        attrs = {}
+        for k, quantity in enumerate(quantities):
+            true = 0.0 if (index, k) == (1, 2) else 10.0 ** -(4 + k)
+            attrs |= {f"estimated_error_{quantity}": 10.0 ** -(4 + k) / ratio,
+                      f"true_error_{quantity}": true,
+                      f"reference_accuracy_{quantity}": 1e-9}
+        results[f"scene_{index}"] = CaseResult(f"scene_{index}", "", attrs=attrs)
+    summary = estimates.summarize({}, results, StudyRun())
+    paths = estimates.figures(results, summary, tmp_path)
+    check_pngs(paths, tmp_path, {"estimates-pairs.png"}
+               | {f"estimates-ratio-{q}.png" for q in quantities})
+    figures = dict(drawn)
+    for quantity in quantities:
+        ax = figures[f"estimates-ratio-{quantity}.png"].axes[0]
+        assert ax.get_xscale() == "log" and quantity in figures[
+            f"estimates-ratio-{quantity}.png"].get_suptitle()
+        names = [label.get_text() for label in ax.get_yticklabels()]
+        expected = ["scene_0", "scene_1 (true 0)" if quantity == quantities[2] else "scene_1",
+                    "scene_2"]
+        assert names == expected and list(ax.get_yticks()) == [2, 1, 0]  # the first on top
+        (band,) = [patch for patch in ax.patches if patch.get_label().startswith("target")]
+        low, high = band.get_x(), band.get_x() + band.get_width()
+        assert (low, high) == pytest.approx((1 / PESSIMISM, OPTIMISM))
+        points = np.concatenate([line.get_xdata() for line in ax.get_lines()
+                                 if line.get_marker() == "o"])
+        assert sorted(points) == pytest.approx(sorted(
+            r for i, r in enumerate((0.9, 1.3, 40.0))
+            if not (quantity == quantities[2] and i == 1)))
 
 
 # ------------------------------------------------------------------------------------------

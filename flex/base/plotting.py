@@ -229,9 +229,15 @@ def _texts(fig) -> list:
 
 
 def _categorical(axis) -> bool:
-    """Whether ``axis`` shows names (bar-chart categories) rather than numbers."""
+    """Whether ``axis`` shows names (bar-chart categories, or tick labels set as fixed
+    texts) rather than numbers."""
     import re
 
+    from matplotlib.ticker import FixedFormatter, FixedLocator, FuncFormatter
+
+    if isinstance(axis.get_major_locator(), FixedLocator) and isinstance(
+            axis.get_major_formatter(), FixedFormatter | FuncFormatter):
+        return True  # set_ticks(positions, labels): names at fixed places
     for tick in axis.get_major_ticks():
         text = re.sub(r"\\mathdefault|\\times|[${}^]", "", tick.label1.get_text())
         if re.search(r"[A-Za-z_]{2,}", text):

@@ -53,6 +53,9 @@ class Dataset:
     units: str
     description: str = ""
     compress: bool = False  #: gzip (with shuffle) in the file: large fields (nodal snapshots)
+    #: further attributes written on the dataset (small scalars or text: a report table's
+    #: title and column position, :func:`flex.data.tables.findings_table`)
+    attrs: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass
@@ -210,6 +213,8 @@ def _write_dataset(group, path: str, dataset: Dataset) -> None:
         created = group.create_dataset(path, data=data)
     created.attrs["units"] = dataset.units
     created.attrs["description"] = dataset.description
+    for key, value in dataset.attrs.items():
+        created.attrs[key] = value
 
 
 def _string_dtype():

@@ -38,3 +38,30 @@ def table_datasets(rows: Iterable[Mapping[str, Any]], columns: Mapping[str, Colu
                                        else None)
         out[prefix + name] = Dataset(np.array(values, dtype=kind), units, description)
     return out
+
+
+#: the group under ``/summary`` holding the tables a report shows with the study's findings
+FINDINGS = "findings"
+#: attributes of a findings table's column datasets: the table's title, the column's
+#: position in it, the table's position among the findings tables, the column's header
+TITLE_ATTR, COLUMN_ATTR, ORDER_ATTR, LABEL_ATTR = ("table_title", "table_column",
+                                                   "table_order", "table_label")
+
+
+def findings_table(name: str, title: str, rows: Iterable[Mapping[str, Any]],
+                   columns: Mapping[str, Column], order: int = 0,
+                   labels: Mapping[str, str] | None = None) -> dict[str, Dataset]:
+    """A table the report shows with the study's findings (``flex report``: its study report
+    section): the columns of :func:`table_datasets` under ``findings/<name>/``, each marked
+    (dataset attributes) with the table's ``title``, its own position, the table's ``order``
+    among the findings tables (smallest first) and its header (``labels[column]``, default
+    the column's name with spaces; the report adds ``[units]``).
+
+    The report shows every row: keep the cells short (a number, a name, a few words) and
+    the long explanations in the column descriptions or the study's printed report."""
+    out = table_datasets(rows, columns, f"{FINDINGS}/{name}")
+    for position, (key, dataset) in enumerate(out.items()):
+        column = key.rsplit("/", 1)[-1]
+        dataset.attrs.update({TITLE_ATTR: title, COLUMN_ATTR: position, ORDER_ATTR: order,
+                              LABEL_ATTR: (labels or {}).get(column, column.replace("_", " "))})
+    return out

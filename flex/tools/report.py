@@ -3,13 +3,16 @@
 Every number in a report is read from the HDF5 file it names; nothing is typed by hand. A
 report holds, in this order:
 
-1. the study (root attribute ``study``), the file, and the study's own printed report (root
-   attribute ``summary_report``) as a fenced block;
+1. the study (root attribute ``study``), the file, and the study's own report
+   (:mod:`flex.tools.report_findings`): its findings (root attribute ``summary_findings``)
+   and findings tables (``/summary/findings/...``), its printed report (root attribute
+   ``summary_report``) folded; without findings the printed report as written (Markdown)
+   or as a fenced block;
 2. provenance: flex version, git commit (and whether the tree was dirty), engine versions,
    Python, platform, creation time, command, wall time, failed cases; other root attributes;
 3. the cases: status, samples, time range, solver counters, validity warnings, what
    ``"auto"`` chose (fidelity, solver defaults), failure messages; other case attributes;
-4. every dataset under ``/summary`` (and any other top-level group), grouped by its parent
+4. every other dataset under ``/summary`` (and any other top-level group), grouped by its parent
    group, with units and descriptions: scalars as rows, 1-D arrays of one length as the
    columns of one table, other short arrays as lists, small 2-D arrays as tables, arrays of
    more than :data:`LARGE` elements as shape, minimum and maximum;
@@ -17,17 +20,19 @@ report holds, in this order:
 6. the resolved scene (root attribute ``scene_toml``), folded.
 
 Numbers are shown with 4 significant digits (:func:`format_value`); integers and booleans
-as they are. A study run writes ``reports/<stem>.md`` beside its result file
-(:func:`default_report_path`, :func:`write_report`).
+as they are. A table cell longer than a few words is a note below its table (one note per
+distinct text), a table wider than a line is split into tables repeating the row names, and
+prose is wrapped to short lines (:func:`flex.tools.markdown.table`,
+:func:`flex.tools.markdown.wrap_markdown`). A study run writes ``reports/<stem>.md`` beside
+its result file (:func:`default_report_path`, :func:`write_report`).
 """
 
 from __future__ import annotations
 
 import math
 import os
-import re
 from collections import Counter
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 from urllib.parse import quote
@@ -38,6 +43,18 @@ from flex.base.errors import OutputError
 from flex.data.outputs import RESULT_SUFFIXES, check_writable_folder, figures_folder
 from flex.data.results import atomic_path, attribute_value, case_names, reading
 from flex.tools.inspect import stress_lines
+from flex.tools.markdown import (
+    cell,
+    code,
+    fenced,
+    format_value,
+    note_lines,
+    noted,
+    table,
+    with_unit,
+    wrap_markdown,
+)
+from flex.tools.report_findings import columns_legend, is_findings_column, study_report_lines
 
 REPORT_SUFFIX = ".md"
 #: arrays with more elements than this are summarised (shape, minimum, maximum)
@@ -47,8 +64,16 @@ PROVENANCE_KEYS = ("flex_format", "study", "flex_version", "git_commit", "git_di
                    *(f"{engine}_version" for engine in ENGINES), "python_version",
                    "platform", "created_utc", "command", "wall_time_s", "failed_cases")
 #: root attributes shown in their own sections (not in the table of other attributes)
-SHOWN_ELSEWHERE = ("scene_toml", "summary_report")
+SHOWN_ELSEWHERE = ("scene_toml", "summary_report", "summary_findings")
 CASE_KNOWN = ("status", "message", "scene_toml", "solver_settings_toml", "validity_warning")
+#: a case's note longer than this is shown below the cases table, once for the cases that
+#: share it [characters]
+CASE_NOTE = 100
+#: a budget cell (beside the quantity's name) longer than this is shown below the budget
+#: table, once for the rows sharing it [characters]
+BUDGET_CELL = 60
+#: a scalar's value or description longer than this is shown below its table [characters]
+DESCRIPTION = 160
 COUNTER_TITLES = {"steps": "steps", "newton_iterations": "Newton iterations",
                   "jacobian_updates": "Jacobian updates", "wall_time_s": "wall time [s]"}
 
@@ -63,6 +88,8 @@ class _Item:
     units: str
     description: str
     data: np.ndarray
+    #: its other attributes (a findings table's title and column: flex.data.tables)
+    attrs: dict[str, Any] = field(default_factory=dict)
 
     @property
     def name(self) -> str:
@@ -77,27 +104,6 @@ class _Item:
     @property
     def is_text(self) -> bool:
         return self.data.dtype.kind == "O"
-
-
-def format_value(value: Any) -> str:
-    """A value as the report shows it: floats with 4 significant digits (``:.4g``, so never
-    more digits than the value has: ``0.08``, ``1500``, ``7.93e+10``), integers exactly,
-    booleans as ``true``/``false``, text as it is (bytes decoded as UTF-8)."""
-    if isinstance(value, np.ndarray) and value.shape == ():
-        value = value[()]
-    if isinstance(value, np.generic):
-        value = value.item()
-    if isinstance(value, bytes):
-        return value.decode("utf-8", "replace")
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        return f"{value:.4g}"
-    if value is None:
-        return ""
-    return str(value)
 
 
 def figures_of(path: str | Path) -> list[Path]:
@@ -129,7 +135,7 @@ def render_report(path: str | Path, report_folder: str | Path | None = None, *,
     folder = Path(report_folder) if report_folder is not None else default_report_path(
         shown).parent
     root, cases, items = _read(path)
-    lines = _title_section(shown, folder, root)
+    lines = _title_section(shown, folder, root, items)
     lines += _provenance_section(root)
     lines += _cases_section(cases)
     lines += _data_section(items)
@@ -211,38 +217,12 @@ def _item(top: str, path: str, dataset) -> _Item:
     else:
         data = np.asarray(raw)
     return _Item(top, path, str(attribute_value(dataset.attrs.get("units", "")) or ""),
-                 str(attribute_value(dataset.attrs.get("description", "")) or ""), data)
+                 str(attribute_value(dataset.attrs.get("description", "")) or ""), data,
+                 {key: attribute_value(value) for key, value in dataset.attrs.items()
+                  if key not in ("units", "description")})
 
 
 # --- Markdown helpers -------------------------------------------------------------------
-
-def _cell(value: Any) -> str:
-    """A table cell: formatted, on one line, with ``|`` escaped."""
-    text = value if isinstance(value, str) else format_value(value)
-    return " ".join(text.split()).replace("|", "\\|")
-
-
-def _table(header: list[str], rows: list[list[Any]]) -> list[str]:
-    lines = ["| " + " | ".join(_cell(h) for h in header) + " |",
-             "|" + "|".join("---" for _ in header) + "|"]
-    lines += ["| " + " | ".join(_cell(value) for value in row) + " |" for row in rows]
-    return lines + [""]
-
-
-def _fenced(text: str, language: str = "text") -> list[str]:
-    """``text`` in a fenced block whose fence is longer than any backtick run inside."""
-    longest = max((len(run) for run in re.findall(r"`+", text)), default=0)
-    fence = "`" * max(3, longest + 1)
-    return [f"{fence}{language}", text.rstrip("\n"), fence, ""]
-
-
-def _code(text: str) -> str:
-    """Inline code that survives backticks in ``text``."""
-    longest = max((len(run) for run in re.findall(r"`+", text)), default=0)
-    fence = "`" * (longest + 1)
-    pad = " " if text.startswith("`") or text.endswith("`") else ""
-    return f"{fence}{pad}{text}{pad}{fence}"
-
 
 def _link(target: Path, folder: Path) -> str:
     """``target`` relative to ``folder`` as a URL path (``../figures/a.png``)."""
@@ -250,23 +230,17 @@ def _link(target: Path, folder: Path) -> str:
     return quote(Path(relative).as_posix())
 
 
-def _with_unit(name: str, units: str) -> str:
-    return f"{name} [{units}]" if units else name
-
-
 # --- sections ---------------------------------------------------------------------------
 
-def _title_section(path: Path, folder: Path, root: dict[str, Any]) -> list[str]:
+def _title_section(path: Path, folder: Path, root: dict[str, Any],
+                   items: list[_Item]) -> list[str]:
     study = str(root.get("study") or "(no study attribute)")
     lines = [f"# {study}", "",
-             f"Generated by `flex report` from [{_code(path.name)}]({_link(path, folder)}); "
+             f"Generated by `flex report` from [{code(path.name)}]({_link(path, folder)}); "
              f"every number below is read from that file.", "", "## Study report", ""]
-    report = root.get("summary_report")
-    if isinstance(report, str) and report.strip():
-        if "\n|---" in report:  # the study wrote Markdown (its tables): shown as written
-            return lines + [report.strip(), ""]
-        return lines + ["The study's printed report (root attribute `summary_report`):", "",
-                        *_fenced(report)]
+    body = study_report_lines(root, items)
+    if body:
+        return lines + body
     return lines + ["This file has no study report (root attribute `summary_report`): it "
                     "was written before flex stored one, or by a tool that does not.", ""]
 
@@ -285,15 +259,15 @@ def _provenance_section(root: dict[str, Any]) -> list[str]:
         ["python", root.get("python_version", "")],
         ["platform", root.get("platform", "")],
         ["created_utc", root.get("created_utc", "")],
-        ["command", _code(str(root["command"])) if root.get("command") else ""],
+        ["command", code(str(root["command"])) if root.get("command") else ""],
         ["wall_time_s", root.get("wall_time_s", "not recorded")],
         ["failed_cases", root.get("failed_cases", "not recorded")],
     ]
-    lines = ["## Provenance", "", *_table(["item", "value"], rows)]
-    others = [[_code(key), value] for key, value in root.items()
+    lines = ["## Provenance", "", *table(["item", "value"], rows)]
+    others = [[code(key), value] for key, value in root.items()
               if key not in PROVENANCE_KEYS and key not in SHOWN_ELSEWHERE]
     if others:
-        lines += ["Other root attributes:", "", *_table(["attribute", "value"], others)]
+        lines += ["Other root attributes:", "", *table(["attribute", "value"], others)]
     return lines
 
 
@@ -304,18 +278,19 @@ def _cases_section(cases: list[dict[str, Any]]) -> list[str]:
     counters = _counter_keys(cases)
     header = ["case", "status", "samples", "t [s]",
               *(COUNTER_TITLES.get(key, key.replace("_", " ")) for key in counters), "notes"]
-    rows = []
+    rows, notes = [], {}
     for case in cases:
         attrs, time_s = case["attrs"], case["time"]
         has_time = time_s is not None and np.ndim(time_s) == 1 and len(time_s)
         status = str(attrs.get("status", ""))
-        rows.append([_code(case["name"]), status if status == "ok" else f"**{status}**",
+        rows.append([code(case["name"]), status if status == "ok" else f"**{status}**",
                      len(time_s) if has_time else "-",
                      f"{format_value(time_s[0])} .. {format_value(time_s[-1])}" if has_time
                      else "-",
                      *(attrs.get(f"counter_{key}", "-") for key in counters),
-                     "<br>".join(_case_notes(attrs))])
-    lines += _table(header, rows)
+                     "<br>".join(noted(" ".join(note.split()), notes, CASE_NOTE)
+                                 for note in _case_notes(attrs))])
+    lines += table(header, rows, long_cell=None, width=None) + note_lines(notes)
     return lines + _budget_section(cases) + _case_attributes(cases)
 
 
@@ -334,7 +309,7 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
     rows, notes = [], {}
     for case in cases:
         for row in budget_rows(case["attrs"]):
-            rows.append([_code(case["name"]), row.what, row.value_text,
+            rows.append([code(case["name"]), row.what, row.value_text,
                          row.problem or f"{'bound ' if row.bound else ''}{row.total:.2g} "
                                         f"{row.units}",
                          f"{100 * row.relative:.2g} %" if math.isfinite(row.relative) else "-",
@@ -351,15 +326,17 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
                 case["name"])
     if not rows:
         return []
-    lines = ["Estimated error of each headline quantity (total = the root-sum-square of the "
-             "terms, in the quantity's unit: what the error is; certificate = the bound "
-             "refinement decides on, the estimate times its stated safety factor; a raw "
-             "whole-run peak's error is a bound, not an estimate, marked so):", ""]
-    lines += _table(["case", "quantity", "value", "estimated error", "relative",
-                     "certificate", *TERMS], rows)
+    lines = [*wrap_markdown("Estimated error of each headline quantity (total = the "
+                            "root-sum-square of the terms, in the quantity's unit: what the "
+                            "error is; certificate = the bound refinement decides on, the "
+                            "estimate times its stated safety factor; a raw whole-run peak's "
+                            "error is a bound, not an estimate, marked so):"), ""]
+    lines += table(["case", "quantity", "value", "estimated error", "relative",
+                     "certificate", *TERMS], rows, long_cell=[None, None] + [BUDGET_CELL] * (
+                         4 + len(TERMS)), width=None)
     for key, texts in notes.items():
         for text, names in texts.items():
-            who = "every case" if len(names) == len(cases) else ", ".join(map(_code, names))
+            who = "every case" if len(names) == len(cases) else ", ".join(map(code, names))
             lines.append(f"- {key.replace('_', ' ')} ({who}): {text}")
     return lines + [""]
 
@@ -419,13 +396,13 @@ def _case_attributes(cases: list[dict[str, Any]]) -> list[str]:
         return []
     lines = ["Other case attributes:", ""]
     if len(keys) <= 8:
-        rows = [[_code(name), *(attrs.get(key, "-") for key in keys)]
+        rows = [[code(name), *(attrs.get(key, "-") for key in keys)]
                 for name, attrs in extra.items() if attrs]
-        return lines + _table(["case", *keys], rows)
+        return lines + table(["case", *keys], rows)
     for name, attrs in extra.items():
         if attrs:
-            shown = "; ".join(f"{key} = {_cell(value)}" for key, value in attrs.items())
-            lines.append(f"- {_code(name)}: {shown}")
+            shown = "; ".join(f"{key} = {cell(value)}" for key, value in attrs.items())
+            lines += wrap_markdown(f"- {code(name)}: {shown}")
     return lines + [""]
 
 
@@ -434,11 +411,15 @@ def _data_section(items: list[_Item]) -> list[str]:
     lines = ["## Summary", ""]
     if not any(item.top == "summary" for item in items):
         lines += ["This file has no `/summary` tables.", ""]
+    if any(is_findings_column(item) for item in items):
+        lines += ["The findings tables (`/summary/findings/...`) are shown in the study report "
+                  "above.", ""]
+        items = [item for item in items if not is_findings_column(item)]
     groups: dict[str, list[_Item]] = {}
     for item in items:
         groups.setdefault(item.group, []).append(item)
     for group in sorted(groups):  # a group before the groups inside it
-        lines += [f"### {_code(group)}", ""]
+        lines += [f"### {code(group)}", ""]
         lines += _group_lines(groups[group])
     return lines
 
@@ -452,62 +433,67 @@ def _group_lines(items: list[_Item]) -> list[str]:
     matrices = [item for item in items if item.data.ndim >= 2 and item not in large]
     lines: list[str] = []
     if scalars:
-        lines += _table(["name", "value", "unit", "description"],
-                        [[_code(i.name), i.data[()], i.units, i.description] for i in scalars])
+        lines += table(["name", "value", "unit", "description"],
+                       [[code(i.name), i.data[()], i.units, i.description] for i in scalars],
+                       long_cell=DESCRIPTION)
     lengths = Counter(len(item.data) for item in vectors)
     for length in dict.fromkeys(len(item.data) for item in vectors):
         members = [item for item in vectors if len(item.data) == length]
         if lengths[length] >= 2 and length > 0:
             lines += _columns_table(members)
         else:
-            lines += [_vector_line(item) for item in members] + [""]
+            lines += [line for item in members for line in wrap_markdown(_vector_line(item))]
+            lines.append("")
     for item in matrices:
         lines += _matrix_table(item)
     if large:
         lines += [f"Large arrays (more than {LARGE} elements), summarised:", ""]
-        lines += _table(["name", "shape", "min", "max", "unit", "description"],
+        lines += table(["name", "shape", "min", "max", "unit", "description"],
                         [_large_row(item) for item in large])
     return lines
 
 
 def _columns_table(items: list[_Item]) -> list[str]:
     """1-D arrays of one length as the columns of one table (short text first, as row
-    labels; long text last), then what each column is."""
-    def order(item: _Item) -> int:
+    labels, the one with the most distinct values leading: it names the rows where a wide
+    table is split; long text last), then what each column is (folded)."""
+    def order(item: _Item) -> tuple[int, int]:
         if not item.is_text:
-            return 1
-        return 0 if max(len(str(value)) for value in item.data) <= 40 else 2
+            return 1, 0
+        if max(len(str(value)) for value in item.data) > 40:
+            return 2, 0
+        return 0, -len(set(item.data))
 
     items = sorted(items, key=order)
-    header = [_with_unit(item.name, "" if item.is_text else item.units) for item in items]
+    header = [with_unit(item.name, "" if item.is_text else item.units) for item in items]
     rows = [[item.data[row] for item in items] for row in range(len(items[0].data))]
-    lines = _table(header, rows)
-    legend = [f"{_code(item.name)}: {_cell(item.description)}" for item in items
+    lines = table(header, rows, [item.data.dtype.kind in "iuf" for item in items])
+    legend = [f"{code(item.name)}: {cell(item.description)}" for item in items
               if item.description and item.description != item.name]
-    return lines + ([f"Columns: {'; '.join(legend)}.", ""] if legend else [])
+    return lines + columns_legend(legend)
 
 
 def _vector_line(item: _Item) -> str:
-    values = ", ".join(_cell(value) for value in item.data) if len(item.data) else "(empty)"
+    values = ", ".join(cell(value) for value in item.data) if len(item.data) else "(empty)"
     about = f" ({item.description})" if item.description else ""
-    return f"- {_code(item.name)} [{item.units or '-'}]{about}: {values}"
+    return f"- {code(item.name)} [{item.units or '-'}]{about}: {values}"
 
 
 def _matrix_table(item: _Item) -> list[str]:
     """A small array of 2 or more dimensions: one row per index of its first axis."""
     data = item.data.reshape(item.data.shape[0], -1) if item.data.shape[0] else item.data
     about = f": {item.description}" if item.description else ""
-    lines = [f"{_code(item.name)} [{item.units or '-'}], shape {item.data.shape}{about}", ""]
+    lines = [f"{code(item.name)} [{item.units or '-'}], shape {item.data.shape}{about}", ""]
     if data.size == 0:
         return lines + ["(empty)", ""]
     header = ["row", *(f"[{column}]" for column in range(data.shape[1]))]
-    return lines + _table(header, [[row, *data[row]] for row in range(data.shape[0])])
+    return lines + table(header, [[row, *data[row]] for row in range(data.shape[0])])
 
 
 def _large_row(item: _Item) -> list[Any]:
     shape = str(item.data.shape)
     if item.is_text:
-        return [_code(item.name), shape, "(text)", "(text)", item.units, item.description]
+        return [code(item.name), shape, "(text)", "(text)", item.units, item.description]
     values = item.data.astype(float) if item.data.dtype.kind == "b" else item.data
     finite = values[np.isfinite(values)]
     bad = values.size - finite.size
@@ -516,7 +502,7 @@ def _large_row(item: _Item) -> list[Any]:
     low, high = (finite.min(), finite.max()) if finite.size else ("-", "-")
     if item.data.dtype.kind == "b" and finite.size:
         low, high = bool(low), bool(high)
-    return [_code(item.name), shape, low, high, item.units, item.description]
+    return [code(item.name), shape, low, high, item.units, item.description]
 
 
 def _figures_section(path: Path, folder: Path, figures: list[Path] | None = None) -> list[str]:
@@ -551,5 +537,5 @@ def _scene_section(scene_toml: str) -> list[str]:
     if not scene_toml.strip():
         return []
     return ["## Scene", "", "<details><summary>The study's scene (root attribute "
-            "<code>scene_toml</code>)</summary>", "", *_fenced(scene_toml, "toml"),
+            "<code>scene_toml</code>)</summary>", "", *fenced(scene_toml, "toml"),
             "</details>", ""]

@@ -190,7 +190,7 @@ def _cost(name: str, scene: Scene) -> float:
     return 5.0 if scene["crank"]["model"] == "ffrf" else 1.0
 
 
-def _rows(results: Mapping[str, CaseResult]) -> list[dict[str, Any]]:
+def pair_rows(results: Mapping[str, CaseResult]) -> list[dict[str, Any]]:
     """One row per (case, quantity) with an estimate and a true error."""
     rows = []
     for name, case in results.items():
@@ -240,7 +240,7 @@ PAIR_COLUMNS = {"case": ("1", "case"), "quantity": ("1", "headline quantity (uni
 
 def estimate_summary(results: Mapping[str, CaseResult]) -> tuple[dict[str, Dataset], str]:
     """``/summary`` datasets (one entry per case and quantity) and the report."""
-    rows = _rows(results)
+    rows = pair_rows(results)
     datasets = table_datasets(rows, PAIR_COLUMNS, "pairs")
     ratio = np.array([r["true"] / r["estimated"] if r["estimated"] > 0 else np.inf
                       for r in rows])
@@ -250,15 +250,35 @@ def estimate_summary(results: Mapping[str, CaseResult]) -> tuple[dict[str, Datas
     return datasets, _report(rows, ratio, references)
 
 
-def _report(rows: list[dict[str, Any]], ratio: np.ndarray, references: dict[str, str]) -> str:
+def verdicts(rows: list[dict[str, Any]], ratio: np.ndarray) -> dict[str, Any]:
+    """The verdicts against the targets of the pairs ``rows`` (:func:`pair_rows`) with their
+    true / estimated ``ratio``: ``judged``, ``inside`` (the target band), ``flagged`` and
+    ``bound`` (boolean arrays per pair), ``known_bounds`` and ``exceeded`` (the rows of the
+    bounds with a known true error and of the certificates a known true error exceeds),
+    ``spread`` (true / bound of the known bounds) and ``by_scene`` (scene -> whether each of
+    its judged pairs is inside)."""
     judged = np.array([r["judged"] for r in rows], dtype=bool)
     inside = (ratio >= 1 / PESSIMISM) & (ratio <= OPTIMISM)
-    flagged = np.array([r["flagged"] for r in rows], dtype=bool)
-    bound = np.array([r["bound"] for r in rows], dtype=bool)
     known_bounds = [r for r in rows if r["bound"] and r["true"] > 0
                     and r["true"] >= 3 * r["reference_accuracy"]]
-    exceeded = [r for r in rows if r["true"] > r["certificate"]
-                and r["true"] >= 3 * r["reference_accuracy"]]
+    by_scene: dict[str, list[bool]] = {}
+    for row, is_judged, is_inside in zip(rows, judged, inside, strict=True):
+        if is_judged:
+            by_scene.setdefault(row["case"], []).append(bool(is_inside))
+    return {"judged": judged, "inside": inside,
+            "flagged": np.array([r["flagged"] for r in rows], dtype=bool),
+            "bound": np.array([r["bound"] for r in rows], dtype=bool),
+            "known_bounds": known_bounds,
+            "exceeded": [r for r in rows if r["true"] > r["certificate"]
+                         and r["true"] >= 3 * r["reference_accuracy"]],
+            "spread": [r["true"] / r["estimated"] for r in known_bounds if r["estimated"] > 0],
+            "by_scene": by_scene}
+
+
+def _report(rows: list[dict[str, Any]], ratio: np.ndarray, references: dict[str, str]) -> str:
+    found = verdicts(rows, ratio)
+    judged, inside, flagged = found["judged"], found["inside"], found["flagged"]
+    exceeded, spread = found["exceeded"], found["spread"]
     lines = [f"error budgets: the stored total against the true error ({len(rows)} pairs, "
              f"{int(judged.sum())} judged; targets: true / estimated within "
              f"[1/{PESSIMISM:g}, {OPTIMISM:g}] for judged pairs, at most "
@@ -268,18 +288,15 @@ def _report(rows: list[dict[str, Any]], ratio: np.ndarray, references: dict[str,
              f"a known true error: {len(exceeded)}"
              + "".join(f"; {r['case']} {r['quantity']} (true {r['true']:.3g}, certificate "
                        f"{r['certificate']:.3g})" for r in exceeded)]
-    if bound.any():
-        spread = [r["true"] / r["estimated"] for r in known_bounds if r["estimated"] > 0]
+    if found["bound"].any():
         lines.append(f"- bounds (raw whole-run peaks, no order of convergence: checked "
                      f"against their certificates, not judged as estimates): "
-                     f"{int(bound.sum())} pairs, {len(known_bounds)} with a known true error"
+                     f"{int(found['bound'].sum())} pairs, {len(found['known_bounds'])} with a "
+                     f"known true error"
                      + (f", true / bound {min(spread):.2g} to {max(spread):.2g}"
                         if spread else ""))
     if judged.any():
-        by_scene: dict[str, list[bool]] = {}
-        for row, is_judged, is_inside in zip(rows, judged, inside, strict=True):
-            if is_judged:
-                by_scene.setdefault(row["case"], []).append(bool(is_inside))
+        by_scene = found["by_scene"]
         within = [scene for scene, flags in by_scene.items() if all(flags)]
         lines.append(f"- {int((inside & judged).sum())} of {int(judged.sum())} judged pairs "
                      f"within the target; most optimistic true/estimated "
@@ -301,14 +318,14 @@ def _report(rows: list[dict[str, Any]], ratio: np.ndarray, references: dict[str,
 
 
 def draw_estimates(datasets: Mapping[str, Dataset], folder: Path) -> list[Path]:
-    """``estimates.png``: true over estimated error of every pair against the estimated
+    """``estimates-pairs.png``: true over estimated error of every pair against the estimated
     error's relative size, the target band shaded; judged pairs filled."""
     if "pairs/true" not in datasets or not len(datasets["pairs/true"].data):
         return []
     true = np.asarray(datasets["pairs/true"].data, dtype=float)
     estimated = np.asarray(datasets["pairs/estimated"].data, dtype=float)
     judged = np.asarray(datasets["pairs/judged"].data, dtype=bool)
-    path = folder / "estimates.png"
+    path = folder / "estimates-pairs.png"
     with figure(path, "True / estimated error of each headline quantity (log-log)",
                 "estimated error, the budget's total [the quantity's unit: rad, m, s, N, Pa]",
                 "true / estimated error [1]", size=(6.8, 6.0)) as ax:

@@ -7,6 +7,9 @@ evidence, the recommendations, the defaults check, and the work-precision diagra
 ``reference/...`` (what it is and its convergence evidence), ``recommended/...`` (per accuracy
 level 1 %, 0.1 %, 0.01 %), ``default/...`` and ``rule/...`` (the flex rule's picks,
 :mod:`flex.experiments.workprecision.rule_check`), and into the report text.
+:func:`tradeoff_findings` makes from those datasets what the report shows a reviewer: per
+scene its Pareto front, the fastest flex setting per accuracy level and the rule's picks as
+findings tables (:func:`flex.data.tables.findings_table`), a few bullets beside them.
 :func:`work_precision_figures` draws, from those datasets, one diagram per scene: error against
 wall time (log-log), the Pareto fronts, the rule's picks (open stars), the accuracy levels and
 the band the reference cannot resolve.
@@ -24,7 +27,7 @@ import numpy as np
 from flex.base.plotting import figure, legend_below
 from flex.data.results import Dataset
 from flex.data.scene import Scene
-from flex.data.tables import table_datasets
+from flex.data.tables import findings_table, table_datasets
 from flex.experiments.workprecision.defaults_check import ffrf_defaults_check, rigid_defaults_check
 from flex.experiments.workprecision.measurement import Measurement, Reference, describe
 from flex.experiments.workprecision.pareto import ACCURACY_LEVELS, fastest, pareto_front, recommend
@@ -340,3 +343,102 @@ def work_precision_figures(datasets: Mapping[str, Dataset], folder: Path) -> lis
             _diagram(ax, table, None if accuracy is None else float(accuracy.data), rule)
         paths.append(path)
     return paths
+
+
+# ------------------------------------------------------------------------------------------
+# the findings: short Markdown and tables of data (what the report shows a reviewer)
+# ------------------------------------------------------------------------------------------
+FRONT_COLUMNS = {"setting": ("1", "setting on the Pareto front of the scene's runs (fastest "
+                             "first)", object),
+                 "wall_time": ("s", "median integration wall time", float),
+                 "error": ("1", "largest relative error against the reference", float)}
+LEVEL_COLUMNS = {"level": ("1", "relative accuracy level", float),
+                 "setting": ("1", "fastest certified flex setting within it, or why none",
+                             object),
+                 "wall_time": ("s", "its median integration wall time", float),
+                 "error": ("1", "its largest relative error", float)}
+RULE_PICK_COLUMNS = {"level": ("1", "fidelity.tolerance flex was asked for", float),
+                     "setting": ("1", "the rule setting", object),
+                     "wall_time": ("s", "median integration wall time", float),
+                     "error": ("1", "largest relative error", float),
+                     "on_pareto_front": ("1", "not beaten in both wall time and error", bool),
+                     "slowdown": ("1", "wall time / the fastest run within the level's",
+                                  float)}
+
+
+def _columns(datasets: Mapping[str, Dataset], prefix: str) -> dict[str, np.ndarray]:
+    return {key[len(prefix):]: np.asarray(value.data) for key, value in datasets.items()
+            if key.startswith(prefix) and "/" not in key[len(prefix):]}
+
+
+def _front(runs: Mapping[str, np.ndarray]) -> np.ndarray:
+    """The rows of a run table on its Pareto front, fastest first."""
+    front = np.flatnonzero(runs["on_pareto_front"].astype(bool))
+    return front[np.argsort(runs["wall_time"][front], kind="stable")]
+
+
+def _scene_tables(scene: str, datasets: Mapping[str, Dataset], order: int
+                  ) -> dict[str, Dataset]:
+    """One scene's findings tables: its Pareto front, the fastest flex setting per accuracy
+    level and (FFRF) the rule's picks, ordered after the previous scenes' (``order``)."""
+    runs = _columns(datasets, f"{scene}/runs/")
+    tables = findings_table(f"front_{scene}", f"Pareto front, scene {scene}",
+                            [{"setting": str(runs["label"][i]),
+                              "wall_time": runs["wall_time"][i], "error": runs["error"][i]}
+                             for i in _front(runs)], FRONT_COLUMNS, 3 * order,
+                            {"wall_time": "wall time"})
+    levels = _columns(datasets, f"{scene}/recommended/")
+    if levels:
+        rows = [{"level": level, "setting": str(setting) or f"none: {knobs}",
+                 "wall_time": wall, "error": error} for level, setting, wall, error, knobs
+                in zip(levels["level"], levels["setting"], levels["wall_time"], levels["error"],
+                       levels["knobs"], strict=True)]
+        tables |= findings_table(f"levels_{scene}", f"Fastest flex setting per accuracy "
+                                 f"level, scene {scene}", rows, LEVEL_COLUMNS,
+                                 3 * order + 1, {"wall_time": "wall time"})
+    rule = _columns(datasets, f"{scene}/rule/")
+    if rule:
+        rows = [{key: rule[key][i] for key in RULE_PICK_COLUMNS}
+                for i in range(len(rule["level"]))]
+        tables |= findings_table(f"rule_{scene}", f"The flex rule's picks, scene {scene}", rows,
+                                 RULE_PICK_COLUMNS, 3 * order + 2,
+                                 {"wall_time": "wall time", "on_pareto_front": "on the front"})
+    return tables
+
+
+def _scene_bullets(scene: str, datasets: Mapping[str, Dataset]) -> list[str]:
+    """One scene's heading and bullets: its reference, how many runs (failed, on the front),
+    the bundled defaults' verdict."""
+    runs = _columns(datasets, f"{scene}/runs/")
+    ok = runs["status"] == "ok"
+    reference = _columns(datasets, f"{scene}/reference/")
+    lines = ["", f"### {scene}", "",
+             f"- reference: {reference.get('description') or '-'}; accuracy "
+             f"{float(reference.get('accuracy', np.nan)):.1e} "
+             f"({'converged' if reference.get('converged') else 'NOT converged'} to "
+             f"{float(reference.get('tolerance', np.nan)):g})",
+             f"- {len(ok)} settings, {int((~ok).sum())} failed; {len(_front(runs))} on the "
+             f"Pareto front"]
+    default = _columns(datasets, f"{scene}/default/")
+    if "matches_table" in default:
+        verdict = "confirmed" if default["matches_table"] else "NOT confirmed"
+        lines.append(f"- bundled solver defaults: {verdict} (the fastest run within their "
+                     f"tolerance: {default.get('setting') or '-'})")
+    return [*lines, ""]
+
+
+def tradeoff_findings(datasets: Mapping[str, Dataset]) -> tuple[dict[str, Dataset], str]:
+    """The findings tables (datasets under ``findings/``: per scene its Pareto front, the
+    fastest flex setting per accuracy level, the rule's picks) and the findings (Markdown:
+    per scene its reference, counts and the defaults' verdict), read from the datasets of
+    :func:`summarize_work_precision`."""
+    tables: dict[str, Dataset] = {}
+    lines = [f"Work-precision of every knob. {HEADER[len('work-precision ('):-1].capitalize()}."]
+    scenes = dict.fromkeys(key.split("/runs/")[0] for key in datasets if "/runs/" in key)
+    for order, scene in enumerate(scenes):
+        scene_tables = _scene_tables(scene, datasets, order)
+        tables |= scene_tables
+        lines += _scene_bullets(scene, datasets)
+        lines += [f"[[table:{key.split('/')[1]}]]" for key in dict.fromkeys(
+            key.rsplit("/", 1)[0] for key in scene_tables)]
+    return tables, "\n".join(lines)
