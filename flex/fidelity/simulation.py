@@ -353,7 +353,7 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
                   else {})
         step = next_attempt(current.scene, list(rows.values()), tolerance, attempt,
                             time.perf_counter() - start, link_models, free,
-                            frozenset(budget.step_bounds), falls, floors)
+                            _flagged(rows, budget.step_bounds), falls, floors)
         lines.append(f"{attempt}: {settings_text(current.scene, link_models)}"
                      f"{' (the last companion at these settings, reused)' if reused else ''}: "
                      f"{step.line}")
@@ -366,6 +366,15 @@ def refine(resolution: Resolution, name: str = "case", *, cache_dir: Path | None
     _say_status(name, step.status, tolerance)
     _state_coverage(result, budget, kept, name, link_models, refined=True)
     return result
+
+
+def _flagged(rows: Mapping[str, Any], step_bounds: tuple[str, ...]) -> frozenset[str]:
+    """The quantities refinement does not chase: their step term is a bound (outside the
+    asymptotic range: it need not shrink with the step) and their largest term (where
+    another term dominates, its knob is still worth turning)."""
+    return frozenset(name for name in step_bounds if name in rows and rows[name].terms
+                     and max(rows[name].terms, key=lambda term: rows[name].terms[term])
+                     == "step")
 
 
 def _asked_rows(scene: Scene, budget: ErrorBudget, link_models: Mapping[str, LinkModel]
