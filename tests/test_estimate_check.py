@@ -47,3 +47,17 @@ def test_a_raw_peak_is_a_bound_checked_against_its_certificate_not_judged():
     case.attrs[f"true_error_{PEAK}"] = 3e-7  # above its certificate: still named
     _, report = estimate_summary({"a": case})
     assert "exceeded by a known true error: 1" in report
+
+
+def test_a_true_error_at_the_noise_floor_is_no_known_exceedance():
+    """Two runs' round-off (1e-13 rad on a crank angle of order 1, below the study's noise
+    floor) above a certificate of 3e-14 is not named; the same miss above the floor is."""
+    case = _case(2e-7, "")
+    case.attrs.update({f"estimated_error_{END}": 2.4e-14, f"true_error_{END}": 1e-13,
+                       f"reference_accuracy_{END}": 1e-15})
+    _, report = estimate_summary({"a": case})
+    assert "exceeded by a known true error: 0" in report
+    case.attrs.update({f"estimated_error_{END}": 2.4e-7, f"true_error_{END}": 1e-6,
+                       f"reference_accuracy_{END}": 1e-8})
+    _, report = estimate_summary({"a": case})
+    assert "exceeded by a known true error: 1" in report and END in report
