@@ -59,7 +59,7 @@ from flex.tools.report import default_report_path, figures_of, render_report
 MAKE_ALL_STUDIES = ("kinematics", "dynamics", "modal", "flexible", "spring", "wing", "crank",
                     "kfit")
 LONG_STUDIES = ("tradeoff", "stability", "bench", "estimates", "calibrate", "design",
-                "validation", "ladder", "spring_mass")
+                "validation", "ladder", "spring_mass", "references")
 STUDIES = ("simulate", *MAKE_ALL_STUDIES, *LONG_STUDIES)
 RESULTS_DIR = Path("results")
 #: keys that change what a study simulates in kind, not in degree: the drive, the wing, the

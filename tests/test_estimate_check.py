@@ -4,6 +4,8 @@ reported by name."""
 
 from __future__ import annotations
 
+import pytest
+
 from flex.data.results import CaseResult
 from flex.experiments.workprecision.estimate_check import estimate_summary, pair_rows
 from flex.fidelity.stored_budget import BOUNDS_ATTR, CERTIFICATE_ATTR, STEP_BOUNDS_ATTR
@@ -61,3 +63,32 @@ def test_a_true_error_at_the_noise_floor_is_no_known_exceedance():
                        f"reference_accuracy_{END}": 1e-8})
     _, report = estimate_summary({"a": case})
     assert "exceeded by a known true error: 1" in report and END in report
+
+
+def test_a_run_is_compared_with_the_stored_reference_of_its_physics():
+    """A value's true error is its difference to the stored value, a history's the largest
+    difference of the curves (the stored one interpolated on the run's times); the stored
+    accuracy travels with it."""
+    import numpy as np
+
+    from flex.data.reference_store import StoredReference
+    from flex.data.results import Dataset
+    from flex.experiments.workprecision.estimate_check import _compare
+
+    time_s = np.linspace(0.0, 0.03, 31)
+    run = CaseResult("run", "", datasets={
+        "time": Dataset(time_s, "s"), "crank/angle": Dataset(np.sin(time_s * 10) + 1e-3, "rad")},
+        attrs={f"estimated_error_{END}": 2e-3, "estimated_error_history_crank_angle": 2e-3})
+    stored_time = np.linspace(0.0, 0.03, 301)
+    reference = StoredReference(
+        "ref", {}, "model", "evidence", {END: float(np.sin(0.3)) - 5e-4,
+                                         "history_crank_angle": 1.0},
+        {END: 1e-5, "history_crank_angle": 2e-5}, {END: "rad", "history_crank_angle": "rad"},
+        {"time": stored_time, "crank/angle": np.sin(stored_time * 10)},
+        {"time": "s", "crank/angle": "rad"})
+    _compare(run, reference, "lifted")
+    assert run.attrs[f"true_error_{END}"] == pytest.approx(1.5e-3, rel=1e-9)
+    assert run.attrs[f"reference_accuracy_{END}"] == 1e-5
+    # linear interpolation of the stored sine at the run's (common) samples: exact there
+    assert run.attrs["true_error_history_crank_angle"] == pytest.approx(1e-3, rel=1e-6)
+    assert run.attrs[f"estimate_ratio_{END}"] == pytest.approx(2e-3 / 1.5e-3)

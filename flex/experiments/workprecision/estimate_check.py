@@ -1,25 +1,18 @@
 """Is a run's error budget honest? The stored total against the true error on many scenes.
 
 :func:`check_one` runs a scene as a user would (its own settings, the error budget on:
-:mod:`flex.fidelity.error_budget`) and builds its reference, the next rung of flex's ladder
-converged in step, modes and mesh:
-
-- the **model**: an FFRF coupler becomes the nonlinear FE coupler (an undamped one; the
-  crank has no higher rung and stays FFRF, with :data:`REFERENCE_MODES` modes); a rigid plate
-  link becomes the calibrated exact beam (:data:`REFERENCE_ELEMENTS` elements: the flexible
-  truth its user gets, against which its budget's model term must hold); a lumped rigid link
-  stays rigid (no plate: the budget leaves its elasticity out and says so);
-- the **step**: the run's divided by :data:`REFINEMENT`; a second reference at twice that
-  step gives the reference's own step accuracy (Richardson, the integrator's order);
-- the **mesh**: the reference's value plus the change the FFRF model (with
-  :data:`REFERENCE_MODES` modes, at the reference step) shows from the run's mesh to one
-  :data:`MESH_REFINEMENT` times finer (the mesh error of the same elements in the nonlinear
-  body, to leading order); a third of that change is counted in the reference's accuracy.
+:mod:`flex.fidelity.error_budget`) and compares it with the **stored reference** of its
+physics (:mod:`flex.data.reference_store`, made once by ``make references``: the calibrated
+exact beam for a plate link, the rigid mechanism at a fine step for lumped links,
+:mod:`flex.experiments.workprecision.stored_references`). Nothing is computed for the
+reference inside the run: a scene whose physics the store lacks fails with the command that
+makes it.
 
 Per headline quantity it stores on the case, as attributes:
 
-- ``true_error_<q>``: |run - reference| [the quantity's units];
-- ``reference_accuracy_<q>``: the reference's own error (step + mesh, above);
+- ``true_error_<q>``: |run - reference| [the quantity's units]; a history's the largest
+  difference of the run's curve to the stored one (sampled every 1e-5 s, interpolated);
+- ``reference_accuracy_<q>``: the reference's own error, as stored;
 - ``estimate_ratio_<q>``: estimated / true error (1: exact; below 1: optimistic).
 
 A pair is *judged* only where the true error is known (at least 3x the reference's
@@ -41,29 +34,16 @@ import numpy as np
 
 from flex.base.caseloop import run_each
 from flex.base.plotting import figure
-from flex.config.knobs import integrator_order
-from flex.config.settings import resolve_solver_settings
-from flex.data.headlines import BUILTIN_HEADLINES
-from flex.data.plates import is_damped
+from flex.data.headlines import BUILTIN_HEADLINES, history_difference
+from flex.data.reference_store import MissingReferenceError, StoredReference, reference_for
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import LINKS, Scene
 from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
-from flex.dynamics.link_models import EXACT_BEAM, FFRF, NONLINEAR_FE, RIGID
-from flex.fidelity.error_estimate import richardson_error
+from flex.experiments.workprecision.stored_references import curve_datasets
 from flex.fidelity.simulation import simulate_case
 from flex.fidelity.stored_budget import CERTIFICATE_ATTR, PREFIX, STEP_BOUNDS_ATTR, named_quantities
 
-#: the reference's step is the run's divided by this (order 2: 16x more accurate where the
-#: run is asymptotic); a second reference at twice it measures the first's step error
-REFINEMENT = 4
-#: modes of an FFRF link that stays FFRF in the reference, and of the mesh correction
-REFERENCE_MODES = 24
-#: elements of the exact beam that stands for a rigid plate link in its reference (0.011 % of
-#: the 0.7 mm plate's peak from its element limit, flex.config.ladder.EXACT_BEAM_COMPANIONS)
-REFERENCE_ELEMENTS = 128
-#: the mesh correction's finer mesh: the run's element size over this
-MESH_REFINEMENT = 2.0
 #: targets (issue 35): true / estimated within [1 / PESSIMISM, OPTIMISM] for every judged
 #: pair in the asymptotic range; at most FLAGGED_SHARE of all pairs flagged outside it (a
 #: step term that is a bound); no true error above its certificate
@@ -83,111 +63,59 @@ def _run(scene: Scene, name: str, overrides: list[str], cache_dir: Path | None) 
                          name, cache_dir=cache_dir)
 
 
-def reference_overrides(scene: Scene) -> tuple[list[str], str]:
-    """The overrides that lift a resolved scene's links to the reference's rung (see the
-    module doc), and a phrase saying what the reference is."""
-    overrides, parts = [], []
-    for link in LINKS:
-        values = scene[link]
-        if values["model"] == RIGID and values["geometry"] == "plate":  # its elasticity
-            overrides += [f'{link}.model="{EXACT_BEAM}"', f"{link}.elements={REFERENCE_ELEMENTS}"]
-            parts.append(f"the calibrated exact beam {link} ({REFERENCE_ELEMENTS} elements: the "
-                         f"flexible truth a user of the rigid {link} gets)")
-            continue
-        if values["model"] != FFRF:
-            continue
-        if link == "coupler" and not is_damped(values):
-            overrides.append(f'coupler.model="{NONLINEAR_FE}"')
-            parts.append("the nonlinear FE coupler")
-        else:
-            overrides.append(f"{link}.modes={REFERENCE_MODES}")
-            parts.append(f"the FFRF {link} with {REFERENCE_MODES} modes (its top rung)")
-    return overrides, ", ".join(parts) or "the same rigid model"
-
-
-def _mesh_overrides(scene: Scene, fine: bool) -> list[str]:
-    """The FFRF mesh-correction runs' overrides: every meshed link FFRF with
-    :data:`REFERENCE_MODES` modes, on the run's mesh or one :data:`MESH_REFINEMENT` finer."""
-    out = []
-    for link in LINKS:
-        if scene[link]["model"] == FFRF:
-            size = float(scene[link]["mesh_size_m"]) / (MESH_REFINEMENT if fine else 1.0)
-            out += [f"{link}.modes={REFERENCE_MODES}", f"{link}.mesh_size_m={size!r}"]
-    return out
-
-
-def check_one(name: str, scene: Scene, cache_dir: Path | None) -> CaseResult:
-    """The run of ``scene`` with its error budget, compared with its reference (see the
-    module doc); a failed run or reference makes a failed case."""
+def check_one(name: str, scene: Scene, cache_dir: Path | None,
+              store: Mapping[str, StoredReference]) -> CaseResult:
+    """The run of ``scene`` with its error budget, compared with the stored reference of its
+    physics (module doc); a failed run, or physics the store lacks, makes a failed case."""
     run = _run(scene, name, ["simulation.error_estimate=true"], cache_dir)
     if run.status != "ok":
         return run
-    resolved, _ = resolve_solver_settings(scene)
-    step = float(resolved["simulation"]["step_s"])
-    lift, what = reference_overrides(resolved)
-    quiet = ["simulation.error_estimate=false"]
-    runs = {"best": (lift, step / REFINEMENT), "other": (lift, 2 * step / REFINEMENT)}
-    if any(resolved[link]["model"] == FFRF for link in LINKS):
-        runs["mesh"] = (_mesh_overrides(resolved, False), step / REFINEMENT)
-        runs["mesh_other"] = (_mesh_overrides(resolved, False), 2 * step / REFINEMENT)
-        runs["fine_mesh"] = (_mesh_overrides(resolved, True), step / REFINEMENT)
-    done = {}
-    for key, (overrides, h) in runs.items():
-        done[key] = _run(resolved, f"{name}_{key}", [*overrides, *quiet,
-                                                     f"simulation.step_s={h!r}"], cache_dir)
-        if done[key].status != "ok":
-            return CaseResult(name, run.scene_toml, status="failed",
-                              message=f"reference ({key}) failed: {done[key].message}")
-    run.attrs["reference"] = (f"{what}, step {step / REFINEMENT:g} s"
-                              + (f", mesh corrected by the FFRF model from the run's mesh to "
-                                 f"one {MESH_REFINEMENT:g}x finer" if "mesh" in done else ""))
-    _compare(run, done, step, integrator_order(resolved["simulation"]))
+    try:
+        reference = reference_for(store, scene)
+    except MissingReferenceError as exc:
+        return CaseResult(name, run.scene_toml, status="failed", message=str(exc))
+    run.attrs["reference"] = f"stored {reference.name}: {reference.model}"
+    same_model = not any(scene[link]["geometry"] == "plate" for link in LINKS)
+    _compare(run, reference, "same model" if same_model else "lifted")
     return run
 
 
-def _compare(run: CaseResult, references: dict[str, CaseResult], step: float, order: int
-             ) -> None:
-    """``true_error_*``, ``reference_accuracy_*`` and ``estimate_ratio_*`` on ``run``. A
-    quantity the lifted reference does not compute (the nonlinear FE coupler's stress) is
-    measured against the FFRF one (:data:`REFERENCE_MODES` modes, mesh-corrected): its model
-    term is then not checked (``reference_rung_<q>``)."""
-    h = step / REFINEMENT
+def _compare(run: CaseResult, reference: StoredReference, rung: str) -> None:
+    """``true_error_*``, ``reference_accuracy_*``, ``reference_rung_*`` and
+    ``estimate_ratio_*`` on ``run`` for each quantity both have."""
+    curves = curve_datasets(reference)
     for quantity, headline in BUILTIN_HEADLINES.items():
-        values = {key: headline.read(case.datasets) for key, case in references.items()}
         ours = headline.read(run.datasets)
-        if ours is None or f"{PREFIX}{quantity}" not in run.attrs:
+        if (ours is None or f"{PREFIX}{quantity}" not in run.attrs
+                or quantity not in reference.values):
             continue
-        base, other = ("best", "other") if values["best"] is not None else ("mesh", "mesh_other")
-        if values.get(base) is None or values.get(other) is None:
-            continue
-        correction = (values["fine_mesh"] - values["mesh"]
-                      if values.get("mesh") is not None and values.get("fine_mesh") is not None
-                      else 0.0)
-        true = abs(ours - (values[base] + correction))
+        if headline.kind == "history":
+            true = history_difference(run.datasets, curves, headline.series)
+        else:
+            true = abs(ours - reference.values[quantity])
         run.attrs[f"true_error_{quantity}"] = true
-        run.attrs[f"reference_accuracy_{quantity}"] = richardson_error(
-            values[base], values[other], h, 2 * h, order) + abs(correction) / 3.0
-        run.attrs[f"reference_rung_{quantity}"] = "lifted" if base == "best" else "same model"
+        run.attrs[f"reference_accuracy_{quantity}"] = reference.accuracies[quantity]
+        run.attrs[f"reference_rung_{quantity}"] = rung
         run.attrs[f"estimate_ratio_{quantity}"] = (
             run.attrs[f"{PREFIX}{quantity}"] / true if true > 0 else math.inf)
 
 
-def check_estimates(scenes: Mapping[str, Scene], cache_dir: Path | None = None,
-                    progress: Progress | None = None, executor: Any = None
-                    ) -> dict[str, CaseResult]:
-    """:func:`check_one` for every scene: in order in this process, or on ``executor``
-    (:mod:`flex.sweep`'s, passed in) in parallel, the costliest first (:func:`_cost`)."""
-    return run_each(dict(scenes), functools.partial(check_one, cache_dir=cache_dir), progress,
-                    executor=executor, cost=_cost)
+def check_estimates(scenes: Mapping[str, Scene], store: Mapping[str, StoredReference],
+                    cache_dir: Path | None = None, progress: Progress | None = None,
+                    executor: Any = None) -> dict[str, CaseResult]:
+    """:func:`check_one` for every scene against ``store``: in order in this process, or on
+    ``executor`` (:mod:`flex.sweep`'s, passed in) in parallel, the costliest first
+    (:func:`_cost`)."""
+    return run_each(dict(scenes), functools.partial(check_one, cache_dir=cache_dir,
+                                                    store=store),
+                    progress, executor=executor, cost=_cost)
 
 
 def _cost(name: str, scene: Scene) -> float:
-    """A scene's rough cost for ordering the jobs [arbitrary units]: an FFRF coupler's
-    reference is the nonlinear FE coupler at a quarter of the step (its steps cost ~1 mm /
-    thickness x 0.1 s), an FFRF crank's a 24-mode FFRF run; a rigid scene is cheap."""
-    if scene["coupler"]["model"] == "ffrf":
-        return 10.0 + 1e-3 / float(scene["coupler"]["thickness_m"])
-    return 5.0 if scene["crank"]["model"] == "ffrf" else 1.0
+    """A scene's rough cost for ordering the jobs [arbitrary units]: a meshed link's run
+    (its reductions and budget companions) before a rigid one; thinner plates first."""
+    return sum(10.0 + 1e-3 / float(scene[link]["thickness_m"]) for link in LINKS
+               if scene[link]["model"] == "ffrf")
 
 
 def pair_rows(results: Mapping[str, CaseResult]) -> list[dict[str, Any]]:

@@ -1,0 +1,104 @@
+"""Stored references (flex.data.reference_store, flex.experiments.workprecision.
+stored_references): found by a scene's physics whatever its model and settings, written and
+read back unchanged, refused with one message when missing, foreign or broken; a reference's
+accuracy is the arithmetic its contract states, on runs made independently here; the bundled
+store holds every scene make estimates judges."""
+
+from __future__ import annotations
+
+import h5py
+import numpy as np
+import pytest
+
+from flex.base.errors import ResultFileError
+from flex.data.headlines import BUILTIN_HEADLINES
+from flex.data.reference_store import (
+    MissingReferenceError,
+    StoredReference,
+    bundled_store,
+    physics_identity,
+    read_store,
+    reference_for,
+    write_store,
+)
+from flex.data.scene import default_scene
+from flex.data.scene_edit import derive_scene
+
+
+def _reference(scene, name="thesis") -> StoredReference:
+    return StoredReference(name, physics_identity(scene), "the rigid mechanism", "evidence",
+                           {"crank_angle_end_rad": 0.6}, {"crank_angle_end_rad": 1e-7},
+                           {"crank_angle_end_rad": "rad"},
+                           {"time": np.linspace(0, 0.03, 4), "crank/angle": np.arange(4.0)},
+                           {"time": "s", "crank/angle": "rad"})
+
+
+def test_a_scene_finds_its_physics_whatever_its_model_and_settings():
+    base = derive_scene(default_scene(), ['coupler.geometry="plate"'])
+    store = {"thesis": _reference(base)}
+    ffrf = derive_scene(base, ['coupler.model="ffrf"', "coupler.mesh_size_m=0.003",
+                               "simulation.step_s=2e-5", "coupler.modes=4",
+                               "fidelity.tolerance=0.001"])
+    assert reference_for(store, ffrf).name == "thesis"
+    for physics in ("coupler.thickness_m=0.002", "drive.spring_preload_m=0.011",
+                    "simulation.end_time_s=0.02"):
+        with pytest.raises(MissingReferenceError, match="make references"):
+            reference_for(store, derive_scene(base, [physics]))
+
+
+def test_a_store_reads_back_what_was_written(tmp_path):
+    path = tmp_path / "refs.h5"
+    reference = _reference(default_scene())
+    write_store(path, {"thesis": reference}, {"git_commit": "abc"})
+    (back,) = read_store(path).values()
+    assert back.values == reference.values and back.accuracies == reference.accuracies
+    assert back.units == reference.units and back.digest == reference.digest
+    np.testing.assert_array_equal(back.curves["crank/angle"], reference.curves["crank/angle"])
+    assert back.curve_units["crank/angle"] == "rad"
+
+
+def test_a_missing_foreign_or_broken_store_is_refused_with_one_message(tmp_path):
+    with pytest.raises(ResultFileError, match="no reference store"):
+        read_store(tmp_path / "none.h5")
+    foreign = tmp_path / "foreign.h5"
+    with h5py.File(foreign, "w") as h5:
+        h5["x"] = 1.0
+    with pytest.raises(ResultFileError, match="not a flex reference store"):
+        read_store(foreign)
+    text = tmp_path / "text.h5"
+    text.write_text("not hdf5")
+    with pytest.raises(ResultFileError, match="unreadable reference store"):
+        read_store(text)
+
+
+def test_a_rigid_reference_states_its_step_change_over_three():
+    """make_reference on the rigid thesis mechanism over 5 ms: the value is the run at the
+    reference step, its accuracy a third of the change to an independent run at twice the
+    step (order 2)."""
+    from flex.experiments.workprecision.stored_references import (
+        RIGID_REFERENCE_STEP_S,
+        make_reference,
+    )
+    from flex.fidelity.simulation import simulate_case
+
+    scene = derive_scene(default_scene(), ["simulation.end_time_s=0.005"])
+    case = make_reference("rigid", scene)
+    assert case.status == "ok", case.message
+    coarse = simulate_case(derive_scene(scene, [
+        f"simulation.step_s={2 * RIGID_REFERENCE_STEP_S!r}", "simulation.error_estimate=false",
+        "simulation.output_step_s=0.0"]))
+    angle = BUILTIN_HEADLINES["crank_angle_end_rad"]
+    value = case.attrs["reference_value_crank_angle_end_rad"]
+    assert case.attrs["reference_accuracy_crank_angle_end_rad"] == pytest.approx(
+        abs(value - angle.read(coarse.datasets)) / 3.0, rel=1e-9)
+    assert 0 < case.attrs["reference_accuracy_crank_angle_end_rad"] < 1e-6 * abs(value)
+
+
+def test_the_bundled_store_holds_every_scene_make_estimates_judges():
+    from studies import estimates
+
+    store = read_store(bundled_store())
+    scenes = estimates.cases(default_scene())
+    for name, scene in scenes.items():
+        reference = reference_for(store, scene)
+        assert reference.values, name
