@@ -102,3 +102,19 @@ def test_the_bundled_store_holds_every_scene_make_estimates_judges():
     for name, scene in scenes.items():
         reference = reference_for(store, scene)
         assert reference.values, name
+
+
+def test_a_stored_curve_between_its_samples_states_its_interpolation_error():
+    """A 1 kHz sine sampled every 1e-5 s (the store's spacing), read at the midpoints: the
+    cubic spline's true error against the sine lies within [1/3, 3] of the stated one."""
+    from flex.experiments.workprecision.stored_references import curve_at
+
+    stored_s = np.arange(0.0, 0.01 + 1e-12, 1e-5)
+    omega = 2 * np.pi * 1000.0
+    reference = StoredReference("sine", {}, "", "", {}, {}, {},
+                                {"time": stored_s, "x": np.sin(omega * stored_s)},
+                                {"time": "s", "x": "m"})
+    middle_s = stored_s[100:-100] + 5e-6
+    values, stated = curve_at(reference, "x", middle_s)
+    true = float(np.max(np.abs(values - np.sin(omega * middle_s))))
+    assert 1 / 3 <= true / stated <= 3

@@ -11,8 +11,10 @@ makes it.
 Per headline quantity it stores on the case, as attributes:
 
 - ``true_error_<q>``: |run - reference| [the quantity's units]; a history's the largest
-  difference of the run's curve to the stored one (sampled every 1e-5 s, interpolated);
-- ``reference_accuracy_<q>``: the reference's own error, as stored;
+  difference of the run's curve to the stored one (sampled every 1e-5 s, a cubic spline at
+  the run's times: :func:`flex.experiments.workprecision.stored_references.curve_at`);
+- ``reference_accuracy_<q>``: the reference's own error, as stored (a history's plus its
+  interpolation's);
 - ``estimate_ratio_<q>``: estimated / true error (1: exact; below 1: optimistic).
 
 A pair is *judged* only where the true error is known (at least 3x the reference's
@@ -34,13 +36,13 @@ import numpy as np
 
 from flex.base.caseloop import run_each
 from flex.base.plotting import figure
-from flex.data.headlines import BUILTIN_HEADLINES, history_difference
+from flex.data.headlines import BUILTIN_HEADLINES
 from flex.data.reference_store import MissingReferenceError, StoredReference, reference_for
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import LINKS, Scene
 from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
-from flex.experiments.workprecision.stored_references import curve_datasets
+from flex.experiments.workprecision.stored_references import curve_at
 from flex.fidelity.simulation import simulate_case
 from flex.fidelity.stored_budget import CERTIFICATE_ATTR, PREFIX, STEP_BOUNDS_ATTR, named_quantities
 
@@ -83,18 +85,22 @@ def check_one(name: str, scene: Scene, cache_dir: Path | None,
 def _compare(run: CaseResult, reference: StoredReference, rung: str) -> None:
     """``true_error_*``, ``reference_accuracy_*``, ``reference_rung_*`` and
     ``estimate_ratio_*`` on ``run`` for each quantity both have."""
-    curves = curve_datasets(reference)
     for quantity, headline in BUILTIN_HEADLINES.items():
         ours = headline.read(run.datasets)
         if (ours is None or f"{PREFIX}{quantity}" not in run.attrs
                 or quantity not in reference.values):
             continue
+        accuracy = reference.accuracies[quantity]
         if headline.kind == "history":
-            true = history_difference(run.datasets, curves, headline.series)
+            time_s = np.asarray(run.datasets["time"].data, dtype=float)
+            theirs, sampling = curve_at(reference, headline.series, time_s)
+            true = float(np.max(np.abs(np.asarray(run.datasets[headline.series].data)
+                                       - theirs)))
+            accuracy += sampling
         else:
             true = abs(ours - reference.values[quantity])
         run.attrs[f"true_error_{quantity}"] = true
-        run.attrs[f"reference_accuracy_{quantity}"] = reference.accuracies[quantity]
+        run.attrs[f"reference_accuracy_{quantity}"] = accuracy
         run.attrs[f"reference_rung_{quantity}"] = rung
         run.attrs[f"estimate_ratio_{quantity}"] = (
             run.attrs[f"{PREFIX}{quantity}"] / true if true > 0 else math.inf)
