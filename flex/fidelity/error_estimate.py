@@ -47,11 +47,16 @@ from flex.config.knobs import STEP, integrator_order
 from flex.data.headlines import BUILTIN_HEADLINES, Headline, history_difference
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, apply_overrides
+from flex.dynamics.advice import CHANNEL_ATTR
 
 #: a time scale with fewer steps per period than this is outside the asymptotic range
 MIN_STEPS_PER_PERIOD = 10.0
 #: an observed order within this distance of the integrator's is in the asymptotic range
 ORDER_WINDOW = 0.5
+#: an unresolved time scale whose numerical frequency lies at least this many times above the
+#: headline channel's cut-off is outside what a quantity read on the channel sees
+#: (:func:`filtered_out`)
+CHANNEL_MARGIN = 2.0
 #: outside the window the step term is a bound: this many times the larger difference of
 #: the three runs (a grid convergence index's safety factor for an unproven order)
 BOUND_FACTOR = 3.0
@@ -118,8 +123,35 @@ def unresolved_time_scales(time_scales: list[tuple[float, float, str]], step_s: 
     """The time scales (``(period [s], needed, what)``) with fewer than
     :data:`MIN_STEPS_PER_PERIOD` steps per period at ``step_s``, as phrases."""
     return [f"{what} ({period:.3g} s: {period / step_s:.3g} steps per period)"
-            for period, _, what in time_scales
-            if math.isfinite(period) and period / step_s < MIN_STEPS_PER_PERIOD]
+            for period, _, what in _unresolved(time_scales, step_s)]
+
+
+def _unresolved(time_scales: list[tuple[float, float, str]], step_s: float
+                ) -> list[tuple[float, float, str]]:
+    return [scale for scale in time_scales
+            if math.isfinite(scale[0]) and scale[0] / step_s < MIN_STEPS_PER_PERIOD]
+
+
+def numerical_frequency_Hz(period_s: float, step_s: float) -> float:
+    """The frequency [Hz] at which an implicit second-order integrator carries a mode of
+    ``period_s`` [s] at ``step_s`` [s]: 2 atan(omega h / 2) / (2 pi h), the trapezoidal
+    rule's algorithmic frequency (generalized-alpha's lies near it): the mode itself when
+    resolved, below the Nyquist frequency 1 / (2 h) however fast it is."""
+    omega_h = 2 * math.pi * step_s / period_s
+    return 2 * math.atan(omega_h / 2) / (2 * math.pi * step_s)
+
+
+def filtered_out(time_scales: list[tuple[float, float, str]], step_s: float,
+                 cutoff_Hz: float | None) -> bool:
+    """Whether every time scale ``step_s`` leaves unresolved rings, as integrated, at least
+    :data:`CHANNEL_MARGIN` times above the headline channel's cut-off ``cutoff_Hz`` [Hz]:
+    a quantity read on the channel then does not see it (its low-pass passes 1 / (1 +
+    margin^8) of it, 0.4 %, and less the higher it lies), and is in the asymptotic range of
+    what it does see. False without a channel."""
+    if cutoff_Hz is None or not math.isfinite(cutoff_Hz):
+        return False
+    return all(numerical_frequency_Hz(period, step_s) >= CHANNEL_MARGIN * cutoff_Hz
+               for period, _, _ in _unresolved(time_scales, step_s))
 
 
 def estimate_step_error(scene: Scene, result: CaseResult,
@@ -143,13 +175,20 @@ def estimate_step_error(scene: Scene, result: CaseResult,
     sim = scene["simulation"]
     step = float(sim["step_s"])
     unresolved = unresolved_time_scales(time_scales, step)
+    # quantities read on the headline channel do not see time scales it filters out
+    seen = set() if not unresolved else {
+        name for name, headline in headlines.items()
+        if not (headline.channel and filtered_out(time_scales, step,
+                                                  result.attrs.get(CHANNEL_ATTR)))}
     order = integrator_order(sim)
-    steps = [step, STEP.finer(step)] + ([STEP.finer(STEP.finer(step))] if unresolved else [])
+    steps = [step, STEP.finer(step)] + ([STEP.finer(STEP.finer(step))] if seen else [])
     start = time.perf_counter()
     made = [result]
     for companion_step in steps[1:]:
         if len(made) == 2 and allowances is not None and _bound_suffices(
-                headlines, [run.datasets for run in made], allowances):
+                {name: h for name, h in headlines.items() if name in seen},
+                [run.datasets for run in made],
+                {name: a for name, a in allowances.items() if name in seen}):
             steps = steps[:2]
             break
         try:
@@ -165,16 +204,19 @@ def estimate_step_error(scene: Scene, result: CaseResult,
         headline.read(made[-1].datasets) is not None for headline in headlines.values()
         if headline.read(result.datasets) is not None)
     values, bounds = _step_values(headlines, [run.datasets for run in made], order,
-                                  bool(unresolved), report_finest)
+                                  seen, report_finest)
     return ErrorEstimate(values, _method(steps, step, order, unresolved, report_finest),
-                         _validity(unresolved, bounds), time.perf_counter() - start, bounds,
+                         _validity(unresolved, bounds, len(seen) < len(headlines)),
+                         time.perf_counter() - start, bounds,
                          made[-1] if report_finest else None)
 
 
 def _step_values(headlines: Mapping[str, Headline], runs: list[Mapping[str, Any]], order: int,
-                 unresolved: bool, finest: bool) -> tuple[dict[str, float], dict[str, float]]:
+                 unresolved: set[str], finest: bool
+                 ) -> tuple[dict[str, float], dict[str, float]]:
     """Each quantity's step error (of the run, or of the finest run) and the quantities
-    whose value is a bound, with their observed order (NaN: not observed)."""
+    whose value is a bound, with their observed order (NaN: not observed); ``unresolved``:
+    the quantities that see a time scale the step leaves unresolved."""
     values: dict[str, float] = {}
     bounds: dict[str, float] = {}
     for name, headline in headlines.items():
@@ -186,7 +228,7 @@ def _step_values(headlines: Mapping[str, Headline], runs: list[Mapping[str, Any]
             continue
         differences = [_difference(headline, runs[k], runs[k + 1], read_values[k:k + 2])
                        for k in range(len(runs) - 1)]
-        if unresolved and len(differences) == 1:  # the order was not observed: a bound
+        if name in unresolved and len(differences) == 1:  # the order unobserved: a bound
             values[name], bounds[name] = BOUND_FACTOR * differences[0], math.nan
             continue
         values[name], observed = (finest_estimate if finest else finer_estimate)(differences,
@@ -272,11 +314,15 @@ def finest_estimate(differences: list[float], order: int) -> tuple[float, float 
     return BOUND_FACTOR * max(first, last), observed
 
 
-def _validity(unresolved: list[str], bounds: dict[str, float]) -> str:
+def _validity(unresolved: list[str], bounds: dict[str, float], channel_sees: bool) -> str:
     if not unresolved:
         return (f"asymptotic: every time scale of the scene has at least "
                 f"{MIN_STEPS_PER_PERIOD:g} steps per period")
     text = "outside the asymptotic range for " + "; ".join(unresolved)
+    if channel_sees:
+        text += (f" (not for the quantities read on the headline channel: as integrated "
+                 f"it rings at least {CHANNEL_MARGIN:g}x above the channel's cut-off, which "
+                 f"filters it out; their step terms are estimates at the integrator's order)")
     if bounds and all(math.isnan(order) for order in bounds.values()):
         return text + (": the order was not observed (its bound met the tolerance): the step "
                        "terms are bounds")
@@ -334,4 +380,5 @@ def _crest(magnitude: np.ndarray) -> np.ndarray:
 __all__ = ["BOUND_FACTOR", "BOUND_SHARE", "ErrorEstimate", "MIN_STEPS_PER_PERIOD",
            "ORDER_WINDOW", "estimate_step_error", "finer_estimate", "finest_estimate",
            "headline_difference",
-           "peak_difference", "richardson_error", "unresolved_time_scales"]
+           "peak_difference", "richardson_error", "unresolved_time_scales", "CHANNEL_MARGIN",
+           "filtered_out", "numerical_frequency_Hz"]
