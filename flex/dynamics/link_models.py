@@ -315,8 +315,15 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
     announce_mesh(link, c, f"reduction with {c['modes']} modes (instant if cached)",
                    c["modes"])
     with heartbeat(f"{link} reduction ({c['modes']} modes)"):
-        return build_reduction(Plate.of(c), c["mesh_size_m"], c["modes"], cache_dir,
-                               mode_selection=c["mode_selection"], mesh_order=mesh_order)
+        reduction = build_reduction(Plate.of(c), c["mesh_size_m"], c["modes"], cache_dir,
+                                    mode_selection=c["mode_selection"], mesh_order=mesh_order)
+    if c.get("geometric_stiffness") and not reduction.from_cache:
+        from flex.bodies.geometric_stiffness import geometric_stiffness
+
+        # now, while the build's mesh is at hand (0.1 s), and stored beside the reduction:
+        # a run that loads the reduction in another process would mesh the plate again (1-2 s)
+        geometric_stiffness(reduction)
+    return reduction
 
 
 #: an FFRF link's stored motion: its modal coordinates on its reduction's basis

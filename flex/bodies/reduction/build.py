@@ -80,6 +80,10 @@ class Reduction(PlateLink):
     #: the tetrahedra's order: 2 (quadratic, the default) or 1 (linear)
     mesh_order: int = MESH_ORDER
     _ffrf_interface: Any = field(default=None, repr=False, compare=False)
+    #: the ``ngsolve.Mesh`` of a build made in this process (second order after the import),
+    #: None when loaded from the cache: what is assembled on the mesh later (the geometric
+    #: stiffness) uses it instead of meshing the plate again (about as long as a build)
+    _mesh: Any = field(default=None, repr=False, compare=False)
 
     @property
     def n_modal_coordinates(self) -> int:
@@ -259,8 +263,8 @@ def build_reduction(plate: Plate, mesh_size_m: float, modes: int,
     parameters = _reduction_parameters(sizes, poisson_ratio, modes, mode_selection, mesh_order)
     key = cache_key(parameters)
     cache_file = None if cache_dir is None else Path(cache_dir) / f"{key}.hdf5"
-    fem, made, from_cache, cache_file = _cached_or_built(parameters, key, cache_file,
-                                                         ngsolve_threads)
+    fem, made, mesh, from_cache, cache_file = _cached_or_built(parameters, key, cache_file,
+                                                               ngsolve_threads)
     meta = fem.metaData["flex"]
     return Reduction(
         fem=fem, **sizes, poisson_ratio=float(poisson_ratio), modes=int(modes),
@@ -272,7 +276,7 @@ def build_reduction(plate: Plate, mesh_size_m: float, modes: int,
         cold_build_time_s=float(meta["cold_build_time_s"]),
         build_time_s=time.perf_counter() - start, from_cache=from_cache,
         cache_file=cache_file, key=key, mesh_order=int(mesh_order),
-        _ffrf_interface=made,
+        _ffrf_interface=made, _mesh=mesh,
     )
 
 
@@ -296,25 +300,26 @@ def _reduction_parameters(sizes: dict[str, float], poisson_ratio: float, modes: 
 
 
 def _cached_or_built(parameters: dict[str, Any], key: str, cache_file: Path | None,
-                     ngsolve_threads: int | None) -> tuple[Any, Any, bool, Path | None]:
+                     ngsolve_threads: int | None
+                     ) -> tuple[Any, Any, Any, bool, Path | None]:
     """The FEMinterface of ``key``: the cache entry that proves its content, or a new build
-    stored in its place. Returns the FEMinterface, its ObjectFFRFreducedOrderInterface (None
-    when loaded from the cache), whether it was loaded, and the cache file (None when nothing
-    is kept)."""
+    stored in its place. Returns the FEMinterface, its ObjectFFRFreducedOrderInterface and
+    its mesh (both None when loaded from the cache), whether it was loaded, and the cache
+    file (None when nothing is kept)."""
     fem = load_cached(cache_file, key) if cache_file is not None else None
     from_cache = fem is not None
-    made = None
+    made = mesh = None
     if fem is None:
         say_unproven(cache_file)
         with ngsolve_thread_count(ngsolve_threads):
-            fem, made = _build_fem(parameters, key)
+            fem, made, mesh = _build_fem(parameters, key)
         if cache_file is not None and not store(
                 cache_file, lambda temporary: fem.SaveToFile(str(temporary), mode="HDF5"),
                 REDUCTION_CACHE):
             cache_file = None  # not kept (said): nothing is cached beside it either
         elif cache_file is not None:
             ffrf_interface(fem, interface_path(cache_file, key), made=made)
-    return fem, made, from_cache, cache_file
+    return fem, made, mesh, from_cache, cache_file
 
 
 def _node_set_fields(fem) -> dict[str, np.ndarray]:
@@ -331,11 +336,12 @@ def _node_set_fields(fem) -> dict[str, np.ndarray]:
     return fields
 
 
-def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
+def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any, Any]:
     """Mesh + Craig-Bampton + stress modes.
 
     Returns the FEMinterface (flex's own data in ``metaData['flex']``, the mid-length node set
-    in ``nodeSets``) and its ObjectFFRFreducedOrderInterface.
+    in ``nodeSets``), its ObjectFFRFreducedOrderInterface and the mesh (second order after
+    the import).
     """
     import exudyn as exu
     from exudyn.FEM import FEMinterface, KirchhoffMaterial
@@ -388,7 +394,7 @@ def _build_fem(parameters: dict[str, Any], key: str) -> tuple[Any, Any]:
         "digest": fem_content_digest(fem),
     }
     fem.metaData["flex"]["meta_digest"] = meta_digest(fem.metaData["flex"])
-    # handed to the Reduction (not stored): saves re-projecting on the first add
-    return fem, interface
+    # handed to the Reduction (not stored): saves re-projecting on the first add, remeshing
+    return fem, interface, mesh
 
 
