@@ -10,14 +10,20 @@ export EXUDYN_NO_USER_SETTINGS := 1
 # (measured: the suite's collection 6.8 s instead of 2.7 s). The venv is installed without
 # compiling every module of every package (~20 s); what runs is compiled once, on first import.
 unexport PYTHONDONTWRITEBYTECODE
+# OpenBLAS (numpy's, scipy's and NGsolve's each) starts a thread per core that spins between
+# calls; with two studies at a time, their process pools and anyone else's jobs on the cores,
+# the spinning took the cores from the work: the modal study alone beside another engineer's
+# jobs (load ~5.5, 2 cores) took 87.5 s wall, 84.6 s CPU with the default and 37.1 s, 34.0 s
+# with one thread (back to back). flex parallelizes over processes, not inside BLAS.
+export OPENBLAS_NUM_THREADS := 1
 export MPLBACKEND := Agg
 RUN := $(PY) -m flex run
 
 STUDIES := kinematics dynamics modal flexible spring wing crank kfit
 # long runs, not part of `all` (README "Speed and accuracy", "Numerical stability"). On 2
 # shared cores: tradeoff ~11 min with an empty reduction cache, stability ~6-10 min, bench
-# ~14 min (it times `make all FORCE=1` twice); `make all` itself takes about 5-6 min when
-# every study reruns with an empty cache.
+# ~14 min (it times `make all FORCE=1` twice); `make all` itself took 3.6-7.8 min (6.8
+# CPU-minutes) with an empty cache while another engineer's jobs shared the cores (README).
 # `flex run stability` exits 0 when exactly its runs built to diverge fail.
 LONG := tradeoff stability bench estimates calibrate design validation ladder spring_mass references
 

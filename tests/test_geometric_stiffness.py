@@ -19,6 +19,7 @@ from flex.base.errors import SceneError
 from flex.base.physics import Plate, euler_buckling_load_N
 from flex.bodies.geometric_stiffness import (
     add_geometric_stiffness,
+    compute_geometric_stiffness,
     geometric_stiffness,
     pinned_pinned_eigen,
 )
@@ -129,6 +130,19 @@ def test_a_linear_tetrahedra_reduction_gets_its_geometric_stiffness(reduction_ca
     _, load_N = pinned_pinned_eigen(linear, stiffness, 0.0)
     # linear tetrahedra lock in bending: stiffer than the beam, never softer
     assert load_N > 0.99 * euler_load_N()
+
+def test_the_builds_own_mesh_gives_what_a_remade_mesh_gives():
+    # a reduction built in this process assembles K_G on its own mesh (no meshing again); one
+    # loaded from the cache remakes the mesh from its arguments: the same matrices
+    sizes = {key: PLATE[key] for key in ("length_m", "width_m", "youngs_modulus_Pa",
+                                         "density_kg_per_m3", "poisson_ratio")}
+    built = build_reduction(Plate(**sizes, thickness_m=0.003), 0.005, 2, cache_dir=None)
+    assert built._mesh is not None
+    own = compute_geometric_stiffness(built)
+    remade = compute_geometric_stiffness(dataclasses.replace(built, _mesh=None))
+    np.testing.assert_array_equal(own.matrix_per_N, remade.matrix_per_N)
+    np.testing.assert_array_equal(own.axial_force_row_N_per_m, remade.axial_force_row_N_per_m)
+
 
 @pytest.mark.parametrize("load_ratio", [-0.5, 0.25, 0.5, 0.75])
 def test_bending_frequency_follows_the_axial_load(reduction, stiffness, load_ratio):

@@ -331,6 +331,39 @@ def test_selection_rejects_unordered_sizes_and_reports_no_level_within_tolerance
     assert selection.selected_index is None  # even the finest level is 2.5 % off
 
 
+def test_selection_takes_a_given_reference_instead_of_extrapolating():
+    sizes_m = 0.004 * 2.0 ** (-np.arange(3) / 2)
+    frequencies = 1000.0 * (1 + 0.3 * (sizes_m / 0.004) ** 2 / 100)
+    selection = mesh_convergence.select_production_mesh(sizes_m, frequencies, 0.001,
+                                                        (1000.0, "order 4"))
+    assert (selection.reference_frequency, selection.reference_method) == (1000.0, "order 4")
+    assert math.isnan(selection.observed_order)
+    assert selection.selected_index == 2  # 0.3, 0.15, 0.075 % off the given value
+    with pytest.raises(SceneError, match="positive"):
+        mesh_convergence.select_production_mesh(sizes_m, frequencies, 0.001, (-1.0, "bad"))
+
+
+def test_raising_the_order_on_a_coarse_mesh_reaches_what_refining_the_mesh_does():
+    # 10 mm plate: orders 2-4 on a 10 mm mesh (0.5k-3k DOF) against second order on 5 and
+    # 3.5 mm meshes (2k, 5k DOF), two independent ways to the same limit
+    study = mesh_convergence.mesh_convergence(
+        COUPLER_LENGTH_M, 0.01, WIDTH_M, mesh_sizes_m=[0.01, 0.005, 0.0035],
+        relative_tolerance=1e-3, reference_orders=(3, 4), reference_max_dof_count=5000)
+    orders = study.orders
+    assert orders.mesh_size_m == 0.01 and list(orders.orders) == [2, 3, 4]
+    assert orders.frequencies_Hz[0] == study.frequencies_Hz[0]  # order 2: the level itself
+    # conforming elements bound the frequency from above: each refinement lowers it
+    assert np.all(np.diff(orders.frequencies_Hz) < 0)
+    assert np.all(np.diff(study.frequencies_Hz) < 0)
+    reference = study.selection.reference_frequency
+    assert reference == orders.frequencies_Hz[-1] < study.frequencies_Hz.min()
+    # the finest second-order level is within its own error (measured 2.4e-4) of it
+    assert study.frequencies_Hz[-1] / reference - 1 < 3e-4
+    assert orders.relative_error_estimate < 2e-4
+    assert study.selection.reference_method.startswith("order 4 on the 10 mm mesh")
+    assert study.production_mesh_size_m == 0.005  # 0.06 % off; the 10 mm level 0.4 %
+
+
 # --------------------------------------------------------------------------------------------
 # The thesis's tables
 # --------------------------------------------------------------------------------------------

@@ -128,24 +128,20 @@ def unit_axial_stress_matrices(reduction: Any, rising: bool = False) -> Any:
     tension of 1 N at ``end_b`` falling linearly to zero at ``end_a``: a distributed axial
     load).
 
-    The mesh is remade with the reduction's arguments (the same mesh and node numbering, as
-    :mod:`flex.bodies.nonlinear` relies on); the node positions are checked against the
-    reduction's.
+    The mesh is the reduction's own when it was built in this process, else remade with the
+    reduction's arguments (the same mesh and node numbering, as :mod:`flex.bodies.nonlinear`
+    relies on; the node positions are checked against the reduction's).
     """
     import ngsolve as ngs
     from scipy.sparse import csr_matrix
 
-    from flex.bodies.nonlinear import build_nonlinear_plate
-
     r = reduction
-    plate = build_nonlinear_plate(r.plate, r.mesh_size_m, mesh_order=r.mesh_order)
-    positions = r.fem.GetNodePositionsAsArray()
-    if plate.node_positions_m.shape != positions.shape or not np.allclose(
-            plate.node_positions_m, positions, rtol=0, atol=1e-9 * r.length_m):
-        raise RuntimeError("the remade mesh differs from the reduction's: cannot project")
-    space = ngs.NodalFESpace(plate.mesh, order=r.mesh_order) ** 3
+    mesh = getattr(r, "_mesh", None)
+    if mesh is None:
+        mesh = _remade_mesh(r)
+    space = ngs.NodalFESpace(mesh, order=r.mesh_order) ** 3
     u, v = space.TnT()
-    n_nodes = len(positions)
+    n_nodes = r.fem.NumberOfNodes()
     coordinate = np.arange(3 * n_nodes)
     ngsolve_index = (coordinate % 3) * n_nodes + coordinate // 3  # of Exudyn 3 i + c
     weight = ngs.x / r.length_m if rising else 1.0
@@ -158,6 +154,20 @@ def unit_axial_stress_matrices(reduction: Any, rising: bool = False) -> Any:
     matrix = csr_matrix((np.asarray(values), np.asarray(columns).astype(np.int64),
                          np.asarray(pointers).astype(np.int64)), shape=(space.ndof, space.ndof))
     return matrix[ngsolve_index][:, ngsolve_index]
+
+
+def _remade_mesh(reduction: Any) -> Any:
+    """The reduction's mesh made again from its arguments, its node positions checked
+    against the reduction's."""
+    from flex.bodies.nonlinear import build_nonlinear_plate
+
+    r = reduction
+    plate = build_nonlinear_plate(r.plate, r.mesh_size_m, mesh_order=r.mesh_order)
+    positions = r.fem.GetNodePositionsAsArray()
+    if plate.node_positions_m.shape != positions.shape or not np.allclose(
+            plate.node_positions_m, positions, rtol=0, atol=1e-9 * r.length_m):
+        raise RuntimeError("the remade mesh differs from the reduction's: cannot project")
+    return plate.mesh
 
 
 def projected(reduction: Any, matrix: Any) -> np.ndarray:

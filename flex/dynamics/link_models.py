@@ -297,13 +297,16 @@ def announce_mesh(link: str, values: dict[str, Any], what: str, modes: int | Non
 
 
 def reduction_for_scene(scene: Scene, link: str = "coupler", *,
-                        cache_dir: Path | None = None, mesh_order: int = 2):
+                        cache_dir: Path | None = None, mesh_order: int = 2,
+                        solve_modes: int | None = None):
     """The Craig-Bampton reduction of the scene's plate ``link`` (coupler or crank).
 
     ``cache_dir``: the reduction cache folder (loaded from there if present, written there
     if built; :func:`flex.bodies.reduction.reduction_cache_dir` names the user's), or None to
     build it in memory without any disk cache. ``mesh_order``: the tetrahedra's order (2, or
-    1 for the work-precision study's linear ones).
+    1 for the work-precision study's linear ones). ``solve_modes``: the link's modes as the
+    first of an eigen-solve of that many (:func:`flex.bodies.reduction.build_reduction`),
+    None: solved for its own count.
     """
     from flex.bodies.reduction import build_reduction
 
@@ -315,8 +318,16 @@ def reduction_for_scene(scene: Scene, link: str = "coupler", *,
     announce_mesh(link, c, f"reduction with {c['modes']} modes (instant if cached)",
                    c["modes"])
     with heartbeat(f"{link} reduction ({c['modes']} modes)"):
-        return build_reduction(Plate.of(c), c["mesh_size_m"], c["modes"], cache_dir,
-                               mode_selection=c["mode_selection"], mesh_order=mesh_order)
+        reduction = build_reduction(Plate.of(c), c["mesh_size_m"], c["modes"], cache_dir,
+                                    mode_selection=c["mode_selection"], mesh_order=mesh_order,
+                                    solve_modes=solve_modes)
+    if c.get("geometric_stiffness") and not reduction.from_cache:
+        from flex.bodies.geometric_stiffness import geometric_stiffness
+
+        # now, while the build's mesh is at hand (0.1 s), and stored beside the reduction:
+        # a run that loads the reduction in another process would mesh the plate again (1-2 s)
+        geometric_stiffness(reduction)
+    return reduction
 
 
 #: an FFRF link's stored motion: its modal coordinates on its reduction's basis

@@ -157,7 +157,8 @@ class PlateModes:
       scaled to a largest vertex displacement magnitude of 1 (sign: largest component > 0).
     - ``surface_triangles``: (n_triangles, 3) vertex indices of the boundary triangles.
     - ``element_count`` (tetrahedra), ``node_count`` (vertices), ``dof_count`` (unknowns of
-      the order-2 vector H1 space), ``constraint_count`` (linear constraints imposed).
+      the vector H1 space of the element order), ``constraint_count`` (linear constraints
+      imposed).
     - ``max_relative_residual``: max over modes of |K phi - lambda M phi - C^T mu| / |K phi|,
       the check that the eigensolver converged.
     - ``rigid_body_frequencies_Hz``: the skipped free-free rigid-body frequencies, Hz (should be
@@ -386,7 +387,9 @@ def plate_modes(length_m: float, thickness_m: float, width_m: float, mesh_size_m
     (z), netgen ``mesh_size_m`` (maxh), all in m; ``boundary_condition`` from
     :data:`LINK_BOUNDARY_CONDITIONS`; ``mode_count`` elastic modes wanted (1..200);
     ``material``; ``element_order`` of the vector H1 space (2 = second-order tetrahedra; 1 is
-    allowed to show shear locking); ``minimum_share`` for :func:`classify_kind_shares`;
+    allowed to show shear locking; 3 and 4 give a converged reference on a coarse mesh,
+    :mod:`flex.experiments.thesis.mesh_convergence`); ``minimum_share`` for
+    :func:`classify_kind_shares`;
     ``mesh`` an already built ``ngsolve.Mesh`` of the same plate (from
     :func:`flex.bodies.plate.plate_mesh`) to skip meshing. Returns :class:`PlateModes`. Method,
     joint constraints and classification: see the module doc.
@@ -447,8 +450,8 @@ def _check_plate_inputs(length_m: float, thickness_m: float, width_m: float,
                    mesh_size_m=mesh_size_m)
     check_choice("boundary_condition", boundary_condition, LINK_BOUNDARY_CONDITIONS)
     check_count("mode_count", mode_count)
-    if element_order not in (1, 2, 3):
-        raise SceneError(f"element_order = {element_order!r}: must be 1, 2 or 3")
+    if element_order not in (1, 2, 3, 4):
+        raise SceneError(f"element_order = {element_order!r}: must be 1, 2, 3 or 4")
     material.check()
 
 

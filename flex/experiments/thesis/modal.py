@@ -16,7 +16,7 @@ datasets stored under ``/summary`` (units from the keys: ``_m``, ``_s``, ``_Hz``
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, MutableMapping
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -25,9 +25,10 @@ import numpy as np
 
 from flex.base.physics import Plate
 from flex.base.thesis import THESIS_TABLE5
+from flex.bodies.plate import plate_mesh
 from flex.data.results import Dataset
 from flex.experiments.thesis.beams import Material, beam_link_modes
-from flex.experiments.thesis.fe_modes import plate_modes
+from flex.experiments.thesis.fe_modes import PlateModes, plate_modes
 from flex.experiments.thesis.mesh_convergence import mesh_convergence
 from flex.experiments.thesis.thesis_tables import (
     TABLE5_FE_MESH_SIZES_M,
@@ -38,6 +39,18 @@ from flex.experiments.thesis.thesis_tables import (
 
 CONVERGENCE_TOLERANCE = 0.001
 """Relative tolerance of the production mesh, on the first pinned-pinned in-plane frequency."""
+REFERENCE_ORDERS = (3, 4)
+"""Element orders raised to on one level's mesh for the converged reference (p-refinement:
+order 4 there is within ~3e-5 of the limit on every Table 5 plate, measured, where the
+finest second-order levels that Richardson extrapolation needed cost 4x the whole survey's
+time; reference notes, /work/shared/reference-notes.md)."""
+REFERENCE_MAX_DOF = 25_000
+"""Unknowns of the highest order's solve at most: the finest level's mesh within it carries
+the orders (each plate's costs 1-4 s on one core)."""
+CONVERGENCE_MAX_DOF = 20_000
+"""Second-order levels up to about this many unknowns: two to four levels finer than the
+production mesh show that it stays within tolerance (the levels above it, up to 60k, cost
+two thirds of the survey and served the Richardson reference only)."""
 CRANK_SECTION_M = (0.010, 0.010)
 """Thickness and width of the crank plate, m: flex's reading of the thesis's ANSYS section
 (Table 7)."""
@@ -72,12 +85,15 @@ def _store(datasets: dict[str, Dataset], prefix: str, table: dict) -> None:
 
 def survey(scene: Any, progress: Progress | None = None) -> tuple[dict[str, Dataset], str]:
     """The whole modal survey of ``scene``'s links: ``(datasets, report)``. ``progress`` gets
-    one call per long step (about 30 s in all on one core) and a final ``done``."""
+    one call per long step (about 20 s in all, measured on 2 shared cores) and a final
+    ``done``. Each plate is
+    meshed once per maxh: its free-free and pinned-pinned modes, Table 5's FE column (the
+    pinned-pinned solutions themselves) and its convergence levels share the meshes."""
     material = scene_material(scene)
     thicknesses_m = THESIS_TABLE5["coupler_thickness_m"]
     links = link_plates(scene, thicknesses_m)
-    steps = (["Table 5: 3D FE of the four coupler plates", "Tables 7 and 9: BEAM188 emulation"]
-             + [f"modes of {name}, {condition}" for name in links for condition in CONDITIONS]
+    steps = ([f"modes of {name}, {condition}" for name in links for condition in CONDITIONS]
+             + ["Table 5: 3D FE of the four coupler plates", "Tables 7 and 9: BEAM188 emulation"]
              + [f"mesh convergence, coupler t = {t * 1e3:g} mm" for t in thicknesses_m])
     counter = iter(range(len(steps)))
 
@@ -87,8 +103,18 @@ def survey(scene: Any, progress: Progress | None = None) -> tuple[dict[str, Data
             progress(steps[index], index, len(steps))
 
     datasets: dict[str, Dataset] = {}
+    meshes: dict[tuple[float, ...], dict[float, Any]] = {}  # plate sizes [m] -> maxh -> mesh
+    mode_lines, pinned = [], {}
+    for name, (plate, mesh_m) in links.items():
+        for condition in CONDITIONS:
+            step()
+            line, fe = link_modes(datasets, name, plate, mesh_m, condition,
+                                  meshes.setdefault(plate.sizes_m, {}))
+            mode_lines.append(line)
+            pinned[name, condition] = fe
     step()
-    table5 = thesis_table5_reproduction(material=material)
+    table5 = thesis_table5_reproduction(material=material, fe_modes=[
+        pinned[f"coupler_t{t * 1e3:g}mm", "pinned-pinned"] for t in thicknesses_m])
     _store(datasets, "table5", table5)
     lines = table5_report(table5)
     step()
@@ -97,15 +123,15 @@ def survey(scene: Any, progress: Progress | None = None) -> tuple[dict[str, Data
         _store(datasets, f"table_{link}", table)
         lines.append(link_table_line(link, table))
     lines.append("  first five modes [Hz] (FE | Timoshenko beam), kinds from the mode shapes:")
-    for name, (plate, mesh_m) in links.items():
-        for condition in CONDITIONS:
-            step()
-            lines.append(link_modes(datasets, name, plate, mesh_m, condition))
-    lines.append(f"  mesh convergence (pinned-pinned in-plane bending, tolerance "
-                 f"{CONVERGENCE_TOLERANCE:.1%}):")
+    lines += mode_lines
+    lines.append(f"  mesh convergence (pinned-pinned in-plane bending, second-order tetrahedra, "
+                 f"tolerance {CONVERGENCE_TOLERANCE:.1%}; reference: the element order raised "
+                 f"to {REFERENCE_ORDERS[-1]} on one level's mesh):")
     for thickness_m in thicknesses_m:
         step()
-        lines.append(convergence(datasets, scene, thickness_m, material))
+        coupler = replace(Plate.of(scene["coupler"]), thickness_m=float(thickness_m))
+        lines.append(convergence(datasets, scene, thickness_m, material,
+                                 meshes.setdefault(coupler.sizes_m, {})))
     if progress:
         progress("done", len(steps), len(steps))
     return datasets, "\n".join(lines)
@@ -160,12 +186,18 @@ def link_plates(scene: Any, thicknesses_m: np.ndarray) -> dict[str, tuple[Plate,
 
 
 def link_modes(datasets: dict[str, Dataset], name: str, plate: Plate, mesh_size_m: float,
-               condition: str) -> str:
+               condition: str, meshes: MutableMapping[float, Any] | None = None
+               ) -> tuple[str, PlateModes]:
     """Store the first five FE and Timoshenko modes of one plate (meshed at netgen maxh
     ``mesh_size_m`` [m]) under ``links/<name>/<condition>/`` (pinned-pinned also the mesh and
-    the mode shapes); return the report line."""
+    the mode shapes); return the report line and the FE modes. ``meshes``: the plate's
+    meshes by maxh [m], used and filled (None: meshed here)."""
     material = Material.of(plate)
-    fe = plate_modes(*plate.sizes_m, mesh_size_m, condition, material=material)
+    meshes = {} if meshes is None else meshes
+    if mesh_size_m not in meshes:
+        meshes[mesh_size_m] = plate_mesh(*plate.sizes_m, mesh_size_m)
+    fe = plate_modes(*plate.sizes_m, mesh_size_m, condition, material=material,
+                     mesh=meshes[mesh_size_m])
     beam = beam_link_modes(*plate.sizes_m, condition, material=material)
     group = f"links/{name}/{condition}"
     datasets[f"{group}/fe_frequencies"] = Dataset(fe.frequencies_Hz, "Hz", "3D FE")
@@ -183,16 +215,21 @@ def link_modes(datasets: dict[str, Dataset], name: str, plate: Plate, mesh_size_
                                                    "(mode, node, xyz), max |u| = 1")
     pairs = ", ".join(f"{f:.0f} {k} | {b:.0f}" for f, k, b in
                       zip(fe.frequencies_Hz, fe.mode_kinds, beam.frequencies_Hz, strict=True))
-    return f"    {name:16s} {condition:13s} {pairs}"
+    return f"    {name:16s} {condition:13s} {pairs}", fe
 
 
 def convergence(datasets: dict[str, Dataset], scene: Any, thickness_m: float,
-                material: Material) -> str:
+                material: Material, meshes: MutableMapping[float, Any] | None = None) -> str:
     """Store the mesh convergence of the coupler plate of thickness ``thickness_m`` [m] under
-    ``convergence/coupler_t<t>mm/``; return the report line."""
+    ``convergence/coupler_t<t>mm/`` (the levels, the order raised on one of them, the
+    reference and the production mesh); return the report line. ``meshes``: the plate's
+    meshes by maxh [m], used and filled."""
     coupler = scene["coupler"]
     conv = mesh_convergence(coupler["length_m"], thickness_m, coupler["width_m"],
-                            relative_tolerance=CONVERGENCE_TOLERANCE, material=material)
+                            relative_tolerance=CONVERGENCE_TOLERANCE,
+                            max_dof_count=CONVERGENCE_MAX_DOF, material=material,
+                            reference_orders=REFERENCE_ORDERS,
+                            reference_max_dof_count=REFERENCE_MAX_DOF, meshes=meshes)
     group = f"convergence/coupler_t{thickness_m * 1e3:g}mm"
     datasets[f"{group}/mesh_size"] = Dataset(np.asarray(conv.mesh_sizes_m), "m", "maxh")
     datasets[f"{group}/elements"] = Dataset(np.asarray(conv.element_counts), "1", "tets")
@@ -203,11 +240,23 @@ def convergence(datasets: dict[str, Dataset], scene: Any, thickness_m: float,
         conv.selection.reference_frequency, "Hz", conv.selection.reference_method)
     datasets[f"{group}/production_mesh_size"] = Dataset(conv.production_mesh_size_m, "m",
                                                         "coarsest level within tolerance")
+    orders = conv.orders
+    datasets[f"{group}/order/mesh_size"] = Dataset(orders.mesh_size_m, "m",
+                                                   "maxh of the mesh the order is raised on")
+    datasets[f"{group}/order/order"] = Dataset(orders.orders, "1", "tetrahedra's order")
+    datasets[f"{group}/order/dof"] = Dataset(orders.dof_counts, "1", "DOF")
+    datasets[f"{group}/order/frequency"] = Dataset(orders.frequencies_Hz, "Hz",
+                                                   "first in-plane bending")
+    datasets[f"{group}/order/relative_error_estimate"] = Dataset(
+        orders.relative_error_estimate, "1", "reference: |f(p max) - f(p max - 1)| / f(p max)")
     return (f"    t = {thickness_m * 1e3:4g} mm: levels "
             f"{', '.join(f'{h * 1e3:.2g}' for h in conv.mesh_sizes_m)} mm -> "
-            f"{', '.join(f'{f:.1f}' for f in conv.frequencies_Hz)} Hz; reference "
-            f"{conv.selection.reference_frequency:.2f} Hz "
-            f"({conv.selection.reference_method}); production mesh "
+            f"{', '.join(f'{f:.1f}' for f in conv.frequencies_Hz)} Hz; orders "
+            f"{', '.join(str(p) for p in orders.orders)} on the "
+            f"{orders.mesh_size_m * 1e3:.2g} mm mesh -> "
+            f"{', '.join(f'{f:.2f}' for f in orders.frequencies_Hz)} Hz; reference "
+            f"{conv.selection.reference_frequency:.2f} Hz (estimated error "
+            f"{orders.relative_error_estimate:.0e}); production mesh "
             f"{conv.production_mesh_size_m * 1e3:.3g} mm")
 
 
@@ -236,7 +285,8 @@ def draw_figures(datasets: dict[str, Dataset], folder: Path) -> list[Path]:
 
 
 def draw_convergence(path: Path, datasets: dict[str, Dataset]) -> Path:
-    """Relative error of each Table 5 plate's frequency against its reference, by DOF."""
+    """Relative error of each Table 5 plate's frequency against its reference, by DOF: the
+    second-order levels and, where stored, the orders raised on the reference's mesh."""
     from flex.base.plotting import decade_ticks, figure
 
     s = {k: v.data for k, v in datasets.items()}
@@ -252,17 +302,25 @@ def draw_convergence(path: Path, datasets: dict[str, Dataset]) -> Path:
             error = np.abs(frequency / reference - 1)
             drawn = error > 0  # the finest level is the reference itself when not extrapolated
             how = ("Richardson extrapolation" if method == "richardson"
-                   else "finest level, not drawn" if method == "finest" else method)
+                   else "finest level, not drawn" if method == "finest"
+                   else method.split(", estimated")[0])
             ax.loglog(dof[drawn], error[drawn], "o-", color=f"C{index}",
                       label=f"t = {t:g} mm (reference: {how})")
             production = np.isclose(s[f"{group}/mesh_size"],
                                     float(s[f"{group}/production_mesh_size"]))
             ax.loglog(dof[production & drawn], error[production & drawn], "o", ms=11,
                       mfc="none", color=f"C{index}")
+            if f"{group}/order/dof" in s:  # the order raised on one mesh (the reference's)
+                order_error = np.abs(np.asarray(s[f"{group}/order/frequency"]) / reference - 1)
+                shown = order_error > 0  # the highest order is the reference
+                ax.loglog(np.asarray(s[f"{group}/order/dof"])[shown], order_error[shown], "s--",
+                          color=f"C{index}", mfc="none")
         ax.axhline(CONVERGENCE_TOLERANCE, color="r", ls="--",
                    label=f"tolerance {CONVERGENCE_TOLERANCE:.1%}")
         ax.plot([], [], "o", ms=11, mfc="none", color="k",
                 label="production mesh (coarsest within tolerance)")
+        ax.plot([], [], "s--", mfc="none", color="k",
+                label="element order 2, 3 on the reference's mesh (order 4)")
         decade_ticks(ax)
     return path
 

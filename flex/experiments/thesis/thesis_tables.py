@@ -40,7 +40,7 @@ from flex.experiments.thesis.beams import (
     euler_bernoulli_bending_rad_per_s,
     timoshenko_bending_rad_per_s,
 )
-from flex.experiments.thesis.fe_modes import plate_modes
+from flex.experiments.thesis.fe_modes import PlateModes, plate_modes
 
 DEPLOYMENT_TIME_S = THESIS_DELTA_T_S
 """Deployment time delta_t of the thesis's criterion, s
@@ -95,7 +95,8 @@ def _table5_published_columns(length_m: float, width_m: float) -> dict[str, np.n
 def thesis_table5_reproduction(mesh_sizes_m: Sequence[float] | None = TABLE5_FE_MESH_SIZES_M,
                                material: Material = THESIS_STEEL,
                                deployment_time_s: float = DEPLOYMENT_TIME_S,
-                               criterion_k: float = THESIS_K_CRITERION
+                               criterion_k: float = THESIS_K_CRITERION,
+                               fe_modes: Sequence[PlateModes] | None = None
                                ) -> dict[str, np.ndarray]:
     """Table 5 of Cavezza 2012 recomputed: four plate couplers 0.08 x 0.01 x t m.
 
@@ -106,7 +107,9 @@ def thesis_table5_reproduction(mesh_sizes_m: Sequence[float] | None = TABLE5_FE_
     pinned-pinned, netgen maxh ``mesh_sizes_m[i]`` m; None skips the FE columns), then for
     Euler-Bernoulli and FE both period conventions and the counts n = delta_t / T with
     ``deployment_time_s`` (s), and the verdicts of the criterion with k = ``criterion_k``
-    ("rigid" if n > k, Eq. 64-65).
+    ("rigid" if n > k, Eq. 64-65). ``fe_modes``: the four plates' pinned-pinned FE modes of
+    ``material`` when the caller has them already (the modal survey solves the same plates);
+    one that is not that plate at that maxh is solved here, as are all with None.
 
     Returns a dict of numpy arrays, one entry per model (index 0..3), with units in the keys:
     ``model``, ``coupler_{length,width,thickness}_m``, ``thesis_frequency_as_published``,
@@ -140,7 +143,7 @@ def thesis_table5_reproduction(mesh_sizes_m: Sequence[float] | None = TABLE5_FE_
     }
     table.update(_periods_and_counts("euler_bernoulli", eb, deployment_time_s, criterion_k))
     if mesh_sizes_m is not None:
-        table.update(_table5_fe_columns(mesh_sizes_m, material, eb, timoshenko))
+        table.update(_table5_fe_columns(mesh_sizes_m, material, eb, timoshenko, fe_modes))
         table.update(_periods_and_counts("fe", table["fe_omega_rad_per_s"], deployment_time_s,
                                          criterion_k))
     table["deployment_time_s"] = np.array(deployment_time_s)
@@ -149,17 +152,20 @@ def thesis_table5_reproduction(mesh_sizes_m: Sequence[float] | None = TABLE5_FE_
 
 
 def _table5_fe_columns(mesh_sizes_m: Sequence[float], material: Material,
-                       eb_rad_per_s: np.ndarray, timoshenko_rad_per_s: np.ndarray
-                       ) -> dict[str, np.ndarray]:
+                       eb_rad_per_s: np.ndarray, timoshenko_rad_per_s: np.ndarray,
+                       solved: Sequence[PlateModes] | None = None) -> dict[str, np.ndarray]:
     """The 3D FE columns of Table 5 (:func:`thesis_table5_reproduction`): first pinned-pinned
-    in-plane bending of each plate at netgen maxh ``mesh_sizes_m`` (m, one per model)."""
+    in-plane bending of each plate at netgen maxh ``mesh_sizes_m`` (m, one per model);
+    ``solved``: those solutions if the caller has them, else None."""
     sizes = np.asarray(mesh_sizes_m, dtype=float)
     if sizes.shape != (4,):
         raise SceneError("mesh_sizes_m: give four sizes (m), one per Table 5 model")
     fe, elements, dofs = [], [], []
-    for t, size_m in zip(THESIS_TABLE5["coupler_thickness_m"], sizes, strict=True):
-        modes = plate_modes(THESIS_COUPLER_LENGTH_M, float(t), THESIS_TABLE5_WIDTH_M,
-                            float(size_m), "pinned-pinned", 5, material)
+    for index, (t, size_m) in enumerate(zip(THESIS_TABLE5["coupler_thickness_m"], sizes,
+                                            strict=True)):
+        modes = _given_modes(solved, index, float(t), float(size_m)) or plate_modes(
+            THESIS_COUPLER_LENGTH_M, float(t), THESIS_TABLE5_WIDTH_M, float(size_m),
+            "pinned-pinned", 5, material)
         fe.append(modes.frequencies_rad_per_s[modes.first_of_kind("in-plane bending")])
         elements.append(modes.element_count)
         dofs.append(modes.dof_count)
@@ -173,6 +179,20 @@ def _table5_fe_columns(mesh_sizes_m: Sequence[float], material: Material,
         "fe_vs_euler_bernoulli_relative": fe_omega / eb_rad_per_s - 1.0,
         "fe_vs_timoshenko_relative": fe_omega / timoshenko_rad_per_s - 1.0,
     }
+
+
+def _given_modes(solved: Sequence[PlateModes] | None, index: int, thickness_m: float,
+                 mesh_size_m: float) -> PlateModes | None:
+    """``solved[index]`` if it is the Table 5 plate's of this thickness [m], pinned-pinned at
+    this maxh [m], else None (a scene with another coupler length or width solved other
+    plates)."""
+    modes = None if solved is None else solved[index]
+    if modes is None or (modes.boundary_condition, modes.length_m, modes.thickness_m,
+                         modes.width_m, modes.mesh_size_m) != (
+            "pinned-pinned", THESIS_COUPLER_LENGTH_M, thickness_m, THESIS_TABLE5_WIDTH_M,
+            mesh_size_m):
+        return None
+    return modes
 
 
 THESIS_ANSYS_SECTION_SIDE_M = 0.010
