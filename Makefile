@@ -22,8 +22,8 @@ RUN := $(PY) -m flex run
 STUDIES := kinematics dynamics modal flexible spring wing crank kfit
 # long runs, not part of `all` (README "Speed and accuracy", "Numerical stability"). On 2
 # shared cores: tradeoff ~11 min with an empty reduction cache, stability ~6-10 min, bench
-# ~14 min (it times `make all FORCE=1` twice); `make all` itself took 3.6-7.8 min (6.8
-# CPU-minutes) with an empty cache while another engineer's jobs shared the cores (README).
+# ~14 min (it times `make all FORCE=1` twice); `make all` itself took 3.5 min from a fresh
+# clone with an empty cache on 2 quiet cores, 3.6-7.8 min on shared ones (README).
 # `flex run stability` exits 0 when exactly its runs built to diverge fail.
 LONG := tradeoff stability bench estimates calibrate design validation ladder spring_mass references
 
