@@ -1,23 +1,18 @@
 """Study ``estimates``: is the error budget every run stores honest?
 
-Each scene runs as a user would run it (its own, "auto", settings; the error budget on: step,
-modes, mesh and model, :mod:`flex.fidelity.error_budget`) over the whole deployment, and is
-compared with the stored reference of its physics (``make references``, bundled in
+16 scenes run as a user would (own "auto" settings, the error budget on) over the whole
+deployment, each against the stored reference of its physics (``make references``:
 ``flex/data/references.h5``; :mod:`flex.experiments.workprecision.estimate_check`): plate links
-against the calibrated exact beam, the flexible truth a user of a rigid or FFRF plate gets;
-lumped rigid links against the same rigid model at a fine step. Stored per case: the run, its
-``estimated_error_*``, ``true_error_*``, ``reference_accuracy_*`` and ``estimate_ratio_*``
-attributes; under ``/summary/pairs`` one entry per case and headline quantity; the findings
-and their tables (``/summary/findings``) and a figure per quantity
-(:mod:`flex.experiments.workprecision.estimate_report`). Targets (issue
-35): true / estimated within [1/2, 1.5] for every pair in the asymptotic range, at most 10 % of
-the pairs flagged outside it, no certificate exceeded; on 16 scenes (thin and thick plates,
-springs, a constant-speed drive, aluminium). Then five plate scenes on physics no calibration
-fitted, each asked 1 %, 0.3 % and 0.1 % on its deployment peak deflection, first guess and
-refined (:mod:`flex.experiments.workprecision.tolerance_check`): how often the tolerance is
-truly met, and how often a run states it met and misses. Left out for want of a stored
-reference: a damped plate (the beam has no damping model) and the FFRF crank on a lumped
-coupler (a beam crank needs a beam coupler).
+against the calibrated exact beam, lumped rigid links against the rigid model at a fine step.
+Stored per case: the run and its ``estimated_error_*``, ``true_error_*``,
+``reference_accuracy_*``, ``estimate_ratio_*``; ``/summary/pairs``, the findings tables and a
+figure per quantity (:mod:`flex.experiments.workprecision.estimate_report`). Targets: true /
+estimated within [1/2, 1.5] for every judged pair, at most 10 % flagged, no certificate
+exceeded. Then five plate scenes no calibration fitted, asked 1 %, 0.3 % and 0.1 % on the
+deployment peak deflection, first guess and refined
+(:mod:`flex.experiments.workprecision.tolerance_check`). Left out for want of a stored
+reference: a damped plate (the beam has no damping model), the FFRF crank on a lumped coupler
+(a beam crank needs a beam coupler).
 """
 
 from __future__ import annotations

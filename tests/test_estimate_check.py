@@ -92,3 +92,26 @@ def test_a_run_is_compared_with_the_stored_reference_of_its_physics():
     # linear interpolation of the stored sine at the run's (common) samples: exact there
     assert run.attrs["true_error_history_crank_angle"] == pytest.approx(1e-3, rel=1e-6)
     assert run.attrs[f"estimate_ratio_{END}"] == pytest.approx(2e-3 / 1.5e-3)
+
+
+def test_the_tolerance_table_counts_what_the_reference_can_decide():
+    """tolerance_rows: per level and mode, the cases the reference decides, how many truly
+    meet the tolerance, how many state it met, and those stating it met that miss it."""
+    from flex.experiments.workprecision.tolerance_check import tolerance_rows
+
+    def case(true, met, decided=True):
+        return CaseResult("c", "", attrs={
+            "tolerance_true_error": true, "tolerance_allowed": 1.0,
+            "tolerance_truly_met": true <= 1.0, "tolerance_decided": decided,
+            "tolerance_met": met})
+
+    results = {"a--0.01--first": case(0.5, True), "b--0.01--first": case(2.0, True),
+               "c--0.01--first": case(0.9, False, decided=False),
+               "a--0.01--refined": case(0.2, True)}
+    rows = {(r["tolerance"], r["mode"]): r for r in tolerance_rows(results)}
+    first = rows[(0.01, "first")]
+    assert first["decided"] == "2 of 3" and first["truly_met"] == 1
+    assert first["stated_met"] == 2 and first["stated_but_missed"] == 1
+    assert first["worst_true_over_allowed"] == 2.0
+    assert rows[(0.01, "refined")]["truly_met"] == 1
+    assert rows[(0.001, "first")]["decided"] == "0 of 0"
