@@ -71,10 +71,12 @@ def test_a_missing_foreign_or_broken_store_is_refused_with_one_message(tmp_path)
         read_store(text)
 
 
-def test_a_rigid_reference_states_its_step_change_over_three():
+def test_a_rigid_reference_states_its_step_error_at_the_observed_order():
     """make_reference on the rigid thesis mechanism over 5 ms: the value is the run at the
-    reference step, its accuracy a third of the change to an independent run at twice the
-    step (order 2)."""
+    reference step, its accuracy Richardson's at the order independent runs at 2x and 4x the
+    step show (within 0.5 of 2 here: the step's error, not a bound)."""
+    import math
+
     from flex.experiments.workprecision.stored_references import (
         RIGID_REFERENCE_STEP_S,
         make_reference,
@@ -84,13 +86,16 @@ def test_a_rigid_reference_states_its_step_change_over_three():
     scene = derive_scene(default_scene(), ["simulation.end_time_s=0.005"])
     case = make_reference("rigid", scene)
     assert case.status == "ok", case.message
-    coarse = simulate_case(derive_scene(scene, [
-        f"simulation.step_s={2 * RIGID_REFERENCE_STEP_S!r}", "simulation.error_estimate=false",
-        "simulation.output_step_s=0.0"]))
     angle = BUILTIN_HEADLINES["crank_angle_end_rad"]
     value = case.attrs["reference_value_crank_angle_end_rad"]
+    coarse = [angle.read(simulate_case(derive_scene(scene, [
+        f"simulation.step_s={k * RIGID_REFERENCE_STEP_S!r}", "simulation.error_estimate=false",
+        "simulation.output_step_s=0.0"])).datasets) for k in (2, 4)]
+    fine, coarser = abs(value - coarse[0]), abs(coarse[0] - coarse[1])
+    order = math.log2(coarser / fine)
+    assert abs(order - 2) <= 0.5
     assert case.attrs["reference_accuracy_crank_angle_end_rad"] == pytest.approx(
-        abs(value - angle.read(coarse.datasets)) / 3.0, rel=1e-9)
+        fine / (2**order - 1), rel=1e-9)
     assert 0 < case.attrs["reference_accuracy_crank_angle_end_rad"] < 1e-6 * abs(value)
 
 
@@ -120,10 +125,10 @@ def test_a_stored_curve_between_its_samples_states_its_interpolation_error():
     assert 1 / 3 <= true / stated <= 3
 
 
-def test_a_peak_that_moves_between_levels_counts_its_change_whole():
+def test_a_peak_that_moves_between_levels_is_a_bound():
     """The rigid thesis mechanism at 11 mm preload, first 0.2 ms: joint C's force peaks at
     release at 2.5e-6 s, and 1.5e-5 s later (the multiplier's Newton jitter) at 1.25e-6 s:
-    not one feature converging, so its accuracy is the whole change, not a third of it."""
+    not one feature converging, so its accuracy is a bound, 3x the larger change."""
     from flex.experiments.workprecision.stored_references import make_reference
 
     scene = derive_scene(default_scene(), ["drive.spring_preload_m=0.011",
@@ -134,4 +139,4 @@ def test_a_peak_that_moves_between_levels_counts_its_change_whole():
     (force,) = [part for part in evidence.split("; ")
                 if part.startswith("joint_C_deployment_peak_force_N:")]
     step_change = float(force.split("step ")[1].split(",")[0])
-    assert step_change == pytest.approx(4.5e-7 * 13.48, rel=0.2)  # whole, not / 3
+    assert step_change >= 3 * 4.5e-7 * 13.48 * 0.8  # 3x at least the 6e-6 N change
