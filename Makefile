@@ -122,11 +122,17 @@ FIT_FILES = $(foreach fit,$(FITS),results/$(fit)-$(if $(filter calibrate,$(fit))
 calibration-install: $(FIT_FILES) | $(STAMP)
 	$(PY) -m flex.config.calibration install --into flex/config $^
 
-# estimates judges against the bundled store: a new store makes it out of date
-results/estimates.h5: flex/data/references.h5
+# estimates and calibrate judge against the bundled store: a new store makes them out of date
+results/estimates.h5 results/calibrate.h5: flex/data/references.h5
+# a study's scene list beside its module (studies/<study>.toml) is its input too; references
+# makes every calibrate scene's physics, estimates reads the references' physics list
+STUDY_TOMLS := $(wildcard studies/*.toml)
+$(STUDY_TOMLS:studies/%.toml=results/%.h5): results/%.h5: studies/%.toml
+results/references.h5: studies/calibrate.toml
+results/estimates.h5: studies/references.toml
 
 # after make references: its converged references become the bundled store every judging
-# study reads (flex/data/references.h5: commit it; make estimates reads it)
+# study reads (flex/data/references.h5: commit it; make estimates and make calibrate read it)
 references-install: results/references.h5 | $(STAMP)
 	$(PY) -m flex.experiments.workprecision.stored_references install $< flex/data/references.h5
 

@@ -16,6 +16,7 @@ import tomllib
 from functools import partial
 from pathlib import Path
 
+from flex.data.reference_store import distinct_physics
 from flex.data.results import CaseResult
 from flex.data.scene import Scene, derived_scenes
 from flex.experiments.workprecision.stored_references import make_reference, reference_table
@@ -26,10 +27,16 @@ DESCRIPTION = "converged references (calibrated exact beam), stored once for mak
 SWEEP = True  # resumable cases (flex run references --folder, --retry-failed)
 PHYSICS: dict[str, list[str]] = tomllib.loads(
     Path(__file__).with_suffix(".toml").read_text("utf-8"))["physics"]
+#: the calibrate study's scenes (calibrate.toml beside this file): its grids are measured
+#: against these references; one per physics (a scene equal to one above is not made twice)
+CALIBRATE_SCENES = tomllib.loads((Path(__file__).parent / "calibrate.toml").read_text("utf-8"))
+CALIBRATE_PHYSICS = {name: ['coupler.geometry="plate"', *overrides]
+                     for section in ("calibration", "validation")
+                     for name, overrides in CALIBRATE_SCENES[section].items()}
 
 
 def cases(scene: Scene) -> dict[str, Scene]:
-    return derived_scenes(scene, PHYSICS)
+    return distinct_physics(derived_scenes(scene, PHYSICS | CALIBRATE_PHYSICS))
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:

@@ -434,3 +434,25 @@ def test_rule_extraction_refuses_a_foreign_result_file(tmp_path):
     with pytest.raises(FlexError, match="not calibrate"):
         extract_rule(path, rule)
     assert rule.read_text() == "kept"
+
+
+def test_the_installed_damped_levels_are_carried_when_the_fit_has_no_damped_scene():
+    """The calibration family is undamped (the stored references' beam has no damping): the
+    refit keeps the installed damped levels as they are, and says what moved per level."""
+    from flex.experiments.fitting.calibration import carried_levels
+    from flex.experiments.fitting.calibration_report import moved_rows
+
+    cases = {f"t{t}": _case(f"t{t}", t, step_law_error, cost)
+             for t in (0.001, 0.0012, 0.0015, 0.002)}
+    fitted = fit_levels(cases, [0.01])
+    installed = rule_constants()["levels"]
+    carried = carried_levels(fitted, installed)
+    damped = [level for level in installed if level["damping"] == "damped"]
+    assert [level["tolerance"] for level in carried] == [level["tolerance"] for level in damped]
+    assert all(level["carried"] and level["modes"] == level["modes_max"] for level in carried)
+    rows = {(row["damping"], row["tolerance"]): row for row in moved_rows(
+        installed, [*fitted, *carried])}
+    for level in damped:  # carried: nothing moved
+        row = rows[("damped", level["tolerance"])]
+        assert row["before"] == row["after"] != "none"
+    assert rows[("undamped", 0.01)]["after"].startswith(f"{fitted[0]['modes']} modes")

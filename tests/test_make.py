@@ -40,9 +40,10 @@ LONG = _variable("LONG")
 
 
 def _inputs() -> list[str]:
-    """What the Makefile should track: flex/**/*.py, flex/**/*.toml, the study modules,
-    pyproject.toml (relative paths)."""
-    files = [p for pattern in ("flex/**/*.py", "flex/**/*.toml", "studies/*.py")
+    """What the Makefile should track: flex/**/*.py, flex/**/*.toml, the study modules and
+    their scene lists, the reference store, pyproject.toml (relative paths)."""
+    files = [p for pattern in ("flex/**/*.py", "flex/**/*.toml", "studies/*.py",
+                               "studies/*.toml", "flex/data/references.h5")
              for p in ROOT.glob(pattern) if "__pycache__" not in p.parts]
     return sorted({str(p.relative_to(ROOT)) for p in files} | {"pyproject.toml"})
 
@@ -122,7 +123,8 @@ def database(tree: Path) -> dict[str, tuple[list[str], list[str]]]:
 
 def test_each_result_file_depends_on_its_module_the_library_data_and_pyproject(tree):
     rules = database(tree)
-    library = [name for name in _inputs() if name.startswith("flex/")]
+    library = [name for name in _inputs() if name.startswith("flex/")
+               and not name.endswith(".h5")]  # the store: the judging studies' input
     assert any(name.startswith("flex/data/scenes/") and name.endswith(".toml") for name in library)
     assert "flex/config/criteria_fit.toml" in library
     assert "flex/config/solver_defaults.toml" in library
@@ -135,6 +137,10 @@ def test_each_result_file_depends_on_its_module_the_library_data_and_pyproject(t
         assert not others & set(normal)  # no other study's module
         assert order == [".venv/.installed"]  # (re)making the .venv reruns nothing
         assert rules[study][0] == [f"results/{study}.h5"]  # the phony alias
+        if (ROOT / "studies" / f"{study}.toml").exists():  # its scene list
+            assert f"studies/{study}.toml" in normal
+    for judging in ("estimates", "calibrate"):  # they read the reference store
+        assert "flex/data/references.h5" in rules[f"results/{judging}.h5"][0]
 
 
 def test_all_builds_every_study_file_and_none_of_the_long_ones(tree):

@@ -2,7 +2,7 @@
 stored_references): found by a scene's physics whatever its model and settings, written and
 read back unchanged, refused with one message when missing, foreign or broken; a reference's
 accuracy is the arithmetic its contract states, on runs made independently here; the bundled
-store holds every scene make estimates judges."""
+store holds every scene make estimates and make calibrate judge."""
 
 from __future__ import annotations
 
@@ -99,11 +99,12 @@ def test_a_rigid_reference_states_its_step_error_at_the_observed_order():
     assert 0 < case.attrs["reference_accuracy_crank_angle_end_rad"] < 1e-6 * abs(value)
 
 
-def test_the_bundled_store_holds_every_scene_make_estimates_judges():
-    from studies import estimates
+def test_the_bundled_store_holds_every_scene_make_estimates_and_make_calibrate_judge():
+    from flex.study import study_scene
+    from studies import calibrate, estimates
 
     store = read_store(bundled_store())
-    scenes = estimates.cases(default_scene())
+    scenes = estimates.cases(default_scene()) | calibrate.cases(study_scene(calibrate))
     for name, scene in scenes.items():
         reference = reference_for(store, scene)
         assert reference.values, name
@@ -140,3 +141,79 @@ def test_a_peak_that_moves_between_levels_is_a_bound():
                 if part.startswith("joint_C_deployment_peak_force_N:")]
     step_change = float(force.split("step ")[1].split(",")[0])
     assert step_change >= 3 * 4.5e-7 * 13.48 * 0.8  # 3x at least the 6e-6 N change
+
+
+def _crests(frequency_Hz: float, step_s: float = 1.25e-6):
+    from flex.data.results import CaseResult, Dataset
+
+    time_s = np.arange(0.0, 0.02, step_s)
+    deflection = np.sin(2 * np.pi * frequency_Hz * time_s) * (1 + 5 * time_s)  # last crest
+    return CaseResult("run", "", {"time": Dataset(time_s, "s", "time"),
+                                  "coupler/midpoint_deflection": Dataset(deflection, "m", "w")})
+
+
+def test_a_late_crest_that_moves_as_the_frequency_converges_is_one_feature():
+    """A crest near 20 ms of a link whose frequency converges at order 2 over three levels
+    (1000 Hz x (1 + 1e-3 / 4^k)) moves by several steps, but its shift shrinks 4x: one feature.
+    A peak that jumps to another crest between the two finest levels, after not moving
+    between the coarser two, is not."""
+    from flex.experiments.workprecision.stored_references import (
+        PEAK_SHIFT_STEPS,
+        _peak_moved,
+        _peak_time_s,
+    )
+
+    headline = BUILTIN_HEADLINES["coupler_peak_deflection_m"]
+    finest, coarse, coarser = (_crests(1000.0 * (1 + 1e-3 / 4**k)) for k in (2, 1, 0))
+    shift_s = abs(_peak_time_s(headline, finest.datasets) - _peak_time_s(headline,
+                                                                          coarse.datasets))
+    assert shift_s > PEAK_SHIFT_STEPS * 1.25e-6  # it does move by more than two steps
+    assert not _peak_moved(headline, finest, coarse, coarser)
+    jumped = _crests(1000.0 * (1 + 5e-2))
+    assert _peak_moved(headline, jumped, coarse, coarse)
+
+
+def _plate_reference(scene, peak_m=1e-4, accuracy_m=2e-8) -> StoredReference:
+    time_s = np.linspace(0.0, 0.03, 3001)
+    curves = {"time": time_s, "crank/angle": 50.0 * time_s, "slider/position": 0.1 - time_s,
+              "coupler/midpoint_deflection": peak_m * np.sin(2e3 * time_s)}
+    quantity = "coupler_deployment_peak_deflection_m"
+    return StoredReference("plate", physics_identity(scene), "the calibrated exact beam", "",
+                           {quantity: peak_m}, {quantity: accuracy_m}, {quantity: "m"}, curves,
+                           dict.fromkeys(curves, "1"))
+
+
+def test_a_stored_reference_measures_a_run_by_its_curves_and_its_peak():
+    """The calibration's grid against a stored reference: a run whose curves are offset by
+    known amounts has exactly those errors; the reference's accuracy is the stored one
+    relative to its peak."""
+    from flex.experiments.workprecision.measurement import Observables, stored_as_reference
+
+    stored = _plate_reference(derive_scene(default_scene(), ['coupler.geometry="plate"']))
+    reference = stored_as_reference(stored)
+    assert reference.accuracy == pytest.approx(2e-8 / 1e-4)
+    time_s = np.linspace(0.0, 0.03, 1501)
+    curves = stored.curves
+    run = Observables(time_s, np.interp(time_s, curves["time"], curves["crank/angle"]) + 1e-3,
+                      np.interp(time_s, curves["time"], curves["slider/position"]) - 2e-6,
+                      np.zeros_like(time_s), 1.01e-4)
+    errors = reference.errors(run)
+    assert errors["crank_angle_rad"] == pytest.approx(1e-3, rel=1e-6)
+    assert errors["slider_position_m"] == pytest.approx(2e-6, rel=1e-6)
+    assert errors["peak_deflection_relative"] == pytest.approx(0.01)
+
+
+def test_a_grid_case_refuses_a_changed_store_and_physics_it_lacks(tmp_path):
+    from flex.data.reference_store import store_digest
+    from flex.experiments.fitting.calibration import measure_case
+
+    plate = derive_scene(default_scene(), ['coupler.geometry="plate"', 'coupler.model="ffrf"'])
+    store = {"plate": _plate_reference(plate)}
+    path = tmp_path / "refs.h5"
+    write_store(path, store, {})
+    changed = measure_case("p", plate, reference_store=path, reference_store_digest="0" * 64)
+    assert changed.status == "failed" and "changed while the sweep ran" in changed.message
+    thicker = derive_scene(plate, ["coupler.thickness_m=0.002"])
+    lacking = measure_case("p", thicker, reference_store=path,
+                           reference_store_digest=store_digest(read_store(path)))
+    assert lacking.status == "failed" and "no stored reference" in lacking.message

@@ -161,11 +161,13 @@ def test_the_calibrate_studys_case_function_can_be_sent_to_a_worker():
 
     import studies.calibrate as calibrate
     from flex.config.ffrf_rule import rule_constants
+    from flex.data.reference_store import bundled_store
     from flex.experiments.fitting.calibration import measure_case
 
     # as studies/calibrate.py binds it
-    pickle.dumps(partial(measure_case, repeats=calibrate.REPEATS, cache_dir=None,
-                         mesh_rule=dict(rule_constants()["mesh"])))
+    pickle.dumps(partial(measure_case, reference_store=bundled_store(),
+                         reference_store_digest="0" * 64, repeats=calibrate.REPEATS,
+                         cache_dir=None, mesh_rule=dict(rule_constants()["mesh"])))
 
 def test_local_process_pool_survives_a_crashing_worker(tmp_path):
     scenes = {**_scenes(), "crash": _rigid(35.0)}

@@ -82,6 +82,18 @@ class StoredReference:
         return physics_digest(self.physics)
 
 
+def store_digest(references: Mapping[str, StoredReference]) -> str:
+    """A content digest of a store's references (names, physics, values, accuracies and
+    curves): what a sweep binds so that its cases rerun when the store changes."""
+    parts: list[tuple[str, Any]] = []
+    for name, ref in sorted(references.items()):
+        parts += [(f"{name}/physics", ref.digest), (f"{name}/model", ref.model)]
+        parts += [(f"{name}/value/{q}", v) for q, v in sorted(ref.values.items())]
+        parts += [(f"{name}/accuracy/{q}", v) for q, v in sorted(ref.accuracies.items())]
+        parts += [(f"{name}/curves/{c}", v) for c, v in sorted(ref.curves.items())]
+    return content_digest(parts)
+
+
 def physics_identity(scene: Mapping[str, Mapping[str, Any]]) -> dict[str, dict[str, Any]]:
     """The physics of a resolved scene (module doc): its mechanism sections without
     :data:`MODEL_KEYS`, and ``simulation.end_time_s`` [s]."""
@@ -96,6 +108,19 @@ def physics_digest(physics: Mapping[str, Mapping[str, Any]]) -> str:
     """A content digest of :func:`physics_identity`'s result (numbers as written)."""
     return content_digest((f"{section}.{key}", value) for section, values in
                           sorted(physics.items()) for key, value in sorted(values.items()))
+
+
+def distinct_physics(scenes: Mapping[str, Mapping[str, Any]]) -> dict[str, Any]:
+    """``scenes`` without those whose physics (:func:`physics_identity`) an earlier one has:
+    one stored reference per physics, named after its first scene."""
+    seen: set[str] = set()
+    out = {}
+    for name, scene in scenes.items():
+        digest = physics_digest(physics_identity(scene))
+        if digest not in seen:
+            seen.add(digest)
+            out[name] = scene
+    return out
 
 
 def reference_for(store: Mapping[str, StoredReference], scene: Mapping[str, Any]
@@ -184,5 +209,6 @@ def _collect(path: str, item: Any, curves: dict[str, np.ndarray],
 
 
 __all__ = ["BUNDLED_STORE_NAME", "CURVE_STEP_S", "FORMAT", "MODEL_KEYS", "MissingReferenceError",
+           "distinct_physics",
            "PHYSICS_SECTIONS", "StoredReference", "bundled_store", "physics_digest",
-           "physics_identity", "read_store", "reference_for", "write_store"]
+           "physics_identity", "read_store", "reference_for", "store_digest", "write_store"]

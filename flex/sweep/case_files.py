@@ -15,8 +15,9 @@ from flex.data.results import CaseResult, Dataset, open_results, write_results
 from flex.data.scene import Scene, to_toml
 
 #: keyword arguments of a case function that say where things are kept, not what a case
-#: computes: left out of its identity (:func:`case_hash`), so a moved cache resumes
-LOCATION_ARGUMENTS = frozenset({"cache_dir"})
+#: computes: left out of its identity (:func:`case_hash`), so a moved cache resumes (a
+#: reference store's content enters it as the function's bound store digest)
+LOCATION_ARGUMENTS = frozenset({"cache_dir", "reference_store"})
 #: 2: a content digest of the case (``sweep_content_digest``), checked when a rerun resumes
 SWEEP_FORMAT = "flex-sweep-case/2"
 

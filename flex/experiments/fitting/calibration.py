@@ -48,23 +48,25 @@ from flex.config.ffrf_rule import (
     steps_per_first_period,
     top_mode_ratio,
 )
+from flex.data.reference_store import (
+    MissingReferenceError,
+    StoredReference,
+    read_store,
+    reference_for,
+    store_digest,
+)
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
 from flex.data.tables import table_datasets
 from flex.dynamics.advice import FFRF_DEFLECTION_LIMIT
-from flex.experiments.workprecision.coupler_reference import (
-    LEVELS,
-    Progress,
-    coupler_setting,
-    scene_reference,
-)
+from flex.experiments.workprecision.coupler_reference import LEVELS, Progress, coupler_setting
 from flex.experiments.workprecision.measurement import (
     ReductionPool,
-    Reference,
     Setting,
     certifies,
     measure,
     scene_for,
+    stored_as_reference,
 )
 
 #: the grid: in-plane eigenmodes and steps per first bending period
@@ -102,17 +104,21 @@ def grid_settings(scene: Scene, mesh_rule: Mapping[str, float] | None = None
             for modes in GRID_MODES for per in GRID_STEPS_PER_PERIOD]
 
 
-def measure_scene(name: str, scene: Scene, repeats: int = 3, cache_dir: Path | None = None,
+def measure_scene(name: str, scene: Scene, store: Mapping[str, StoredReference],
+                  repeats: int = 3, cache_dir: Path | None = None,
                   progress: Progress | None = None,
                   mesh_rule: Mapping[str, float] | None = None) -> CaseResult:
-    """Reference and grid of one scene, as a case (datasets ``grid/*``, ``reference/*``;
-    attributes ``reference_accuracy``, ``first_period_s``, ``rule_mesh_size_m``)."""
-    pool = ReductionPool(cache_dir)
+    """The grid of one scene measured against the stored reference of its physics
+    (``store``: :mod:`flex.data.reference_store`, made by ``make references``), as a case
+    (datasets ``grid/*``; attributes ``reference_accuracy`` (relative, of the deployment
+    peak), ``reference_peak_deflection_m``, ``reference_evidence``, ``first_period_s``,
+    ``rule_mesh_size_m``). Physics the store lacks make a failed case naming it."""
     try:
-        reference = scene_reference(scene, pool, progress)
-    except FlexError as exc:
-        return CaseResult(name, to_toml(scene), status="failed",
-                          message=f"reference failed: {exc}")
+        stored = reference_for(store, scene)
+    except MissingReferenceError as exc:
+        return CaseResult(name, to_toml(scene), status="failed", message=str(exc))
+    reference = stored_as_reference(stored)
+    pool = ReductionPool(cache_dir, solve_modes=max(GRID_MODES))  # one solve per plate
     rows = []
     for modes, per, setting in grid_settings(scene, mesh_rule):
         if progress:
@@ -123,23 +129,32 @@ def measure_scene(name: str, scene: Scene, repeats: int = 3, cache_dir: Path | N
             pass  # measure() reports it as a failed setting
         m = measure(scene, setting, reference, repeats, pool)
         rows.append((modes, per, m))
-    return CaseResult(name, to_toml(scene), _datasets(reference, rows), attrs={
+    return CaseResult(name, to_toml(scene), _datasets(rows), attrs={
         "reference_accuracy": reference.accuracy,
         "reference_peak_deflection_m": reference.peak_deflection_m,
+        "reference_name": stored.name, "reference_evidence": stored.evidence,
         "first_period_s": first_period_s(scene["coupler"]),
         "rule_mesh_size_m": rule_mesh_size_m(scene["coupler"], mesh_rule)})
 
 
-def measure_case(name: str, scene: Scene, *, repeats: int = 3, cache_dir: Path | None = None,
+def measure_case(name: str, scene: Scene, *, reference_store: Path, reference_store_digest: str,
+                 repeats: int = 3, cache_dir: Path | None = None,
                  mesh_rule: Mapping[str, float] | None = None) -> CaseResult:
     """:func:`measure_scene` as a sweep case function (:func:`flex.sweep.run_sweep`). Bind
-    ``mesh_rule`` (the rule's mesh constants) with the scene's solver keys pinned: the case's
-    identity then holds everything it depends on, and installing a refitted rule does not
-    make its cases stale."""
-    return measure_scene(name, scene, repeats, cache_dir, mesh_rule=mesh_rule)
+    ``mesh_rule`` (the rule's mesh constants) with the scene's solver keys pinned, and the
+    store's file and digest (:func:`flex.data.reference_store.store_digest`): the case's
+    identity then holds everything it depends on; installing a refitted rule does not make
+    its cases stale, a remade store does. A store whose digest differs from the bound one
+    (remade while the sweep ran) makes a failed case."""
+    store = read_store(reference_store)
+    if store_digest(store) != reference_store_digest:
+        return CaseResult(name, to_toml(scene), status="failed", message=(
+            f"{reference_store} changed while the sweep ran (digest "
+            f"{store_digest(store)[:12]}, bound {reference_store_digest[:12]}): run again"))
+    return measure_scene(name, scene, store, repeats, cache_dir, mesh_rule=mesh_rule)
 
 
-measure_case.case_version = 3  # type: ignore[attr-defined]
+measure_case.case_version = 4  # 4: stored references, nested reductions  # type: ignore[attr-defined]
 
 
 #: ``grid/<column>``: one row per grid pair (modes, steps per first period) of a scene
@@ -147,8 +162,10 @@ GRID_COLUMNS = {
     "modes": ("1", "in-plane fixed-interface eigenmodes", float),
     "steps_per_first_period": ("1", "step = first bending period / this", float),
     "step": ("s", "time step", float),
-    "peak_deflection_error": ("1", "relative error of the peak midpoint deflection against the "
-                                   "reference (NaN: failed)", float),
+    "peak_deflection_m": ("m", "the run's deployment peak of the elastic midpoint deflection "
+                               "on the headline channel (NaN: failed)", float),
+    "peak_deflection_error": ("1", "its relative error against the stored reference (NaN: "
+                                   "failed)", float),
     "crank_angle_error": ("1", "largest crank angle error / its swing", float),
     "slider_position_error": ("1", "largest slider error / its travel", float),
     "total_time": ("s", "median time of the whole run (warm reduction cache)", float),
@@ -156,29 +173,21 @@ GRID_COLUMNS = {
 }
 
 
-def _datasets(reference: Reference, rows: Sequence[tuple[int, float, Any]]
-              ) -> dict[str, Dataset]:
+def _datasets(rows: Sequence[tuple[int, float, Any]]) -> dict[str, Dataset]:
+    """The grid's table (:data:`GRID_COLUMNS`); the reference's curves stay in the store."""
     def error(m: Any, key: str) -> float:
         return m.errors.get(key, math.nan) if m.ok else math.nan
 
     grid = [{"modes": modes, "steps_per_first_period": per,
              "step": dict(m.setting.overrides)["simulation.step_s"],
+             "peak_deflection_m": m.peak_m if m.ok else math.nan,
              "peak_deflection_error": error(m, "peak_deflection_relative"),
              "crank_angle_error": error(m, "crank_angle_relative"),
              "slider_position_error": error(m, "slider_position_relative"),
              "total_time": m.total_time_s,
              "newton_per_step": m.newton_iterations / max(m.steps, 1)}
             for modes, per, m in rows]
-    out = table_datasets(grid, GRID_COLUMNS, "grid")
-    for knob, evidence in reference.evidence.items():
-        safe = knob.replace(" ", "_").replace(">", "").replace("-", "to")
-        out[f"reference/evidence/{safe}"] = Dataset(
-            float(evidence.get("error", math.nan)), "1",
-            f"relative change of the reference for {knob}")
-    out["reference/time"] = Dataset(reference.observables.time_s, "s", "time")
-    out["reference/midpoint_deflection"] = Dataset(reference.observables.deflection_m, "m",
-                                                   "elastic midpoint deflection")
-    return out
+    return table_datasets(grid, GRID_COLUMNS, "grid")
 
 
 # ------------------------------------------------------------------------------------------
@@ -481,6 +490,24 @@ def family_bounds(scenes: Mapping[str, Scene]) -> dict[str, float]:
                    for scene in scenes.values()]
     return {"slenderness_min": float(min(slenderness)),
             "slenderness_max": float(max(slenderness)), "damped_ratio_min": DAMPED_RATIO_MIN}
+
+
+def carried_levels(fitted: Sequence[Mapping[str, Any]],
+                   installed: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """The installed levels of the damping classes the fit calibrated no level for (the
+    calibrate study's family is undamped: the stored references' beam has no damping model),
+    kept as they are (``carried`` True, ``modes`` their ``modes_max``)."""
+    calibrated = {level["damping"] for level in fitted if level.get("modes") is not None}
+    return [{**level, "modes": level["modes_max"], "carried": True} for level in installed
+            if level.get("damping", "undamped") not in calibrated]
+
+
+def widened_bounds(bounds: Mapping[str, float], installed: Mapping[str, float]
+                   ) -> dict[str, float]:
+    """The family's slenderness range over the fitted and the carried levels' scenes."""
+    return {**bounds,
+            "slenderness_min": min(bounds["slenderness_min"], installed["slenderness_min"]),
+            "slenderness_max": max(bounds["slenderness_max"], installed["slenderness_max"])}
 
 
 def rule_toml(levels: Sequence[Mapping[str, Any]], bounds: Mapping[str, float],

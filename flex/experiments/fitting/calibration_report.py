@@ -28,11 +28,12 @@ from flex.config.ffrf_rule import (
 )
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene
-from flex.data.tables import table_datasets
+from flex.data.tables import findings_table, table_datasets
 from flex.experiments.fitting.calibration import (
     LEVELS,
     MARGIN,
     SLOWDOWN_LIMIT,
+    carried_levels,
     coupler_of,
     cross_validate,
     damping_of,
@@ -42,6 +43,7 @@ from flex.experiments.fitting.calibration import (
     n_load_of,
     rule_toml,
     validate,
+    widened_bounds,
 )
 from flex.experiments.fitting.rule_designs import TWIN_CLOSENESS, design_frontier, near_twins
 from flex.experiments.workprecision.pareto import pareto_front
@@ -51,7 +53,11 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
                         validation: Mapping[str, Scene]) -> tuple[dict[str, Dataset], str]:
     """Fit on ``calibration``'s cases, validate on ``validation``'s (see module doc)."""
     fitted = fit_levels({name: results[name] for name in calibration if name in results})
+    installed = rule_constants()
+    carried = carried_levels(fitted, installed["levels"])
     bounds = family_bounds(calibration)
+    if carried:
+        bounds = widened_bounds(bounds, installed["family"])
     rows = validate({name: results[name] for name in validation if name in results}, fitted,
                     bounds)
     in_sample = validate({name: results[name] for name in calibration if name in results},
@@ -61,7 +67,7 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
     family = _within_family(results, {**calibration, **validation}, bounds)
     designs = design_frontier(family)
     twins = [{**row, "tolerance": level} for level in LEVELS for row in near_twins(family, level)]
-    toml = rule_toml(fitted, bounds, rule_constants()["mesh"])
+    toml = rule_toml([*fitted, *carried], bounds, installed["mesh"])
     datasets = {"rule/toml": Dataset(toml, "1", "the rule's constants (make calibration-install)")}
     for index, level in enumerate(fitted):
         prefix = f"levels/{index}"
@@ -93,8 +99,82 @@ def calibration_summary(results: Mapping[str, CaseResult], calibration: Mapping[
     datasets.update(_row_datasets("cross_validation", left_out))
     datasets.update(_design_datasets(designs))
     datasets.update(_twin_datasets(twins))
-    return datasets, _report(results, fitted, rows, toml, in_sample, left_out,
+    carried_classes = {level["damping"] for level in carried}
+    levels = [*(level for level in fitted if level.get("modes") is not None
+                or level["damping"] not in carried_classes), *carried]
+    moved = moved_rows(installed["levels"], levels)
+    datasets.update(findings_table("moved", "The rule refitted: what moved", moved,
+                                   MOVED_COLUMNS, order=1))
+    datasets.update(findings_table("levels", "Refitted levels", _level_rows(levels),
+                                   LEVEL_COLUMNS, order=2))
+    return datasets, _report(results, levels, rows, toml, in_sample, left_out,
                              [*_design_lines(designs), *_twin_lines(twins)])
+
+
+#: the refitted levels' table (:func:`_level_rows`)
+LEVEL_COLUMNS = {"damping": ("1", "damping class", object),
+                 "tolerance": ("1", "level (relative error of the deployment peak)"),
+                 "source": ("1", "refitted on stored references, or carried from the "
+                                 "installed rule", object),
+                 "scenes": ("1", "scenes the level rests on"),
+                 "n_range": ("1", "n = t_load / T1 it holds over", object),
+                 "modes": ("1", "most in-plane modes a scene gets (0: not calibrated)"),
+                 "steps_law": ("1", "steps per first period, N = C n^-B", object),
+                 "worst_error": ("1", "largest certified calibration error")}
+
+
+def _level_rows(levels: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    rows = []
+    for level in levels:
+        fitted = level.get("modes") is not None
+        rows.append({
+            "damping": level["damping"], "tolerance": level["tolerance"],
+            "source": "carried" if level.get("carried") else
+            ("refitted" if fitted else f"not calibrated: {level.get('reason', '')}"),
+            "scenes": len(level.get("scenes", ())),
+            "n_range": (f"{level['n_load_min']:.3g}-{level['n_load_max']:.3g}" if fitted
+                        else ""),
+            "modes": level.get("modes") or 0,
+            "steps_law": (f"{level['steps_coefficient']:.3g} n^-{level['steps_exponent']:.2f}"
+                          if fitted else ""),
+            "worst_error": level.get("worst_error", math.nan)})
+    return rows
+
+
+#: the "what moved" table (:func:`moved_rows`)
+MOVED_COLUMNS = {"damping": ("1", "damping class", object),
+                 "tolerance": ("1", "level"),
+                 "before": ("1", "the installed level: modes, steps law, n range", object),
+                 "after": ("1", "the refitted level", object),
+                 "worst_error_before": ("1", "its largest certified calibration error"),
+                 "worst_error_after": ("1", "the refit's")}
+
+
+def moved_rows(installed: Sequence[Mapping[str, Any]], refitted: Sequence[Mapping[str, Any]]
+               ) -> list[dict[str, Any]]:
+    """Per (damping, level) in either rule: the installed level against the refitted one,
+    in words (a level only one of them calibrates: "none")."""
+    def text(level: Mapping[str, Any] | None) -> str:
+        if level is None or level.get("modes", level.get("modes_max")) is None:
+            return "none"
+        return (f"{level.get('modes', level.get('modes_max'))} modes max (cut-off "
+                f"{level['mode_cutoff_ratio']:g} x f1), N = {level['steps_coefficient']:.3g} "
+                f"n^-{level['steps_exponent']:.2f}, n {level['n_load_min']:.3g}-"
+                f"{level['n_load_max']:.3g}")
+
+    def key(level: Mapping[str, Any]) -> tuple[str, float]:
+        return (level.get("damping", "undamped"), float(level["tolerance"]))
+
+    before = {key(level): level for level in installed}
+    after = {key(level): level for level in refitted if level.get("modes") is not None}
+    return [{"damping": damping, "tolerance": tolerance,
+             "before": text(before.get((damping, tolerance))),
+             "after": text(after.get((damping, tolerance))),
+             "worst_error_before": before.get((damping, tolerance), {}).get("worst_error",
+                                                                           math.nan),
+             "worst_error_after": after.get((damping, tolerance), {}).get("worst_error",
+                                                                         math.nan)}
+            for damping, tolerance in sorted(before.keys() | after.keys())]
 
 
 def _within_family(results: Mapping[str, CaseResult], scenes: Mapping[str, Scene],
@@ -214,8 +294,9 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
             left_out: Sequence[Mapping[str, Any]] = (), comparison: Sequence[str] = ()
             ) -> str:
     lines = ["# FFRF settings rule: calibration and validation", "",
-             "Error: relative error of the peak elastic midpoint deflection against each "
-             "scene's converged reference, plus the reference's own accuracy (certified). "
+             "Error: relative error of the elastic midpoint deflection's deployment peak (on "
+             "the headline channel) against the stored reference of each scene's physics "
+             "(make references), plus the reference's own accuracy (certified). "
              f"A level is fitted on the calibration scenes whose reference can certify it, "
              f"within {MARGIN:g} x the level on every one.", "",
              "## References", "", "| scene | first period T1 [s] | reference accuracy | "
@@ -246,7 +327,9 @@ def _report(results: Mapping[str, CaseResult], fitted: Sequence[Mapping[str, Any
                      f"mode (rounded up to the grid); worst certified error "
                      f"{level['worst_error']:.2g} over "
                      f"{len(level['scenes'])} scenes ({', '.join(level['scenes'])})"
-                     + _beyond_text(level))
+                     + _beyond_text(level)
+                     + ("; carried from the installed rule, not refitted" if level.get("carried")
+                        else ""))
     lines += ["", "## Validation (scenes not used in the fit)", "",
               "| scene | n = t_load / T1 | level | certifiable | rule pick | rule error | rule "
               "time [s] | fastest within [s] (pair) | slowdown | meets |",

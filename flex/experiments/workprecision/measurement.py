@@ -44,6 +44,7 @@ import numpy as np
 from flex.base.errors import FlexError, SceneError
 from flex.base.physics import Plate
 from flex.config.settings import has_auto_link_keys, resolve_link_keys, resolved_simulation
+from flex.data.reference_store import StoredReference
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import Scene, to_toml
 from flex.data.scene_edit import derive_scene
@@ -277,6 +278,26 @@ class Reference:
         return out
 
 
+def stored_as_reference(stored: StoredReference) -> Reference:
+    """A stored reference (:mod:`flex.data.reference_store`: made once by ``make references``)
+    as the :class:`Reference` runs are measured against: its curves (every
+    :data:`~flex.data.reference_store.CURVE_STEP_S`), its :data:`PEAK_HEADLINE` and, as its
+    accuracy, that headline's stored accuracy relative to it (what a grid's certified peak
+    error adds; the curves' own errors, a few 1e-5 of the swing and the travel, are not
+    added)."""
+    curves = stored.curves
+    peak = stored.values[PEAK_HEADLINE]
+    observables = Observables(np.asarray(curves["time"], dtype=float),
+                              np.asarray(curves["crank/angle"], dtype=float),
+                              np.asarray(curves["slider/position"], dtype=float),
+                              np.asarray(curves["coupler/midpoint_deflection"], dtype=float),
+                              peak)
+    relative = stored.accuracies[PEAK_HEADLINE] / abs(peak)
+    return Reference(f"stored reference {stored.name}", observables, Setting(stored.model),
+                     {"stored reference": {"error": relative}}, relative, 0.0,
+                     stored.evidence)
+
+
 # ------------------------------------------------------------------------------------------
 # running a setting
 # ------------------------------------------------------------------------------------------
@@ -297,6 +318,7 @@ class Measurement:
     newton_iterations: int = 0
     jacobian_updates: int = 0
     errors: dict[str, float] = field(default_factory=dict)
+    peak_m: float = float("nan")  #: the run's peak deflection as the errors compare it [m]
 
     @property
     def ok(self) -> bool:
@@ -321,12 +343,15 @@ class ReductionPool:
 
     ``cache_dir``: the reduction cache folder they are loaded from or written to, also used
     by the runs of :func:`run_once` for what they build themselves (None: built in memory,
-    no disk cache).
+    no disk cache). ``solve_modes``: every reduction of fewer modes is the first modes of
+    one eigen-solve of this many (:func:`flex.bodies.reduction.build_reduction`; a grid of
+    1, 2, 4 and 8 modes then meshes and solves each plate once), None: each its own solve.
     """
 
-    def __init__(self, cache_dir: Path | None = None) -> None:
+    def __init__(self, cache_dir: Path | None = None, solve_modes: int | None = None) -> None:
         self._by_key: dict[tuple, Any] = {}
         self.cache_dir = cache_dir
+        self.solve_modes = solve_modes
 
     def for_scene(self, scene: Scene, order: int = 2) -> Any:
         """The scene's reduction (tetrahedra of ``order``) for an ``ffrf`` coupler, else
@@ -340,10 +365,11 @@ class ReductionPool:
         from flex.dynamics.link_models import reduction_for_scene
 
         c = scene["coupler"]
-        key = (Plate.of(c), c["mesh_size_m"], c["modes"], order)
+        solve = max(self.solve_modes, c["modes"]) if self.solve_modes else None
+        key = (Plate.of(c), c["mesh_size_m"], c["modes"], order, solve)
         if key not in self._by_key:
             self._by_key[key] = reduction_for_scene(scene, cache_dir=self.cache_dir,
-                                                    mesh_order=order)
+                                                    mesh_order=order, solve_modes=solve)
         return self._by_key[key]
 
 
@@ -401,6 +427,7 @@ def measure(base: Scene, setting: Setting, reference: Reference, repeats: int = 
             if index == 0 and counters["total_time_s"] > REPEAT_LIMIT_S:
                 break
         measurement.errors = reference.errors(observables)
+        measurement.peak_m = observables.peak_m if reference.flexible else float("nan")
     except FlexError as exc:
         measurement.status, measurement.message = "failed", str(exc)
         return measurement
