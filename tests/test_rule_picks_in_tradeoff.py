@@ -80,7 +80,7 @@ def test_the_rigid_scene_has_no_rule_setting(case_scenes):
 def test_the_reduction_pool_keys_auto_modes_by_the_rule(case_scenes, monkeypatch):
     # a rule setting's reduction is the one the run resolves, not one shared by all "auto"s
     monkeypatch.setattr("flex.dynamics.link_models.reduction_for_scene",
-                        lambda scene, cache_dir=None, mesh_order=2: (
+                        lambda scene, cache_dir=None, mesh_order=2, solve_modes=None: (
                             scene["coupler"]["modes"], scene["coupler"]["mesh_size_m"]))
     scene = case_scenes["ffrf_1mm"]
     pool = ReductionPool()
