@@ -353,8 +353,8 @@ def _reference_lines(scene: Scene, results: dict[str, CaseResult], plates: Plate
         datasets.update(found)
         lines += more
     if lines:
-        lines.append("  (~: a difference below 3x the reference's own accuracy, not resolved; "
-                     "the nonlinear FE coupler on the same mesh: make ladder)")
+        lines.append(f"  (~: a difference below {RESOLVED:g}x the reference's own accuracy, "
+                     "not resolved; the nonlinear FE coupler on the same mesh: make ladder)")
     return lines
 
 
