@@ -36,6 +36,7 @@ def _variable(name: str) -> list[str]:
 
 
 STUDIES = _variable("STUDIES")
+ALL_ORDER = _variable("ALL_ORDER")
 LONG = _variable("LONG")
 
 
@@ -46,6 +47,10 @@ def _inputs() -> list[str]:
                                "studies/*.toml", "flex/data/references.h5")
              for p in ROOT.glob(pattern) if "__pycache__" not in p.parts]
     return sorted({str(p.relative_to(ROOT)) for p in files} | {"pyproject.toml"})
+
+
+#: the bundled reference store: the studies that judge against it depend on it
+STORE = "flex/data/references.h5"
 
 
 def _set_time(path: Path, when: float) -> None:
@@ -83,6 +88,7 @@ def tree(tmp_path: Path) -> Path:
     shutil.copy(MAKEFILE, tmp_path / "Makefile")
     for name in _inputs():
         _set_time(tmp_path / name, T0)
+    _set_time(tmp_path / STORE, T0)
     _set_time(tmp_path / ".venv" / ".installed", T0 + 10)
     for study in STUDIES:
         _set_time(tmp_path / "results" / f"{study}.h5", T0 + 20)
@@ -145,7 +151,7 @@ def test_each_result_file_depends_on_its_module_the_library_data_and_pyproject(t
 
 def test_all_builds_every_study_file_and_none_of_the_long_ones(tree):
     normal, _ = database(tree)["all"]
-    assert normal == [f"results/{study}.h5" for study in STUDIES]
+    assert normal == [f"results/{study}.h5" for study in ALL_ORDER]
     assert not {"tradeoff", "stability", "bench"} & set(STUDIES)
     for study in LONG:
         _set_time(tree / "results" / f"{study}.h5", T0 + 20)
@@ -169,6 +175,13 @@ def test_touching_a_study_module_makes_only_that_study_out_of_date(tree, study):
         assert status == (1 if other == study else 0), other
 
 
+def test_a_new_reference_store_reruns_the_studies_that_judge_against_it(tree):
+    _set_time(tree / STORE, T0 + 30)
+    assert runs(tree, "all") == ["flexible"]
+    assert runs(tree, "estimates") == ["estimates"]
+    assert runs(tree, "calibrate") == ["calibrate"]
+
+
 @pytest.mark.parametrize("name", ["flex/dynamics/solver.py", "flex/data/scenes/cavezza2012.toml",
                                   "flex/config/criteria_fit.toml",
                                   "flex/config/solver_defaults.toml",
@@ -177,7 +190,7 @@ def test_touching_the_library_or_its_data_reruns_every_study(tree, name):
     assert (tree / name).exists()
     _set_time(tree / name, T0 + 30)
     _set_time(tree / ".venv" / ".installed", T0 + 40)  # what the .venv rule would do
-    assert runs(tree, "all") == STUDIES
+    assert runs(tree, "all") == ALL_ORDER
 
 
 def test_a_new_venv_alone_reruns_nothing(tree):
@@ -223,7 +236,7 @@ def test_a_run_that_changes_its_target_and_then_fails_leaves_it_out_of_date(tree
 
 
 def test_force_reruns_what_is_asked_for(tree):
-    assert runs(tree, "all", "FORCE=1") == STUDIES
+    assert runs(tree, "all", "FORCE=1") == ALL_ORDER
     assert runs(tree, "dynamics", "FORCE=1") == ["dynamics"]
     assert runs(tree, "bench") == ["bench"]  # no result yet
 
@@ -399,6 +412,7 @@ def test_one_registry_of_studies_ties_the_makefile_the_cli_and_the_readme():
     assert set(STUDIES) == {"simulate", *MAKE_ALL_STUDIES, *LONG_STUDIES}
     assert len(STUDIES) == 1 + len(MAKE_ALL_STUDIES) + len(LONG_STUDIES)
     assert globals()["STUDIES"] == list(MAKE_ALL_STUDIES)  # the Makefile's, in its order
+    assert sorted(ALL_ORDER) == sorted(MAKE_ALL_STUDIES)  # what `make all` starts, reordered
     assert LONG == list(LONG_STUDIES)
     for study in STUDIES:
         assert (ROOT / "studies" / f"{study}.py").is_file()

@@ -178,7 +178,9 @@ def _helix_segment_mesh(design: SpringDesign, turns: float, maxh: float, element
         centre = face.center
         if face.mass < 2.0 * math.pi * radius_wire**2:
             face.name = "clamped" if abs(centre.z) < 0.5 * height_end + 1e-12 else "loaded"
-    mesh = ngs.Mesh(OCCGeometry(wire_solid).GenerateMesh(maxh=maxh))
+    # serially: the same mesh as netgen's parallel meshing without its spinning threads
+    # (flex.bodies.plate.plate_mesh)
+    mesh = ngs.Mesh(OCCGeometry(wire_solid).GenerateMesh(maxh=maxh, parallel_meshing=False))
     mesh.Curve(element_order)
     if not {"clamped", "loaded"} <= set(mesh.GetBoundaries()):
         raise SceneError("spring FE: could not identify the helix segment's end faces")
