@@ -27,6 +27,7 @@ from flex.experiments.fitting.calibration import measure_case
 from flex.experiments.fitting.calibration_report import calibration_summary, draw_calibration
 from flex.experiments.workprecision.tolerance_check import (
     SEPARATOR,
+    USER_KEYS,
     check_tolerances,
     tolerance_findings,
     tolerance_scenes,
@@ -45,10 +46,6 @@ OVERRIDES = ['coupler.geometry="plate"', 'coupler.model="ffrf"',
              "simulation.step_s=1e-5", "simulation.spectral_radius=0.9",
              'simulation.newton="modified"', "simulation.newton_relative_tolerance=1e-8"]
 REPEATS = 1  # the fit compares laws by a time model over each grid (modelled_time_s)
-#: what a user leaves to flex: the held-out scenes' tolerance runs undo the grid's pins
-USER_KEYS = ['coupler.model="auto"', 'coupler.modes="auto"', 'coupler.mesh_size_m="auto"',
-             'simulation.step_s="auto"', 'simulation.spectral_radius="auto"',
-             'simulation.newton="auto"', 'simulation.newton_relative_tolerance="auto"']
 SWEEP = True  # resumable cases (flex run calibrate --folder, --retry-failed)
 
 #: the scenes, as --set overrides per name (studies/calibrate.toml: what each set is for)
@@ -64,7 +61,8 @@ def cases(scene: Scene) -> dict[str, Scene]:
 
 
 def simulate_cases(scenes: dict[str, Scene], run: StudyRun) -> dict[str, CaseResult]:
-    """The grids on the sweep engine (resumable; ``results/calibrate-cases``), then the
+    """The grids on the sweep engine (resumable; ``results/calibrate-cases``; a scene's grid
+    runs in one worker, so its timings, which the fit compares, share one load), then the
     held-out scenes' tolerance runs (each against the store)."""
     from contextlib import closing
 

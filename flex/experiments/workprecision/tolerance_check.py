@@ -34,6 +34,11 @@ QUANTITY = "coupler_deployment_peak_deflection_m"
 MODES = {"first": False, "refined": True}
 #: a case name's separator between scene, level and mode
 SEPARATOR = "--"
+#: the keys a user asking a tolerance leaves to flex (``"auto"``): a study that pins them for
+#: its own runs (calibrate's grid) sets them back for its tolerance runs
+USER_KEYS = ('coupler.model="auto"', 'coupler.modes="auto"', 'coupler.mesh_size_m="auto"',
+             'simulation.step_s="auto"', 'simulation.spectral_radius="auto"',
+             'simulation.newton="auto"', 'simulation.newton_relative_tolerance="auto"')
 
 
 def tolerance_scenes(scenes: Mapping[str, Scene]) -> dict[str, Scene]:
@@ -139,5 +144,5 @@ def tolerance_findings(results: Mapping[str, CaseResult]) -> tuple[dict[str, Any
     return table, "\n".join(lines), report
 
 
-__all__ = ["COLUMNS", "LEVELS", "MODES", "QUANTITY", "SEPARATOR", "check_tolerance",
+__all__ = ["COLUMNS", "LEVELS", "MODES", "QUANTITY", "SEPARATOR", "USER_KEYS", "check_tolerance",
            "check_tolerances", "tolerance_findings", "tolerance_rows", "tolerance_scenes"]
