@@ -115,3 +115,23 @@ def test_the_tolerance_table_counts_what_the_reference_can_decide():
     assert first["worst_true_over_allowed"] == 2.0
     assert rows[(0.01, "refined")]["truly_met"] == 1
     assert rows[(0.001, "first")]["decided"] == "0 of 0"
+
+
+def test_a_pair_is_judged_when_no_error_of_the_reference_can_flip_its_verdict():
+    """Estimate 1e-7: a true error 4e-9 +- 7e-9 (the 3 mm plate's deployment peak against its
+    stored reference) lies wholly below 1/2 of it: judged, outside (pessimistic); 8e-8 +- 1e-8
+    wholly inside [1/2, 1.5]: judged, within; 5.5e-8 +- 1e-8 straddles 1/2: not judged."""
+    from flex.experiments.workprecision.estimate_check import reference_decides
+
+    assert reference_decides(4e-9, 7e-9, 1e-7)
+    assert reference_decides(8e-8, 1e-8, 1e-7)
+    assert not reference_decides(5.5e-8, 1e-8, 1e-7)
+    assert not reference_decides(1.45e-7, 1e-8, 1e-7)  # straddles 1.5
+    assert reference_decides(1.7e-7, 1e-8, 1e-7)  # wholly above: optimistic
+    case = _case(2e-7, "")
+    case.attrs.update({f"true_error_{PEAK}": 4e-9, f"reference_accuracy_{PEAK}": 7e-9})
+    rows = {row["quantity"]: row for row in pair_rows({"a": case})}
+    assert rows[PEAK]["judged"]
+    case.attrs[f"reference_accuracy_{PEAK}"] = 1e-7
+    rows = {row["quantity"]: row for row in pair_rows({"a": case})}
+    assert not rows[PEAK]["judged"] and rows[PEAK]["why"] == "reference not accurate enough"
