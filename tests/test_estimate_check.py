@@ -128,6 +128,8 @@ def test_a_pair_is_judged_when_no_error_of_the_reference_can_flip_its_verdict():
     assert not reference_decides(5.5e-8, 1e-8, 1e-7)
     assert not reference_decides(1.45e-7, 1e-8, 1e-7)  # straddles 1.5
     assert reference_decides(1.7e-7, 1e-8, 1e-7)  # wholly above: optimistic
+    assert not reference_decides(2.7e-5, 8e-5, 0.0)  # nothing estimated, nothing sure
+    assert reference_decides(2.7e-5, 1e-5, 0.0)  # nothing estimated, surely an error
     case = _case(2e-7, "")
     case.attrs.update({f"true_error_{PEAK}": 4e-9, f"reference_accuracy_{PEAK}": 7e-9})
     rows = {row["quantity"]: row for row in pair_rows({"a": case})}

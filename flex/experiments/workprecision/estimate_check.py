@@ -130,8 +130,8 @@ def reference_decides(true: float, accuracy: float, estimated: float) -> bool:
     estimated [each in the quantity's unit] lies inside [1 / PESSIMISM, OPTIMISM], or wholly
     outside it (a verdict no error of the reference can flip; the earlier rule, accuracy
     within a third of the true error, left pairs 20x outside the band undecided)."""
-    if estimated <= 0:
-        return True
+    if estimated <= 0:  # an estimate of nothing: wrong only where the error surely is not
+        return true - accuracy > 0
     low, high = max(true - accuracy, 0.0) / estimated, (true + accuracy) / estimated
     return (1 / PESSIMISM <= low and high <= OPTIMISM) or high < 1 / PESSIMISM or low > OPTIMISM
 
