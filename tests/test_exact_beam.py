@@ -325,3 +325,33 @@ def test_the_beam_needs_a_plate_and_other_models_do_not_read_elements():
     with pytest.raises(SceneError, match="coupler.elements") as refused:
         flex.simulate(scene)
     assert '"exact_beam"' in str(refused.value)
+
+
+def test_a_beam_run_stalled_on_its_newton_floor_is_run_again_and_says_so():
+    """The 3 mm plate driven at 60 rad/s as a 128-element beam at 5e-6 s stalls Newton just
+    above its tolerance 0.68 ms in (the beam companion of a 0.3 % run): it is run again at 4x
+    the tolerance, and the case says so. A stall far above the tolerance, or a run without a
+    beam, stays a divergence."""
+    from flex.data.scene import load_scene
+    from flex.dynamics.link_models import BUILTIN_LINK_MODELS
+    from flex.dynamics.solver import NEWTON_RETRY_ATTR, _newton_floor_retry
+    from flex.fidelity.simulation import simulate_case
+
+    beam = load_scene(None, ['coupler.geometry="plate"', "coupler.thickness_m=0.003",
+                             'drive.kind="constant_speed"', "drive.crank_speed_rad_per_s=60.0",
+                             'coupler.model="exact_beam"', "coupler.elements=128",
+                             "simulation.step_s=5e-6", "simulation.end_time_s=0.0008",
+                             "simulation.error_estimate=false"])
+    case = simulate_case(beam, "floor")
+    assert case.status == "ok", case.message
+    assert "round-off floor" in case.attrs[NEWTON_RETRY_ATTR]
+    assert 'newton_relative_tolerance = 4e-06' in case.scene_toml
+    from flex.config.settings import resolve_solver_settings
+
+    concrete, _ = resolve_solver_settings(beam)
+    stalled = "Newton failed (... relative error = {} ...)"
+    assert _newton_floor_retry(concrete, stalled.format("3e-6"), BUILTIN_LINK_MODELS)
+    assert _newton_floor_retry(concrete, stalled.format("5e-6"), BUILTIN_LINK_MODELS) is None
+    assert _newton_floor_retry(concrete, stalled.format("nan"), BUILTIN_LINK_MODELS) is None
+    rigid, _ = resolve_solver_settings(load_scene(None, []))
+    assert _newton_floor_retry(rigid, stalled.format("3e-8"), BUILTIN_LINK_MODELS) is None

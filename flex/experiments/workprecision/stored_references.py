@@ -47,6 +47,7 @@ from flex.data.scene import LINKS, Scene, to_toml
 from flex.data.scene_edit import derive_scene
 from flex.dynamics.exact_beam_link import beam_calibration_of
 from flex.dynamics.link_models import EXACT_BEAM, RIGID
+from flex.dynamics.solver import NEWTON_RETRY_ATTR
 from flex.fidelity.simulation import simulate_case
 
 #: the reference beam's elements: a slender plate's (length / thickness at least
@@ -151,9 +152,8 @@ def make_reference(name: str, scene: Scene, cache_dir: Path | None = None) -> Ca
     except SceneError as exc:
         return CaseResult(name, to_toml(scene), status="failed", message=str(exc))
     done: dict[str, CaseResult] = {}
-    retried: list[str] = []
     for key, run_scene in runs.items():
-        done[key] = _run(run_scene, f"{name}_{key}", cache_dir, plates, retried)
+        done[key] = simulate_case(run_scene, f"{name}_{key}", cache_dir=cache_dir)
         if done[key].status != "ok":
             return CaseResult(name, to_toml(scene), status="failed",
                               message=f"reference run {key} failed: {done[key].message}")
@@ -175,8 +175,8 @@ def make_reference(name: str, scene: Scene, cache_dir: Path | None = None) -> Ca
                         + f", model {model:.3g} {headline.unit}")
     case.attrs["reference_evidence"] = (
         f"{what}; step {runs[FINEST]['simulation']['step_s']:g} s; "
-        + (f"{', '.join(retried)} at {NEWTON_RETRY_FACTOR:g}x the beam's Newton tolerance (its "
-           f"round-off floor); " if retried else "")
+        + "".join(f"{key}: {run.attrs[NEWTON_RETRY_ATTR]}; " for key, run in done.items()
+                  if NEWTON_RETRY_ATTR in run.attrs)
         + "accuracy = each knob's "
         f"error from two coarser levels (at the observed order, else 3x the larger change) + "
         f"idealization {idealization:.2g} x the elastic part. "
@@ -188,32 +188,6 @@ def make_reference(name: str, scene: Scene, cache_dir: Path | None = None) -> Ca
 #: (2: a peak that moves between levels counts its change whole only when its shift does not
 #: shrink, :func:`_peak_moved`)
 make_reference.case_version = 2  # type: ignore[attr-defined]
-
-
-#: a beam run whose Newton stalls is run again once with this many times the beam's relative
-#: Newton tolerance: the residual's round-off floor lies above them on some physics (the 2 mm plate
-#: driven at 60 rad/s stalled at 128 elements at 1.77e-6 against 1e-6, 0.165 ms in); the
-#: tolerance moved the 3 mm plate's deployment peak by 6e-6 of itself (1e-7 -> 1e-6), and the
-#: levels' changes, which make the accuracy, include what it moves
-NEWTON_RETRY_FACTOR = 4.0
-
-
-def _run(scene: Scene, name: str, cache_dir: Path | None, plates: list[str],
-         retried: list[str]) -> CaseResult:
-    """One reference run; a beam run whose Newton stalls once more at
-    :data:`NEWTON_RETRY_FACTOR` x the beam's relative tolerance (its name added to
-    ``retried``)."""
-    from flex.dynamics.exact_beam_link import exact_beam_newton_tolerances
-
-    run = simulate_case(scene, name, cache_dir=cache_dir)
-    if run.status == "ok" or not plates or "Newton failed" not in run.message:
-        return run
-    relative, _ = exact_beam_newton_tolerances(max(int(scene[link]["elements"])
-                                                   for link in plates))
-    retried.append(name)
-    return simulate_case(derive_scene(scene, [
-        f"simulation.newton_relative_tolerance={NEWTON_RETRY_FACTOR * relative!r}"]),
-        name, cache_dir=cache_dir)
 
 
 def _change(headline: Headline, finest: CaseResult, coarse: CaseResult) -> float:
