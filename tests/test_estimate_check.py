@@ -137,3 +137,30 @@ def test_a_pair_is_judged_when_no_error_of_the_reference_can_flip_its_verdict():
     case.attrs[f"reference_accuracy_{PEAK}"] = 1e-7
     rows = {row["quantity"]: row for row in pair_rows({"a": case})}
     assert not rows[PEAK]["judged"] and rows[PEAK]["why"] == "reference not accurate enough"
+
+
+def test_a_bound_or_flagged_pair_needs_its_reference_only_to_decide_its_certificate():
+    """A raw peak (a bound) or a flagged estimate is asked whether its certificate holds:
+    true 1.5e-7 +- 2e-8 against a certificate of 2.5e-7 is decided (surely within), though
+    the same interval over the estimate straddles 1/2 and 1.5 of the band; 2.4e-7 +- 2e-8 is
+    not. An error below the solver's noise floor needs no reference at all."""
+    from flex.experiments.workprecision.estimate_check import certificate_decided
+
+    assert certificate_decided(1.5e-7, 2e-8, 2.5e-7)
+    assert certificate_decided(3e-7, 2e-8, 2.5e-7)  # surely exceeded
+    assert not certificate_decided(2.4e-7, 2e-8, 2.5e-7)
+    for bounded in (PEAK, ""):
+        case = _case(1.5e-7, bounded)  # flagged (a bounded step term), or a raw-peak bound
+        case.attrs[f"reference_accuracy_{PEAK}"] = 2e-8
+        if not bounded:
+            case.attrs[BOUNDS_ATTR] = PEAK
+        row = {row["quantity"]: row for row in pair_rows({"a": case})}[PEAK]
+        assert not row["judged"] and "certificate checked" in row["why"]
+        case.attrs[f"true_error_{PEAK}"] = 2.4e-7
+        row = {row["quantity"]: row for row in pair_rows({"a": case})}[PEAK]
+        assert row["why"] == "reference not accurate enough to check its certificate"
+    case = _case(2e-7, "")
+    case.attrs.update({f"estimated_error_{END}": 2.4e-14, f"true_error_{END}": 1e-13,
+                       f"reference_accuracy_{END}": 1e-12})  # reference noisier than both
+    row = {row["quantity"]: row for row in pair_rows({"a": case})}[END]
+    assert row["why"] == "noise floor"

@@ -59,9 +59,11 @@ class Rung:
     #: companion's difference, not the fractions (None: the fractions)
     measured_against: Callable[[Mapping[str, Any]], tuple[str, ...]] | None = None
     measured_against_text: str = ""
-    #: the ``measured_against`` companion's own error on the link's own quantities, relative
-    #: to them [1], for a scene (added to the term: its sign is unknown)
-    measured_against_error: Callable[[Mapping[str, Any]], float] | None = None
+    #: a second ``measured_against`` companion, coarser (overrides as there): the term is then
+    #: the difference to the two extrapolated (Richardson at each quantity's ``mesh_order``)
+    #: plus the extrapolation's size, the companion's own error (None: one companion, its
+    #: difference whole)
+    measured_against_coarser: Callable[[Mapping[str, Any]], tuple[str, ...]] | None = None
     #: the ``measured_against`` companion resolves the link's own knobs (an FFRF body's
     #: modes and mesh: the exact beam has neither), so its difference holds their errors
     #: too: the budget measures them apart only when that difference is a sizable share of
@@ -137,45 +139,41 @@ _FFRF_MEASURED_BY = (
     f"{FFRF_MOTION_ERROR_FRACTION:g} of what the elasticity changes in the motion and the "
     f"joint forces (make flexible; the difference to rigid twins)")
 
-#: the exact beam companion that measures a link's model term (an FFRF body's, a rigid
-#: plate's), sized to the tolerance: its own error must stay well below the term it measures.
-#: Rows: (tolerance at or above, elements, step at most [s], own error at most), tightest
-#: last: its elements' and step's error on the deployment peak at most a third of the
-#: tolerance. Measured against 256 elements at 2.5e-6 s (thesis deployment, 30 ms):
-#: 32 elements at 2e-5 s 0.30 / 0.21 / 0.15 % (0.7 / 1 / 3 mm; 0.3 s), 64 at 2e-5 s 0.07 /
-#: 0.04 / 0.03 % (0.5-0.7 s), 128 at 1e-5 s 0.011 / 0.006 / 0.001 % (2-2.5 s); at 4e-5 s the
-#: 3 mm plate's step error reached 0.37 %. 64 elements at 1 % were tried against the stored
-#: references (make estimates): the deflection terms came to 0.4-0.8 of the true errors
-#: (0.1-0.3 with 32) but 8 FFRF certificates fell below the truth (joint forces 1.3-2.6x,
-#: the aluminium plate's stress 2.3x: a stress converges at order 1 in the elements, and
-#: the own-error column was measured on the deflection); 32 at 1 % keeps them
-EXACT_BEAM_COMPANIONS = ((0.01, 32, 2e-5, 0.0033), (0.003, 64, 2e-5, 0.001),
-                         (0.0, 128, 1e-5, 0.0002))
-"""Rows (tolerance at or above, elements, step at most [s], own error at most [1]): the last
-column bounds the companion's own error on the link's own quantities relative to them (above
-the measured values; the model term adds it, since its sign is unknown)."""
+#: the exact beam companions that measure a link's model term (an FFRF body's, a rigid
+#: plate's), sized to the tolerance. Rows: (tolerance at or above, elements, step at most
+#: [s]), tightest last; an FFRF body's term also runs a second companion at half the elements
+#: (:data:`COARSER_COMPANION_DIVISOR`) and extrapolates the two (Richardson at the quantity's
+#: order, :attr:`flex.data.headlines.Headline.mesh_order`), adding the extrapolation's size.
+#: Measured against 256 elements at 2.5e-6 s (thesis deployment, 30 ms): 32 elements at
+#: 2e-5 s 0.30 / 0.21 / 0.15 % (0.7 / 1 / 3 mm; 0.3 s), 64 at 2e-5 s 0.07 / 0.04 / 0.03 %
+#: (0.5-0.7 s), 128 at 1e-5 s 0.011 / 0.006 / 0.001 % (2-2.5 s); at 4e-5 s the 3 mm plate's
+#: step error reached 0.37 %. Against the stored references (8 FFRF scenes of make estimates
+#: at 1 %, the deployment peak deflection and first crest): 32 elements with a fixed own-error
+#: bound of 0.33 % made the term 6-60x the FFRF's true error (0.01-0.3 %); 64 and 32
+#: extrapolated brought the pairs the references decide to 0.5-0.8 of it, the joint forces'
+#: and stresses' within 0.5-1.2 (``/tmp/s12/comp.py`` in session 12's note). 64 alone (no
+#: extrapolation, a fixed bound) had let 8 certificates fall below the truth.
+EXACT_BEAM_COMPANIONS = ((0.003, 64, 2e-5), (0.0, 128, 1e-5))
+"""Rows (tolerance at or above, elements, step at most [s]): the finer companion's."""
+#: the second, coarser companion's elements: the finer one's over this
+COARSER_COMPANION_DIVISOR = 2
 
 
 def exact_beam_companion(tolerance: float) -> tuple[int, float]:
     """The exact beam companion's elements and largest step [s] at ``tolerance`` [1]: the
     first row of :data:`EXACT_BEAM_COMPANIONS` it reaches."""
-    return next((elements, step) for floor, elements, step, _ in EXACT_BEAM_COMPANIONS
+    return next((elements, step) for floor, elements, step in EXACT_BEAM_COMPANIONS
                 if tolerance >= floor)
 
 
-def _exact_beam_companion_error(scene: Mapping[str, Any]) -> float:
-    """The exact beam companion's own error bound [1] at ``scene``'s tolerance (the last
-    column of :data:`EXACT_BEAM_COMPANIONS`)."""
-    tolerance = Tolerance.of(scene).relative
-    return next(error for floor, _, _, error in EXACT_BEAM_COMPANIONS if tolerance >= floor)
-
-
-def _against_exact_beam(scene: Mapping[str, Any]) -> tuple[str, ...]:
+def _against_exact_beam(scene: Mapping[str, Any], divisor: int = 1) -> tuple[str, ...]:
     """A scene's overrides that put a link on the exact beam rung, sized to the scene's
     tolerance (:func:`exact_beam_companion`), at the run's step or the companion's, whichever
     is finer (the companion's: the largest that divides the run's end time, so it ends where
-    the run does; the budget compares the curves interpolated, not sample by sample)."""
+    the run does; the budget compares the curves interpolated, not sample by sample); its
+    elements over ``divisor``."""
     elements, step_s = exact_beam_companion(Tolerance.of(scene).relative)
+    elements //= divisor
     run_step_s = float(scene["simulation"]["step_s"])
     end_s = float(scene["simulation"]["end_time_s"])
     if step_s < run_step_s:
@@ -185,11 +183,19 @@ def _against_exact_beam(scene: Mapping[str, Any]) -> tuple[str, ...]:
             f"simulation.step_s={step_s!r}")
 
 
+def _against_coarser_beam(scene: Mapping[str, Any]) -> tuple[str, ...]:
+    """:func:`_against_exact_beam` with :data:`COARSER_COMPANION_DIVISOR` times fewer
+    elements, at the same step: the pair the model term extrapolates."""
+    return _against_exact_beam(scene, COARSER_COMPANION_DIVISOR)
+
+
 _AGAINST_EXACT_BEAM_TEXT = (
-    "FFRF ({links}): the difference to a companion whose {links} is the geometrically exact "
-    "beam, calibrated on the plate (the rung above, on the same scene: the difference holds "
-    "the FFRF body's modes, mesh and step errors), plus the companion's own error bound on "
-    "the link's own quantities (its elements and step, beside its measured idealization)")
+    "FFRF ({links}): the difference to the geometrically exact beam, calibrated on the plate "
+    "(the rung above, on the same scene: the difference holds the FFRF body's modes, mesh and "
+    "step errors), extrapolated from two companions (the beam's elements halved, Richardson "
+    "at each quantity's order: 2 for a displacement or the motion, 1 for a stress), plus the "
+    "extrapolation's size (its sign unknown); the beam's own step error, common to both, and "
+    "its measured idealization are not in it")
 
 #: a rigid plate link: its elasticity is measured on the run's own scene, the difference to a
 #: companion whose link is the geometrically exact beam (the rung the rigid model leaves out
@@ -208,13 +214,13 @@ LINEAR_FFRF_RUNG = Rung(
     "linear FFRF ({links}): plus the difference to a companion with geometric stiffness",
     _FFRF_MEASURED_BY, measured_against=_against_exact_beam,
     measured_against_text="linear " + _AGAINST_EXACT_BEAM_TEXT, resolves_knobs=True,
-    measured_against_error=_exact_beam_companion_error)
+    measured_against_coarser=_against_coarser_beam)
 #: flex's default flexible body: FFRF in the chord frame with geometric stiffness
 FFRF_RUNG = Rung(2, "FFRF", _geometric_ffrf_bound, GEOMETRIC_FFRF_ERROR,
                  FFRF_MOTION_ERROR_FRACTION, measured_by=_FFRF_MEASURED_BY,
                  measured_against=_against_exact_beam,
                  measured_against_text=_AGAINST_EXACT_BEAM_TEXT, resolves_knobs=True,
-                 measured_against_error=_exact_beam_companion_error)
+                 measured_against_coarser=_against_coarser_beam)
 EXACT_BEAM_ERROR_PER_SLENDERNESS = 0.05
 """The geometrically exact beam's model error against the 3-D plate, relative to the link's
 own deflection, per thickness / length (its idealization: plane sections, a pin at the
@@ -339,7 +345,7 @@ def next_rung(link: str, values: Mapping[str, Any], link_models: Mapping[str, An
     return above[0] if above else None
 
 
-__all__ = ["EXACT_BEAM_COMPANIONS", "exact_beam_companion",
+__all__ = ["COARSER_COMPANION_DIVISOR", "EXACT_BEAM_COMPANIONS", "exact_beam_companion",
            "EXACT_BEAM_ERROR_PER_SLENDERNESS", "EXACT_BEAM_MEASURED_LOAD_RATIO",
            "EXACT_BEAM_RUNG", "FFRF_MEASURED_LOAD_RATIO",
            "FFRF_MOTION_ERROR_FRACTION", "FFRF_RUNG", "GEOMETRIC_FFRF_ERROR",

@@ -20,7 +20,8 @@ peak bending stress), four named terms and their total [the quantity's units]:
 - ``model``: the link model against the next rung of flex's ladder, read from the rung each
   link's model entry names (:mod:`flex.config.ladder`; no model is named here): a rung that
   measures its term on the scene (``measured_against``: the FFRF bodies, against the exact
-  beam) gets the difference to that companion; a link on another
+  beam) gets the difference to that companion (an FFRF body's: to two beam companions
+  extrapolated, plus the extrapolation's size, ``measured_against_coarser``); a link on another
   bounded rung (the exact beam) gets its rung's ``own_fraction`` of what its elasticity
   changes in its own quantities and the ``motion_fraction`` of what it changes in the
   motion and the joint forces (the difference to a companion whose bounded links are rigid
@@ -194,41 +195,60 @@ def _measured_model_term(scene: Scene, result: CaseResult, companions: _Companio
                          rungs: dict[str, Rung]) -> tuple[dict[str, Any], list[str]]:
     """The model term of the links whose rung measures it on the run's scene (a companion
     one rung up, :attr:`flex.config.ladder.Rung.measured_against`: an FFRF body's, a rigid
-    plate's): each headline quantity's difference to that companion, the sentence, and under
-    ``""`` the links it measured. A companion the scene cannot run (a model the rung above
-    does not offer for it, e.g. a damped link) leaves a bounded rung's links to its measured
-    fractions, and says so; a rung without fractions (rigid) keeps the failure: its term is
-    unknown."""
+    plate's): each headline quantity's difference to that companion (where a rung has a
+    coarser companion too, to the two extrapolated, plus the extrapolation's size:
+    :func:`_extrapolated_difference`), the sentence, and under ``""`` the links it measured.
+    A companion the scene cannot run (a model the rung above does not offer for it, e.g. a
+    damped link) leaves a bounded rung's links to its measured fractions, and says so; a
+    rung without fractions (rigid) keeps the failure: its term is unknown."""
     measured = {link: rung for link, rung in rungs.items() if rung.measured_against}
     if not measured:
         return {}, []
-    overrides = [override.format(link=link) for link, rung in measured.items()
-                 for override in rung.measured_against(scene)]
     failures = len(companions.failures)
-    above = companions.run("model", _companion(scene, list(dict.fromkeys(overrides))))
+    above = companions.run("model", _measuring_companion(scene, measured, coarser=False))
     if above is None:
         if not all(rung.bounded for rung in measured.values()):
             return {}, []
         reason = companions.failures.pop(failures).split(": ", 1)[1]
         return {}, [f"not measured on the scene ({reason}): the measured fractions instead"]
     terms: dict[str, Any] = dict(companions.differences(result, above))
-    errors = [rung.measured_against_error(scene) for rung in measured.values()
-              if rung.measured_against_error is not None]
-    for name in terms:  # the companion's own error, sign unknown: on a measured link's own
-        # quantities and on the joints' force peaks (the elastic ringing it resolves only to
-        # that error sets them; a peak of the motion's series that names no link)
-        headline = companions.headlines[name]
-        rung = measured.get(headline.link)
-        if rung is not None and rung.measured_against_error is not None:
-            error = rung.measured_against_error(scene)
-        elif (headline.link is None and headline.series is not None
-              and headline.kind != "history" and errors):
-            error = max(errors)
-        else:
-            continue
-        terms[name] += error * abs(headline.read(result.datasets) or 0.0)
+    if any(rung.measured_against_coarser for rung in measured.values()):
+        coarser = companions.run("model", _measuring_companion(scene, measured, coarser=True))
+        if coarser is not None:
+            for name in terms:
+                terms[name] = _extrapolated_difference(companions.headlines[name], result,
+                                                       above, coarser, terms[name])
     terms[""] = set(measured)
     return terms, _grouped(measured, "measured_against_text")
+
+
+def _measuring_companion(scene: Scene, measured: Mapping[str, Rung], coarser: bool) -> Scene:
+    """The companion scene whose ``measured`` links stand on the rung above (each rung's
+    ``measured_against``; with ``coarser``, its ``measured_against_coarser`` where it has
+    one)."""
+    overrides = [override.format(link=link) for link, rung in measured.items()
+                 for override in (rung.measured_against_coarser if coarser
+                                  and rung.measured_against_coarser else
+                                  rung.measured_against)(scene)]
+    return _companion(scene, list(dict.fromkeys(overrides)))
+
+
+def _extrapolated_difference(headline: Headline, result: CaseResult, fine: CaseResult,
+                             coarse: CaseResult, difference: float) -> float:
+    """A quantity's model term from two companions one rung up [its unit]: the difference of
+    ``result`` to their Richardson extrapolation at the quantity's ``mesh_order`` (the
+    elements halved between them), plus the extrapolation's size (the finer companion's own
+    error, its sign unknown). A history: the difference to the finer companion plus that
+    size (curves are not extrapolated). ``difference``: the run's difference to the finer
+    companion, kept where the coarser one lacks the quantity."""
+    change = headline_difference(headline, fine.datasets, coarse.datasets)
+    if change is None or math.isnan(change) or math.isnan(difference):
+        return difference
+    share = 1.0 / (2.0 ** headline.mesh_order - 1.0)
+    ours, finer, coarser = (headline.read(case.datasets) for case in (result, fine, coarse))
+    if headline.kind == "history" or None in (ours, finer, coarser):
+        return difference + share * change
+    return abs(ours - (finer + share * (finer - coarser))) + share * change
 
 
 def _model_term(scene: Scene, result: CaseResult, companions: _Companions,

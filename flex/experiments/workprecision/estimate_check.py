@@ -17,9 +17,13 @@ Per headline quantity it stores on the case, as attributes:
   interpolation's);
 - ``estimate_ratio_<q>``: estimated / true error (1: exact; below 1: optimistic).
 
-A pair is *judged* only where the true error is known (at least 3x the reference's
-accuracy) and above the solver's noise floor (:data:`NOISE_FLOOR` of the quantity's
-scale); the others are stored and said, not judged. :func:`estimate_summary` makes the
+A pair is *judged* only where the reference decides its verdict (:func:`reference_decides`:
+true +- the reference's accuracy, over the estimate, wholly inside or wholly outside the
+band), it lies above the solver's noise floor (:data:`NOISE_FLOOR` of the quantity's
+scale), and its total is an estimate; a bound (a raw whole-run peak) or a flagged estimate
+(its step term a bound) is asked only whether its certificate holds, and its reference is
+accurate enough when it decides that (:func:`certificate_decided`). The others are stored
+and said, not judged, each with why (:func:`_why_not_judged`). :func:`estimate_summary` makes the
 table, the verdicts against the targets (true / estimated within [1 / :data:`PESSIMISM`,
 :data:`OPTIMISM`]) and the figure data.
 """
@@ -136,6 +140,31 @@ def reference_decides(true: float, accuracy: float, estimated: float) -> bool:
     return (1 / PESSIMISM <= low and high <= OPTIMISM) or high < 1 / PESSIMISM or low > OPTIMISM
 
 
+def certificate_decided(true: float, accuracy: float, certificate: float) -> bool:
+    """Whether a reference of ``accuracy`` decides a certificate check: the interval
+    [true - accuracy, true + accuracy] lies wholly below ``certificate`` or wholly above it
+    [each in the quantity's unit]."""
+    return true + accuracy <= certificate or true - accuracy > certificate
+
+
+def _why_not_judged(true: float, known: bool, above_noise: bool, bound: bool,
+                    flagged: bool) -> str:
+    """Why a pair is not judged, in the order the checks decide: two runs that agree
+    exactly, an error below the solver's noise floor (no reference need decide it), a
+    reference that cannot decide what the pair is asked, a bound, a flagged estimate."""
+    if true == 0:
+        return "every run agrees exactly"
+    if not above_noise:
+        return "noise floor"
+    if not known:
+        return "reference not accurate enough" + (" to check its certificate"
+                                                  if bound or flagged else "")
+    if bound:
+        return "a bound (raw whole-run peak): its certificate checked, not judged"
+    return ("flagged: outside the asymptotic range (its step term a bound), its certificate "
+            "checked")
+
+
 def pair_rows(results: Mapping[str, CaseResult]) -> list[dict[str, Any]]:
     """One row per (case, quantity) with an estimate and a true error."""
     rows = []
@@ -148,26 +177,25 @@ def pair_rows(results: Mapping[str, CaseResult]) -> list[dict[str, Any]]:
             accuracy = float(case.attrs[f"reference_accuracy_{quantity}"])
             scale = _SCALES.get(quantity) or abs(float(case.attrs.get(
                 f"headline_{quantity}", max(true, estimated))))
-            known = true > 0 and reference_decides(true, accuracy, estimated)
             above_noise = max(true, estimated) > NOISE_FLOOR * scale
             terms = {term: float(case.attrs.get(f"{PREFIX}{quantity}_{term}", 0.0))
                      for term in ("step", "modes", "mesh", "model")}
             flagged = quantity in named_quantities(case.attrs, STEP_BOUNDS_ATTR)
             bound = quantity in named_quantities(case.attrs)
             factor = float(case.attrs.get(CERTIFICATE_ATTR, 1.0))
+            # a bound or a flagged pair is asked one thing, whether its certificate holds;
+            # an estimate whether true / estimated lies in the band
+            known = true > 0 and (certificate_decided(true, accuracy, factor * estimated)
+                                  if bound or flagged else
+                                  reference_decides(true, accuracy, estimated))
+            judged = known and above_noise and not flagged and not bound
             rows.append({"case": name, "quantity": quantity, "estimated": estimated,
                          "certificate": factor * estimated, "flagged": flagged,
                          "bound": bound, "true": true, "reference_accuracy": accuracy,
-                         "above_noise": above_noise,
-                         "judged": known and above_noise and not flagged and not bound,
+                         "above_noise": above_noise, "judged": judged,
                          "largest_term": max(terms, key=terms.get),
-                         "why": "" if known and above_noise and not flagged and not bound else
-                         ("every run agrees exactly" if true == 0 else
-                          "reference not accurate enough" if not known else
-                          "noise floor" if not above_noise else
-                          "a bound (raw whole-run peak): its certificate checked, not judged"
-                          if bound else
-                          "flagged: outside the asymptotic range (its step term a bound)"),
+                         "why": "" if judged else _why_not_judged(true, known, above_noise,
+                                                                   bound, flagged),
                          "same_model": case.attrs.get(f"reference_rung_{quantity}")
                          == "same model"})
     return rows
