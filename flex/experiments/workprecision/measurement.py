@@ -278,13 +278,24 @@ class Reference:
         return out
 
 
-def stored_as_reference(stored: StoredReference) -> Reference:
+#: what a stored reference's accuracy covers (:func:`stored_as_reference`): its peak only
+#: (the calibration grid, which certifies the peak), or every error measure of
+#: :meth:`Reference.errors` (the crank angle's and slider position's curves and the peak:
+#: the work-precision studies, whose error is the largest of them)
+PEAK_ONLY, EVERY_MEASURE = "peak", "every measure"
+
+
+def stored_as_reference(stored: StoredReference, covers: str = PEAK_ONLY) -> Reference:
     """A stored reference (:mod:`flex.data.reference_store`: made once by ``make references``)
     as the :class:`Reference` runs are measured against: its curves (every
     :data:`~flex.data.reference_store.CURVE_STEP_S`), its :data:`PEAK_HEADLINE` and, as its
-    accuracy, that headline's stored accuracy relative to it (what a grid's certified peak
-    error adds; the curves' own errors, a few 1e-5 of the swing and the travel, are not
-    added)."""
+    accuracy (relative), what ``covers`` says: :data:`PEAK_ONLY`, that headline's stored
+    accuracy relative to it (what a grid's certified peak error adds; the curves' own errors
+    are not added); :data:`EVERY_MEASURE`, the largest of each measure's relative accuracy:
+    the crank angle's and slider position's stored history accuracies plus their cubic
+    interpolation's error (:func:`~flex.experiments.workprecision.stored_references.curve_at`),
+    over the scales :meth:`Reference.errors` divides by, and the peak's (the error of a
+    largest relative error is at most the largest error of its parts)."""
     curves = stored.curves
     peak = stored.values[PEAK_HEADLINE]
     observables = Observables(np.asarray(curves["time"], dtype=float),
@@ -292,10 +303,35 @@ def stored_as_reference(stored: StoredReference) -> Reference:
                               np.asarray(curves["slider/position"], dtype=float),
                               np.asarray(curves["coupler/midpoint_deflection"], dtype=float),
                               peak)
-    relative = stored.accuracies[PEAK_HEADLINE] / abs(peak)
+    accuracies = {"peak_deflection_relative": stored.accuracies[PEAK_HEADLINE] / abs(peak)}
+    if covers == EVERY_MEASURE:
+        accuracies |= _curve_accuracies(stored, observables)
+    elif covers != PEAK_ONLY:
+        raise ValueError(f"covers = {covers!r}; accepted: {PEAK_ONLY!r}, {EVERY_MEASURE!r}")
+    relative = max(accuracies.values())
+    measures = ", ".join(f"{name.removesuffix('_relative').replace('_', ' ')} {value:.1e}"
+                         for name, value in accuracies.items())
     return Reference(f"stored reference {stored.name}", observables, Setting(stored.model),
-                     {"stored reference": {"error": relative}}, relative, 0.0,
-                     stored.evidence)
+                     {"stored reference": {"error": relative, **accuracies}}, relative, 0.0,
+                     f"the stored reference {stored.name} (make references): {stored.model}; "
+                     f"relative accuracy {measures} (its evidence in the store)")
+
+
+def _curve_accuracies(stored: StoredReference, observables: Observables) -> dict[str, float]:
+    """The crank angle's and slider position's relative accuracy as :meth:`Reference.errors`
+    reads them: the stored history accuracy plus the interpolation's, over the curve's
+    scale."""
+    from flex.experiments.workprecision.stored_references import curve_at
+
+    out = {}
+    for measure, path, history, fallback in (
+            ("crank_angle_relative", "crank/angle", "history_crank_angle", ANGLE_SCALE_RAD),
+            ("slider_position_relative", "slider/position", "history_slider_position",
+             SLIDER_SCALE_M)):
+        _, sampling = curve_at(stored, path, observables.time_s)
+        scale = _scale(np.asarray(stored.curves[path], dtype=float), fallback)
+        out[measure] = (stored.accuracies[history] + sampling) / scale
+    return out
 
 
 # ------------------------------------------------------------------------------------------

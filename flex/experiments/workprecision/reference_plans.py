@@ -6,8 +6,9 @@ accuracy it claims, a description, the three-level knob sequences
 that the knobs' errors add up; :func:`build_reference` runs it
 (:func:`flex.experiments.workprecision.convergence.converged_reference`).
 :func:`reference_plan` gives the work-precision study's plans: the scipy reference DAE for the
-rigid coupler, and flex's FFRF model for the 1 mm and 10 mm steel plates
-(:data:`FFRF_REFERENCE`), refined in step, mesh and modes (and Newton tolerance).
+rigid coupler, and flex's FFRF model for the 10 mm steel plate (:data:`FFRF_REFERENCE`),
+refined in step, mesh and modes (and Newton tolerance). The 1 mm plate's reference is stored
+(``make references``; :func:`~flex.experiments.workprecision.measurement.stored_as_reference`).
 """
 
 from __future__ import annotations
@@ -56,19 +57,6 @@ FFRF_REFERENCE: dict[str, dict[str, Any]] = {
                   "mesh_base": {"step": 1.25e-6, "modes": 12}, "mesh_ratio": 2**0.5,
                   "modes_base": {"step": 1.25e-6, "mesh": 0.005},
                   "newton_base": {"step": 1.25e-6, "mesh": 0.005, "modes": 12}},
-}
-#: exact-beam references: the geometrically exact beam (the ladder's cheap rung) where the
-#: ladder says it is exact enough to certify 1 %: its idealization bound
-#: (:data:`flex.config.ladder.EXACT_BEAM_ERROR_PER_SLENDERNESS` x t / L: 6.25e-4 for the 1 mm
-#: plate) within a third of it with its numerics (not for 10 mm: 6.25e-3). Finest elements and
-#: step; sequences of elements and step (x2, three levels each) through it. The 1 mm plate's
-#: FFRF reference (48 modes on a 0.75 mm mesh at 3.125e-7 s, with its sequences) took over an
-#: hour on 2 cores (its reduction alone > 50 min cold) and certified 1 % only (accuracy
-#: 1.6e-3); measured for this plan (coupler deployment peak on the headline channel): 64 ->
-#: 128 -> 256 elements at 2.5e-6 s change it by 3.8e-4 then 5.8e-5 (order 2.7), h = 1e-5 ->
-#: 5e-6 -> 2.5e-6 s at 128 elements by 2.5e-5 then 3e-6, 15 s for the finest run
-BEAM_REFERENCE: dict[str, dict[str, Any]] = {
-    "ffrf_1mm": {"elements": 256, "step": 2.5e-6},
 }
 #: formal orders that cap an observed order: generalized-alpha is second order in the step;
 #: quadratic tetrahedra converge at up to fourth order in the element size (eigenvalues,
@@ -127,57 +115,13 @@ def ffrf_refinements(plan: dict[str, Any]) -> list[Refinement]:
     ]
 
 
-def _beam_setting(elements: int, step: float) -> Setting:
-    """An exact-beam reference-level setting: coupler elements, step [s], modified Newton
-    (the beam's own tolerances, :mod:`flex.dynamics.exact_beam_link`), spectral radius 0.9."""
-    return S(f"reference exact beam elements={elements} h={step:g}",
-             coupler__model="exact_beam", coupler__elements=elements, step_s=step,
-             newton="modified", spectral_radius=0.9)
-
-
-def exact_beam_bound(scene: Scene) -> tuple[float, str]:
-    """The exact beam's idealization bound for the scene's coupler (relative to its own
-    deflection, :data:`flex.config.ladder.EXACT_BEAM_RUNG`) and what it is."""
-    from flex.config.ladder import EXACT_BEAM_ERROR_PER_SLENDERNESS, EXACT_BEAM_RUNG
-
-    return (EXACT_BEAM_RUNG.own(scene["coupler"], None),
-            f"the exact beam's idealization: the ladder's bound "
-            f"{EXACT_BEAM_ERROR_PER_SLENDERNESS:g} x thickness / length of the coupler's "
-            f"deflection (taken for every measure)")
-
-
-def beam_plan(scene_name: str) -> ReferencePlan:
-    """The exact-beam reference of :data:`BEAM_REFERENCE` ``[scene_name]``: claims 1e-3;
-    its accuracy holds the element and step sequences' estimates and the ladder's
-    idealization bound (:func:`exact_beam_bound`)."""
-    from flex.config.knobs import ELEMENTS
-
-    plan = BEAM_REFERENCE[scene_name]
-    elements, step = plan["elements"], plan["step"]
-    refinements = [
-        Refinement("coupler.elements", tuple(_beam_setting(elements // k, step)
-                                             for k in (1, 2, 4)), ELEMENTS.ratio, ELEMENTS.order),
-        Refinement("step_s", tuple(_beam_setting(elements, step * k) for k in (1, 2, 4)),
-                   2.0, MAX_ORDER["step"])]
-    description = (
-        f"the geometrically exact beam (the ladder's rung above FFRF), {elements} elements, "
-        f"generalized-alpha index 3 (rho 0.9), h = {step:g} s, modified Newton; shown "
-        f"converged by three-level sequences of elements and step (x2) with Richardson error "
-        f"estimates, each through the reference, plus the ladder's bound on the beam's "
-        f"idealization (its model term): the FFRF settings' errors hold their model error")
-    return ReferencePlan(refinements[0].levels[0], {}, 1e-3, description, refinements, None,
-                         exact_beam_bound)
-
-
 def reference_plan(scene_name: str) -> ReferencePlan:
     """The plan of the work-precision study's scene ``scene_name``: ``"rigid"``
-    (:func:`rigid_plan`), a key of :data:`BEAM_REFERENCE` (:func:`beam_plan`) or of
-    :data:`FFRF_REFERENCE` (claims 1e-3; the anchor is the step sequence's finest level
-    unless every sequence runs through the reference, :func:`through_reference`)."""
+    (:func:`rigid_plan`) or a key of :data:`FFRF_REFERENCE` (claims 1e-3; the anchor is the
+    step sequence's finest level unless every sequence runs through the reference,
+    :func:`through_reference`)."""
     if scene_name == "rigid":
         return rigid_plan()
-    if scene_name in BEAM_REFERENCE:
-        return beam_plan(scene_name)
     plan = FFRF_REFERENCE[scene_name]
     step, mesh, modes = plan["step"], plan["mesh"], plan["modes"]
     refinements = ffrf_refinements(plan)

@@ -88,11 +88,16 @@ def run_work_precision(scenes: Mapping[str, Scene], settings: Mapping[str, Seque
                        repeats: int, progress: Progress | None = None,
                        notes: dict[str, Any] | None = None,
                        plans: Callable[[str], ReferencePlan] = reference_plan, *,
-                       cache_dir: Path | None = None) -> dict[str, CaseResult]:
-    """Per scene its reference (``plans(scene name)``) and then each of ``settings[scene
-    name]``, measured ``repeats`` times; returns one case per run and stores
-    ``notes["runs"][scene name]`` (:class:`SceneRuns`). ``cache_dir``: the reduction cache
-    folder (None: reductions are built in memory, no disk cache)."""
+                       cache_dir: Path | None = None,
+                       stored: Mapping[str, Reference] | None = None
+                       ) -> dict[str, CaseResult]:
+    """Per scene its reference (``stored[scene name]`` where given: a stored reference,
+    :func:`~flex.experiments.workprecision.measurement.stored_as_reference`, made once by
+    ``make references``, its time 0 here; else built by ``plans(scene name)``) and then each
+    of ``settings[scene name]``, measured ``repeats`` times; returns one case per run and
+    stores ``notes["runs"][scene name]`` (:class:`SceneRuns`). ``cache_dir``: the reduction
+    cache folder (None: reductions are built in memory, no disk cache)."""
+    stored = stored or {}
     total = sum(len(plan) + 1 for plan in settings.values())
     done = 0
     results: dict[str, CaseResult] = {}
@@ -102,11 +107,11 @@ def run_work_precision(scenes: Mapping[str, Scene], settings: Mapping[str, Seque
         if progress:
             progress(f"{scene_name}: reference", done, total)
         started = time.perf_counter()
-        reference = build_reference(
+        reference = stored.get(scene_name) or build_reference(
             scene, scene_name, plans(scene_name), pool,
             (lambda text, name=scene_name, at=done: progress(f"{name}: {text}", at, total))
             if progress else None)
-        reference_time = time.perf_counter() - started
+        reference_time = 0.0 if scene_name in stored else time.perf_counter() - started
         done += 1
         results[f"{scene_name}__reference"] = reference_case(scene_name, scene, reference)
         measurements = []
