@@ -3,10 +3,9 @@
 For every scene of a family (FFRF coupler on a rigid crank: plates of several thicknesses
 and materials, springs and drives) :func:`measure_scene` runs
 
-- a **converged reference**
-  (:func:`flex.experiments.workprecision.coupler_reference.scene_reference`: 12 in-plane
-  modes, a mesh of about the thickness and a step that resolves the 12th mode, with the
-  evidence of three one-level coarsenings);
+- against the **stored reference** of its physics (``make references``,
+  :mod:`flex.data.reference_store`: the calibrated exact beam, its deployment peak's accuracy
+  added to each measured error);
 - the **grid**: every pair of :data:`GRID_MODES` and :data:`GRID_STEPS_PER_PERIOD` (step T1 /
   N) on the rule's mesh, each timed as a user runs it (whole ``simulate``, warm reduction
   cache, median of ``repeats``) and measured against the reference (relative error of the

@@ -12,15 +12,16 @@ same run. :func:`run_bench` runs the six parts of a :class:`BenchPlan` in order,
 - ``ffrf_1mm`` (:func:`bench_ffrf`): the fastest candidate within the peak-deflection
   accuracy, the untuned first set-up, the flex defaults, and the nonlinear FE coupler (if
   installed and asked for: ``nonlinear``, the bench study's ``FLEX_BENCH_NONLINEAR`` not
-  ``0``) against its own run at half the step;
+  ``0``) against its own run at half the step; the FFRF runs against the stored reference of
+  the plate's physics (``make references``: the calibrated exact beam);
 - ``reduction`` (:func:`bench_reduction`): the plate reduction cold (empty cache), from cache,
   and its first FFRF projection;
 - ``step_cost`` (:func:`bench_step_cost`, when the plan has a :class:`StepCostPlan`): the cost
   of an FFRF step against mesh size and mode count, joint markers on every face node (before)
   and on the fewest nodes (now);
 - ``plates`` (:func:`bench_plates`, when the plan has a :class:`PlatesPlan`): plates of other
-  thicknesses and materials at flex's own settings per tolerance, against converged
-  references;
+  thicknesses and materials at flex's own settings per tolerance, against the stored
+  references of their physics;
 - ``budget`` (:func:`flex.experiments.workprecision.budget_cost.bench_budget`, when the plan
   has a :class:`~flex.experiments.workprecision.budget_cost.BudgetPlan`): the 1 % answer's
   cost, the run with its budget against the run alone and the command line against the run
@@ -54,6 +55,7 @@ import numpy as np
 
 from flex.base.errors import FlexError
 from flex.base.physics import Plate
+from flex.data.reference_store import StoredReference
 from flex.data.results import CaseResult
 from flex.data.scene import Scene
 from flex.dynamics.link_models import NONLINEAR_FE
@@ -112,8 +114,9 @@ class BenchPlan:
 
     Rigid: ``rigid_reference``; the crank-angle accuracy [rad]; the tuned Newton knobs
     (``simulation`` keys) and the untuned ones; the steps [s] probed for the tuned setting,
-    largest first; the scipy DOP853 relative tolerances probed, loosest first. FFRF: its
-    reference; the relative peak-deflection accuracy; the target integration time [s]; the
+    largest first; the scipy DOP853 relative tolerances probed, loosest first. FFRF (its
+    reference the stored one of its physics, ``make references``): the relative
+    peak-deflection accuracy; the target integration time [s]; the
     candidate settings, cheapest first; the untuned first set-up; the flex defaults; the
     nonlinear FE coupler at a fine and a coarse step.
     """
@@ -124,7 +127,6 @@ class BenchPlan:
     rigid_untuned: Mapping[str, Any]
     rigid_steps: Sequence[float]
     scipy_rtols: Sequence[float]
-    ffrf_reference: ReferencePlan
     ffrf_accuracy: float
     ffrf_target_s: float
     ffrf_candidates: Sequence[Setting]
@@ -240,10 +242,12 @@ def bench_rigid(scene: Scene, plan: BenchPlan, repeats: int, pool: ReductionPool
 
 
 def bench_ffrf(scene: Scene, plan: BenchPlan, repeats: int, pool: ReductionPool, say: Say,
-               notes: dict[str, Any], nonlinear: bool = True) -> dict[str, CaseResult]:
+               notes: dict[str, Any], store: Mapping[str, StoredReference],
+               nonlinear: bool = True) -> dict[str, CaseResult]:
     """FFRF part: the fastest candidate within the peak accuracy, untuned, defaults,
-    nonlinear FE (if installed and ``nonlinear``)."""
-    reference = build_reference(scene, "ffrf_1mm", plan.ffrf_reference, pool)
+    nonlinear FE (if installed and ``nonlinear``), against the stored reference of the
+    scene's physics in ``store`` (:func:`_stored`)."""
+    reference = _stored(store, scene)
     say(f"ffrf_1mm reference: accuracy {reference.accuracy:.1e}, peak "
         f"{reference.peak_deflection_m * 1e6:.2f} um")
     out: dict[str, CaseResult] = {}
@@ -374,21 +378,20 @@ def _newton_variants(scene: Scene, plan: StepCostPlan, repeats: int, pool: Reduc
 
 
 def bench_plates(scene: Scene, plan: PlatesPlan, repeats: int, pool: ReductionPool, say: Say,
-                 notes: dict[str, Any]) -> dict[str, CaseResult]:
-    """Per plate: the converged reference of
-    :mod:`flex.experiments.workprecision.coupler_reference` (the calibration's; its accuracy
-    certifies a level only within a third of it), then per tolerance flex's own choice (every
-    solver and link key ``"auto"``: :mod:`flex.config.ffrf_rule`, or the visible fallback)
-    timed and measured against it. ``notes["plates"]``: one row each."""
+                 notes: dict[str, Any], store: Mapping[str, StoredReference]
+                 ) -> dict[str, CaseResult]:
+    """Per plate: the stored reference of its physics (``store``, :func:`_stored`; its
+    accuracy certifies a level only within a third of it), then per tolerance flex's own
+    choice (every solver and link key ``"auto"``: :mod:`flex.config.ffrf_rule`, or the
+    visible fallback) timed and measured against it. ``notes["plates"]``: one row each."""
     from flex.config.settings import AUTO_OVERRIDES, resolve_solver_settings
     from flex.data.scene_edit import derive_scene
-    from flex.experiments.workprecision.coupler_reference import scene_reference
     from flex.experiments.workprecision.measurement import certifies
 
     rows, out = [], {}
     for name, overrides in plan.plates.items():
         plate = derive_scene(scene, list(overrides))
-        reference = scene_reference(plate, pool, say)
+        reference = _stored(store, plate)
         say(f"{name}: reference accuracy {reference.accuracy:.1e}")
         for tolerance in plan.tolerances:
             auto = Setting(f"flex defaults at {tolerance:g}", tuple(AUTO_OVERRIDES) + (
@@ -509,30 +512,48 @@ def bench_make_all(say: Say, notes: dict[str, Any], run: bool = True) -> None:
                         f"{out[f'{failed[0]}_error'][-200:]}")
 
 
+def _stored(store: Mapping[str, StoredReference], scene: Scene) -> Reference:
+    """The stored reference of ``scene``'s physics as what runs are measured against, its
+    accuracy the peak's (what the FFRF parts certify); :class:`FlexError` naming the command
+    that makes it when the store lacks it."""
+    from flex.data.reference_store import MissingReferenceError, reference_for
+    from flex.experiments.workprecision.measurement import stored_as_reference
+
+    try:
+        return stored_as_reference(reference_for(store, scene))
+    except MissingReferenceError as exc:
+        raise FlexError(str(exc)) from exc
+
+
 def run_bench(scenes: Mapping[str, Scene], plan: BenchPlan, repeats: int,
               progress: Progress | None = None, notes: dict[str, Any] | None = None, *,
-              cache_dir: Path | None = None, nonlinear: bool = True, make_all: bool = True
-              ) -> dict[str, CaseResult]:
+              cache_dir: Path | None = None, nonlinear: bool = True, make_all: bool = True,
+              store: Mapping[str, StoredReference] | None = None) -> dict[str, CaseResult]:
     """Run the seven parts in order on ``scenes["rigid"]`` and ``scenes["ffrf_1mm"]`` (see the
     module doc); each part's failure is stored, the others still run.
 
     ``cache_dir``: the reduction cache folder of the timed runs (None: reductions built in
     memory, no disk cache; the ``reduction`` part always times its own empty folders);
     ``nonlinear``: time the nonlinear FE coupler too (if installed); ``make_all``: time
-    ``make all`` (the ``make_all`` part).
+    ``make all`` (the ``make_all`` part); ``store``: the stored references the FFRF parts
+    are measured against (:mod:`flex.data.reference_store`; None: the bundled store).
     """
+    if store is None:
+        from flex.data.reference_store import bundled_store, read_store
+
+        store = read_store(bundled_store())
     pool = ReductionPool(cache_dir)
     notes = {} if notes is None else notes
     results: dict[str, CaseResult] = {}
     parts: list[tuple[str, Callable[[Say], Any]]] = [
         ("rigid", lambda say: bench_rigid(scenes["rigid"], plan, repeats, pool, say, notes)),
         ("ffrf_1mm", lambda say: bench_ffrf(scenes["ffrf_1mm"], plan, repeats, pool, say,
-                                            notes, nonlinear)),
+                                            notes, store, nonlinear)),
         ("reduction", lambda say: bench_reduction(scenes["ffrf_1mm"], say, notes)),
         ("step_cost", lambda say: plan.step_cost and bench_step_cost(
             scenes["ffrf_1mm"], plan.step_cost, repeats, pool, say, notes)),
         ("plates", lambda say: plan.plates and bench_plates(
-            scenes["ffrf_1mm"], plan.plates, repeats, pool, say, notes)),
+            scenes["ffrf_1mm"], plan.plates, repeats, pool, say, notes, store)),
         ("budget", lambda say: plan.budget and bench_budget(
             plan.budget, repeats, cache_dir, say, notes)),
         ("make_all", lambda say: bench_make_all(say, notes, make_all))]
