@@ -164,3 +164,14 @@ def test_a_bound_or_flagged_pair_needs_its_reference_only_to_decide_its_certific
                        f"reference_accuracy_{END}": 1e-12})  # reference noisier than both
     row = {row["quantity"]: row for row in pair_rows({"a": case})}[END]
     assert row["why"] == "noise floor"
+
+
+def test_the_findings_count_the_pairs_no_reference_could_decide():
+    from flex.experiments.workprecision.estimate_report import estimate_findings
+
+    case = _case(2e-7, "")
+    case.attrs[f"reference_accuracy_{PEAK}"] = 1.5e-7  # straddles the band: undecided
+    _, findings = estimate_findings({"a": case})
+    line = next(text for text in findings.splitlines() if "not accurate enough" in text)
+    assert "to decide: 1 of 2 pairs (target: none)" in line
+    assert "reference too coarse 1" in line

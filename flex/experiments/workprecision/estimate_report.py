@@ -89,7 +89,8 @@ def _bullets(rows: list[dict[str, Any]], ratio: np.ndarray, found: Mapping[str, 
              f"- flagged outside the asymptotic range: {int(flagged.sum())} of {len(rows)} pairs "
              f"({100 * flagged.mean() if rows else 0:.0f} %; target at most "
              f"{100 * FLAGGED_SHARE:g} %)",
-             f"- certificates exceeded by a known true error: {len(found['exceeded'])}"]
+             f"- certificates exceeded by a known true error: {len(found['exceeded'])}",
+             _not_judged_line(rows)]
     if found["bound"].any():
         spread = found["spread"]
         lines.append(f"- bounds (raw whole-run peaks: checked against their certificates, not "
@@ -101,6 +102,23 @@ def _bullets(rows: list[dict[str, Any]], ratio: np.ndarray, found: Mapping[str, 
         lines.append(f"- true / estimated of the judged pairs: {ratio[judged].min():.3g} (most "
                      f"pessimistic) to {ratio[judged].max():.3g} (most optimistic)")
     return lines
+
+
+def _not_judged_line(rows: list[dict[str, Any]]) -> str:
+    """How many pairs are not judged, by why (:func:`pair_rows`' why, in few words); the
+    references too coarse to decide the band or the certificate first (a target: none)."""
+    counts: dict[str, int] = {}
+    for row in rows:
+        if row["why"]:
+            note = short_note(row, 1.0).removesuffix("; model unchecked")
+            note += " (a certificate)" if "certificate" in str(row["why"]) and \
+                "reference" in str(row["why"]) else ""
+            counts[note] = counts.get(note, 0) + 1
+    coarse = sum(n for note, n in counts.items() if note.startswith("reference too coarse"))
+    return (f"- reference not accurate enough to decide: {coarse} of {len(rows)} pairs (target: "
+            f"none); every pair not judged, by why: "
+            + ", ".join(f"{note} {n}" for note, n in sorted(counts.items(),
+                                                            key=lambda item: -item[1])))
 
 
 def estimate_findings(results: Mapping[str, CaseResult]) -> tuple[dict[str, Dataset], str]:
