@@ -108,9 +108,13 @@ def test_the_1mm_reference_is_the_stored_beam_whose_accuracy_covers_every_measur
     swing = np.ptp(stored.curves["crank/angle"])
     assert record["crank_angle_relative"] >= stored.accuracies["history_crank_angle"] / swing
     assert every.accuracy < 1e-3  # good enough to certify the study's 1 % and 0.1 % levels
-    assert "ffrf_1mm" in tradeoff.STORED
+    assert set(tradeoff.STORED) == {"ffrf_1mm", "ffrf_10mm"}
     with pytest.raises(ValueError, match="accepted"):
         stored_as_reference(stored, "peaks")
+    from flex.experiments.workprecision.reference_plans import reference_plan
+
+    with pytest.raises(ValueError, match="make references"):  # no in-run plate reference
+        reference_plan("ffrf_10mm")
 
 
 def test_richardson_estimates_the_fine_error_of_a_second_order_sequence():
