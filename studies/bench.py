@@ -135,7 +135,8 @@ def summarize(scene: Scene, results: dict[str, CaseResult],
               run: StudyRun) -> Summary:
     """The table and the per-part datasets
     (:func:`flex.experiments.workprecision.benchmark_report.bench_summary`)."""
-    return Summary(*bench_summary(run.notes, PLAN))
+    datasets, report, findings = bench_summary(run.notes, PLAN)
+    return Summary(datasets, report, findings=findings)
 
 
 def figures(results: dict[str, CaseResult], summary: Summary, folder: Path) -> list[Path]:

@@ -2,10 +2,11 @@
 
 :func:`bench_summary` turns the notes of :func:`flex.experiments.workprecision.benchmark.run_bench`
 into datasets -- ``rigid/...``, ``ffrf_1mm/...`` (times [s], errors, ratios, each run's profile),
-``step_cost/...``, ``reduction/...``, ``make_all/...`` -- and the printed table (``table/what``,
-``table/value``, ``table/detail``). :func:`bench_figures` draws the integration times at equal
-accuracy, the Exudyn CPU shares of the untuned and tuned runs, and the FFRF cost per step against
-mesh and modes (before and after the cheap joint markers).
+``step_cost/...``, ``reduction/...``, ``make_all/...`` -- the printed table (``table/what``,
+``table/value``, ``table/detail``) and the findings, a table per section.
+:func:`bench_figures` draws the integration times at equal accuracy, the Exudyn CPU shares of
+the untuned and tuned runs, and the FFRF cost per step against mesh and modes (before and
+after the cheap joint markers).
 """
 
 from __future__ import annotations
@@ -282,33 +283,65 @@ def _budget_rows(notes: Mapping[str, Any], datasets: dict[str, Dataset]) -> list
     return out
 
 
-def bench_summary(notes: Mapping[str, Any], plan: BenchPlan) -> tuple[dict[str, Dataset], str]:
-    """Datasets and the printed table of a benchmark run (see the module doc)."""
-    datasets: dict[str, Dataset] = {}
-    rows: list[Row] = []
+#: the findings tables' columns (:func:`bench_findings`): one row per measurement
+BENCH_COLUMNS = {"measurement": ("1", "what was timed or measured", object),
+                 "value": ("see measurement", "its median time, ratio or count, as printed",
+                           object),
+                 "how": ("1", "the setting, its error and what the value is against",
+                         object)}
+
+
+def _sections(notes: Mapping[str, Any], plan: BenchPlan, datasets: dict[str, Dataset]
+              ) -> list[tuple[str, str, list[Row]]]:
+    """The benchmark's rows by section: (table name, title, rows); each row also fills its
+    datasets."""
+    speed = []
     if notes.get("rigid"):
-        rows += _rigid_rows(notes["rigid"], datasets)
+        speed += _rigid_rows(notes["rigid"], datasets)
     if notes.get("ffrf_1mm"):
-        rows += _ffrf_rows(notes["ffrf_1mm"], plan, datasets)
-    for part in ("rigid", "ffrf_1mm"):
-        if notes.get(part):
-            rows += _profile_rows(part, notes[part], datasets)
-    rows += _step_cost_rows(notes.get("step_cost", []), datasets)
-    rows += _newton_rows(notes.get("newton", []), datasets)
-    rows += _plates_rows(notes.get("plates", []), datasets)
-    rows += _budget_rows(notes, datasets)
-    rows += _cache_rows(notes, datasets)
-    rows += [(key, "failed", value[:150]) for key, value in notes.items()
-             if key.endswith("_failed")]
+        speed += _ffrf_rows(notes["ffrf_1mm"], plan, datasets)
+    profiles = [row for part in ("rigid", "ffrf_1mm") if notes.get(part)
+                for row in _profile_rows(part, notes[part], datasets)]
+    return [("speed", "Time to a stated accuracy (integration medians; ratios from this run)",
+             speed),
+            ("profiles", "Where the time goes (Exudyn's CPU shares)", profiles),
+            ("step_cost", "The cost of an FFRF step", _step_cost_rows(
+                notes.get("step_cost", []), datasets) + _newton_rows(notes.get("newton", []),
+                                                                      datasets)),
+            ("plates", "Plates at flex's own settings, against their stored references",
+             _plates_rows(notes.get("plates", []), datasets)),
+            ("budget", "The 1 % answer's cost", _budget_rows(notes, datasets)),
+            ("cache", "Reductions and make all", _cache_rows(notes, datasets)),
+            ("failed", "Parts that failed", [(key, "failed", value[:150])
+                                             for key, value in notes.items()
+                                             if key.endswith("_failed")])]
+
+
+def bench_summary(notes: Mapping[str, Any], plan: BenchPlan
+                  ) -> tuple[dict[str, Dataset], str, str]:
+    """Datasets, the printed table and the findings (a table per section,
+    :func:`flex.data.tables.findings_table`) of a benchmark run (see the module doc)."""
+    from flex.data.tables import findings_table
+
+    datasets: dict[str, Dataset] = {}
+    sections = [section for section in _sections(notes, plan, datasets) if section[2]]
+    rows = [row for _, _, part in sections for row in part]
     _put(datasets, "table/what", np.array([r[0] for r in rows], dtype=object), "1",
          "measurement")
     _put(datasets, "table/value", np.array([r[1] for r in rows], dtype=object), "see value",
          "result")
     _put(datasets, "table/detail", np.array([r[2] for r in rows], dtype=object), "1", "how")
+    findings = ["- every number is measured by this run, on whatever else the machine was "
+                "doing: times are medians of repeats, each ratio is of two times measured here"]
+    for order, (name, title, part) in enumerate(sections):
+        datasets |= findings_table(name, title, [
+            {"measurement": what, "value": value, "how": detail}
+            for what, value, detail in part], BENCH_COLUMNS, order)
+        findings.append(f"[[table:{name}]]")
     width = max((len(r[0]) for r in rows), default=10)
     lines = ["bench (medians of repeats; ratios from this run)"]
     lines += [f"  {what:{width}s}  {value:>10s}  {detail}" for what, value, detail in rows]
-    return datasets, "\n".join(lines)
+    return datasets, "\n".join(lines), "\n\n".join(findings)
 
 
 def _times_figure(data: Mapping[str, Dataset], folder: Path, target_s: float) -> list[Path]:
