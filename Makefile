@@ -24,8 +24,8 @@ STUDIES := kinematics dynamics modal flexible spring wing crank kfit
 # to start is a short one (the same studies as STUDIES)
 ALL_ORDER := kfit crank flexible modal wing spring dynamics kinematics
 # long runs, not part of `all` (README "Speed and accuracy", "Numerical stability"). On 2
-# shared cores: tradeoff ~11 min with an empty reduction cache, stability ~6-10 min, bench
-# ~14 min (it times `make all FORCE=1` twice); `make all` itself took 2.6 min from a fresh
+# shared cores: tradeoff ~8 min (7.5 min measured warm), stability ~6-10 min, bench ~6 min
+# (it times `make all FORCE=1` twice); `make all` itself took 2.6 min from a fresh
 # clone with an empty cache on 2 quiet cores, 3.9 min on cores shared with other jobs (README).
 # `flex run stability` exits 0 when exactly its runs built to diverge fail.
 LONG := tradeoff stability bench estimates calibrate design validation ladder spring_mass references
