@@ -93,3 +93,17 @@ def test_a_ripple_pinned_at_the_runs_end_is_not_read_as_the_peak():
 def test_a_run_shorter_than_twice_the_channels_tail_has_no_channel():
     time_s = np.arange(0.0, 0.003, 2e-6)  # 3 cut-off periods of 1 kHz: a 2-period tail
     assert channel_datasets(_run(time_s, np.sin(2 * np.pi * 100 * time_s)), 1000.0) == {}
+
+
+def test_a_deployment_peak_still_rising_at_the_deployment_end_is_said_to_be_no_crest():
+    """A deflection that rises through the crank's first maximum (at 8 ms) has its deployment
+    peak at the deployment's last sample: no crest; one that crests at 3 ms has a crest."""
+    from flex.data.headlines import peak_at_deployment_end
+
+    time_s = np.arange(0.0, 0.012, 1e-5)
+    angle = np.sin(0.5 * np.pi * time_s / 0.008)  # first maximum at 8 ms
+    rising = _run(time_s, 1e-5 * time_s / 0.012, angle)
+    cresting = _run(time_s, 1e-5 * np.sin(np.pi * time_s / 0.006) ** 2, angle)
+    assert peak_at_deployment_end(rising, "coupler/midpoint_deflection")
+    assert not peak_at_deployment_end(cresting, "coupler/midpoint_deflection")
+    assert not peak_at_deployment_end(_run(time_s, 1e-5 * time_s), "coupler/midpoint_deflection")

@@ -268,6 +268,20 @@ def deployment_peak_value(path: str) -> Callable[[Mapping[str, Any]], float | No
     return read
 
 
+def peak_at_deployment_end(datasets: Mapping[str, Any], path: str) -> bool:
+    """Whether the largest ``|path|`` over the deployment (on the headline channel, as
+    :func:`deployment_peak_value` reads it) is the deployment's last sample with ``|path|``
+    still rising into it: no crest, a value that follows the deployment time (the stiff 10 mm
+    plate's deflection, the aluminium 1 mm plate's). False without a deployment end (the
+    window is then the whole run) or without the series."""
+    end = deployment_end(datasets)
+    if path not in datasets or end is None or end < 1:
+        return False
+    values = np.abs(channel(datasets, path))[:end + 1]
+    return bool(values.size > 1 and np.argmax(values) == values.size - 1
+                and values[-1] > values[-2])
+
+
 def deployment_time_s(datasets: Mapping[str, Any]) -> float | None:
     """Time of the first maximum of the crank angle [s] (delta_t, docs/criterion.md;
     :func:`flex.data.headlines.first_maximum_index`, which ignores round-off); None
@@ -415,4 +429,5 @@ __all__ = ["BUILTIN_HEADLINES", "KINDS", "Headline", "above_roundoff", "channel"
            "deflection_resolution_m", "deployment_end",
            "DEFAULT_QUANTITIES", "QUANTITY_GROUPS", "channel_series", "deployment_peak_value",
            "deployment_time_s",
-           "final_value", "history_difference", "first_crest_value", "peak_value"]
+           "final_value", "history_difference", "first_crest_value", "peak_at_deployment_end",
+           "peak_value"]

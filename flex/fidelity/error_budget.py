@@ -50,7 +50,13 @@ from flex.base.errors import FlexError
 from flex.config.knobs import NO_KNOB, Knob, linked_knobs
 from flex.config.ladder import Rung
 from flex.config.tolerance import Tolerance
-from flex.data.headlines import BUILTIN_HEADLINES, Headline, crest_gap
+from flex.data.headlines import (
+    BUILTIN_HEADLINES,
+    DEPLOYMENT,
+    Headline,
+    crest_gap,
+    peak_at_deployment_end,
+)
 from flex.data.results import CaseResult
 from flex.data.scene import LINKS, Scene, apply_overrides, model_names
 from flex.dynamics.link_models import BUILTIN_LINK_MODELS, LinkModel, flexible_links
@@ -343,7 +349,8 @@ def error_budget(scene: Scene, result: CaseResult,
                     for term in TERMS} for name in values}
     methods = {"step": step.method, **knob_how, "model": model_how}
     return ErrorBudget(values, terms, {k: v for k, v in methods.items() if k not in failed},
-                       leaves_out, step.validity,
+                       leaves_out, step.validity + _rising_at_end(step.finest or result, values,
+                                                                  headlines),
                        step.companion_wall_time_s + companions.wall_time_s,
                        _crest_gaps(step.finest or result, values, headlines),
                        {name: (headlines[name].unit, headlines[name].what) for name in values},
@@ -366,6 +373,23 @@ def _unknown(terms: dict[str, dict[str, float]], failed: set[str], failures: lis
             out[term] = (reason if term in failed and reason else
                          f"{term}: its companion run has no {headlines[name].what}")
     return [" ".join(text.split()) for text in out.values()]
+
+
+def _rising_at_end(result: CaseResult, values: dict[str, float],
+                   headlines: Mapping[str, Headline]) -> str:
+    """The validity's sentence on the deployment peaks that are no crest: the deployment's
+    last sample, still rising (:func:`flex.data.headlines.peak_at_deployment_end`); their
+    step and model terms compare values read at each run's own deployment end, so they hold
+    the deployment time's error, but the value is as sensitive to it as the deflection is
+    steep there. Empty when every deployment peak is a crest."""
+    names = [name for name in values if headlines[name].window == DEPLOYMENT
+             and headlines[name].kind == "value" and headlines[name].series is not None
+             and peak_at_deployment_end(result.datasets, headlines[name].series)]
+    if not names:
+        return ""
+    return (f"; {', '.join(names)}: no crest, the deployment's last sample with the series "
+            f"still rising (the value follows the deployment time; its terms compare each "
+            f"run at its own deployment end)")
 
 
 def _crest_gaps(result: CaseResult, values: dict[str, float],
