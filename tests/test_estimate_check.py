@@ -175,3 +175,19 @@ def test_the_findings_count_the_pairs_no_reference_could_decide():
     line = next(text for text in findings.splitlines() if "not accurate enough" in text)
     assert "to decide: 1 of 2 pairs (target: none)" in line
     assert "reference too coarse 1" in line
+
+
+def test_a_joint_force_error_below_the_multipliers_noise_is_the_noise_floor():
+    """A rigid run's joint-force peak 1.6e-5 N off a 6.4 N reference whose own Newton noise is
+    8e-5 N (the index-3 multipliers at 1.25e-6 s): below JOINT_FORCE_NOISE_FLOOR, not a
+    reference too coarse; the same error on a 0.1 N peak is above it."""
+    from flex.experiments.workprecision.estimate_check import JOINT_FORCE_NOISE_FLOOR
+
+    force = "joint_A_deployment_peak_force_N"
+    for peak_N, why in ((6.4, "noise floor"), (0.1, "reference not accurate enough")):
+        case = CaseResult("case", "", attrs={
+            f"estimated_error_{force}": 2.5e-6, f"true_error_{force}": 1.6e-5,
+            f"reference_accuracy_{force}": 6.9e-5, f"headline_{force}": peak_N})
+        row = pair_rows({"a": case})[0]
+        assert row["why"] == why
+    assert 1.6e-5 / 6.4 < JOINT_FORCE_NOISE_FLOOR < 1.6e-5 / 0.1
