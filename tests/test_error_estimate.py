@@ -296,6 +296,14 @@ def test_an_ffrf_run_states_every_term_of_its_budget(reduction_cache):
         limit = finer + (finer - coarser) / 3
         assert rows[name].terms["model"] == pytest.approx(
             abs(rows[name].value - limit) + abs(finer - coarser) / 3, rel=1e-6)
+    # a raw whole-run peak (a bound): the crest-aware difference to the finer beam plus the
+    # extrapolation's size, not extrapolated
+    from flex.fidelity.error_estimate import headline_difference
+
+    raw = BUILTIN_HEADLINES["coupler_peak_deflection_m"]
+    assert rows[raw.name].terms["model"] == pytest.approx(
+        headline_difference(raw, result.datasets, fine.datasets)
+        + headline_difference(raw, fine.datasets, coarse.datasets) / 3, rel=1e-6)
     # the model term met the tolerance: the modes and mesh errors it holds are not measured
     # apart (their companions do not run)
     assert deflection.terms["modes"] == 0 and deflection.terms["mesh"] == 0

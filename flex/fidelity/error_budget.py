@@ -244,15 +244,17 @@ def _extrapolated_difference(headline: Headline, result: CaseResult, fine: CaseR
     """A quantity's model term from two companions one rung up [its unit]: the difference of
     ``result`` to their Richardson extrapolation at the quantity's ``mesh_order`` (the
     elements halved between them), plus the extrapolation's size (the finer companion's own
-    error, its sign unknown). A history: the difference to the finer companion plus that
-    size (curves are not extrapolated). ``difference``: the run's difference to the finer
-    companion, kept where the coarser one lacks the quantity."""
+    error, its sign unknown). A history or a raw whole-run peak: the difference to the finer
+    companion plus that size (curves are not extrapolated; a raw peak's difference is crest-
+    aware, :func:`flex.fidelity.error_estimate.peak_difference`, and its total a bound).
+    ``difference``: the run's difference to the finer companion, kept where the coarser one
+    lacks the quantity."""
     change = headline_difference(headline, fine.datasets, coarse.datasets)
     if change is None or math.isnan(change) or math.isnan(difference):
         return difference
     share = 1.0 / (2.0 ** headline.mesh_order - 1.0)
     ours, finer, coarser = (headline.read(case.datasets) for case in (result, fine, coarse))
-    if headline.kind == "history" or None in (ours, finer, coarser):
+    if headline.kind in ("history", "peak") or None in (ours, finer, coarser):
         return difference + share * change
     return abs(ours - (finer + share * (finer - coarser))) + share * change
 
