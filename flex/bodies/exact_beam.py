@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from flex.base import physics
+from flex.base.channel import ChannelFilter
 from flex.base.physics import SHEAR_CORRECTION_RECTANGLE, check_positive, rectangle_section
 from flex.data.results import Dataset
 
@@ -173,14 +174,31 @@ def section_stress_peaks(section: ExactBeamSection, axial_N: np.ndarray, shear_N
 
 
 def section_datasets(link: str, section: ExactBeamSection, force_N: np.ndarray,
-                     moment_Nm: np.ndarray) -> dict[str, Dataset]:
+                     moment_Nm: np.ndarray, low_pass: ChannelFilter | None = None,
+                     channel: str = "") -> dict[str, Dataset]:
     """The stored series of a beam ``link`` from its elements' section forces ``force_N``
     (samples, elements, 2: axial N, shear Q) and moments ``moment_Nm`` (samples, elements):
     ``<link>/axial_force`` at the midpoint, ``peak_bending_stress`` and
     ``peak_von_mises_stress`` away from the end faces (elements whose centre lies one
     thickness or more from both, as the FFRF link's window; the middle element of a plate
     too stubby for it), where that peak is (``peak_von_mises_position``, from the first
-    end) and ``peak_von_mises_stress_at_joints`` (the other elements)."""
+    end) and ``peak_von_mises_stress_at_joints`` (the other elements). With the headline
+    channel's filter ``low_pass`` (:func:`flex.base.channel.channel_filter`; ``channel``: how
+    its series say so) also ``channel/<link>/peak_bending_stress`` and
+    ``channel/<link>/peak_von_mises_stress``: the same peaks of the low-passed section forces
+    (a peak series low-passed would rectify the field's ringing, :mod:`flex.base.channel`)."""
+    out = _section_peaks(link, section, force_N, moment_Nm)
+    if low_pass is not None:
+        smooth = _section_peaks(link, section, low_pass(force_N), low_pass(moment_Nm))
+        out.update({f"channel/{path}": Dataset(smooth[path].data, "Pa",
+                                               f"{smooth[path].description}, {channel}")
+                    for path in (f"{link}/peak_bending_stress", f"{link}/peak_von_mises_stress")})
+    return out
+
+
+def _section_peaks(link: str, section: ExactBeamSection, force_N: np.ndarray,
+                   moment_Nm: np.ndarray) -> dict[str, Dataset]:
+    """:func:`section_datasets` without the channel."""
     count = force_N.shape[1]
     normal, von_mises = section_stress_peaks(section, force_N[..., 0], force_N[..., 1],
                                              moment_Nm)

@@ -11,8 +11,13 @@ from typing import Any
 
 import numpy as np
 
+from flex.base.channel import (
+    CHANNEL_EDGE_PERIODS,
+    channel_filter,
+    channel_text,
+    undetermined_samples,
+)
 from flex.base.errors import SimulationError
-from flex.base.lowpass import zero_phase_lowpass
 from flex.data.headlines import channel_series
 from flex.data.plates import plate_mass_properties
 from flex.data.results import Dataset
@@ -213,22 +218,6 @@ def channel_cutoff_Hz(scene: Scene,
     return CHANNEL_FACTOR * min(omegas) / (2.0 * np.pi) if omegas else None
 
 
-#: order of the channel's Butterworth low-pass (run forward and backward: zero phase, twice
-#: the attenuation)
-CHANNEL_ORDER = 4
-#: a cut-off above this fraction of the sampling's Nyquist frequency leaves the series as they
-#: are: the samples hold no content above it worth filtering
-CHANNEL_NYQUIST_FRACTION = 0.8
-#: the channel filter's padding at each end, in periods of its cut-off
-CHANNEL_PAD_PERIODS = 3.0
-#: the channel's last samples within this many cut-off periods of the run's end are not
-#: determined by the run: the zero-phase filter reads its padding there, a guess of how the
-#: series goes on (the odd extension pins the channel to the raw last sample, ripple and all:
-#: a 1 mm plate's joint force read 41 N at the end of a 10 ms run at h = 5e-6 s against a
-#: deployment peak of 26.9 N at h = 1e-5 and 2.5e-6 s). A unit step in the padding moves the
-#: channel by 2 % one period before the end, 0.5 % at 1.5 and 0.12 % at 2 (4th order, both
-#: ways). ``channel/determined`` marks them; the headline readers stop before them
-CHANNEL_EDGE_PERIODS = 2.0
 #: dataset marking the channel's determined samples (1) and its undetermined tail (0)
 CHANNEL_DETERMINED = "channel/determined"
 #: case attribute holding the channel's cut-off [Hz]
@@ -240,36 +229,28 @@ def channel_datasets(datasets: Mapping[str, Dataset], cutoff_Hz: float | None,
     """The ``series`` a run has (None: those the built-in headlines read on the channel,
     :func:`flex.data.headlines.channel_series`), on its headline channel (``channel/<path>``):
     low-passed forward and backward (zero phase; SAE J211 / ISO 6487 read crash-test peaks
-    on such channels) at ``cutoff_Hz`` (:func:`channel_cutoff_Hz`) by a
-    :data:`CHANNEL_ORDER`-th order Butterworth filter (:mod:`flex.base.lowpass`); none
-    without a cut-off (nothing flexible), when the sampling holds nothing above it or when
-    the run is shorter than twice the channel's undetermined tail; with them
-    :data:`CHANNEL_DETERMINED`, which marks that tail (:data:`CHANNEL_EDGE_PERIODS`)."""
+    on such channels) at ``cutoff_Hz`` (:func:`channel_cutoff_Hz`) by
+    :func:`flex.base.channel.channel_filter`; none where the run has no channel (no cut-off,
+    a sampling that holds nothing above it, a run shorter than twice the channel's
+    undetermined tail); with them :data:`CHANNEL_DETERMINED`, which marks that tail
+    (:data:`flex.base.channel.CHANNEL_EDGE_PERIODS`). A series whose ``channel/<path>`` the
+    run already has is left as it is: a link's stress peaks are read on its low-passed field
+    (:mod:`flex.base.channel`), never the peak series low-passed."""
     time_s = np.asarray(datasets["time"].data, dtype=float)
-    if cutoff_Hz is None or time_s.size < 16:
-        return {}
-    sample_s = float(np.median(np.diff(time_s)))
-    if not cutoff_Hz < CHANNEL_NYQUIST_FRACTION * 0.5 / sample_s:
-        return {}
-    # padding (odd extension) of CHANNEL_PAD_PERIODS cut-off periods: the filter's transient
-    # has died out before the series starts (scipy's default, 27 samples, left a 1 % error on
-    # a crest 0.8 ms after the start at a 1 kHz cut-off; tests/test_headline_channel.py)
-    pad = min(time_s.size - 1, int(np.ceil(CHANNEL_PAD_PERIODS / (cutoff_Hz * sample_s))))
-    edge = int(np.ceil(CHANNEL_EDGE_PERIODS / (cutoff_Hz * sample_s)))
-    if time_s.size < 2 * edge:  # a run shorter than twice its undetermined tail: raw series
+    low_pass = channel_filter(time_s, cutoff_Hz)
+    if low_pass is None:
         return {}
     determined = np.ones(time_s.size, dtype=np.uint8)
-    determined[time_s.size - edge:] = 0
+    determined[time_s.size - undetermined_samples(time_s, cutoff_Hz):] = 0
     return {CHANNEL_DETERMINED: Dataset(
         determined, "1", f"1 where the headline channel is determined by the run's samples, "
         f"0 within {CHANNEL_EDGE_PERIODS:g} cut-off periods of the run's end (the filter reads "
         f"its padding there; the headlines are not read on those samples)")} | {
         f"channel/{path}": Dataset(
-        zero_phase_lowpass(np.asarray(datasets[path].data, dtype=float), CHANNEL_ORDER,
-                           cutoff_Hz, 1.0 / sample_s, pad),
-        datasets[path].units, f"{datasets[path].description}, on the headline channel "
-        f"(zero-phase {CHANNEL_ORDER}th-order Butterworth low-pass at {cutoff_Hz:.4g} Hz)")
-        for path in (channel_series() if series is None else series) if path in datasets}
+        low_pass(np.asarray(datasets[path].data, dtype=float)),
+        datasets[path].units, f"{datasets[path].description}, {channel_text(cutoff_Hz)}")
+        for path in (channel_series() if series is None else series)
+        if path in datasets and f"channel/{path}" not in datasets}
 
 
 def extreme_inputs(scene: Scene,

@@ -90,6 +90,10 @@ class Mechanism:
     #: registry they come from
     models: dict[str, Any] = field(default_factory=dict)
     link_models: Any = None
+    #: the headline channel's cut-off [Hz] (:func:`flex.dynamics.advice.channel_cutoff_Hz`;
+    #: None: no channel): a link's datasets read their stress peaks on their low-passed field
+    #: with it (:mod:`flex.base.channel`)
+    channel_cutoff_Hz: float | None = None
 
 
 @dataclass(frozen=True)

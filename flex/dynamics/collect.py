@@ -75,11 +75,13 @@ def _own_datasets(model: Any, link: str, datasets: dict[str, Dataset],
     wrote ``crank/angle`` ran as ok, its crank angle silently replaced."""
     from flex.base.errors import ArgumentError
 
-    foreign = [name for name in datasets if not name.startswith(f"{link}/") or name in collected]
+    foreign = [name for name in datasets
+               if not name.startswith((f"{link}/", f"channel/{link}/")) or name in collected]
     if foreign:
         raise ArgumentError(f"link model {model.name!r} ({link}) writes {', '.join(foreign)}: a "
-                            f"link model's datasets are its own link's, {link}/..., and never "
-                            f"replace the mechanism's (fix the entry's datasets function)")
+                            f"link model's datasets are its own link's, {link}/... (and "
+                            f"channel/{link}/...), and never replace the mechanism's (fix the "
+                            f"entry's datasets function)")
     return datasets
 
 

@@ -150,6 +150,7 @@ def exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, D
     """The flexible coupler's datasets (chord angle, midpoint; a crank's are read with its
     motion) and the beam's own section forces and stresses
     (:func:`flex.bodies.exact_beam.section_datasets`)."""
+    from flex.base.channel import channel_filter, channel_text
     from flex.bodies.exact_beam import section_datasets
 
     out = flexible_datasets(mech, link, time_s)
@@ -159,7 +160,10 @@ def exact_beam_datasets(mech: Any, link: str, time_s: np.ndarray) -> dict[str, D
                       for i in range(count)], axis=1)  # sample, element, (N, Q)
     moment = np.stack([sensor_data(mech, f"{link}.element_{i}.TorqueLocal")[:, 3]
                        for i in range(count)], axis=1)
-    out.update(section_datasets(link, handles["section"], force, moment))
+    cutoff_Hz = mech.channel_cutoff_Hz
+    out.update(section_datasets(link, handles["section"], force, moment,
+                                channel_filter(time_s, cutoff_Hz),
+                                "" if cutoff_Hz is None else channel_text(cutoff_Hz)))
     return out
 
 

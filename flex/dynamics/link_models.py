@@ -44,7 +44,10 @@ The contract of an entry -- what a link model declares, point by point:
 6. **its sensors and datasets**: ``sensors(builder, link, handles)`` adds what its
    ``datasets(mech,
    link, time_s)`` reads after the run (the coupler's ``coupler/...`` datasets; a crank's
-   motion is read from its joint markers or rigid body by :mod:`flex.dynamics.collect`);
+   motion is read from its joint markers or rigid body by :mod:`flex.dynamics.collect`;
+   a link with a stress field also its stress peaks on the headline channel,
+   ``channel/<link>/...``, read on the field low-passed at ``mech.channel_cutoff_Hz``,
+   :mod:`flex.base.channel`);
    ``energy``: whether its energy is known (else the run has no ``energy/...``);
    ``recorder(mech, link, settings)``: an extra recorder of the run (nodal coordinates), or
    None.

@@ -73,7 +73,38 @@ def elastic_datasets(mech: Any, link: str, start_marker: str, end_marker: str,
             bending_stress_history(reduction, modal, stress_window_m(reduction)), "Pa",
             "largest |sigma_xx| away from the end faces (bending + membrane)")
         out.update(peak_datasets(link, reduction, modal))
+        out.update(channel_stress_datasets(link, reduction, modal, time_s,
+                                           mech.channel_cutoff_Hz))
     out.update(frame_datasets(mech, link))
+    return out
+
+
+def channel_stress_datasets(link: str, reduction: Any, modal: np.ndarray, time_s: np.ndarray,
+                            cutoff_Hz: float | None) -> dict[str, Dataset]:
+    """An FFRF ``link``'s stress peaks on the headline channel [Pa]:
+    ``channel/<link>/peak_bending_stress`` and ``channel/<link>/peak_von_mises_stress``, the
+    largest over the mesh nodes of the low-passed field. The stress is linear in the modal
+    coordinates ``modal`` (samples, coordinates), so the field low-passed is the field of the
+    low-passed coordinates (:mod:`flex.base.channel`: a peak series low-passed would rectify
+    the field's ringing). None without a channel (``cutoff_Hz`` None, or a sampling at
+    ``time_s`` [s] that holds nothing above it)."""
+    from flex.base.channel import channel_filter, channel_text
+    from flex.bodies.reduction import bending_stress_history
+    from flex.bodies.stress import region_nodes, von_mises_history
+
+    low_pass = channel_filter(time_s, cutoff_Hz)
+    if low_pass is None:
+        return {}
+    smooth = low_pass(modal)
+    on = channel_text(cutoff_Hz)
+    out = {f"channel/{link}/peak_bending_stress": Dataset(
+        bending_stress_history(reduction, smooth, stress_window_m(reduction)), "Pa",
+        f"largest |sigma_xx| away from the end faces (bending + membrane) of the field {on}")}
+    away = region_nodes(reduction)["away"]
+    if away.size:
+        out[f"channel/{link}/peak_von_mises_stress"] = Dataset(
+            von_mises_history(reduction, smooth, away)[0], "Pa",
+            f"largest nodal von Mises stress away from the joint faces of the field {on}")
     return out
 
 
@@ -137,8 +168,8 @@ def flexible_sensors(builder: Any, link: str, handles: dict[str, Any]) -> None:
     builder.mech.flexible_energy[link] = (sensors[0], sensors[1])
 
 
-__all__ = ["elastic_datasets", "flexible_datasets", "flexible_sensors", "frame_datasets",
-           "sensor_data", "stress_window_m"]
+__all__ = ["channel_stress_datasets", "elastic_datasets", "flexible_datasets", "flexible_sensors",
+           "frame_datasets", "sensor_data", "stress_window_m"]
 
 
 # ------------------------------------------------------------------------------------------

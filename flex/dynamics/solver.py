@@ -352,12 +352,12 @@ def _integrate(scene: Scene, name: str, reduction: Any, crank_reduction: Any, *,
     recorders = [recorder for link, model in mech.models.items()
                  if (recorder := model.recorder(mech, link, settings)) is not None]
     counters = run(mech, name)
+    cutoff_Hz = mech.channel_cutoff_Hz = channel_cutoff_Hz(scene, link_models)
     with np.errstate(all="ignore"):  # a diverged run overflows; check_finite reports it
         datasets = collect(mech)
     check_finite(datasets, settings, scene, mechanism_reductions(mech), link_models)
     for recorder in recorders:  # its own time: after the check of the sampled datasets
         datasets.update(recorder.datasets())
-    cutoff_Hz = channel_cutoff_Hz(scene, link_models)
     datasets.update(channel_datasets(datasets, cutoff_Hz, channel_series(headlines)))
     import tomli_w
 

@@ -23,13 +23,15 @@ SWEEP_FORMAT = "flex-sweep-case/2"
 
 
 def _physics_versions() -> str:
-    """What a flexible link's physics depends on beyond the scene: the reduction's basis
-    (chord frame since version 2) and its geometric stiffness (a changed body must not
-    resume stale cases)."""
+    """What a flexible link's physics and outputs depend on beyond the scene: the
+    reduction's basis (chord frame since version 2), its geometric stiffness and what its
+    headline channel reads (a changed body or channel must not resume stale cases)."""
+    from flex.base.channel import CHANNEL_FORMAT_VERSION
     from flex.bodies.geometric_stiffness import GEOMETRIC_FORMAT_VERSION
     from flex.bodies.reduction import CACHE_FORMAT_VERSION
 
-    return f"#reduction{CACHE_FORMAT_VERSION}#geometric{GEOMETRIC_FORMAT_VERSION}"
+    return (f"#reduction{CACHE_FORMAT_VERSION}#geometric{GEOMETRIC_FORMAT_VERSION}"
+            f"#channel{CHANNEL_FORMAT_VERSION}")
 
 
 def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:
