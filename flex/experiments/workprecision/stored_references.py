@@ -184,10 +184,14 @@ def make_reference(name: str, scene: Scene, cache_dir: Path | None = None) -> Ca
     return case
 
 
-#: bumped when how a reference's accuracy is computed changes: a resumed sweep remakes its cases
-#: (2: a peak that moves between levels counts its change whole only when its shift does not
-#: shrink, :func:`_peak_moved`)
-make_reference.case_version = 2  # type: ignore[attr-defined]
+#: bumped when how a reference's accuracy is computed changes, and made of the reference's
+#: discretization, so a resumed sweep remakes its cases when either changes (2: a peak that
+#: moves between levels counts its change whole only when its shift does not shrink,
+#: :func:`_peak_moved`; a resumed sweep had kept 64-element stocky references after their
+#: constant changed: the scene a case gets is the physics, not the lifted one)
+make_reference.case_version = (  # type: ignore[attr-defined]
+    f"2/elements {REFERENCE_ELEMENTS}, {STOCKY_REFERENCE_ELEMENTS} below L/t {SLENDER_RATIO:g}"
+    f"/step {REFERENCE_STEP_S:g}, rigid {RIGID_REFERENCE_STEP_S:g}")
 
 
 def _change(headline: Headline, finest: CaseResult, coarse: CaseResult) -> float:
