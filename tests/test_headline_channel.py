@@ -107,3 +107,23 @@ def test_a_deployment_peak_still_rising_at_the_deployment_end_is_said_to_be_no_c
     assert peak_at_deployment_end(rising, "coupler/midpoint_deflection")
     assert not peak_at_deployment_end(cresting, "coupler/midpoint_deflection")
     assert not peak_at_deployment_end(_run(time_s, 1e-5 * time_s), "coupler/midpoint_deflection")
+
+
+def test_a_joint_force_on_the_channel_is_the_modulus_of_the_low_passed_force():
+    """A joint force of 10 + 5 sin(2 pi 100 t) N along x with a 20 kHz ringing of 2 N across
+    it: its modulus rectifies the ringing (+ r^2 / 2|F|), and a low-pass of the modulus keeps
+    that mean, 2^2 / (4 x 15) = 0.067 N above the crest; the channel low-passes the force
+    vector first, so its peak is the crest's, 15 N (within the filter's 1e-3)."""
+    from flex.base.channel import channel_filter
+    from flex.dynamics.collect import _joint_channel
+
+    time_s = np.arange(0.0, 0.02, 2e-6)
+    force = np.stack([10.0 + 5.0 * np.sin(2 * np.pi * 100 * time_s),
+                      2.0 * np.sin(2 * np.pi * 20_000 * time_s)], axis=1)
+    channel = _joint_channel(time_s, 1000.0, {"A": force})["channel/joints/A/force_modulus"]
+    modulus = channel_filter(time_s, 1000.0)(np.hypot(*force.T))
+    middle = slice(2000, -2000)  # away from the channel's padded ends
+    assert np.max(channel.data[middle]) == pytest.approx(15.0, rel=1e-3)
+    assert np.max(modulus[middle]) - 15.0 == pytest.approx(4.0 / 60.0, rel=0.1)
+    assert channel.units == "N"
+    assert _joint_channel(time_s, None, {"A": force}) == {}

@@ -1,6 +1,7 @@
 """The headline channel's filter: how a run's series are low-passed before a headline is read
-on them (:func:`flex.dynamics.advice.channel_datasets`), and how a link's stress field is
-(:mod:`flex.dynamics.link_outputs`, :mod:`flex.bodies.exact_beam`).
+on them (:func:`flex.dynamics.advice.channel_datasets`), and how a link's stress field and a
+joint's force vector are (:mod:`flex.dynamics.link_outputs`, :mod:`flex.bodies.exact_beam`,
+:mod:`flex.dynamics.collect`).
 
 The cut-off itself is the scene's (:func:`flex.dynamics.advice.channel_cutoff_Hz`); this
 module holds what does not depend on the scene: the filter's order, padding and
@@ -13,7 +14,9 @@ plate's exact beam its channel peak moved by +-1 % without order under element a
 refinement, 27.59 / 27.13 / 27.30 MPa at 64 / 128 / 256 elements). Low-passing each
 element's section forces first, then taking the largest stress, converges at order 2 in the
 elements: 26.773, 26.825, 26.838, 26.840 MPa at 32 to 256 elements, within 2e-6 of itself
-from h = 1e-5 to 2.5e-6 s (session 13, ``/tmp/s13/stressexp.py``).
+from h = 1e-5 to 2.5e-6 s (session 13, ``/tmp/s13/stressexp.py``). A joint force's modulus
+is such a nonlinear reading too: it is the modulus of the low-passed force vector
+(:mod:`flex.dynamics.collect`).
 """
 
 from __future__ import annotations
@@ -41,9 +44,11 @@ CHANNEL_PAD_PERIODS = 3.0
 #: ways). ``channel/determined`` marks them; the headline readers stop before them
 CHANNEL_EDGE_PERIODS = 2.0
 #: what a channel series means, as a version: 2 reads a link's stress peaks on its low-passed
-#: field (module doc), 1 low-passed the peak series itself. Part of a sweep case's identity
+#: field (module doc), 1 low-passed the peak series itself; 3 also reads a joint force's
+#: modulus on the low-passed force vector (a modulus rectifies ringing across the force as a
+#: peak over a field does). Part of a sweep case's identity
 #: (:func:`flex.sweep.case_files.case_hash`): a case file of another version is rerun
-CHANNEL_FORMAT_VERSION = 2
+CHANNEL_FORMAT_VERSION = 3
 
 #: a filter of a run's series: samples along axis 0 in, the same shape out, low-passed
 ChannelFilter = Callable[[np.ndarray], np.ndarray]
