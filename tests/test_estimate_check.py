@@ -45,7 +45,7 @@ def test_a_raw_peak_is_a_bound_checked_against_its_certificate_not_judged():
     assert rows[PEAK]["bound"] and not rows[PEAK]["judged"] and "bound" in rows[PEAK]["why"]
     assert rows[END]["judged"] and not rows[END]["bound"]
     _, report = estimate_summary({"a": case})
-    assert "bounds (raw whole-run peaks" in report and "1 pairs, 1 with a known" in report
+    assert "bounds (raw peaks" in report and "1 pairs, 1 with a known" in report
     case.attrs[f"true_error_{PEAK}"] = 3e-7  # above its certificate: still named
     _, report = estimate_summary({"a": case})
     assert "exceeded by a known true error: 1" in report
@@ -191,3 +191,20 @@ def test_a_joint_force_error_below_the_multipliers_noise_is_the_noise_floor():
         row = pair_rows({"a": case})[0]
         assert row["why"] == why
     assert 1.6e-5 / 6.4 < JOINT_FORCE_NOISE_FLOOR < 1.6e-5 / 0.1
+
+
+def test_a_stored_bound_adds_its_terms_and_says_it_is_a_bound():
+    """A quantity the budget names a bound (a ``peak`` headline's raw maximum; no built-in
+    is one): its total is the sum of its terms, not their root-sum-square, and its line says
+    it is a bound, not an estimate."""
+    from flex.fidelity.stored_budget import budget_rows
+
+    terms = {"step": 3e-7, "modes": 0.0, "mesh": 1e-7, "model": 2e-7}
+    attrs = {f"headline_{PEAK}": 1e-4, f"estimated_error_{PEAK}": sum(terms.values()),
+             f"estimated_error_{PEAK}_relative": sum(terms.values()) / 1e-4,
+             **{f"estimated_error_{PEAK}_{term}": value for term, value in terms.items()},
+             BOUNDS_ATTR: PEAK}
+    row = next(row for row in budget_rows(attrs) if row.quantity == PEAK)
+    assert row.bound and not row.problem
+    assert row.total == pytest.approx(6e-7, rel=1e-12)
+    assert "a bound, not an estimate" in row.text()

@@ -46,9 +46,11 @@ CHANNEL_EDGE_PERIODS = 2.0
 #: what a channel series means, as a version: 2 reads a link's stress peaks on its low-passed
 #: field (module doc), 1 low-passed the peak series itself; 3 also reads a joint force's
 #: modulus on the low-passed force vector (a modulus rectifies ringing across the force as a
-#: peak over a field does). Part of a sweep case's identity
+#: peak over a field does); 4 reads the whole-run peaks and the histories on the channel too
+#: (the slider position joins its series): raw, the step's unresolved top mode put them
+#: outside the asymptotic range. Part of a sweep case's identity
 #: (:func:`flex.sweep.case_files.case_hash`): a case file of another version is rerun
-CHANNEL_FORMAT_VERSION = 3
+CHANNEL_FORMAT_VERSION = 4
 
 #: a filter of a run's series: samples along axis 0 in, the same shape out, low-passed
 ChannelFilter = Callable[[np.ndarray], np.ndarray]

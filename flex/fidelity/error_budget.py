@@ -54,6 +54,7 @@ from flex.data.headlines import (
     BUILTIN_HEADLINES,
     DEPLOYMENT,
     Headline,
+    channel,
     crest_gap,
     peak_at_deployment_end,
 )
@@ -244,7 +245,7 @@ def _extrapolated_difference(headline: Headline, result: CaseResult, fine: CaseR
     """A quantity's model term from two companions one rung up [its unit]: the difference of
     ``result`` to their Richardson extrapolation at the quantity's ``mesh_order`` (the
     elements halved between them), plus the extrapolation's size (the finer companion's own
-    error, its sign unknown). A history or a raw whole-run peak: the difference to the finer
+    error, its sign unknown). A history or a raw peak: the difference to the finer
     companion plus that size (curves are not extrapolated; a raw peak's difference is crest-
     aware, :func:`flex.fidelity.error_estimate.peak_difference`, and its total a bound).
     ``difference``: the run's difference to the finer companion, kept where the coarser one
@@ -396,12 +397,16 @@ def _rising_at_end(result: CaseResult, values: dict[str, float],
 
 def _crest_gaps(result: CaseResult, values: dict[str, float],
                 headlines: Mapping[str, Headline]) -> dict[str, float]:
-    """Each peak's crest gap [its unit] where its headline asks for one (the peak races
-    between crests when its error exceeds it; the first crest does not)."""
+    """Each peak's crest gap [its unit] where its headline asks for one, on the series as
+    the headline reads it (its channel where it has one: the peak races between crests when
+    its error exceeds it; the first crest does not)."""
     out = {}
     for name in values:
-        if headlines[name].crest_gap:
-            gap = crest_gap(result.datasets[headlines[name].series].data)
+        headline = headlines[name]
+        if headline.crest_gap:
+            gap = crest_gap(channel(result.datasets, headline.series)
+                            if headline.series in headline.channel
+                            else result.datasets[headline.series].data)
             if gap is not None:
                 out[name] = gap
     return out

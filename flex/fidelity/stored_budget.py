@@ -61,7 +61,7 @@ class ErrorBudget:
     unknown: list[str] = field(default_factory=list)
     #: the quantities whose step term is a bound (observed order outside the window)
     step_bounds: tuple[str, ...] = ()
-    #: the quantities whose total is a bound, not an estimate: the raw whole-run peaks
+    #: the quantities whose total is a bound, not an estimate: the raw peaks
     #: (:attr:`flex.data.headlines.Headline.bound`)
     bounds: tuple[str, ...] = ()
     #: the run whose values the budget states when it is not the run itself: the step's
@@ -209,7 +209,7 @@ def headline_attrs(datasets: Mapping[str, Any],
 
 def combined(terms: Any, bound: bool = False) -> float:
     """The total of independent error terms: their root-sum-square [their units]; of a
-    bound's terms (a raw whole-run peak's: no independence to lean on) their sum."""
+    bound's terms (a raw peak's: no independence to lean on) their sum."""
     if bound:
         return float(math.fsum(terms))
     return float(math.sqrt(math.fsum(value * value for value in terms)))
@@ -221,7 +221,7 @@ DESCRIBED = "headlines_described"
 UNKNOWN_ATTR = f"{PREFIX}unknown"
 #: the quantities whose step term is a bound, comma-separated ("" when every one is an estimate)
 STEP_BOUNDS_ATTR = f"{PREFIX}step_bounds"
-#: the quantities whose total is a bound, not an estimate (the raw whole-run peaks),
+#: the quantities whose total is a bound, not an estimate (the raw peaks),
 #: comma-separated
 BOUNDS_ATTR = f"{PREFIX}bounds"
 #: case attribute prefix of a peak's crest gap (:func:`flex.data.headlines.crest_gap`)
@@ -247,7 +247,7 @@ class BudgetRow:
     problem: str = ""
     #: the certificate's factor over the estimate (NaN: a file written before certificates)
     certificate_factor: float = math.nan
-    #: the total is a bound, not an estimate (a raw whole-run peak, :data:`BOUNDS_ATTR`)
+    #: the total is a bound, not an estimate (a raw peak, :data:`BOUNDS_ATTR`)
     bound: bool = False
     #: why a stored certificate factor cannot be used ("" if it can, or none is stored)
     certificate_problem: str = ""
@@ -308,7 +308,7 @@ def term_text(value: float) -> str:
 
 
 #: why a raw peak's total is a bound (printed beside it)
-BOUND_TEXT = ("a raw maximum over the whole run races between the crests of the ringing and "
+BOUND_TEXT = ("a raw maximum races between the crests of the ringing and "
               "has no order of convergence; its terms are the largest mismatches of the "
               "companions' crests")
 #: how far a stored total may lie from the root-sum-square of its stored terms (relative)

@@ -301,7 +301,7 @@ def _estimate_lines(attrs: dict[str, Any]) -> list[str]:
         return []
     lines = ["  estimated error (total = the root-sum-square of the terms: the estimate, what "
              "the error is; the certificate: a bound, the estimate times its stated factor, "
-             "what refinement decides on; a raw whole-run peak's is a bound, not an "
+             "what refinement decides on; a raw peak's is a bound, not an "
              "estimate, and says so):"]
     lines += [f"    {row.text()}" for row in rows] or ["    none"]
     for key in ("method", "leaves_out", "validity", "unknown"):

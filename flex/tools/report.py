@@ -329,7 +329,7 @@ def _budget_section(cases: list[dict[str, Any]]) -> list[str]:
     lines = [*wrap_markdown("Estimated error of each headline quantity (total = the "
                             "root-sum-square of the terms, in the quantity's unit: what the "
                             "error is; certificate = the bound refinement decides on, the "
-                            "estimate times its stated safety factor; a raw whole-run peak's "
+                            "estimate times its stated safety factor; a raw peak's "
                             "error is a bound, not an estimate, marked so):"), ""]
     lines += table(["case", "quantity", "value", "estimated error", "relative",
                      "certificate", *TERMS], rows, long_cell=[None, None] + [BUDGET_CELL] * (

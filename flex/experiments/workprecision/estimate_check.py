@@ -21,7 +21,7 @@ A pair is *judged* only where the reference decides its verdict (:func:`referenc
 true +- the reference's accuracy, over the estimate, wholly inside or wholly outside the
 band), it lies above the solver's noise floor (:data:`NOISE_FLOOR` of the quantity's
 scale; :data:`JOINT_FORCE_NOISE_FLOOR` for a joint force), and its total is an estimate; a
-bound (a raw whole-run peak) or a flagged estimate (its step term a bound) is asked only
+bound (a raw peak) or a flagged estimate (its step term a bound) is asked only
 whether its certificate holds, and its reference is accurate enough when it decides that
 (:func:`certificate_decided`). The others are stored and said, not judged, each with why
 (:func:`_why_not_judged`). :func:`estimate_summary` makes the table, the verdicts against
@@ -41,12 +41,13 @@ import numpy as np
 
 from flex.base.caseloop import run_each
 from flex.base.plotting import figure
-from flex.data.headlines import BUILTIN_HEADLINES
+from flex.data.headlines import BUILTIN_HEADLINES, Headline, channel_curve
 from flex.data.reference_store import MissingReferenceError, StoredReference, reference_for
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import LINKS, Scene
 from flex.data.scene_edit import derive_scene
 from flex.data.tables import table_datasets
+from flex.dynamics.advice import CHANNEL_DETERMINED
 from flex.experiments.workprecision.stored_references import curve_at
 from flex.fidelity.simulation import simulate_case
 from flex.fidelity.stored_budget import CERTIFICATE_ATTR, PREFIX, STEP_BOUNDS_ATTR, named_quantities
@@ -105,10 +106,7 @@ def _compare(run: CaseResult, reference: StoredReference, rung: str) -> None:
             continue
         accuracy = reference.accuracies[quantity]
         if headline.kind == "history":
-            time_s = np.asarray(run.datasets["time"].data, dtype=float)
-            theirs, sampling = curve_at(reference, headline.series, time_s)
-            true = float(np.max(np.abs(np.asarray(run.datasets[headline.series].data)
-                                       - theirs)))
+            true, sampling = _history_error(run, reference, headline)
             accuracy += sampling
         else:
             true = abs(ours - reference.values[quantity])
@@ -117,6 +115,22 @@ def _compare(run: CaseResult, reference: StoredReference, rung: str) -> None:
         run.attrs[f"reference_rung_{quantity}"] = rung
         run.attrs[f"estimate_ratio_{quantity}"] = (
             run.attrs[f"{PREFIX}{quantity}"] / true if true > 0 else math.inf)
+
+
+def _history_error(run: CaseResult, reference: StoredReference, headline: Headline
+                   ) -> tuple[float, float]:
+    """A history's true error: the largest difference of the run's curve to the stored one,
+    both on the headline channel where the history is read so, over the times both
+    determine; and the stored curve's interpolation error [the curve's unit]."""
+    time_s, ours = channel_curve(run.datasets, headline.series)
+    path, end_s = headline.series, float(reference.curves["time"][-1])
+    if headline.series in headline.channel and f"channel/{path}" in reference.curves:
+        path = f"channel/{path}"
+        determined = np.count_nonzero(reference.curves.get(CHANNEL_DETERMINED, [1]))
+        end_s = float(reference.curves["time"][max(determined, 1) - 1])
+    inside = time_s <= end_s
+    theirs, sampling = curve_at(reference, path, time_s[inside])
+    return float(np.max(np.abs(ours[inside] - theirs))), sampling
 
 
 def check_estimates(scenes: Mapping[str, Scene], store: Mapping[str, StoredReference],
@@ -169,7 +183,7 @@ def _why_not_judged(true: float, known: bool, above_noise: bool, bound: bool,
         return "reference not accurate enough" + (" to check its certificate"
                                                   if bound or flagged else "")
     if bound:
-        return "a bound (raw whole-run peak): its certificate checked, not judged"
+        return "a bound (a raw peak): its certificate checked, not judged"
     return ("flagged: outside the asymptotic range (its step term a bound), its certificate "
             "checked")
 
@@ -219,7 +233,7 @@ PAIR_COLUMNS = {"case": ("1", "case"), "quantity": ("1", "headline quantity (uni
                 "reference_accuracy": ("see quantity", "the reference's own error"),
                 "certificate": ("see quantity", "the run's certificate (estimate x its factor)"),
                 "flagged": ("1", "outside the asymptotic range: the step term is a bound"),
-                "bound": ("1", "a raw whole-run peak: its total is a bound, not an estimate"),
+                "bound": ("1", "a raw peak: its total is a bound, not an estimate"),
                 "judged": ("1", "the reference decides the verdict (reference_decides), above "
                                 "the noise floor, not flagged"),
                 "largest_term": ("1", "the budget's largest term")}
@@ -280,7 +294,7 @@ def _report(rows: list[dict[str, Any]], ratio: np.ndarray, references: dict[str,
              + "".join(f"; {r['case']} {r['quantity']} (true {r['true']:.3g}, certificate "
                        f"{r['certificate']:.3g})" for r in exceeded)]
     if found["bound"].any():
-        lines.append(f"- bounds (raw whole-run peaks, no order of convergence: checked "
+        lines.append(f"- bounds (raw peaks, no order of convergence: checked "
                      f"against their certificates, not judged as estimates): "
                      f"{int(found['bound'].sum())} pairs, {len(found['known_bounds'])} with a "
                      f"known true error"

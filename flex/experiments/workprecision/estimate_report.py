@@ -93,7 +93,7 @@ def _bullets(rows: list[dict[str, Any]], ratio: np.ndarray, found: Mapping[str, 
              _not_judged_line(rows)]
     if found["bound"].any():
         spread = found["spread"]
-        lines.append(f"- bounds (raw whole-run peaks: checked against their certificates, not "
+        lines.append(f"- bounds (raw peaks: checked against their certificates, not "
                      f"judged): {int(found['bound'].sum())} pairs, "
                      f"{len(found['known_bounds'])} with a known true error"
                      + (f", true / bound {min(spread):.2g} to {max(spread):.2g}" if spread

@@ -9,8 +9,10 @@ by flex's Exudyn model, or the independent scipy reference DAE (:mod:`flex.dynam
 times and returns a :class:`Measurement`: the median wall time of the integration, steps, Newton
 iterations, and the errors against a converged :class:`Reference`:
 
-- ``crank_angle_rad``: max over the run's samples of |theta - theta_ref| [rad];
-- ``slider_position_m``: max |x - x_ref| [m];
+- ``crank_angle_rad``: max over the run's samples of |theta - theta_ref| [rad] (on the
+  headline channel where the run has one, as the history headlines read it: the reference's
+  stored accuracy is of that curve);
+- ``slider_position_m``: max |x - x_ref| [m] (the same);
 - ``peak_deflection_m``: |peak - peak_ref| of the elastic midpoint deflection [m] (flexible
   couplers): the peak is the certified headline a user's tolerance applies to, the coupler's
   deployment peak on the headline channel (:data:`PEAK_HEADLINE`; a raw maximum of undamped
@@ -172,11 +174,10 @@ class Observables:
         :data:`PEAK_HEADLINE` read as the run's headlines read it)."""
         from flex.data.headlines import BUILTIN_HEADLINES
 
-        return Observables(np.asarray(datasets["time"].data),
-                           np.asarray(datasets["crank/angle"].data),
-                           np.asarray(datasets["slider/position"].data),
-                           np.asarray(datasets["coupler/midpoint_deflection"].data)
-                           if flexible else None,
+        time_s, angle, slider = _motion_curves(datasets)
+        return Observables(time_s, angle, slider,
+                           np.asarray(datasets["coupler/midpoint_deflection"].data)[
+                               :time_s.size] if flexible else None,
                            BUILTIN_HEADLINES[PEAK_HEADLINE].read(datasets) if flexible
                            else None)
 
@@ -296,13 +297,12 @@ def stored_as_reference(stored: StoredReference, covers: str = PEAK_ONLY) -> Ref
     interpolation's error (:func:`~flex.experiments.workprecision.stored_references.curve_at`),
     over the scales :meth:`Reference.errors` divides by, and the peak's (the error of a
     largest relative error is at most the largest error of its parts)."""
-    curves = stored.curves
+    curves = {path: Dataset(values, stored.curve_units.get(path, "1"))
+              for path, values in stored.curves.items()}
     peak = stored.values[PEAK_HEADLINE]
-    observables = Observables(np.asarray(curves["time"], dtype=float),
-                              np.asarray(curves["crank/angle"], dtype=float),
-                              np.asarray(curves["slider/position"], dtype=float),
-                              np.asarray(curves["coupler/midpoint_deflection"], dtype=float),
-                              peak)
+    time_s, angle, slider = _motion_curves(curves)
+    observables = Observables(time_s, angle, slider, np.asarray(
+        curves["coupler/midpoint_deflection"].data, dtype=float)[:time_s.size], peak)
     accuracies = {"peak_deflection_relative": stored.accuracies[PEAK_HEADLINE] / abs(peak)}
     if covers == EVERY_MEASURE:
         accuracies |= _curve_accuracies(stored, observables)
@@ -317,6 +317,19 @@ def stored_as_reference(stored: StoredReference, covers: str = PEAK_ONLY) -> Ref
                      f"relative accuracy {measures} (its evidence in the store)")
 
 
+def _motion_curves(datasets: dict[str, Dataset]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Time [s], crank angle [rad] and slider position [m] as the history headlines read them:
+    on the headline channel up to its undetermined tail where the run (or the stored
+    reference) has one (:func:`flex.data.headlines.channel_curve`; the stored accuracy is of
+    that curve), else raw."""
+    from flex.data.headlines import channel_curve
+
+    time_s, angle = channel_curve(datasets, "crank/angle")
+    _, slider = channel_curve(datasets, "slider/position")
+    size = min(angle.size, slider.size)
+    return time_s[:size], angle[:size], slider[:size]
+
+
 def _curve_accuracies(stored: StoredReference, observables: Observables) -> dict[str, float]:
     """The crank angle's and slider position's relative accuracy as :meth:`Reference.errors`
     reads them: the stored history accuracy plus the interpolation's, over the curve's
@@ -328,8 +341,9 @@ def _curve_accuracies(stored: StoredReference, observables: Observables) -> dict
             ("crank_angle_relative", "crank/angle", "history_crank_angle", ANGLE_SCALE_RAD),
             ("slider_position_relative", "slider/position", "history_slider_position",
              SLIDER_SCALE_M)):
-        _, sampling = curve_at(stored, path, observables.time_s)
-        scale = _scale(np.asarray(stored.curves[path], dtype=float), fallback)
+        stored_path = f"channel/{path}" if f"channel/{path}" in stored.curves else path
+        _, sampling = curve_at(stored, stored_path, observables.time_s)
+        scale = _scale(np.asarray(stored.curves[stored_path], dtype=float), fallback)
         out[measure] = (stored.accuracies[history] + sampling) / scale
     return out
 

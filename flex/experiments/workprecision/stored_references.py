@@ -14,7 +14,7 @@ converges it:
 - the **accuracy** of each headline quantity [its unit] is the sum of each knob's error
   from two coarser levels (elements halved and quartered, step doubled and quadrupled: the
   finer change over 2^p - 1 at the observed order p within 0.5 of 2, else a bound, 3x the
-  larger change; a raw whole-run peak, or a peak whose time moves between the levels, always
+  larger change; a raw peak, or a peak whose time moves between the levels, always
   the bound) plus the
   beam's **model term**, its measured idealization (the calibration's residual against the
   3-D plate, relative) times the elastic part of the quantity: the whole value of a link's
@@ -45,6 +45,7 @@ from flex.data.reference_store import CURVE_STEP_S, StoredReference, physics_ide
 from flex.data.results import CaseResult, Dataset
 from flex.data.scene import LINKS, Scene, to_toml
 from flex.data.scene_edit import derive_scene
+from flex.dynamics.advice import CHANNEL_DETERMINED
 from flex.dynamics.exact_beam_link import beam_calibration_of
 from flex.dynamics.link_models import EXACT_BEAM, RIGID
 from flex.dynamics.solver import NEWTON_RETRY_ATTR
@@ -125,7 +126,7 @@ def _knob_error(headline: Headline, done: Mapping[str, CaseResult], knob: str) -
     """The finest run's error in one knob [the quantity's unit] from its two coarser levels
     (:func:`flex.fidelity.error_estimate.finest_estimate`: the finer change over 2^p - 1 at
     the observed order p when it lies within 0.5 of 2; outside, a bound, 3x the larger
-    change). A raw whole-run peak, or a peak that is not one feature over the three levels
+    change). A raw peak, or a peak that is not one feature over the three levels
     (:func:`_peak_moved`), has no order: 3x the larger change. The 3 mm plate's
     joint A peak at 32 / 64 / 128 / 256 elements moved by 5.6, 10.4 and 4.3 mN: one level's
     change over 3 had stated a third of the 64-element value's error."""
@@ -228,7 +229,7 @@ def _peak_moved(headline: Headline, finest: CaseResult, coarse: CaseResult,
 def _peak_time_s(headline: Headline, datasets: Mapping[str, Dataset]) -> float | None:
     """Time [s] of the largest ``|series|`` a peak reads (on the headline channel over the
     deployment where the headline reads it so), None for a quantity without a series."""
-    from flex.data.headlines import channel, deployment_end
+    from flex.data.headlines import DEPLOYMENT, channel, deployment_end
 
     path = headline.series
     if headline.kind not in ("value", "peak") or path is None or path not in datasets:
@@ -236,7 +237,7 @@ def _peak_time_s(headline: Headline, datasets: Mapping[str, Dataset]) -> float |
     on_channel = path in headline.channel and f"channel/{path}" in datasets
     values = np.abs(channel(datasets, path) if on_channel
                     else np.asarray(datasets[path].data, dtype=float))
-    end = deployment_end(datasets) if on_channel else None
+    end = deployment_end(datasets) if on_channel and headline.window == DEPLOYMENT else None
     values = values[:None if end is None else end + 1]
     if not values.size:
         return None
@@ -280,9 +281,12 @@ def stored_reference(case: CaseResult) -> StoredReference:
             values[quantity] = float(case.attrs[f"reference_value_{quantity}"])
             accuracies[quantity] = float(case.attrs[f"reference_accuracy_{quantity}"])
             units[quantity] = headline.unit
-    # the store keeps the curves a true error is read from (the histories'); the study's
-    # file keeps every headline series
-    kept = {"time"} | {h.series for h in BUILTIN_HEADLINES.values() if h.kind == "history"}
+    # the store keeps the curves a true error is read from (the histories', on the headline
+    # channel where they are read so, with its determined part); the study's file keeps
+    # every headline series
+    histories = [h for h in BUILTIN_HEADLINES.values() if h.kind == "history"]
+    kept = {"time", CHANNEL_DETERMINED} | {h.series for h in histories} | {
+        f"channel/{h.series}" for h in histories if h.series in h.channel}
     curves = {path: d for path, d in case.datasets.items() if path in kept}
     return StoredReference(case.name, tomllib.loads(case.attrs["physics_toml"]),
                            str(case.attrs["reference_model"]),
