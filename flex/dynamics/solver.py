@@ -142,6 +142,8 @@ def _exudyn_settings(settings: dict[str, Any]):
     if _is_explicit(settings):
         ti.solverType = getattr(exu.DynamicSolverType, settings["explicit_method"])
         ti.explicit.eliminateConstraints = True  # the planar-motion coordinate constraints
+    if settings.get("newton_on_increment"):  # an exact beam: its residual has a round-off floor
+        ti.newton.residualMode = 1
     ti.newton.relativeTolerance = settings["newton_relative_tolerance"]
     ti.newton.absoluteTolerance = settings["newton_absolute_tolerance"]
     ti.newton.useModifiedNewton = settings["modified_newton"]
@@ -330,7 +332,8 @@ def _newton_floor_retry(scene: Scene, message: str, link_models: Mapping[str, Li
     stalled = float(found.group(1)) if found else float("inf")
     if not tolerance < stalled <= NEWTON_FLOOR_RETRY * tolerance:
         return None
-    looser = NEWTON_FLOOR_RETRY * tolerance
+    # the scene's tolerance loosened (the beam stops at its fraction of it, on the increment)
+    looser = NEWTON_FLOOR_RETRY * float(scene["simulation"]["newton_relative_tolerance"])
     return (derive_scene(scene, [f"simulation.newton_relative_tolerance={looser!r}"]),
             f"the exact beam's Newton stalled on its round-off floor (relative error "
             f"{stalled:.3g} against {tolerance:.3g}); run again with "

@@ -24,14 +24,16 @@ SWEEP_FORMAT = "flex-sweep-case/2"
 
 def _physics_versions() -> str:
     """What a flexible link's physics and outputs depend on beyond the scene: the
-    reduction's basis (chord frame since version 2), its geometric stiffness and what its
-    headline channel reads (a changed body or channel must not resume stale cases)."""
+    reduction's basis (chord frame since version 2), its geometric stiffness, what its
+    headline channel reads and where an exact beam's Newton stops (a changed body, channel or
+    solver must not resume stale cases)."""
     from flex.base.channel import CHANNEL_FORMAT_VERSION
     from flex.bodies.geometric_stiffness import GEOMETRIC_FORMAT_VERSION
     from flex.bodies.reduction import CACHE_FORMAT_VERSION
+    from flex.dynamics.exact_beam_link import EXACT_BEAM_INCREMENT_FRACTION
 
     return (f"#reduction{CACHE_FORMAT_VERSION}#geometric{GEOMETRIC_FORMAT_VERSION}"
-            f"#channel{CHANNEL_FORMAT_VERSION}")
+            f"#channel{CHANNEL_FORMAT_VERSION}#beam-increment{EXACT_BEAM_INCREMENT_FRACTION:g}")
 
 
 def case_hash(scene: Scene, case_function: Callable[..., Any]) -> str:

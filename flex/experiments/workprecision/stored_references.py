@@ -4,7 +4,7 @@
 converges it:
 
 - every plate link becomes the **calibrated exact beam** (:func:`reference_elements`: 256
-  elements, 64 for a stocky plate; its bending stiffness calibrated on the p-converged 3-D
+  elements, 128 for a stocky plate; its bending stiffness calibrated on the p-converged 3-D
   plate of the same geometry, :mod:`flex.bodies.beam_calibration`); a lumped link stays
   rigid (it has no elasticity to model); a damped plate link is refused (the beam has no
   damping model), and so is a plate crank on a lumped coupler (a beam crank needs a beam
@@ -53,20 +53,20 @@ from flex.fidelity.simulation import simulate_case
 
 #: the reference beam's elements: a slender plate's (length / thickness at least
 #: :data:`SLENDER_RATIO`; a 1 mm plate's deployment peak: 64 -> 128 changed it by 3.8e-4,
-#: 128 -> 256 by 6e-5-1.2e-4, at 2.5e-6 and 1.25e-6 s) and a stockier one's: 256 elements
-#: failed Newton on the 3 mm plate at 60 rad/s (relative error 5.0e-6 against 4e-6 at 5 us)
-#: and on the 10 mm plate (4.8e-6 at 12.2 ms), 128 on the 5 mm plate (1.1e-6 against 1e-6 at
-#: 9.9 ms): the residual's round-off floor grows with the elements' axial stiffness
-#: (flex.dynamics.exact_beam_link.exact_beam_newton_tolerances); 64 elements ran all three
-#: (the 3 mm plate's element error at 64: 0.03 %, flex.config.ladder)
+#: 128 -> 256 by 6e-5-1.2e-4, at 2.5e-6 and 1.25e-6 s) and a stockier one's. On its residual
+#: the beam's Newton failed there (256 elements on the 3 mm plate at 60 rad/s, 128 on the 5 mm
+#: plate: the residual's round-off floor grows with the elements' axial stiffness), and 64 were
+#: used; stopping on the increment (flex.dynamics.exact_beam_link) the 5 and 10 mm plates run
+#: 128 elements through, their histories converging at order 2 over 32 / 64 / 128 elements
+#: (the 10 mm plate's crank angle: 7.5e-7 then 2.2e-7 rad, session 14)
 REFERENCE_ELEMENTS = 256
-STOCKY_REFERENCE_ELEMENTS = 64
+STOCKY_REFERENCE_ELEMENTS = 128
 SLENDER_RATIO = 30.0
 #: the reference step [s], with a beam or rigid links only (1e-5 s is the rigid default).
-#: The 1 mm plate's end crank angle at 128 elements: 5e-6 -> 2.5e-6 -> 1.25e-6 s moved it by
-#: 7.5e-6 then 2.0e-6 rad (order 1.9); at 256 elements it scatters by ~5e-6 rad (Newton
-#: tolerances 4x looser there, flex.dynamics.exact_beam_link), which the step's change holds.
-#: 256 elements at 1.25e-6 s: 45 s and ~4 GB (a sensor per element and step) per run
+#: The 1 mm plate's crank angle history at 256 elements: 5e-6 -> 2.5e-6 -> 1.25e-6 s moved it
+#: by 2.1e-7 then 5.0e-8 rad (order 2.1; with Newton stopping on its residual, 2.9e-6 then
+#: 1.6e-5 rad: its round-off floor's noise). 256 elements at 1.25e-6 s: ~50 s and ~4 GB (a
+#: sensor per element and step) per run
 REFERENCE_STEP_S = 1.25e-6
 RIGID_REFERENCE_STEP_S = 1.25e-6
 #: a peak whose time moves by more than this many of the coarser run's steps between two
@@ -191,8 +191,8 @@ def make_reference(name: str, scene: Scene, cache_dir: Path | None = None) -> Ca
 #: :func:`_peak_moved`; a resumed sweep had kept 64-element stocky references after their
 #: constant changed: the scene a case gets is the physics, not the lifted one)
 make_reference.case_version = (  # type: ignore[attr-defined]
-    f"2/elements {REFERENCE_ELEMENTS}, {STOCKY_REFERENCE_ELEMENTS} below L/t {SLENDER_RATIO:g}"
-    f"/step {REFERENCE_STEP_S:g}, rigid {RIGID_REFERENCE_STEP_S:g}")
+    f"3/newton on the increment/elements {REFERENCE_ELEMENTS}, {STOCKY_REFERENCE_ELEMENTS} "
+    f"below L/t {SLENDER_RATIO:g}/step {REFERENCE_STEP_S:g}, rigid {RIGID_REFERENCE_STEP_S:g}")
 
 
 def _change(headline: Headline, finest: CaseResult, coarse: CaseResult) -> float:
