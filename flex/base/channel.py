@@ -48,9 +48,10 @@ CHANNEL_EDGE_PERIODS = 2.0
 #: modulus on the low-passed force vector (a modulus rectifies ringing across the force as a
 #: peak over a field does); 4 reads the whole-run peaks and the histories on the channel too
 #: (the slider position joins its series): raw, the step's unresolved top mode put them
-#: outside the asymptotic range. Part of a sweep case's identity
+#: outside the asymptotic range; 5 reads a peak at its crest between samples (the parabola's
+#: vertex, :func:`flex.data.headlines.crest_value`). Part of a sweep case's identity
 #: (:func:`flex.sweep.case_files.case_hash`): a case file of another version is rerun
-CHANNEL_FORMAT_VERSION = 4
+CHANNEL_FORMAT_VERSION = 5
 
 #: a filter of a run's series: samples along axis 0 in, the same shape out, low-passed
 ChannelFilter = Callable[[np.ndarray], np.ndarray]

@@ -64,6 +64,10 @@ class Rung:
     #: plus the extrapolation's size, the companion's own error (None: one companion, its
     #: difference whole)
     measured_against_coarser: Callable[[Mapping[str, Any]], tuple[str, ...]] | None = None
+    #: a third, coarser still (overrides as there): where the three show the quantity's order,
+    #: the extrapolation's size is how far the two Richardson limits lie apart, not the finer
+    #: companion's own error (None: two companions)
+    measured_against_coarsest: Callable[[Mapping[str, Any]], tuple[str, ...]] | None = None
     #: the ``measured_against`` companion resolves the link's own knobs (an FFRF body's
     #: modes and mesh: the exact beam has neither), so its difference holds their errors
     #: too: the budget measures them apart only when that difference is a sizable share of
@@ -189,12 +193,20 @@ def _against_coarser_beam(scene: Mapping[str, Any]) -> tuple[str, ...]:
     return _against_exact_beam(scene, COARSER_COMPANION_DIVISOR)
 
 
+def _against_coarsest_beam(scene: Mapping[str, Any]) -> tuple[str, ...]:
+    """:func:`_against_exact_beam` with :data:`COARSER_COMPANION_DIVISOR` squared times fewer
+    elements, at the same step: the third level, which observes the elements' order."""
+    return _against_exact_beam(scene, COARSER_COMPANION_DIVISOR ** 2)
+
+
 _AGAINST_EXACT_BEAM_TEXT = (
     "FFRF ({links}): the difference to the geometrically exact beam, calibrated on the plate "
     "(the rung above, on the same scene: the difference holds the FFRF body's modes, mesh and "
     "step errors), extrapolated from two companions (the beam's elements halved, Richardson "
     "at each quantity's order: 2 for a displacement or the motion, 1 for a stress), plus the "
-    "extrapolation's size (its sign unknown); the beam's own step error, common to both, and "
+    "extrapolation's size (its sign unknown: where a third companion, the elements halved "
+    "again, shows the quantity's order within 0.5, how far the two levels' limits lie apart, "
+    "else the finer companion's own error); the beam's own step error, common to both, and "
     "its measured idealization are not in it")
 
 #: a rigid plate link: its elasticity is measured on the run's own scene, the difference to a
@@ -214,13 +226,15 @@ LINEAR_FFRF_RUNG = Rung(
     "linear FFRF ({links}): plus the difference to a companion with geometric stiffness",
     _FFRF_MEASURED_BY, measured_against=_against_exact_beam,
     measured_against_text="linear " + _AGAINST_EXACT_BEAM_TEXT, resolves_knobs=True,
-    measured_against_coarser=_against_coarser_beam)
+    measured_against_coarser=_against_coarser_beam,
+    measured_against_coarsest=_against_coarsest_beam)
 #: flex's default flexible body: FFRF in the chord frame with geometric stiffness
 FFRF_RUNG = Rung(2, "FFRF", _geometric_ffrf_bound, GEOMETRIC_FFRF_ERROR,
                  FFRF_MOTION_ERROR_FRACTION, measured_by=_FFRF_MEASURED_BY,
                  measured_against=_against_exact_beam,
                  measured_against_text=_AGAINST_EXACT_BEAM_TEXT, resolves_knobs=True,
-                 measured_against_coarser=_against_coarser_beam)
+                 measured_against_coarser=_against_coarser_beam,
+                 measured_against_coarsest=_against_coarsest_beam)
 EXACT_BEAM_ERROR_PER_SLENDERNESS = 0.05
 """The geometrically exact beam's model error against the 3-D plate, relative to the link's
 own deflection, per thickness / length (its idealization: plane sections, a pin at the

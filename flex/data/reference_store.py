@@ -41,9 +41,10 @@ from flex.data.cache import content_digest
 #: 2: a link's stress peaks read on its low-passed field; 3: a joint force's modulus on the
 #: low-passed force vector (the headline channel's versions,
 #: :data:`flex.base.channel.CHANNEL_FORMAT_VERSION`); 4: the whole-run peaks and the
-#: histories on the channel (its curves kept, with ``channel/determined``); an older store
+#: histories on the channel (its curves kept, with ``channel/determined``); 5: a peak at its
+#: crest between samples (:func:`flex.data.headlines.crest_value`); an older store
 #: holds values a run of today does not read: it is refused, to be made again
-FORMAT = "flex-references/4"
+FORMAT = "flex-references/5"
 #: the sections of a scene that hold its mechanism's physics
 PHYSICS_SECTIONS = ("crank", "coupler", "slider", "drive", "wing")
 #: keys of a link that choose its model or discretize it, not its physics

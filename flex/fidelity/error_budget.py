@@ -46,6 +46,8 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from flex.base.errors import FlexError
 from flex.config.knobs import NO_KNOB, Knob, linked_knobs
 from flex.config.ladder import Rung
@@ -212,7 +214,7 @@ def _measured_model_term(scene: Scene, result: CaseResult, companions: _Companio
     if not measured:
         return {}, []
     failures = len(companions.failures)
-    above = companions.run("model", _measuring_companion(scene, measured, coarser=False))
+    above = companions.run("model", _measuring_companion(scene, measured))
     if above is None:
         if not all(rung.bounded for rung in measured.values()):
             return {}, []
@@ -220,44 +222,97 @@ def _measured_model_term(scene: Scene, result: CaseResult, companions: _Companio
         return {}, [f"not measured on the scene ({reason}): the measured fractions instead"]
     terms: dict[str, Any] = dict(companions.differences(result, above))
     if any(rung.measured_against_coarser for rung in measured.values()):
-        coarser = companions.run("model", _measuring_companion(scene, measured, coarser=True))
+        coarser = companions.run("model", _measuring_companion(scene, measured, level=1))
+        coarsest = (companions.run("model", _measuring_companion(scene, measured, level=2))
+                    if coarser is not None and any(rung.measured_against_coarsest
+                                                   for rung in measured.values()) else None)
         if coarser is not None:
             for name in terms:
                 terms[name] = _extrapolated_difference(companions.headlines[name], result,
-                                                       above, coarser, terms[name])
+                                                       above, coarser, terms[name], coarsest)
     terms[""] = set(measured)
     return terms, _grouped(measured, "measured_against_text")
 
 
-def _measuring_companion(scene: Scene, measured: Mapping[str, Rung], coarser: bool) -> Scene:
+def _measuring_companion(scene: Scene, measured: Mapping[str, Rung], level: int = 0) -> Scene:
     """The companion scene whose ``measured`` links stand on the rung above (each rung's
-    ``measured_against``; with ``coarser``, its ``measured_against_coarser`` where it has
-    one)."""
+    ``measured_against``; at ``level`` 1 its ``measured_against_coarser``, at 2 its
+    ``measured_against_coarsest``, where it has one)."""
+    def against(rung: Rung) -> Callable[[Mapping[str, Any]], tuple[str, ...]]:
+        coarser = (None, rung.measured_against_coarser, rung.measured_against_coarsest)[level]
+        return coarser or rung.measured_against
+
     overrides = [override.format(link=link) for link, rung in measured.items()
-                 for override in (rung.measured_against_coarser if coarser
-                                  and rung.measured_against_coarser else
-                                  rung.measured_against)(scene)]
+                 for override in against(rung)(scene)]
     return _companion(scene, list(dict.fromkeys(overrides)))
 
 
 def _extrapolated_difference(headline: Headline, result: CaseResult, fine: CaseResult,
-                             coarse: CaseResult, difference: float) -> float:
-    """A quantity's model term from two companions one rung up [its unit]: the difference of
-    ``result`` to their Richardson extrapolation at the quantity's ``mesh_order`` (the
-    elements halved between them), plus the extrapolation's size (the finer companion's own
-    error, its sign unknown). A history or a raw peak: the difference to the finer
-    companion plus that size (curves are not extrapolated; a raw peak's difference is crest-
-    aware, :func:`flex.fidelity.error_estimate.peak_difference`, and its total a bound).
+                             coarse: CaseResult, difference: float,
+                             coarsest: CaseResult | None = None) -> float:
+    """A quantity's model term from companions one rung up [its unit]: the difference of
+    ``result`` to the Richardson extrapolation of the two finer at the quantity's
+    ``mesh_order`` (the elements halved between them), plus the extrapolation's size, its
+    sign unknown: where a third, ``coarsest``, companion shows the order (within
+    :data:`flex.fidelity.error_estimate.ORDER_WINDOW`), how far the limits of the finer and
+    the coarser pair lie apart; else the finer companion's own error. A history: the same on
+    its curves (:func:`_extrapolated_curves`). A raw peak: the difference to the finer
+    companion plus the finer companion's error (its difference is crest-aware,
+    :func:`flex.fidelity.error_estimate.peak_difference`, and its total a bound).
     ``difference``: the run's difference to the finer companion, kept where the coarser one
     lacks the quantity."""
     change = headline_difference(headline, fine.datasets, coarse.datasets)
     if change is None or math.isnan(change) or math.isnan(difference):
         return difference
     share = 1.0 / (2.0 ** headline.mesh_order - 1.0)
+    if headline.kind == "history":
+        return _extrapolated_curves(headline, result, (fine, coarse, coarsest), share,
+                                    difference + share * change)
     ours, finer, coarser = (headline.read(case.datasets) for case in (result, fine, coarse))
-    if headline.kind in ("history", "peak") or None in (ours, finer, coarser):
+    if headline.kind == "peak" or None in (ours, finer, coarser):
         return difference + share * change
-    return abs(ours - (finer + share * (finer - coarser))) + share * change
+    size = share * change
+    third = None if coarsest is None else headline.read(coarsest.datasets)
+    if third is not None and _order_shown(finer - coarser, coarser - third, headline):
+        size = abs(finer + share * (finer - coarser) - (coarser + share * (coarser - third)))
+    return abs(ours - (finer + share * (finer - coarser))) + size
+
+
+def _order_shown(fine_change: float, coarse_change: float, headline: Headline) -> bool:
+    """Whether two successive changes of a quantity (their sign and size) show its
+    ``mesh_order`` within :data:`flex.fidelity.error_estimate.ORDER_WINDOW`."""
+    from flex.fidelity.error_estimate import ORDER_WINDOW
+
+    if not fine_change * coarse_change > 0:
+        return False
+    return abs(math.log2(coarse_change / fine_change) - headline.mesh_order) <= ORDER_WINDOW
+
+
+def _extrapolated_curves(headline: Headline, result: CaseResult,
+                         levels: tuple[CaseResult, CaseResult, CaseResult | None], share: float,
+                         fallback: float) -> float:
+    """A history's model term from companions one rung up: the largest difference of the
+    run's curve to the two finer companions' extrapolated curve, plus the largest distance of
+    that curve to the coarser pair's, where the three show the order on the curves' largest
+    changes; else ``fallback`` (the difference to the finer companion plus its own error)
+    [the curve's unit]. Curves on the headline channel, at the run's times both determine."""
+    from flex.data.headlines import channel_curve
+
+    path = headline.series
+    if levels[2] is None or any(path not in case.datasets for case in (result, *levels)):
+        return fallback
+    time_s, ours = channel_curve(result.datasets, path)
+    curves = [channel_curve(case.datasets, path) for case in levels]
+    inside = time_s <= min(other_s[-1] for other_s, _ in curves)
+    fine, coarse, coarsest = (np.interp(time_s[inside], other_s, values)
+                              for other_s, values in curves)
+    changes = fine - coarse, coarse - coarsest
+    if not _order_shown(float(np.max(np.abs(changes[0]))), float(np.max(np.abs(changes[1]))),
+                        headline):
+        return fallback
+    limit, coarser_limit = fine + share * changes[0], coarse + share * changes[1]
+    return (float(np.max(np.abs(ours[inside] - limit)))
+            + float(np.max(np.abs(limit - coarser_limit))))
 
 
 def _model_term(scene: Scene, result: CaseResult, companions: _Companions,
