@@ -183,8 +183,10 @@ def exact_beam_newton_tolerances(relative_tolerance: float) -> float:
 
 def exact_beam_solver(settings: dict[str, Any], values: dict[str, Any]) -> None:
     """A sparse solver, and Newton stopping on its increment
-    (:func:`exact_beam_newton_tolerances`)."""
+    (:func:`exact_beam_newton_tolerances`), once however many beam links the scene has."""
     settings["linear_solver"] = "EigenSparse"
+    if settings.get("newton_on_increment"):  # a second beam link: already set
+        return
     settings["newton_on_increment"] = True
     tolerance = exact_beam_newton_tolerances(settings["newton_relative_tolerance"])
     settings["newton_relative_tolerance"] = settings["newton_absolute_tolerance"] = tolerance

@@ -301,16 +301,18 @@ def integrate(scene: Scene, name: str = "case", reduction: Any = None,
     return result
 
 
-#: a run with an exact beam link whose Newton stalls just above its relative tolerance (on the
-#: residual's round-off floor, which grows with the beam's axial stiffness and the drive's
-#: constraint forces) is run again at this many times that tolerance, at most
-#: NEWTON_FLOOR_RETRIES times: the 3 mm plate driven at 60 rad/s as a 128-element beam at
-#: 5e-6 s stalled at 1.36e-6 against 1e-6 0.68 ms in, then at 4.65e-6 against 4e-6 0.97 ms in
-#: (the beam companion of a 0.3 % run: its budget had no result); the 2 mm plate at 1.77e-6
-#: (a stored reference). 1.6e-5 against 4e-6 moved a 512-element beam's deployment peak by
-#: 6e-6 of itself and its first crest by 2e-5 (flex.dynamics.exact_beam_link). A stall farther
-#: above the tolerance, or a third, is a divergence, as before
+#: a run with an exact beam link whose Newton stalls (on a round-off floor: on its residual
+#: the 3 mm plate driven at 60 rad/s as a 128-element beam stalled at 1.36e-6 against 1e-6;
+#: an exact beam now stops on its increment, flex.dynamics.exact_beam_link) is run again at
+#: this many times the error it stalled at, at most NEWTON_FLOOR_RETRIES times; a stall above
+#: INCREMENT_CEILING (on the residual: above this many times the tolerance), or a third, is a
+#: divergence
 NEWTON_FLOOR_RETRY = 4.0
+#: a Newton stopping on its increment (an exact beam) that stalls at most this far (relative)
+#: is run again at 4x the stall: its solution is converged to round-off (a beam crank on a beam
+#: coupler stalled at 1.4e-10 against 1e-12 in its first step; the residual default of a rigid
+#: run is 1e-8)
+INCREMENT_CEILING = 1e-8
 NEWTON_FLOOR_RETRIES = 2
 #: the case attribute that says a run was made again at a looser Newton tolerance, and why
 NEWTON_RETRY_ATTR = "newton_floor_retry"
@@ -319,7 +321,7 @@ NEWTON_RETRY_ATTR = "newton_floor_retry"
 def _newton_floor_retry(scene: Scene, message: str, link_models: Mapping[str, LinkModel]
                         ) -> tuple[Scene, str] | None:
     """The scene to run again after a Newton stall on an exact beam's round-off floor (its
-    relative tolerance :data:`NEWTON_FLOOR_RETRY` x the one that stalled) and the sentence
+    tolerance :data:`NEWTON_FLOOR_RETRY` x the error it stalled at) and the sentence
     that says so; None for any other failure."""
     import re
 
@@ -328,12 +330,17 @@ def _newton_floor_retry(scene: Scene, message: str, link_models: Mapping[str, Li
     if EXACT_BEAM not in {scene[link]["model"] for link in entries(scene, link_models)}:
         return None
     found = re.search(r"relative error = ([0-9.eE+-]+)", message)
-    tolerance = float(solver_settings(scene, link_models)["newton_relative_tolerance"])
+    settings = solver_settings(scene, link_models)
+    tolerance = float(settings["newton_relative_tolerance"])
     stalled = float(found.group(1)) if found else float("inf")
-    if not tolerance < stalled <= NEWTON_FLOOR_RETRY * tolerance:
+    # on the increment, any stall below the ceiling is a converged solution's round-off
+    limit = max(NEWTON_FLOOR_RETRY * tolerance,
+                INCREMENT_CEILING if settings.get("newton_on_increment") else 0.0)
+    if not tolerance < stalled <= limit:
         return None
     # the scene's tolerance loosened (the beam stops at its fraction of it, on the increment)
-    looser = NEWTON_FLOOR_RETRY * float(scene["simulation"]["newton_relative_tolerance"])
+    looser = (NEWTON_FLOOR_RETRY * stalled / tolerance
+              * float(scene["simulation"]["newton_relative_tolerance"]))
     return (derive_scene(scene, [f"simulation.newton_relative_tolerance={looser!r}"]),
             f"the exact beam's Newton stalled on its round-off floor (relative error "
             f"{stalled:.3g} against {tolerance:.3g}); run again with "
